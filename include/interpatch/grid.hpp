@@ -1,0 +1,71 @@
+#pragma once
+/// @file grid.hpp
+/// A dense array of rank 1, 2 or 3 in C order (first index slowest): the shape of
+/// every grid of points interpatch reads and writes, first index along u.
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "interpatch/vec3.hpp"
+
+namespace interpatch {
+
+/// Dense rank-`Rank` array in C order. `Grid<Vec3, 2>` of shape {n+1, m+1} holds
+/// the points Q[p][q], p along u, q along v.
+///
+/// Example:
+/// @code
+///   interpatch::PointGrid g({4, 5});
+///   g(3, 4) = {1, 2, 3};
+/// @endcode
+template <class T, std::size_t Rank>
+class Grid {
+ public:
+  using shape_type = std::array<std::size_t, Rank>;
+
+  Grid() { shape_.fill(0); }
+  explicit Grid(const shape_type& shape, const T& fill = T{}) : shape_(shape), data_(count(shape), fill) {}
+  Grid(const shape_type& shape, std::vector<T> data) : shape_(shape), data_(std::move(data)) {}
+
+  [[nodiscard]] const shape_type& shape() const noexcept { return shape_; }
+  [[nodiscard]] std::size_t extent(std::size_t axis) const noexcept { return shape_[axis]; }
+  [[nodiscard]] std::size_t size() const noexcept { return data_.size(); }
+  [[nodiscard]] bool empty() const noexcept { return data_.empty(); }
+
+  template <class... I>
+  T& operator()(I... i) noexcept { return data_[offset(i...)]; }
+  template <class... I>
+  const T& operator()(I... i) const noexcept { return data_[offset(i...)]; }
+
+  [[nodiscard]] T* data() noexcept { return data_.data(); }
+  [[nodiscard]] const T* data() const noexcept { return data_.data(); }
+  [[nodiscard]] const std::vector<T>& values() const noexcept { return data_; }
+  [[nodiscard]] std::vector<T>& values() noexcept { return data_; }
+
+  static std::size_t count(const shape_type& shape) noexcept {
+    std::size_t n = 1;
+    for (auto e : shape) n *= e;
+    return n;
+  }
+
+ private:
+  template <class... I>
+  [[nodiscard]] std::size_t offset(I... i) const noexcept {
+    static_assert(sizeof...(I) == Rank, "one index per axis");
+    const std::array<std::size_t, Rank> idx{static_cast<std::size_t>(i)...};
+    std::size_t off = 0;
+    for (std::size_t a = 0; a < Rank; ++a) off = off * shape_[a] + idx[a];
+    return off;
+  }
+
+  shape_type shape_;
+  std::vector<T> data_;
+};
+
+/// (n+1) × (m+1) points, first index along u.
+using PointGrid = Grid<Vec3, 2>;
+/// (n+1) × (m+1) × (l+1) points, indices along u, v, w.
+using PointGrid3 = Grid<Vec3, 3>;
+
+}  // namespace interpatch

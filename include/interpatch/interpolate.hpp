@@ -1,0 +1,100 @@
+#pragma once
+/// @file interpolate.hpp
+/// Global B-spline interpolation of curves and of grids of points (seed 003;
+/// The NURBS Book §9.2), solved as banded systems factored once.
+
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "interpatch/bspline_curve.hpp"
+#include "interpatch/bspline_surface.hpp"
+#include "interpatch/grid.hpp"
+#include "interpatch/progress.hpp"
+
+namespace interpatch {
+
+/// How data points get their parameters.
+enum class Parametrization {
+  uniform,      ///< equally spaced
+  chord,        ///< proportional to chord length (default)
+  centripetal,  ///< proportional to the square root of chord length
+};
+
+/// Parameters in [0, 1] of points along a polyline, first 0, last 1.
+/// @throws error too_few_points (< 2), not_finite, zero_chord (two consecutive
+///   points coincide, naming the indices and the chord), when `param` is not uniform.
+[[nodiscard]] std::vector<double> curve_parameters(std::span<const Vec3> points, Parametrization param);
+
+/// Knots of degree p by averaging (The NURBS Book eq. 9.8) for interpolation at
+/// `params`, with `extra_start`/`extra_end` additional conditions (end derivatives)
+/// at the first/last parameter. Clamped over [params.front(), params.back()].
+/// @throws error too_few_points, non_increasing.
+[[nodiscard]] KnotVector averaged_knots(std::span<const double> params, int degree, bool extra_start = false,
+                                        bool extra_end = false);
+
+struct CurveInterpolationOptions {
+  /// Degree; unset means min(3, points − 1).
+  std::optional<int> degree;
+  Parametrization param = Parametrization::chord;
+  /// Given parameters (increasing) instead of `param`.
+  std::vector<double> params;
+  /// Derivative dC/dt at the first / last point, t in [0, 1].
+  std::optional<Vec3> start_derivative, end_derivative;
+};
+
+struct CurveInterpolation {
+  BSplineCurve curve;
+  std::vector<double> params;  ///< where the curve passes through each point
+};
+
+/// The B-spline curve of the given degree through every point.
+///
+/// Example:
+/// @code
+///   using namespace interpatch;
+///   std::vector<Vec3> q{{0, 0, 0}, {1, 2, 0}, {3, 3, 0}, {4, 0, 1}};
+///   auto r = interpolate_curve(q);  // cubic, chord-length parameters
+///   Vec3 p = r.curve.point(r.params[2]);  // == q[2] up to rounding
+/// @endcode
+/// @throws error too_few_points, invalid_degree, not_finite, zero_chord, non_increasing, singular.
+[[nodiscard]] CurveInterpolation interpolate_curve(std::span<const Vec3> points,
+                                                   const CurveInterpolationOptions& options = {});
+
+struct SurfaceInterpolationOptions {
+  /// Degrees in u and v; unset means min(3, points − 1) in that direction.
+  std::optional<int> degree_u, degree_v;
+  Parametrization param = Parametrization::chord;
+  progress_callback progress;
+};
+
+struct SurfaceInterpolation {
+  BSplineSurface surface;
+  std::vector<double> params_u, params_v;  ///< S(params_u[p], params_v[q]) = Q[p][q]
+};
+
+/// Parameters of a grid along `axis` (0: u, 1: v): each line of points along the
+/// axis gets chord parameters; lines of zero length (a pole) are left out; the rest
+/// are averaged (seed 003).
+/// @throws error too_few_points, not_finite, zero_chord (every line has a zero
+///   chord at the same place, or all lines have zero length).
+[[nodiscard]] std::vector<double> grid_parameters(const PointGrid& points, int axis, Parametrization param);
+
+/// The B-spline surface with exactly (n+1) × (m+1) control points through every
+/// point Q[p][q] of the grid (first index along u): rows first, then across (seed
+/// 003). Two banded solves, each factored once; the control points are computed in
+/// place of a copy of the data.
+///
+/// Example:
+/// @code
+///   using namespace interpatch;
+///   PointGrid q({7, 13});
+///   for (int i = 0; i < 7; ++i)
+///     for (int j = 0; j < 13; ++j) q(i, j) = {double(i), double(j), std::sin(i + 0.5 * j)};
+///   auto r = interpolate_surface(q);  // bicubic
+///   Vec3 p = r.surface.point(r.params_u[3], r.params_v[5]);  // == q(3, 5) up to rounding
+/// @endcode
+/// @throws error too_few_points, invalid_degree, not_finite, zero_chord, singular, too_large.
+[[nodiscard]] SurfaceInterpolation interpolate_surface(PointGrid points, const SurfaceInterpolationOptions& options = {});
+
+}  // namespace interpatch

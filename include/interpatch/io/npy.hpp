@@ -1,0 +1,30 @@
+#pragma once
+/// @file io/npy.hpp
+/// NumPy .npy arrays of floating point numbers (format versions 1.0, 2.0, 3.0).
+
+#include <cstddef>
+#include <filesystem>
+#include <span>
+#include <vector>
+
+namespace interpatch::io {
+
+/// An array read from .npy: shape and values as float64 in C order.
+struct NpyArray {
+  std::vector<std::size_t> shape;
+  std::vector<double> data;
+};
+
+/// Reads float64 or float32 (widened), little or big endian, C or Fortran order;
+/// the result is always C order.
+/// @throws error file_unreadable (cannot open or read), malformed_file (bad magic,
+///   bad header, unsupported dtype, data shorter or longer than the shape says —
+///   naming the file and the sizes), too_large (the shape needs more memory than
+///   available; refused before allocating).
+[[nodiscard]] NpyArray read_npy(const std::filesystem::path& path);
+
+/// Writes little-endian float64 in C order, atomically.
+/// @throws error file_unwritable, size_mismatch (data size is not the product of shape).
+void write_npy(const std::filesystem::path& path, std::span<const std::size_t> shape, std::span<const double> data);
+
+}  // namespace interpatch::io

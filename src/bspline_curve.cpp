@@ -1,0 +1,217 @@
+#include "interpatch/bspline_curve.hpp"
+
+#include <array>
+#include <cmath>
+
+#include "detail/collocation.hpp"
+#include "detail/text.hpp"
+
+namespace interpatch {
+
+using detail::fail;
+using H = std::array<double, 4>;  // homogeneous point (w x, w y, w z, w)
+
+namespace {
+
+std::vector<H> homogeneous(const std::vector<Vec3>& cp, const std::vector<double>& w) {
+  std::vector<H> h(cp.size());
+  for (std::size_t i = 0; i < cp.size(); ++i) {
+    const double wi = w.empty() ? 1.0 : w[i];
+    h[i] = {cp[i].x * wi, cp[i].y * wi, cp[i].z * wi, wi};
+  }
+  return h;
+}
+
+BSplineCurve from_homogeneous(KnotVector k, const std::vector<H>& h, bool rational) {
+  std::vector<Vec3> cp(h.size());
+  std::vector<double> w;
+  if (rational) w.resize(h.size());
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    const double wi = rational ? h[i][3] : 1.0;
+    cp[i] = {h[i][0] / wi, h[i][1] / wi, h[i][2] / wi};
+    if (rational) w[i] = wi;
+  }
+  return BSplineCurve(std::move(k), std::move(cp), std::move(w));
+}
+
+void check_domain(const KnotVector& k, double t) {
+  // A parameter a few ulps outside the domain is rounding from the caller's mapping.
+  const double a = k.front(), b = k.back();
+  const double slack = 1e-12 * (b - a);
+  if (!(t >= a - slack && t <= b + slack))
+    fail(errc::out_of_domain, "parameter ", t, " is outside the domain [", a, ", ", b, "]");
+}
+
+}  // namespace
+
+BSplineCurve::BSplineCurve(KnotVector knots, std::vector<Vec3> control_points, std::vector<double> weights)
+    : knots_(std::move(knots)), cp_(std::move(control_points)), w_(std::move(weights)) {
+  const auto n = static_cast<std::size_t>(knots_.count());
+  if (cp_.size() != n)
+    fail(errc::size_mismatch, knots_.size(), " knots of degree ", degree(), " need ", n, " control points, got ",
+         cp_.size());
+  if (!w_.empty() && w_.size() != n)
+    fail(errc::size_mismatch, n, " control points need ", n, " weights, got ", w_.size());
+  for (std::size_t i = 0; i < n; ++i)
+    if (!is_finite(cp_[i])) fail(errc::not_finite, "control point ", i, " is ", cp_[i]);
+  for (std::size_t i = 0; i < w_.size(); ++i) {
+    if (!std::isfinite(w_[i])) fail(errc::not_finite, "weight ", i, " is ", w_[i]);
+    if (!(w_[i] > 0)) fail(errc::invalid_weight, "weight ", i, " is ", w_[i], "; weights must be positive");
+  }
+}
+
+Vec3 BSplineCurve::point(double t) const {
+  Vec3 out;
+  derivatives(t, 0, &out);
+  return out;
+}
+
+Vec3 BSplineCurve::derivative(double t, int k) const {
+  if (k <= max_degree) {
+    Vec3 out[max_degree + 1];
+    derivatives(t, k, out);
+    return out[k];
+  }
+  return derivatives(t, k)[static_cast<std::size_t>(k)];
+}
+
+std::vector<Vec3> BSplineCurve::derivatives(double t, int n) const {
+  std::vector<Vec3> out(static_cast<std::size_t>(n) + 1);
+  derivatives(t, n, out.data());
+  return out;
+}
+
+void BSplineCurve::derivatives(double t, int n, Vec3* out) const {
+  check_domain(knots_, t);
+  const int p = degree();
+  const int nb = std::min(n, p);
+  const int s = knots_.find_span(t);
+  double ders[(max_degree + 1) * (max_degree + 1)];
+  knots_.basis_derivatives(s, t, nb, ders);
+  for (int k = nb + 1; k <= n; ++k) out[k] = {};  // polynomial pieces of degree p
+  if (!rational()) {
+    for (int k = 0; k <= nb; ++k) {
+      Vec3 d{};
+      for (int j = 0; j <= p; ++j) d += ders[k * (p + 1) + j] * cp_[static_cast<std::size_t>(s - p + j)];
+      out[k] = d;
+    }
+    return;
+  }
+  // Rational: derivatives of A(t) = Σ N w P and w(t) = Σ N w, then the quotient
+  // rule C^(k) = (A^(k) − Σ_{i=1..k} C(k,i) w^(i) C^(k−i)) / w (The NURBS Book eq. 4.8).
+  Vec3 A[max_degree + 1];
+  double W[max_degree + 1] = {};
+  for (int k = 0; k <= nb; ++k) {
+    Vec3 a{};
+    double w = 0;
+    for (int j = 0; j <= p; ++j) {
+      const auto idx = static_cast<std::size_t>(s - p + j);
+      const double c = ders[k * (p + 1) + j] * w_[idx];
+      a += c * cp_[idx];
+      w += c;
+    }
+    A[k] = a;
+    W[k] = w;
+  }
+  for (int k = 0; k <= n; ++k) {
+    Vec3 v = k <= nb ? A[k] : Vec3{};
+    double binom = 1;  // C(k, i)
+    for (int i = 1; i <= k; ++i) {
+      binom = binom * (k - i + 1) / i;
+      if (i <= nb) v -= binom * W[i] * out[k - i];
+    }
+    out[k] = v / W[0];
+  }
+}
+
+BSplineCurve BSplineCurve::inserted(double t, int times) const {
+  const int p = degree();
+  const auto& U = knots_.values();
+  if (!(t > knots_.front() && t < knots_.back()))
+    fail(errc::out_of_domain, "knot ", t, " to insert is not inside the open domain (", knots_.front(), ", ",
+         knots_.back(), ")");
+  const int s = knots_.multiplicity(t);
+  if (times < 0 || s + times > p)
+    fail(errc::invalid_knots, "inserting ", t, " ", times, " times gives multiplicity ", s + times,
+         ", more than degree ", p);
+  if (times == 0) return *this;
+  const int k = knots_.find_span(t);
+  const int np = knots_.count() - 1;
+  const auto P = homogeneous(cp_, w_);
+  std::vector<H> Q(P.size() + static_cast<std::size_t>(times));
+  for (int i = 0; i <= k - p; ++i) Q[static_cast<std::size_t>(i)] = P[static_cast<std::size_t>(i)];
+  for (int i = k - s; i <= np; ++i) Q[static_cast<std::size_t>(i + times)] = P[static_cast<std::size_t>(i)];
+  std::vector<H> R(static_cast<std::size_t>(p - s + 1));
+  for (int i = 0; i <= p - s; ++i) R[static_cast<std::size_t>(i)] = P[static_cast<std::size_t>(k - p + i)];
+  int L = 0;
+  for (int j = 1; j <= times; ++j) {
+    L = k - p + j;
+    for (int i = 0; i <= p - j - s; ++i) {
+      const double a = (t - U[static_cast<std::size_t>(L + i)]) /
+                       (U[static_cast<std::size_t>(i + k + 1)] - U[static_cast<std::size_t>(L + i)]);
+      auto& r = R[static_cast<std::size_t>(i)];
+      const auto& r1 = R[static_cast<std::size_t>(i + 1)];
+      for (int c = 0; c < 4; ++c) r[c] = a * r1[c] + (1.0 - a) * r[c];
+    }
+    Q[static_cast<std::size_t>(L)] = R[0];
+    Q[static_cast<std::size_t>(k + times - j - s)] = R[static_cast<std::size_t>(p - j - s)];
+  }
+  for (int i = L + 1; i < k - s; ++i) Q[static_cast<std::size_t>(i)] = R[static_cast<std::size_t>(i - L)];
+  std::vector<double> V(U.begin(), U.begin() + k + 1);
+  V.insert(V.end(), static_cast<std::size_t>(times), t);
+  V.insert(V.end(), U.begin() + k + 1, U.end());
+  return from_homogeneous(KnotVector(p, std::move(V)), Q, rational());
+}
+
+BSplineCurve BSplineCurve::refined(std::span<const double> knots) const {
+  BSplineCurve c = *this;
+  for (double t : knots) c = c.inserted(t, 1);
+  return c;
+}
+
+BSplineCurve BSplineCurve::elevated(int times) const {
+  if (times < 0) fail(errc::invalid_degree, "cannot elevate by ", times, " degrees");
+  if (times == 0) return *this;
+  const int p = degree();
+  const int q = p + times;
+  if (q > max_degree) fail(errc::invalid_degree, "elevated degree ", q, " exceeds ", max_degree);
+  // The elevated space has every knot's multiplicity raised by `times`; the curve
+  // lies in it, so interpolation at that space's Greville abscissae recovers its
+  // control points exactly (up to rounding of a well-conditioned banded solve).
+  std::vector<double> V;
+  const auto& U = knots_.values();
+  for (std::size_t i = 0; i < U.size();) {
+    std::size_t j = i;
+    while (j < U.size() && U[j] == U[i]) ++j;
+    V.insert(V.end(), j - i + static_cast<std::size_t>(times), U[i]);
+    i = j;
+  }
+  KnotVector kv(q, std::move(V));
+  const auto g = kv.greville();
+  const auto lu = detail::factor_collocation(kv, g);
+  std::vector<H> rhs(g.size());
+  const int s = p;
+  double N[max_degree + 1];
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const int span = knots_.find_span(g[i]);
+    knots_.basis(span, g[i], N);
+    H h{0, 0, 0, 0};
+    for (int j = 0; j <= s; ++j) {
+      const auto idx = static_cast<std::size_t>(span - p + j);
+      const double w = rational() ? w_[idx] : 1.0;
+      h[0] += N[j] * w * cp_[idx].x;
+      h[1] += N[j] * w * cp_[idx].y;
+      h[2] += N[j] * w * cp_[idx].z;
+      h[3] += N[j] * w;
+    }
+    rhs[i] = h;
+  }
+  lu.solve(rhs.data()->data(), 4, 4);
+  return from_homogeneous(std::move(kv), rhs, rational());
+}
+
+BSplineCurve BSplineCurve::mapped(double a, double b) const {
+  return BSplineCurve(knots_.mapped(a, b), cp_, w_);
+}
+
+}  // namespace interpatch

@@ -1,0 +1,92 @@
+#include "detail/banded.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace interpatch::detail {
+
+BandedLU::BandedLU(int n, int kl, int ku)
+    : n_(n), kl_(kl), ku_(ku), w_(2 * kl + ku + 1),
+      a_(static_cast<std::size_t>(n) * static_cast<std::size_t>(2 * kl + ku + 1), 0.0),
+      piv_(static_cast<std::size_t>(n), 0) {}
+
+bool BandedLU::factor() {
+  double scale = 0;
+  for (double v : a_) scale = std::max(scale, std::abs(v));
+  const double tiny = 1e-14 * scale;
+  const int kuu = kl_ + ku_;  // upper bandwidth of U after row swaps
+  for (int k = 0; k < n_; ++k) {
+    const int last = std::min(n_ - 1, k + kl_);
+    int p = k;
+    double best = std::abs(at(k, k));
+    for (int i = k + 1; i <= last; ++i)
+      if (std::abs(at(i, k)) > best) { best = std::abs(at(i, k)); p = i; }
+    piv_[static_cast<std::size_t>(k)] = p;
+    if (!(best > tiny)) { failed_row_ = k; return false; }
+    const int jlast = std::min(n_ - 1, k + kuu);
+    if (p != k)
+      for (int j = k; j <= jlast; ++j) std::swap(at(k, j), at(p, j));
+    const double inv = 1.0 / at(k, k);
+    for (int i = k + 1; i <= last; ++i) {
+      const double l = at(i, k) * inv;
+      at(i, k) = l;
+      if (l != 0.0)
+        for (int j = k + 1; j <= jlast; ++j) at(i, j) -= l * at(k, j);
+    }
+  }
+  return true;
+}
+
+void BandedLU::solve(double* b, std::size_t width, std::size_t stride) const noexcept {
+  const int kuu = kl_ + ku_;
+  auto row = [&](int i) { return b + static_cast<std::size_t>(i) * stride; };
+  for (int k = 0; k < n_; ++k) {
+    const int p = piv_[static_cast<std::size_t>(k)];
+    double* bk = row(k);
+    if (p != k) std::swap_ranges(bk, bk + width, row(p));
+    const int last = std::min(n_ - 1, k + kl_);
+    for (int i = k + 1; i <= last; ++i) {
+      const double l = at(i, k);
+      if (l == 0.0) continue;
+      double* bi = row(i);
+      for (std::size_t c = 0; c < width; ++c) bi[c] -= l * bk[c];
+    }
+  }
+  for (int k = n_ - 1; k >= 0; --k) {
+    double* bk = row(k);
+    const int jlast = std::min(n_ - 1, k + kuu);
+    for (int j = k + 1; j <= jlast; ++j) {
+      const double u = at(k, j);
+      if (u == 0.0) continue;
+      const double* bj = row(j);
+      for (std::size_t c = 0; c < width; ++c) bk[c] -= u * bj[c];
+    }
+    const double inv = 1.0 / at(k, k);
+    for (std::size_t c = 0; c < width; ++c) bk[c] *= inv;
+  }
+}
+
+void solve_along_axis(const BandedLU& lu, double* data, const std::size_t* shape, std::size_t rank,
+                      std::size_t axis, std::size_t components) {
+  std::size_t outer = 1, inner = components;
+  for (std::size_t a = 0; a < axis; ++a) outer *= shape[a];
+  for (std::size_t a = axis + 1; a < rank; ++a) inner *= shape[a];
+  const std::size_t n = shape[axis];
+  const std::size_t block = n * inner;
+  // Column slices of a few KiB keep the band's rows in cache; many lines are split
+  // across threads line by line instead.
+  constexpr std::size_t slice = 512;
+  const std::size_t slices = (inner + slice - 1) / slice;
+  const auto tasks = static_cast<long long>(outer * slices);
+#pragma omp parallel for schedule(static) if (tasks > 1 && block * outer > 4096)
+  for (long long t = 0; t < tasks; ++t) {
+    const std::size_t o = static_cast<std::size_t>(t) / slices;
+    const std::size_t s = static_cast<std::size_t>(t) % slices;
+    const std::size_t c0 = s * slice;
+    const std::size_t width = std::min(slice, inner - c0);
+    lu.solve(data + o * block + c0, width, inner);
+  }
+}
+
+}  // namespace interpatch::detail

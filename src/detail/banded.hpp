@@ -1,0 +1,49 @@
+#pragma once
+// Banded LU with partial pivoting, factored once and applied to any number of
+// right-hand sides laid out as rows of doubles. Collocation matrices of B-spline
+// interpolation are banded and totally positive (de Boor), so pivoting rarely
+// swaps; it is kept for the rows of end-derivative conditions.
+
+#include <cstddef>
+#include <vector>
+
+namespace interpatch::detail {
+
+class BandedLU {
+ public:
+  /// An n × n zero matrix with kl sub- and ku super-diagonals.
+  BandedLU(int n, int kl, int ku);
+
+  [[nodiscard]] int size() const noexcept { return n_; }
+  /// Entry (i, j), |i − j| inside the band. Set entries before factor().
+  double& at(int i, int j) noexcept { return a_[idx(i, j)]; }
+  [[nodiscard]] double at(int i, int j) const noexcept { return a_[idx(i, j)]; }
+
+  /// LU with partial pivoting. Returns false when a pivot is zero or below
+  /// 1e-14 × the largest entry (the system has no unique solution); `failed_row`
+  /// then tells where.
+  bool factor();
+  [[nodiscard]] int failed_row() const noexcept { return failed_row_; }
+
+  /// Solves A X = B in place. B has n rows; row i starts at b + i*stride and
+  /// holds `width` doubles, one per right-hand side.
+  void solve(double* b, std::size_t width, std::size_t stride) const noexcept;
+
+ private:
+  [[nodiscard]] std::size_t idx(int i, int j) const noexcept {
+    return static_cast<std::size_t>(i) * static_cast<std::size_t>(w_) + static_cast<std::size_t>(j - i + kl_);
+  }
+  int n_, kl_, ku_, w_;  // w_ = 2*kl + ku + 1 columns per row: pivoting widens U by kl
+  std::vector<double> a_;
+  std::vector<int> piv_;
+  int failed_row_ = -1;
+};
+
+/// Solves along one axis of a C-order array of `shape` (doubles, last axis the
+/// `components` of each value) in place: every line along `axis` is a right-hand
+/// side of `lu`. Threads split independent lines and column slices; every number
+/// is computed by the same operations whatever the thread count.
+void solve_along_axis(const BandedLU& lu, double* data, const std::size_t* shape, std::size_t rank,
+                      std::size_t axis, std::size_t components);
+
+}  // namespace interpatch::detail
