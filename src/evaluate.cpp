@@ -8,9 +8,11 @@ namespace interpatch {
 Vec3 unit_normal(const SurfaceDerivatives& d) noexcept {
   const Vec3 n = cross(d.su, d.sv);
   const double len = norm(n);
-  const double scale = norm(d.su) * norm(d.sv);
-  // Relative test: below 1e-12 of |Su||Sv| the cross product is rounding noise.
-  if (len > 1e-12 * scale && len > 0) return n / len;
+  const double big = std::max(norm(d.su), norm(d.sv));
+  // Against the larger partial: at a pole the vanishing one is rounding noise of
+  // size ~1e-15 |S|, and its cross product with the other means nothing. A
+  // parametrization stretched by more than 1e10 is treated as degenerate too.
+  if (len > 1e-10 * big * big) return n / len;
   // A pole: one partial vanishes; the normal is the limit along it.
   Vec3 m = norm(d.sv) <= norm(d.su) ? cross(d.su, d.suv) : cross(d.suv, d.sv);
   const double lm = norm(m);

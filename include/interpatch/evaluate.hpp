@@ -11,7 +11,8 @@ namespace interpatch {
 
 /// Unit normal Su × Sv / |Su × Sv|. Where the parametrization degenerates (a pole:
 /// Su or Sv vanishes) the limit along the vanishing direction is used,
-/// Su × Suv or Suv × Sv; the zero vector when that too vanishes.
+/// Su × Suv or Suv × Sv; the zero vector when that too vanishes. "Vanishes" means
+/// |Su × Sv| <= 1e-10 max(|Su|, |Sv|)².
 [[nodiscard]] Vec3 unit_normal(const SurfaceDerivatives& d) noexcept;
 
 /// Gaussian and mean curvature and the principal curvatures k1 >= k2 with respect

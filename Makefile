@@ -1,0 +1,42 @@
+# interpatch — the two commands (README): `make demo` and `make test`.
+# Each installs what is missing from Debian's packages first.
+
+SHELL := /bin/bash
+DEBS := cmake ninja-build g++ python3 libeigen3-dev liblapack-dev libcli11-dev nlohmann-json3-dev \
+        libgtest-dev libgmock-dev libbenchmark-dev
+SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
+JOBS ?= $(shell nproc)
+
+.PHONY: all deps build demo test test-release test-asan clean
+
+all: build
+
+deps:
+	@missing=""; for p in $(DEBS); do \
+	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" || missing="$$missing $$p"; \
+	done; \
+	if [ -n "$$missing" ]; then \
+	  echo "interpatch: installing from Debian:$$missing"; \
+	  $(SUDO) apt-get update -qq && \
+	  $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing; \
+	fi
+
+build: deps
+	cmake --preset release
+	cmake --build --preset release -j $(JOBS)
+
+demo: build
+	./build/release/interpatch demo -o demo-output
+
+test-release: build
+	ctest --preset release -j $(JOBS)
+
+test-asan: deps
+	cmake --preset asan
+	cmake --build --preset asan -j $(JOBS)
+	ctest --preset asan -j $(JOBS)
+
+test: test-release test-asan
+
+clean:
+	rm -rf build demo-output

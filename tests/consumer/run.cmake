@@ -1,0 +1,27 @@
+# ctest -P script: install the built project to a scratch prefix, then build and run
+# the consumer against it (MODE=install) or against the source tree (MODE=subdirectory).
+set(work "${BINARY_DIR}/consumer-${MODE}")
+file(REMOVE_RECURSE "${work}")
+if(MODE STREQUAL "install")
+  execute_process(COMMAND ${CMAKE_COMMAND} --install "${BINARY_DIR}" --prefix "${work}/prefix"
+                  RESULT_VARIABLE rc OUTPUT_QUIET)
+  if(rc)
+    message(FATAL_ERROR "install failed: ${rc}")
+  endif()
+  set(args "-DCMAKE_PREFIX_PATH=${work}/prefix")
+else()
+  set(args "-DINTERPATCH_SOURCE_DIR=${SOURCE_DIR}")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/consumer" -B "${work}/build" -G Ninja
+                        -DCMAKE_BUILD_TYPE=Release ${args} RESULT_VARIABLE rc)
+if(rc)
+  message(FATAL_ERROR "configuring the consumer failed: ${rc}")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} --build "${work}/build" --target consumer RESULT_VARIABLE rc)
+if(rc)
+  message(FATAL_ERROR "building the consumer failed: ${rc}")
+endif()
+execute_process(COMMAND "${work}/build/consumer" RESULT_VARIABLE rc)
+if(rc)
+  message(FATAL_ERROR "the consumer failed: ${rc}")
+endif()

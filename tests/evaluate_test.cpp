@@ -1,0 +1,62 @@
+#include "interpatch/evaluate.hpp"
+
+#include "test_util.hpp"
+
+namespace interpatch {
+namespace {
+
+// z = a x² + b y² over [0,1]² as a biquadratic Bézier patch (exact): x = u, y = v.
+BSplineSurface paraboloid(double a, double b) {
+  PointGrid cp({3, 3});
+  const double xs[3] = {0, 0.5, 1};
+  const double zx[3] = {0, 0, a};  // Bernstein coefficients of a u²
+  const double zy[3] = {0, 0, b};
+  for (std::size_t i = 0; i < 3; ++i)
+    for (std::size_t j = 0; j < 3; ++j) cp(i, j) = {xs[i], xs[j], zx[i] + zy[j]};
+  const KnotVector k(2, {0, 0, 0, 1, 1, 1});
+  return BSplineSurface(k, k, cp);
+}
+
+TEST(Curvature, ParaboloidMatchesClosedForm) {
+  for (auto [a, b] : {std::pair{1.0, 1.0}, std::pair{0.5, -2.0}, std::pair{3.0, 0.0}}) {
+    const auto s = paraboloid(a, b);
+    for (double u : {0.0, 0.3, 0.8})
+      for (double v : {0.0, 0.45, 1.0}) {
+        const auto d = s.derivatives(u, v);
+        // Monge patch z = f(x,y): K = (fxx fyy − fxy²)/(1+fx²+fy²)², H from the standard formula.
+        const double fx = 2 * a * u, fy = 2 * b * v, fxx = 2 * a, fyy = 2 * b;
+        const double w = 1 + fx * fx + fy * fy;
+        const double K = fxx * fyy / (w * w);
+        const double H = ((1 + fy * fy) * fxx + (1 + fx * fx) * fyy) / (2 * std::pow(w, 1.5));
+        const auto c = curvature(d);
+        EXPECT_NEAR(c.gaussian, K, 1e-13);
+        EXPECT_NEAR(c.mean, H, 1e-13);
+        EXPECT_NEAR(c.k1 + c.k2, 2 * H, 1e-13);
+        EXPECT_NEAR(c.k1 * c.k2, K, 1e-12);
+        const Vec3 n = unit_normal(d);
+        EXPECT_NEAR(norm(n), 1.0, 1e-15);
+        EXPECT_NEAR(dot(n, Vec3{-fx, -fy, 1} / std::sqrt(w)), 1.0, 1e-14);
+      }
+  }
+}
+
+TEST(Curvature, SingularFirstFormGivesNaN) {
+  SurfaceDerivatives d{};
+  d.su = {1, 0, 0};
+  const auto c = curvature(d);
+  EXPECT_TRUE(std::isnan(c.gaussian));
+  EXPECT_TRUE(std::isnan(c.mean));
+  EXPECT_EQ(unit_normal(SurfaceDerivatives{}), (Vec3{0, 0, 0}));
+}
+
+TEST(Linspace, EndsExact) {
+  const auto t = linspace(0.1, 0.7, 7);
+  EXPECT_EQ(t.front(), 0.1);
+  EXPECT_EQ(t.back(), 0.7);
+  EXPECT_NEAR(t[3], 0.4, 1e-16);
+  EXPECT_EQ(linspace(0, 1, 1), (std::vector<double>{0}));
+  EXPECT_TRUE(linspace(0, 1, 0).empty());
+}
+
+}  // namespace
+}  // namespace interpatch

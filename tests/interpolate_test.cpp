@@ -1,0 +1,229 @@
+#include "interpatch/interpolate.hpp"
+
+#include "interpatch/evaluate.hpp"
+#include "test_util.hpp"
+
+namespace interpatch {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double max_error_at_data(const SurfaceInterpolation& r, const PointGrid& q) {
+  double e = 0;
+  for (std::size_t i = 0; i < q.extent(0); ++i)
+    for (std::size_t j = 0; j < q.extent(1); ++j)
+      e = std::max(e, distance(r.surface.point(r.params_u[i], r.params_v[j]), q(i, j)));
+  return e;
+}
+
+TEST(CurveParameters, ChordCentripetalUniform) {
+  const std::vector<Vec3> p{{0, 0, 0}, {1, 0, 0}, {1, 4, 0}, {1, 4, 4}};
+  EXPECT_EQ(curve_parameters(p, Parametrization::chord), (std::vector<double>{0, 1.0 / 9, 5.0 / 9, 1}));
+  EXPECT_EQ(curve_parameters(p, Parametrization::centripetal), (std::vector<double>{0, 0.2, 0.6, 1}));
+  EXPECT_EQ(curve_parameters(p, Parametrization::uniform), (std::vector<double>{0, 1.0 / 3, 2.0 / 3, 1}));
+}
+
+TEST(AveragedKnots, NurbsBookEq98AndEndConditions) {
+  const std::vector<double> t{0, 0.1, 0.3, 0.6, 0.8, 1};
+  EXPECT_EQ(averaged_knots(t, 3).values(),
+            (std::vector<double>{0, 0, 0, 0, (0.1 + 0.3 + 0.6) / 3, (0.3 + 0.6 + 0.8) / 3, 1, 1, 1, 1}));
+  // Both end derivatives: windows of p over all parameters.
+  const auto both = averaged_knots(t, 3, true, true);
+  EXPECT_EQ(both.count(), 8);
+  EXPECT_DOUBLE_EQ(both[4], (0 + 0.1 + 0.3) / 3);
+  EXPECT_DOUBLE_EQ(both[7], (0.6 + 0.8 + 1) / 3);
+  EXPECT_EQ(averaged_knots(t, 1).values(), (std::vector<double>{0, 0, 0.1, 0.3, 0.6, 0.8, 1, 1}));
+}
+
+TEST(InterpolateCurve, PassesThroughRandomPointsEveryDegreeAndParametrization) {
+  auto g = test::rng(30);
+  for (int trial = 0; trial < 150; ++trial) {
+    const std::size_t n = 2 + static_cast<std::size_t>(trial % 19);
+    std::vector<Vec3> q;
+    for (std::size_t i = 0; i < n; ++i) q.push_back(Vec3{static_cast<double>(i), 0, 0} + test::random_point(g, 0.45));
+    CurveInterpolationOptions o;
+    o.degree = 1 + trial % std::min<int>(5, static_cast<int>(n) - 1 + 1);
+    if (*o.degree > static_cast<int>(n) - 1) o.degree = static_cast<int>(n) - 1;
+    o.param = static_cast<Parametrization>(trial % 3);
+    const auto r = interpolate_curve(q, o);
+    ASSERT_EQ(r.curve.control_points().size(), n);
+    const double scale = test::bbox_diagonal(q);
+    for (std::size_t i = 0; i < n; ++i)
+      EXPECT_LT(distance(r.curve.point(r.params[i]), q[i]), 1e-12 * scale);  // banded solve rounding
+  }
+}
+
+TEST(InterpolateCurve, EndDerivativesAreMet) {
+  auto g = test::rng(31);
+  for (int trial = 0; trial < 60; ++trial) {
+    const std::size_t n = 2 + static_cast<std::size_t>(trial % 9);
+    std::vector<Vec3> q;
+    for (std::size_t i = 0; i < n; ++i) q.push_back(Vec3{static_cast<double>(i), 0, 0} + test::random_point(g, 0.4));
+    CurveInterpolationOptions o;
+    o.degree = n >= 3 ? 3 : 2;
+    if (trial % 3 != 2) o.start_derivative = test::random_point(g, 5);
+    if (trial % 3 != 1) o.end_derivative = test::random_point(g, 5);
+    const auto r = interpolate_curve(q, o);
+    const double scale = test::bbox_diagonal(q);
+    for (std::size_t i = 0; i < n; ++i) EXPECT_LT(distance(r.curve.point(r.params[i]), q[i]), 1e-12 * scale);
+    // Derivative rows carry factors ~1/span: a little more rounding than the points.
+    if (o.start_derivative) {
+      EXPECT_LT(norm(r.curve.derivative(0, 1) - *o.start_derivative), 1e-11 * (1 + scale));
+    }
+    if (o.end_derivative) {
+      EXPECT_LT(norm(r.curve.derivative(1, 1) - *o.end_derivative), 1e-11 * (1 + scale));
+    }
+  }
+}
+
+TEST(InterpolateCurve, ReproducesPolynomialsOfItsDegree) {
+  // Points on a cubic in the parameter are reproduced everywhere, not just at the data.
+  auto f = [](double t) { return Vec3{t, 2 * t * t - t, t * t * t - 0.5 * t}; };
+  std::vector<double> t{0, 0.15, 0.2, 0.45, 0.7, 0.9, 1};
+  std::vector<Vec3> q;
+  for (double x : t) q.push_back(f(x));
+  CurveInterpolationOptions o;
+  o.params = t;
+  const auto r = interpolate_curve(q, o);
+  for (int s = 0; s <= 100; ++s) EXPECT_LT(distance(r.curve.point(s / 100.0), f(s / 100.0)), 1e-14);
+}
+
+TEST(InterpolateCurve, InvalidInput) {
+  EXPECT_ERRC((void)interpolate_curve(std::vector<Vec3>{{0, 0, 0}}), too_few_points, "at least 2 points, got 1");
+  CurveInterpolationOptions o;
+  o.degree = 4;
+  EXPECT_ERRC((void)interpolate_curve(std::vector<Vec3>{{0, 0, 0}, {1, 0, 0}, {2, 1, 0}}, o), too_few_points,
+              "degree 4 needs at least 5 points, got 3");
+  o.degree = 0;
+  EXPECT_ERRC((void)interpolate_curve(std::vector<Vec3>{{0, 0, 0}, {1, 0, 0}}, o), invalid_degree, "degree 0");
+  EXPECT_ERRC((void)interpolate_curve(std::vector<Vec3>{{0, 0, 0}, {1, 0, 0}, {1, 0, 0}, {2, 0, 0}}), zero_chord,
+              "points 1 and 2 coincide");
+  EXPECT_ERRC((void)interpolate_curve(std::vector<Vec3>{{0, 0, 0}, {1, NAN, 0}}), not_finite, "point 1");
+  CurveInterpolationOptions given;
+  given.params = {0, 0.5, 0.4};
+  EXPECT_ERRC((void)interpolate_curve(std::vector<Vec3>{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}}, given), non_increasing,
+              "parameter 2 = 0.4");
+  given.params = {0, 1};
+  EXPECT_ERRC((void)interpolate_curve(std::vector<Vec3>{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}}, given), size_mismatch,
+              "3 parameters, got 2");
+}
+
+TEST(InterpolateSurface, PassesThroughRandomGridsOfManyShapesAndDegrees) {
+  auto g = test::rng(40);
+  for (int trial = 0; trial < 120; ++trial) {
+    const std::size_t nu = 2 + static_cast<std::size_t>(trial % 11), nv = 2 + static_cast<std::size_t>((trial * 7) % 17);
+    const auto q = test::random_grid(g, nu, nv, 0.35);
+    SurfaceInterpolationOptions o;
+    o.degree_u = 1 + trial % std::min<int>(5, static_cast<int>(nu) - 1);
+    o.degree_v = 1 + (trial / 3) % std::min<int>(5, static_cast<int>(nv) - 1);
+    o.param = static_cast<Parametrization>(trial % 3);
+    const auto r = interpolate_surface(q, o);
+    EXPECT_EQ(r.surface.control_points().extent(0), nu);  // exactly (n+1) x (m+1) control points
+    EXPECT_EQ(r.surface.control_points().extent(1), nv);
+    EXPECT_EQ(r.surface.degree_u(), *o.degree_u);
+    // Two banded solves: rounding grows with the (small) condition number of the collocation matrices.
+    EXPECT_LT(max_error_at_data(r, q), 1e-12 * test::bbox_diagonal(q.values())) << nu << "x" << nv;
+  }
+}
+
+TEST(InterpolateSurface, SevenByThirteenDegreesTwoThreeAndFiveFive) {
+  auto g = test::rng(41);
+  PointGrid q({7, 13});
+  for (std::size_t i = 0; i < 7; ++i)
+    for (std::size_t j = 0; j < 13; ++j) {
+      const double x = static_cast<double>(i), y = 0.5 * static_cast<double>(j);
+      q(i, j) = {x, y, std::sin(x) * std::cos(y) + 0.01 * test::uniform(g)};
+    }
+  for (auto [p, d] : {std::pair{2, 3}, std::pair{3, 3}, std::pair{5, 5}}) {
+    SurfaceInterpolationOptions o;
+    o.degree_u = p;
+    o.degree_v = d;
+    const auto r = interpolate_surface(q, o);
+    EXPECT_LT(max_error_at_data(r, q), 1e-12 * test::bbox_diagonal(q.values()));
+    EXPECT_EQ(r.surface.knots_u().size(), 7u + static_cast<std::size_t>(p) + 1);
+  }
+  SurfaceInterpolationOptions dflt;
+  EXPECT_EQ(interpolate_surface(q, dflt).surface.degree_u(), 3);
+  PointGrid small({3, 2});
+  for (std::size_t i = 0; i < 3; ++i)
+    for (std::size_t j = 0; j < 2; ++j) small(i, j) = {double(i), double(j), double(i * j)};
+  const auto r = interpolate_surface(small);
+  EXPECT_EQ(r.surface.degree_u(), 2);  // min(3, points - 1)
+  EXPECT_EQ(r.surface.degree_v(), 1);
+}
+
+TEST(InterpolateSurface, HemisphereWithAPoleRow) {
+  // Row u = 0 is the pole: every point equal. Its zero-length line is left out of the
+  // v-parameter average and must not break the interpolation.
+  const std::size_t nu = 9, nv = 17;
+  PointGrid q({nu, nv});
+  for (std::size_t i = 0; i < nu; ++i)
+    for (std::size_t j = 0; j < nv; ++j) {
+      const double th = 0.5 * kPi * static_cast<double>(i) / (nu - 1), ph = 2 * kPi * static_cast<double>(j) / (nv - 1);
+      q(i, j) = {std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)};
+    }
+  for (auto param : {Parametrization::chord, Parametrization::centripetal, Parametrization::uniform}) {
+    SurfaceInterpolationOptions o;
+    o.param = param;
+    const auto r = interpolate_surface(q, o);
+    EXPECT_LT(max_error_at_data(r, q), 1e-12 * 2);  // bbox diagonal ~2
+    // Averaged over the 16 non-pole rows the v-parameters are uniform by symmetry.
+    for (std::size_t j = 0; j < nv; ++j) EXPECT_NEAR(r.params_v[j], static_cast<double>(j) / (nv - 1), 1e-12);
+    // The pole row of control points collapses to the pole.
+    for (std::size_t j = 0; j < nv; ++j) EXPECT_LT(distance(r.surface.control_points()(0, j), {0, 0, 1}), 1e-14);
+    // Between the data the surface stays close to the sphere (interpolation error, not rounding).
+    for (int s = 1; s < 20; ++s) {
+      const Vec3 x = r.surface.point(s / 20.0, (s * 7 % 20) / 20.0);
+      EXPECT_NEAR(norm(x), 1.0, 2e-3);
+    }
+    // The normal at the pole is the limit: the z axis.
+    const auto d = r.surface.derivatives(0.0, 0.3);
+    EXPECT_GT(std::abs(unit_normal(d).z), 0.999);
+  }
+}
+
+TEST(InterpolateSurface, ReproducesTensorPolynomialsEverywhere) {
+  // A surface polynomial of degree (3,3) in uniform parameters lies in the spline space.
+  auto f = [](double u, double v) { return Vec3{u + 0.1 * v * v, v - u * u * v, u * u * u * v - 2 * v * v * v + u * v}; };
+  const std::size_t nu = 8, nv = 6;
+  PointGrid q({nu, nv});
+  for (std::size_t i = 0; i < nu; ++i)
+    for (std::size_t j = 0; j < nv; ++j) q(i, j) = f(static_cast<double>(i) / (nu - 1), static_cast<double>(j) / (nv - 1));
+  SurfaceInterpolationOptions o;
+  o.param = Parametrization::uniform;
+  const auto r = interpolate_surface(q, o);
+  for (int s = 0; s <= 30; ++s)
+    for (int t = 0; t <= 30; ++t) EXPECT_LT(distance(r.surface.point(s / 30.0, t / 30.0), f(s / 30.0, t / 30.0)), 1e-14);
+}
+
+TEST(InterpolateSurface, ParametersAverageTheRows) {
+  // Two lines along u with different spacing: the u-parameters are their average.
+  PointGrid q({3, 2});
+  q(0, 0) = {0, 0, 0}; q(1, 0) = {1, 0, 0}; q(2, 0) = {4, 0, 0};
+  q(0, 1) = {0, 1, 0}; q(1, 1) = {3, 1, 0}; q(2, 1) = {4, 1, 0};
+  const auto tu = grid_parameters(q, 0, Parametrization::chord);
+  EXPECT_DOUBLE_EQ(tu[1], 0.5 * (0.25 + 0.75));
+  const auto tv = grid_parameters(q, 1, Parametrization::chord);
+  EXPECT_EQ(tv, (std::vector<double>{0, 1}));
+}
+
+TEST(InterpolateSurface, InvalidInput) {
+  auto g = test::rng(42);
+  PointGrid q = test::random_grid(g, 4, 5);
+  SurfaceInterpolationOptions o;
+  o.degree_v = 5;
+  EXPECT_ERRC((void)interpolate_surface(q, o), too_few_points, "degree 5 in v needs at least 6 points, got 5");
+  PointGrid thin({1, 5});
+  EXPECT_ERRC((void)interpolate_surface(thin), too_few_points, "at least 2 x 2 points, got 1 x 5");
+  PointGrid bad = q;
+  bad(2, 3).y = INFINITY;
+  EXPECT_ERRC((void)interpolate_surface(bad), not_finite, "point [2][3]");
+  PointGrid dup = q;
+  for (std::size_t i = 0; i < 4; ++i) dup(i, 2) = dup(i, 1);  // column 2 repeats column 1 on every line
+  EXPECT_ERRC((void)interpolate_surface(dup), zero_chord, "grid points 1 and 2 along v coincide on every line");
+  PointGrid flat({3, 3}, Vec3{1, 1, 1});
+  EXPECT_ERRC((void)interpolate_surface(flat), zero_chord, "every line of the grid along u has zero length");
+}
+
+}  // namespace
+}  // namespace interpatch
