@@ -39,11 +39,9 @@ TEST(InterpolateCurve, PassesThroughRandomPointsEveryDegreeAndParametrization) {
   auto g = test::rng(30);
   for (int trial = 0; trial < 150; ++trial) {
     const std::size_t n = 2 + static_cast<std::size_t>(trial % 19);
-    std::vector<Vec3> q;
-    for (std::size_t i = 0; i < n; ++i) q.push_back(Vec3{static_cast<double>(i), 0, 0} + test::random_point(g, 0.45));
+    const auto q = test::random_polyline(g, n, 0.45);
     CurveInterpolationOptions o;
-    o.degree = 1 + trial % std::min<int>(5, static_cast<int>(n) - 1 + 1);
-    if (*o.degree > static_cast<int>(n) - 1) o.degree = static_cast<int>(n) - 1;
+    o.degree = std::min(1 + trial % 5, static_cast<int>(n) - 1);
     o.param = static_cast<Parametrization>(trial % 3);
     const auto r = interpolate_curve(q, o);
     ASSERT_EQ(r.curve.control_points().size(), n);
@@ -57,8 +55,7 @@ TEST(InterpolateCurve, EndDerivativesAreMet) {
   auto g = test::rng(31);
   for (int trial = 0; trial < 60; ++trial) {
     const std::size_t n = 2 + static_cast<std::size_t>(trial % 9);
-    std::vector<Vec3> q;
-    for (std::size_t i = 0; i < n; ++i) q.push_back(Vec3{static_cast<double>(i), 0, 0} + test::random_point(g, 0.4));
+    const auto q = test::random_polyline(g, n, 0.4);
     CurveInterpolationOptions o;
     o.degree = n >= 3 ? 3 : 2;
     if (trial % 3 != 2) o.start_derivative = test::random_point(g, 5);

@@ -24,6 +24,13 @@ inline Vec3 random_point(std::mt19937_64& g, double scale = 1.0) {
   return {scale * uniform(g), scale * uniform(g), scale * uniform(g)};
 }
 
+/// Points marching along x with noise below half the spacing: never coincident.
+inline std::vector<Vec3> random_polyline(std::mt19937_64& g, std::size_t n, double noise) {
+  std::vector<Vec3> q;
+  for (std::size_t i = 0; i < n; ++i) q.push_back(Vec3{static_cast<double>(i), 0, 0} + random_point(g, noise));
+  return q;
+}
+
 /// A smooth random-ish grid: a perturbed plane, never with coincident neighbours.
 inline PointGrid random_grid(std::mt19937_64& g, std::size_t nu, std::size_t nv, double noise = 0.3) {
   PointGrid q({nu, nv});
