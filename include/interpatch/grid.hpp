@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "interpatch/allocator.hpp"
 #include "interpatch/vec3.hpp"
 
 namespace interpatch {
@@ -23,10 +24,13 @@ template <class T, std::size_t Rank>
 class Grid {
  public:
   using shape_type = std::array<std::size_t, Rank>;
+  using storage_type = std::vector<T, large_allocator<T>>;
 
   Grid() { shape_.fill(0); }
   explicit Grid(const shape_type& shape, const T& fill = T{}) : shape_(shape), data_(count(shape), fill) {}
-  Grid(const shape_type& shape, std::vector<T> data) : shape_(shape), data_(std::move(data)) {}
+  /// Takes `data` in C order; its size must be the product of the shape.
+  Grid(const shape_type& shape, storage_type data) : shape_(shape), data_(std::move(data)) {}
+  Grid(const shape_type& shape, const std::vector<T>& data) : shape_(shape), data_(data.begin(), data.end()) {}
 
   [[nodiscard]] const shape_type& shape() const noexcept { return shape_; }
   [[nodiscard]] std::size_t extent(std::size_t axis) const noexcept { return shape_[axis]; }
@@ -40,8 +44,8 @@ class Grid {
 
   [[nodiscard]] T* data() noexcept { return data_.data(); }
   [[nodiscard]] const T* data() const noexcept { return data_.data(); }
-  [[nodiscard]] const std::vector<T>& values() const noexcept { return data_; }
-  [[nodiscard]] std::vector<T>& values() noexcept { return data_; }
+  [[nodiscard]] const storage_type& values() const noexcept { return data_; }
+  [[nodiscard]] storage_type& values() noexcept { return data_; }
 
   static std::size_t count(const shape_type& shape) noexcept {
     std::size_t n = 1;
@@ -60,7 +64,7 @@ class Grid {
   }
 
   shape_type shape_;
-  std::vector<T> data_;
+  storage_type data_;
 };
 
 /// (n+1) × (m+1) points, first index along u.

@@ -2,6 +2,7 @@
 /// @file interpatch.hpp
 /// Everything of interpatch in one include.
 
+#include "interpatch/allocator.hpp"
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/error.hpp"

@@ -1,0 +1,46 @@
+#pragma once
+/// @file allocator.hpp
+/// The allocator behind every grid: large buffers come straight from the system in
+/// 2 MiB-aligned mappings marked for transparent huge pages, small ones from
+/// operator new. Touching fresh memory page by page is a large share of the cost
+/// of a pass over a big grid; huge pages cut the number of page faults 512-fold.
+
+#include <cstddef>
+#include <memory>
+#include <new>
+
+namespace interpatch {
+
+namespace detail {
+/// Buffers at least this large are mapped directly.
+inline constexpr std::size_t large_buffer_bytes = std::size_t{1} << 20;
+/// A zero-filled, 2 MiB-aligned anonymous mapping of at least `bytes`.
+/// @throws std::bad_alloc.
+void* map_pages(std::size_t bytes);
+void unmap_pages(void* p, std::size_t bytes) noexcept;
+}  // namespace detail
+
+/// A std::allocator drop-in that maps large buffers with huge pages.
+template <class T>
+struct large_allocator {
+  using value_type = T;
+  large_allocator() noexcept = default;
+  template <class U>
+  large_allocator(const large_allocator<U>&) noexcept {}
+
+  T* allocate(std::size_t n) {
+    if (n > static_cast<std::size_t>(-1) / sizeof(T)) throw std::bad_array_new_length();
+    const std::size_t bytes = n * sizeof(T);
+    if (bytes >= detail::large_buffer_bytes) return static_cast<T*>(detail::map_pages(bytes));
+    return std::allocator<T>().allocate(n);
+  }
+  void deallocate(T* p, std::size_t n) noexcept {
+    const std::size_t bytes = n * sizeof(T);
+    if (bytes >= detail::large_buffer_bytes) detail::unmap_pages(p, bytes);
+    else std::allocator<T>().deallocate(p, n);
+  }
+  template <class U>
+  friend bool operator==(const large_allocator&, const large_allocator<U>&) noexcept { return true; }
+};
+
+}  // namespace interpatch
