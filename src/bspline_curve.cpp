@@ -1,5 +1,6 @@
 #include "interpatch/bspline_curve.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -212,6 +213,37 @@ BSplineCurve BSplineCurve::elevated(int times) const {
 
 BSplineCurve BSplineCurve::mapped(double a, double b) const {
   return BSplineCurve(knots_.mapped(a, b), cp_, w_);
+}
+
+std::vector<BSplineCurve> make_compatible(std::span<const BSplineCurve> curves) {
+  if (curves.empty()) fail(errc::too_few_points, "no curves to make compatible");
+  int p = 0;
+  const auto dom = curves.front().domain();
+  for (std::size_t k = 0; k < curves.size(); ++k) {
+    p = std::max(p, curves[k].degree());
+    if (curves[k].domain() != dom)
+      fail(errc::out_of_domain, "curve ", k, " has domain [", curves[k].domain().first, ", ",
+           curves[k].domain().second, "], curve 0 has [", dom.first, ", ", dom.second, "]");
+  }
+  std::vector<BSplineCurve> out;
+  out.reserve(curves.size());
+  for (const auto& c : curves) out.push_back(c.elevated(p - c.degree()));
+  // The merged interior knots: every value with its highest multiplicity.
+  std::vector<std::pair<double, int>> merged;
+  for (const auto& c : out)
+    for (const auto& [t, m] : c.knots().interior_breaks()) {
+      auto it = std::lower_bound(merged.begin(), merged.end(), t,
+                                 [](const std::pair<double, int>& a, double x) { return a.first < x; });
+      if (it != merged.end() && it->first == t) it->second = std::max(it->second, m);
+      else merged.insert(it, {t, m});
+    }
+  for (auto& c : out) {
+    std::vector<double> missing;
+    for (const auto& [t, m] : merged)
+      missing.insert(missing.end(), static_cast<std::size_t>(m - c.knots().multiplicity(t)), t);
+    if (!missing.empty()) c = c.refined(missing);
+  }
+  return out;
 }
 
 }  // namespace interpatch

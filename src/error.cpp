@@ -22,6 +22,9 @@ std::string_view to_string(errc code) noexcept {
     case errc::corner_gap: return "corner_gap";
     case errc::network_gap: return "network_gap";
     case errc::incompatible_twist: return "incompatible_twist";
+    case errc::tangent_mismatch: return "tangent_mismatch";
+    case errc::invalid_blend: return "invalid_blend";
+    case errc::no_exact_form: return "no_exact_form";
     case errc::malformed_file: return "malformed_file";
     case errc::file_unreadable: return "file_unreadable";
     case errc::file_unwritable: return "file_unwritable";

@@ -65,4 +65,10 @@ class BSplineCurve {
   std::vector<double> w_;
 };
 
+/// The same curves over one knot vector and one degree: each is elevated to the
+/// highest degree among them, then every knot value gets the highest multiplicity
+/// it has in any of them (knot merging). Geometry unchanged.
+/// @throws error out_of_domain (the domains differ), too_few_points (no curves).
+[[nodiscard]] std::vector<BSplineCurve> make_compatible(std::span<const BSplineCurve> curves);
+
 }  // namespace interpatch

@@ -9,14 +9,10 @@
 #include "interpatch/grid.hpp"
 #include "interpatch/knot_vector.hpp"
 #include "interpatch/progress.hpp"
+#include "interpatch/surface.hpp"
 #include "interpatch/vec3.hpp"
 
 namespace interpatch {
-
-/// A surface point with its first and second partial derivatives.
-struct SurfaceDerivatives {
-  Vec3 s, su, sv, suu, suv, svv;
-};
 
 /// S(u,v) = Σ_i Σ_j N_i(u) N_j(v) w_ij P_ij / Σ_i Σ_j N_i(u) N_j(v) w_ij.
 /// Control points are an (n+1) × (m+1) grid, first index along u. Valid by
@@ -30,7 +26,7 @@ struct SurfaceDerivatives {
 ///   BSplineSurface s(KnotVector(1, {0, 0, 1, 1}), KnotVector(1, {0, 0, 1, 1}), cp);
 ///   Vec3 p = s.point(0.5, 0.5);  // (0.5, 0.5, 0.25)
 /// @endcode
-class BSplineSurface {
+class BSplineSurface final : public Surface {
  public:
   /// @param weights empty, or the same shape as control_points.
   /// @throws error size_mismatch, not_finite, invalid_weight.
@@ -47,9 +43,9 @@ class BSplineSurface {
   [[nodiscard]] std::pair<double, double> domain_v() const noexcept { return {kv_.front(), kv_.back()}; }
 
   /// S(u, v). @throws error out_of_domain.
-  [[nodiscard]] Vec3 point(double u, double v) const;
+  [[nodiscard]] Vec3 point(double u, double v) const override;
   /// S and its partial derivatives up to second order. @throws error out_of_domain.
-  [[nodiscard]] SurfaceDerivatives derivatives(double u, double v) const;
+  [[nodiscard]] SurfaceDerivatives derivatives(double u, double v) const override;
   /// ∂^{ku+kv} S / ∂u^ku ∂v^kv for any orders. @throws error out_of_domain.
   [[nodiscard]] Vec3 derivative(double u, double v, int ku, int kv) const;
 
@@ -58,10 +54,12 @@ class BSplineSurface {
   /// to one curve in v. Both cores share the rows; the result does not depend on
   /// the thread count. @throws error out_of_domain, too_large.
   [[nodiscard]] PointGrid evaluate(std::span<const double> us, std::span<const double> vs,
-                                   const progress_callback& progress = {}) const;
+                                   const progress_callback& progress = {}) const override;
   /// Points and derivatives at every (us[i], vs[j]). @throws error out_of_domain, too_large.
   [[nodiscard]] Grid<SurfaceDerivatives, 2> evaluate_derivatives(std::span<const double> us,
-                                                                 std::span<const double> vs) const;
+                                                                 std::span<const double> vs) const override;
+  /// A copy: a B-spline surface is its own exact form.
+  [[nodiscard]] BSplineSurface to_bspline() const override { return *this; }
 
   /// The same surface with knots inserted in u and v. @throws error out_of_domain, invalid_knots.
   [[nodiscard]] BSplineSurface refined(std::span<const double> knots_u, std::span<const double> knots_v) const;

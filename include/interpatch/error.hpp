@@ -29,6 +29,9 @@ enum class errc {
   corner_gap,              ///< boundary curves do not meet at a corner
   network_gap,             ///< curves of a network miss each other at a node
   incompatible_twist,      ///< given twists disagree with the cross-derivative curves
+  tangent_mismatch,        ///< cross-derivative curves disagree with the boundary tangents at a corner
+  invalid_blend,           ///< a blending function that is not 0 at 0, 1 at 1 and monotone
+  no_exact_form,           ///< the construction has no exact B-spline form (e.g. Gregory's rational twists)
   malformed_file,          ///< a data file is readable but not well formed (NPY header, CSV field)
   // --- files; the command line exits with 4 ---
   file_unreadable,         ///< a file cannot be opened or read

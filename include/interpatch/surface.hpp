@@ -1,0 +1,51 @@
+#pragma once
+/// @file surface.hpp
+/// What every surface of interpatch offers: exact evaluation with derivatives,
+/// batch evaluation over parameter grids, and its exact B-spline form.
+
+#include <span>
+
+#include "interpatch/grid.hpp"
+#include "interpatch/progress.hpp"
+#include "interpatch/vec3.hpp"
+
+namespace interpatch {
+
+class BSplineSurface;
+
+/// A surface point with its first and second partial derivatives.
+struct SurfaceDerivatives {
+  Vec3 s, su, sv, suu, suv, svv;
+};
+
+/// A parametric surface S(u, v) over [0, 1]² (B-spline surfaces over their own
+/// knot domain).
+class Surface {
+ public:
+  virtual ~Surface() = default;
+
+  /// S(u, v). @throws error out_of_domain.
+  [[nodiscard]] virtual Vec3 point(double u, double v) const { return derivatives(u, v).s; }
+  /// S and its partial derivatives up to second order, from the construction's own
+  /// formula. @throws error out_of_domain.
+  [[nodiscard]] virtual SurfaceDerivatives derivatives(double u, double v) const = 0;
+  /// Points at every (us[i], vs[j]). @throws error out_of_domain, too_large.
+  [[nodiscard]] virtual PointGrid evaluate(std::span<const double> us, std::span<const double> vs,
+                                           const progress_callback& progress = {}) const;
+  /// Points and derivatives at every (us[i], vs[j]). @throws error out_of_domain, too_large.
+  [[nodiscard]] virtual Grid<SurfaceDerivatives, 2> evaluate_derivatives(std::span<const double> us,
+                                                                         std::span<const double> vs) const;
+  /// The same surface as a B-spline surface (polynomial or rational) that
+  /// evaluates to the same points up to rounding.
+  /// @throws error no_exact_form when the construction has none.
+  [[nodiscard]] virtual BSplineSurface to_bspline() const = 0;
+
+ protected:
+  Surface() = default;
+  Surface(const Surface&) = default;
+  Surface(Surface&&) = default;
+  Surface& operator=(const Surface&) = default;
+  Surface& operator=(Surface&&) = default;
+};
+
+}  // namespace interpatch

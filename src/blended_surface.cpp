@@ -1,0 +1,240 @@
+#include "interpatch/blended_surface.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "detail/blended_terms.hpp"
+#include "detail/text.hpp"
+#include "interpatch/hermite.hpp"
+
+namespace interpatch {
+
+using detail::fail;
+
+// ---------------------------------------------------------------- Blend
+
+Blend::Blend(KnotVector knots, std::vector<double> coefficients) : knots_(std::move(knots)), c_(std::move(coefficients)) {
+  if (knots_.front() != 0.0 || knots_.back() != 1.0)
+    fail(errc::invalid_knots, "a blending function is defined over [0, 1]; its knots span [", knots_.front(), ", ",
+         knots_.back(), "]");
+  if (c_.size() != static_cast<std::size_t>(knots_.count()))
+    fail(errc::size_mismatch, "a blending function with ", knots_.size(), " knots of degree ", knots_.degree(),
+         " needs ", knots_.count(), " coefficients, got ", c_.size());
+  for (std::size_t i = 0; i < c_.size(); ++i)
+    if (!std::isfinite(c_[i])) fail(errc::not_finite, "blending coefficient ", i, " is ", c_[i]);
+  if (c_.front() != 0.0) fail(errc::invalid_blend, "a blending function must be 0 at 0; its first coefficient is ", c_.front());
+  if (c_.back() != 1.0) fail(errc::invalid_blend, "a blending function must be 1 at 1; its last coefficient is ", c_.back());
+  for (std::size_t i = 1; i < c_.size(); ++i)
+    if (c_[i] < c_[i - 1])
+      fail(errc::invalid_blend, "a blending function must not decrease: coefficient ", i, " = ", c_[i],
+           " is below coefficient ", i - 1, " = ", c_[i - 1]);
+}
+
+Blend Blend::linear() { return Blend(KnotVector(1, {0, 0, 1, 1}), {0, 1}); }
+Blend Blend::hermite() { return Blend(KnotVector(3, {0, 0, 0, 0, 1, 1, 1, 1}), {0, 0, 1, 1}); }
+
+double Blend::derivative(double t, int order) const {
+  if (!(t >= -1e-12 && t <= 1 + 1e-12)) fail(errc::out_of_domain, "blending parameter ", t, " is outside [0, 1]");
+  t = std::clamp(t, 0.0, 1.0);
+  const int p = knots_.degree();
+  if (order > p) return 0.0;
+  const int s = knots_.find_span(t);
+  double d[(max_degree + 1) * (max_degree + 1)];
+  knots_.basis_derivatives(s, t, order, d);
+  double r = 0;
+  for (int j = 0; j <= p; ++j) r += d[order * (p + 1) + j] * c_[static_cast<std::size_t>(s - p + j)];
+  return r;
+}
+
+// ---------------------------------------------------------------- helpers
+
+namespace detail {
+
+BSplineCurve scalar(KnotVector knots, const std::vector<double>& coefficients) {
+  std::vector<Vec3> cp(coefficients.size());
+  for (std::size_t i = 0; i < cp.size(); ++i) cp[i] = {coefficients[i], 0, 0};
+  return BSplineCurve(std::move(knots), std::move(cp));
+}
+
+BSplineCurve one_minus(const BSplineCurve& f) {
+  std::vector<Vec3> cp = f.control_points();
+  for (auto& x : cp) x = {1.0 - x.x, 0, 0};
+  return BSplineCurve(f.knots(), std::move(cp));
+}
+
+std::vector<BSplineCurve> hermite_scalars() {
+  const KnotVector k(3, {0, 0, 0, 0, 1, 1, 1, 1});
+  return {scalar(k, {1, 1, 0, 0}), scalar(k, {0, 0, 1, 1}), scalar(k, {0, 1.0 / 3, 0, 0}), scalar(k, {0, 0, -1.0 / 3, 0})};
+}
+
+BSplineCurve unit(const BSplineCurve& c) {
+  return c.domain() == std::pair<double, double>{0.0, 1.0} ? c : c.mapped(0.0, 1.0);
+}
+
+}  // namespace detail
+
+// ---------------------------------------------------------------- BlendedSurface
+
+BlendedSurface::BlendedSurface(std::shared_ptr<const detail::BlendedTerms> terms) : t_(std::move(terms)) {}
+
+const std::vector<std::string>& BlendedSurface::notes() const noexcept { return t_->notes; }
+
+namespace {
+
+struct D3 {  // value and first two derivatives of a function of one parameter
+  Vec3 v[3];
+};
+
+D3 eval(const BSplineCurve& c, double t) {
+  D3 d;
+  c.derivatives(t, 2, d.v);
+  return d;
+}
+
+// Gregory's blend weight w = a / (a + b) and its partials, a = |u − i|, b = |v − j|.
+struct Weight {
+  double w, wu, wv, wuu, wuv, wvv;
+};
+
+Weight gregory_weight(double u, double v, int i, int j) {
+  const double a = std::abs(u - i), b = std::abs(v - j);
+  const double su = i == 0 ? 1.0 : -1.0, sv = j == 0 ? 1.0 : -1.0;
+  const double s = a + b;
+  if (s == 0.0) return {0.5, 0, 0, 0, 0, 0};  // the corner itself: the β factors vanish there
+  const double s2 = s * s, s3 = s2 * s;
+  return {a / s, su * b / s2, -sv * a / s2, -2 * b / s3, su * sv * (a - b) / s3, 2 * a / s3};
+}
+
+}  // namespace
+
+SurfaceDerivatives BlendedSurface::derivatives(double u, double v) const {
+  if (!(u >= -1e-12 && u <= 1 + 1e-12 && v >= -1e-12 && v <= 1 + 1e-12))
+    fail(errc::out_of_domain, "parameters (", u, ", ", v, ") are outside the domain [0, 1]²");
+  u = std::clamp(u, 0.0, 1.0);
+  v = std::clamp(v, 0.0, 1.0);
+  const auto& T = *t_;
+  // Per-thread scratch: sized once, so repeated evaluation does not allocate.
+  thread_local std::vector<D3> F, G;
+  F.resize(T.f.size());
+  G.resize(T.g.size());
+  for (std::size_t k = 0; k < T.f.size(); ++k) F[k] = eval(T.f[k], u);
+  for (std::size_t l = 0; l < T.g.size(); ++l) G[l] = eval(T.g[l], v);
+  SurfaceDerivatives d{};
+  // Σ f_k(u) a_k(v)
+  for (std::size_t k = 0; k < T.a.size(); ++k) {
+    const D3 A = eval(T.a[k], v);
+    const double f0 = F[k].v[0].x, f1 = F[k].v[1].x, f2 = F[k].v[2].x;
+    d.s += f0 * A.v[0];
+    d.su += f1 * A.v[0];
+    d.sv += f0 * A.v[1];
+    d.suu += f2 * A.v[0];
+    d.suv += f1 * A.v[1];
+    d.svv += f0 * A.v[2];
+  }
+  // Σ b_l(u) g_l(v)
+  for (std::size_t l = 0; l < T.b.size(); ++l) {
+    const D3 B = eval(T.b[l], u);
+    const double g0 = G[l].v[0].x, g1 = G[l].v[1].x, g2 = G[l].v[2].x;
+    d.s += g0 * B.v[0];
+    d.su += g0 * B.v[1];
+    d.sv += g1 * B.v[0];
+    d.suu += g0 * B.v[2];
+    d.suv += g1 * B.v[1];
+    d.svv += g2 * B.v[0];
+  }
+  // Σ c_kl f_k(u) g_l(v)
+  if (!T.c.empty())
+    for (std::size_t k = 0; k < T.f.size(); ++k)
+      for (std::size_t l = 0; l < T.g.size(); ++l) {
+        const Vec3& c = T.c(k, l);
+        const double f0 = F[k].v[0].x, f1 = F[k].v[1].x, f2 = F[k].v[2].x;
+        const double g0 = G[l].v[0].x, g1 = G[l].v[1].x, g2 = G[l].v[2].x;
+        d.s += (f0 * g0) * c;
+        d.su += (f1 * g0) * c;
+        d.sv += (f0 * g1) * c;
+        d.suu += (f2 * g0) * c;
+        d.suv += (f1 * g1) * c;
+        d.svv += (f0 * g2) * c;
+      }
+  // Gregory: −β_i(u) β_j(v) (tv + w (tu − tv)). Along the edge u = i (w = 0) the
+  // twist must be d/du of S_v(u, j) for S_u(i, v) to follow its cross-derivative curve;
+  // along v = j (w = 1), d/dv of S_u(i, v).
+  for (const auto& gc : T.gregory) {
+    const HermiteBasis bu[3] = {hermite_basis(u, 0), hermite_basis(u, 1), hermite_basis(u, 2)};
+    const HermiteBasis bv[3] = {hermite_basis(v, 0), hermite_basis(v, 1), hermite_basis(v, 2)};
+    double B[3], C[3];
+    for (int k = 0; k < 3; ++k) {
+      B[k] = gc.i == 0 ? bu[k].b0 : bu[k].b1;
+      C[k] = gc.j == 0 ? bv[k].b0 : bv[k].b1;
+    }
+    const Weight w = gregory_weight(u, v, gc.i, gc.j);
+    const Vec3 diff = gc.tu - gc.tv;
+    const Vec3 g = gc.tv + w.w * diff, gu = w.wu * diff, gv = w.wv * diff;
+    const Vec3 guu = w.wuu * diff, guv = w.wuv * diff, gvv = w.wvv * diff;
+    d.s -= B[0] * C[0] * g;
+    d.su -= B[1] * C[0] * g + B[0] * C[0] * gu;
+    d.sv -= B[0] * C[1] * g + B[0] * C[0] * gv;
+    d.suu -= B[2] * C[0] * g + 2 * B[1] * C[0] * gu + B[0] * C[0] * guu;
+    d.suv -= B[1] * C[1] * g + B[1] * C[0] * gv + B[0] * C[1] * gu + B[0] * C[0] * guv;
+    d.svv -= B[0] * C[2] * g + 2 * B[0] * C[1] * gv + B[0] * C[0] * gvv;
+  }
+  return d;
+}
+
+bool BlendedSurface::has_exact_form() const noexcept {
+  if (!t_->gregory.empty()) return false;
+  for (const auto* list : {&t_->a, &t_->b})
+    for (const auto& c : *list)
+      if (c.rational()) return false;
+  return true;
+}
+
+BSplineSurface BlendedSurface::to_bspline() const {
+  const auto& T = *t_;
+  if (!T.gregory.empty())
+    fail(errc::no_exact_form, "Gregory's twist correction is a rational blend of u and v with a singular point at "
+                              "each corrected corner; the patch has no exact B-spline form");
+  for (const auto* list : {&T.a, &T.b})
+    for (std::size_t k = 0; k < list->size(); ++k)
+      if ((*list)[k].rational())
+        fail(errc::no_exact_form, "curve ", k, " of the ", list == &T.a ? "v" : "u",
+             "-direction terms is rational; blends of rational curves with different weights have no B-spline "
+             "form of the same kind");
+  // Every function of u on one knot vector and degree, every function of v likewise.
+  std::vector<BSplineCurve> us(T.f), vs(T.g);
+  us.insert(us.end(), T.b.begin(), T.b.end());
+  vs.insert(vs.end(), T.a.begin(), T.a.end());
+  const auto cu = make_compatible(us), cv = make_compatible(vs);
+  const std::size_t nf = T.f.size(), ng = T.g.size();
+  const KnotVector& ku = cu.front().knots();
+  const KnotVector& kv = cv.front().knots();
+  const auto nu = static_cast<std::size_t>(ku.count()), nv = static_cast<std::size_t>(kv.count());
+  PointGrid P({nu, nv});
+  auto coef = [](const BSplineCurve& c, std::size_t i) { return c.control_points()[i].x; };
+  for (std::size_t k = 0; k < T.a.size(); ++k)  // f_k ⊗ a_k
+    for (std::size_t x = 0; x < nu; ++x) {
+      const double fk = coef(cu[k], x);
+      if (fk == 0.0) continue;
+      for (std::size_t y = 0; y < nv; ++y) P(x, y) += fk * cv[ng + k].control_points()[y];
+    }
+  for (std::size_t l = 0; l < T.b.size(); ++l)  // b_l ⊗ g_l
+    for (std::size_t y = 0; y < nv; ++y) {
+      const double gl = coef(cv[l], y);
+      if (gl == 0.0) continue;
+      for (std::size_t x = 0; x < nu; ++x) P(x, y) += gl * cu[nf + l].control_points()[x];
+    }
+  if (!T.c.empty())
+    for (std::size_t k = 0; k < nf; ++k)
+      for (std::size_t l = 0; l < ng; ++l) {
+        const Vec3& c = T.c(k, l);
+        if (c == Vec3{}) continue;
+        for (std::size_t x = 0; x < nu; ++x) {
+          const double fk = coef(cu[k], x);
+          if (fk == 0.0) continue;
+          for (std::size_t y = 0; y < nv; ++y) P(x, y) += (fk * coef(cv[l], y)) * c;
+        }
+      }
+  return BSplineSurface(ku, kv, std::move(P));
+}
+
+}  // namespace interpatch

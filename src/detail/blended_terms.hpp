@@ -1,0 +1,41 @@
+#pragma once
+// The terms of a blended surface (include/interpatch/blended_surface.hpp):
+//   S = Σ_k f_k(u) a_k(v) + Σ_l b_l(u) g_l(v) + Σ_kl c_kl f_k(u) g_l(v) + Gregory terms.
+// Scalar functions f, g are B-spline curves whose x coordinate is the value; every
+// function and curve is over [0, 1].
+
+#include <string>
+#include <vector>
+
+#include "interpatch/bspline_curve.hpp"
+#include "interpatch/grid.hpp"
+
+namespace interpatch::detail {
+
+/// Gregory's correction at corner (i, j): the twist term −β_i(u) β_j(v) T with
+/// T = tv + w (tu − tv), w = |u−i| / (|u−i| + |v−j|): tv = d/du S_v(u, j) along the
+/// edge u = i, tu = d/dv S_u(i, v) along v = j.
+struct GregoryCorner {
+  int i, j;
+  Vec3 tu, tv;
+};
+
+struct BlendedTerms {
+  std::vector<BSplineCurve> f, a;  // a empty, or one curve of v per f
+  std::vector<BSplineCurve> g, b;  // b empty, or one curve of u per g
+  Grid<Vec3, 2> c;                 // |f| × |g| or empty
+  std::vector<GregoryCorner> gregory;
+  std::vector<std::string> notes;
+};
+
+/// A scalar B-spline function as a curve whose x coordinate is the value.
+BSplineCurve scalar(KnotVector knots, const std::vector<double>& coefficients);
+/// 1 − f for a scalar function f.
+BSplineCurve one_minus(const BSplineCurve& f);
+/// The cubic Hermite functions α0, α1, β0, β1 on [0, 1] as scalar Bézier functions
+/// (α0 = B0 + B1, α1 = B2 + B3, β0 = B1/3, β1 = −B2/3).
+std::vector<BSplineCurve> hermite_scalars();
+/// The curve over [0, 1].
+BSplineCurve unit(const BSplineCurve& c);
+
+}  // namespace interpatch::detail

@@ -1,0 +1,53 @@
+#include "interpatch/surface.hpp"
+
+#include <algorithm>
+
+#include "detail/text.hpp"
+#include "interpatch/memory.hpp"
+
+namespace interpatch {
+
+namespace {
+
+// Checked before the parallel loops: an exception must not leave an OpenMP region.
+void check_unit(std::span<const double> ts, const char* dir) {
+  for (double t : ts)
+    if (!(t >= -1e-12 && t <= 1 + 1e-12))  // rounding of the caller's parameter mapping
+      detail::fail(errc::out_of_domain, "parameter ", dir, " = ", t, " is outside the domain [0, 1]");
+}
+
+}  // namespace
+
+PointGrid Surface::evaluate(std::span<const double> us, std::span<const double> vs,
+                            const progress_callback& progress) const {
+  check_unit(us, "u");
+  check_unit(vs, "v");
+  require_memory(us.size() * vs.size(), sizeof(Vec3), "surface evaluation grid");
+  PointGrid out({us.size(), vs.size()});
+  const auto nu = static_cast<long long>(us.size());
+  for (long long r0 = 0; r0 < nu; r0 += 64) {
+    const long long r1 = std::min(nu, r0 + 64);
+#pragma omp parallel for schedule(static)
+    for (long long i = r0; i < r1; ++i)
+      for (std::size_t j = 0; j < vs.size(); ++j)
+        out(static_cast<std::size_t>(i), j) = point(us[static_cast<std::size_t>(i)], vs[j]);
+    if (progress) progress(static_cast<double>(r1) / static_cast<double>(nu));
+  }
+  return out;
+}
+
+Grid<SurfaceDerivatives, 2> Surface::evaluate_derivatives(std::span<const double> us,
+                                                          std::span<const double> vs) const {
+  check_unit(us, "u");
+  check_unit(vs, "v");
+  require_memory(us.size() * vs.size(), sizeof(SurfaceDerivatives), "surface derivative grid");
+  Grid<SurfaceDerivatives, 2> out({us.size(), vs.size()});
+  const auto nu = static_cast<long long>(us.size());
+#pragma omp parallel for schedule(static)
+  for (long long i = 0; i < nu; ++i)
+    for (std::size_t j = 0; j < vs.size(); ++j)
+      out(static_cast<std::size_t>(i), j) = derivatives(us[static_cast<std::size_t>(i)], vs[j]);
+  return out;
+}
+
+}  // namespace interpatch
