@@ -1,1 +1,525 @@
-// (being written)
+#include "interpatch/io/mesh.hpp"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cctype>
+#include <charconv>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <ostream>
+#include <string>
+
+#include "detail/text.hpp"
+#include "interpatch/io/atomic_file.hpp"
+
+namespace interpatch::io {
+namespace fs = std::filesystem;
+
+namespace {
+
+// ---------------------------------------------------------------------------
+// Output in bounded chunks: text and binary values are gathered in a buffer of
+// about a megabyte and handed to the stream, so no file is ever built in memory.
+
+class Sink {
+ public:
+  explicit Sink(std::ostream& os) : os_(os) { buf_.reserve(limit + 256); }
+  Sink(const Sink&) = delete;
+  Sink& operator=(const Sink&) = delete;
+  ~Sink() = default;
+
+  void flush() {
+    os_.write(buf_.data(), static_cast<std::streamsize>(buf_.size()));
+    buf_.clear();
+  }
+
+  Sink& text(std::string_view s) {
+    buf_ += s;
+    maybe_flush();
+    return *this;
+  }
+  Sink& ch(char c) {
+    buf_ += c;
+    return *this;
+  }
+  Sink& uint(std::uint64_t v) {
+    char b[24];
+    const auto r = std::to_chars(b, b + sizeof b, v);
+    buf_.append(b, r.ptr);
+    return *this;
+  }
+  /// Shortest text that reads back as the same double.
+  Sink& shortest(double v) {
+    char b[32];
+    const auto r = std::to_chars(b, b + sizeof b, v);
+    buf_.append(b, r.ptr);
+    return *this;
+  }
+  /// "%.17g", independent of the locale.
+  Sink& digits17(double v) {
+    char b[32];
+    const auto r = std::to_chars(b, b + sizeof b, v, std::chars_format::general, 17);
+    buf_.append(b, r.ptr);
+    return *this;
+  }
+  template <class T>
+  Sink& little(T v) {
+    return bytes(v, std::endian::little);
+  }
+  template <class T>
+  Sink& big(T v) {
+    return bytes(v, std::endian::big);
+  }
+  void end_record() { maybe_flush(); }
+
+ private:
+  template <class T>
+  Sink& bytes(T v, std::endian order) {
+    char b[sizeof(T)];
+    std::memcpy(b, &v, sizeof(T));
+    if (order != std::endian::native) std::reverse(b, b + sizeof(T));
+    buf_.append(b, sizeof(T));
+    return *this;
+  }
+  void maybe_flush() {
+    if (buf_.size() >= limit) flush();
+  }
+
+  static constexpr std::size_t limit = std::size_t{1} << 20;
+  std::ostream& os_;
+  std::string buf_;
+};
+
+std::string lower_extension(const fs::path& path) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+std::string normalized(std::string_view extension) {
+  std::string ext(extension);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (!ext.empty() && ext.front() != '.') ext.insert(ext.begin(), '.');
+  return ext;
+}
+
+constexpr std::array<std::string_view, 6> surface_formats = {".obj", ".stl", ".ply", ".vtk", ".vts", ".xyz"};
+constexpr std::array<std::string_view, 3> volume_formats = {".vtk", ".vts", ".xyz"};
+
+template <std::size_t N>
+std::string list(const std::array<std::string_view, N>& formats) {
+  std::string s;
+  for (std::size_t i = 0; i < N; ++i) {
+    if (i) s += ", ";
+    s += formats[i];
+  }
+  return s;
+}
+
+std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
+
+// ---------------------------------------------------------------------------
+// Faces of a structured surface grid.
+
+/// The corners of cell (i, j) as C-order vertex indices, counterclockwise in
+/// (u, v) so that the face normal is S_u x S_v. Corners at the same point as their
+/// predecessor (a pole row or a collapsed edge) are dropped: 4 corners is a quad,
+/// 3 a triangle, 0 a cell with no area left to draw.
+std::size_t cell_corners(const PointGrid& g, std::size_t i, std::size_t j, std::size_t out[4]) {
+  const std::size_t nv = g.extent(1);
+  const std::size_t cand[4] = {i * nv + j, (i + 1) * nv + j, (i + 1) * nv + j + 1, i * nv + j + 1};
+  const Vec3* p = g.data();
+  std::size_t n = 0;
+  for (std::size_t c : cand) {
+    if (n == 0 || !(p[c] == p[out[n - 1]])) out[n++] = c;
+  }
+  while (n > 1 && p[out[n - 1]] == p[out[0]]) --n;
+  return n >= 3 ? n : 0;
+}
+
+template <class F>
+void for_each_face(const PointGrid& g, F&& f) {
+  const std::size_t nu = g.extent(0), nv = g.extent(1);
+  if (nu < 2 || nv < 2) return;
+  std::size_t c[4];
+  for (std::size_t i = 0; i + 1 < nu; ++i)
+    for (std::size_t j = 0; j + 1 < nv; ++j)
+      if (const std::size_t n = cell_corners(g, i, j, c); n != 0) f(c, n);
+}
+
+/// The triangles of a face (a fan from its first corner), skipping those of zero area.
+template <class F>
+void for_each_triangle(const PointGrid& g, F&& f) {
+  const Vec3* p = g.data();
+  for_each_face(g, [&](const std::size_t* c, std::size_t n) {
+    for (std::size_t k = 1; k + 1 < n; ++k) {
+      const Vec3& a = p[c[0]];
+      const Vec3& b = p[c[k]];
+      const Vec3& d = p[c[k + 1]];
+      const Vec3 nrm = cross(b - a, d - a);
+      if (nrm == Vec3{}) continue;
+      f(a, b, d, nrm);
+    }
+  });
+}
+
+// ---------------------------------------------------------------------------
+// Surface-only formats.
+
+void write_obj(std::ostream& os, const SurfaceMesh& m) {
+  const PointGrid& g = m.points;
+  const std::size_t nu = g.extent(0), nv = g.extent(1);
+  const bool normals = !m.normals.empty();
+  Sink s(os);
+  s.text("# interpatch surface mesh: ").uint(nu).text(" x ").uint(nv).text(" vertices, first index along u\n");
+  for (const Vec3& p : g.values()) {
+    s.text("v ").shortest(p.x).ch(' ').shortest(p.y).ch(' ').shortest(p.z).ch('\n');
+    s.end_record();
+  }
+  for (std::size_t i = 0; i < nu; ++i) {
+    const double u = nu > 1 ? static_cast<double>(i) / static_cast<double>(nu - 1) : 0.0;
+    for (std::size_t j = 0; j < nv; ++j) {
+      const double v = nv > 1 ? static_cast<double>(j) / static_cast<double>(nv - 1) : 0.0;
+      s.text("vt ").shortest(u).ch(' ').shortest(v).ch('\n');
+      s.end_record();
+    }
+  }
+  if (normals) {
+    for (const Vec3& n : m.normals.values()) {
+      s.text("vn ").shortest(n.x).ch(' ').shortest(n.y).ch(' ').shortest(n.z).ch('\n');
+      s.end_record();
+    }
+  }
+  for_each_face(g, [&](const std::size_t* c, std::size_t n) {
+    s.ch('f');
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t idx = c[k] + 1;  // OBJ counts from 1; v, vt and vn share the index
+      s.ch(' ').uint(idx).ch('/').uint(idx);
+      if (normals) s.ch('/').uint(idx);
+    }
+    s.ch('\n');
+    s.end_record();
+  });
+  s.flush();
+}
+
+std::uint32_t stl_triangle_count(const PointGrid& g, const fs::path& path) {
+  std::uint64_t count = 0;
+  for_each_triangle(g, [&](const Vec3&, const Vec3&, const Vec3&, const Vec3&) { ++count; });
+  if (count > std::numeric_limits<std::uint32_t>::max()) {
+    detail::fail(errc::too_large, "cannot write ", quoted(path), ": ", count,
+                 " triangles; binary STL holds at most 4294967295");
+  }
+  return static_cast<std::uint32_t>(count);
+}
+
+void write_stl(std::ostream& os, const SurfaceMesh& m, std::uint32_t triangles) {
+  Sink s(os);
+  // Must not start with "solid": readers take that for ASCII STL.
+  char header[80];
+  std::memset(header, ' ', sizeof header);
+  const char title[] = "interpatch binary STL surface mesh";
+  std::memcpy(header, title, sizeof title - 1);
+  s.text(std::string_view(header, sizeof header));
+  s.little(triangles);
+  auto f32 = [](double v) { return static_cast<float>(v); };
+  for_each_triangle(m.points, [&](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n) {
+    const Vec3 unit = n / norm(n);
+    s.little(f32(unit.x)).little(f32(unit.y)).little(f32(unit.z));
+    for (const Vec3* p : {&a, &b, &c}) s.little(f32(p->x)).little(f32(p->y)).little(f32(p->z));
+    s.little(std::uint16_t{0});
+    s.end_record();
+  });
+  s.flush();
+}
+
+void write_ply(std::ostream& os, const SurfaceMesh& m) {
+  const PointGrid& g = m.points;
+  const bool normals = !m.normals.empty();
+  std::uint64_t faces = 0;
+  for_each_face(g, [&](const std::size_t*, std::size_t) { ++faces; });
+  const bool fits_int = g.size() <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
+
+  Sink s(os);
+  s.text("ply\nformat binary_little_endian 1.0\ncomment interpatch surface mesh ")
+      .uint(g.extent(0))
+      .text(" x ")
+      .uint(g.extent(1))
+      .text(", first index along u\nelement vertex ")
+      .uint(g.size())
+      .text("\nproperty double x\nproperty double y\nproperty double z\n");
+  if (normals) s.text("property double nx\nproperty double ny\nproperty double nz\n");
+  s.text("element face ").uint(faces).text("\nproperty list uchar ").text(fits_int ? "int" : "uint").text(" vertex_indices\nend_header\n");
+  for (std::size_t k = 0; k < g.size(); ++k) {
+    const Vec3& p = g.data()[k];
+    s.little(p.x).little(p.y).little(p.z);
+    if (normals) {
+      const Vec3& n = m.normals.data()[k];
+      s.little(n.x).little(n.y).little(n.z);
+    }
+    s.end_record();
+  }
+  for_each_face(g, [&](const std::size_t* c, std::size_t n) {
+    s.little(static_cast<std::uint8_t>(n));
+    for (std::size_t k = 0; k < n; ++k) {
+      if (fits_int) s.little(static_cast<std::int32_t>(c[k]));
+      else s.little(static_cast<std::uint32_t>(c[k]));
+    }
+    s.end_record();
+  });
+  s.flush();
+}
+
+// ---------------------------------------------------------------------------
+// Structured-grid formats, shared by surfaces (nw = 1) and volumes.
+
+struct Structured {
+  std::size_t nu = 1, nv = 1, nw = 1;
+  const Vec3* points = nullptr;   // C order: index (i * nv + j) * nw + k
+  const Vec3* vectors = nullptr;  // per-point unit normals, or nullptr
+  const double* scalars = nullptr;  // per-point jacobian, or nullptr
+  const char* kind = "surface";
+
+  [[nodiscard]] std::size_t size() const noexcept { return nu * nv * nw; }
+
+  /// Visits the C-order index of every point with i fastest, then j, then k: the
+  /// order of VTK and Plot3D files.
+  template <class F>
+  void each_i_fastest(F&& f) const {
+    for (std::size_t k = 0; k < nw; ++k)
+      for (std::size_t j = 0; j < nv; ++j)
+        for (std::size_t i = 0; i < nu; ++i) f((i * nv + j) * nw + k);
+  }
+};
+
+void write_legacy_vtk(std::ostream& os, const Structured& g) {
+  Sink s(os);
+  s.text("# vtk DataFile Version 3.0\ninterpatch ")
+      .text(g.kind)
+      .text(" grid\nBINARY\nDATASET STRUCTURED_GRID\nDIMENSIONS ")
+      .uint(g.nu).ch(' ').uint(g.nv).ch(' ').uint(g.nw)
+      .text("\nPOINTS ").uint(g.size()).text(" double\n");
+  g.each_i_fastest([&](std::size_t q) {
+    s.big(g.points[q].x).big(g.points[q].y).big(g.points[q].z);
+    s.end_record();
+  });
+  s.ch('\n');
+  if (g.vectors || g.scalars) s.text("POINT_DATA ").uint(g.size()).ch('\n');
+  if (g.vectors) {
+    s.text("NORMALS normals double\n");
+    g.each_i_fastest([&](std::size_t q) {
+      s.big(g.vectors[q].x).big(g.vectors[q].y).big(g.vectors[q].z);
+      s.end_record();
+    });
+    s.ch('\n');
+  }
+  if (g.scalars) {
+    s.text("SCALARS jacobian double 1\nLOOKUP_TABLE default\n");
+    g.each_i_fastest([&](std::size_t q) {
+      s.big(g.scalars[q]);
+      s.end_record();
+    });
+    s.ch('\n');
+  }
+  s.flush();
+}
+
+/// VTK XML StructuredGrid with the arrays as raw appended little-endian data, each
+/// preceded by its byte count as UInt64 (header_type), so grids of any size fit.
+void write_vts(std::ostream& os, const Structured& g) {
+  const std::uint64_t n = g.size();
+  const std::uint64_t vec_bytes = 24 * n, scal_bytes = 8 * n;
+  std::uint64_t offset = 0;
+  auto next_offset = [&](std::uint64_t bytes) {
+    const std::uint64_t o = offset;
+    offset += 8 + bytes;
+    return o;
+  };
+  Sink s(os);
+  auto extent = [&]() {
+    s.text("0 ").uint(g.nu - 1).text(" 0 ").uint(g.nv - 1).text(" 0 ").uint(g.nw - 1);
+  };
+  s.text("<?xml version=\"1.0\"?>\n"
+         "<VTKFile type=\"StructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+         "  <StructuredGrid WholeExtent=\"");
+  extent();
+  s.text("\">\n    <Piece Extent=\"");
+  extent();
+  s.text("\">\n      <PointData");
+  if (g.vectors) s.text(" Normals=\"Normals\"");
+  if (g.scalars) s.text(" Scalars=\"jacobian\"");
+  s.text(">\n");
+  if (g.vectors) {
+    s.text("        <DataArray type=\"Float64\" Name=\"Normals\" NumberOfComponents=\"3\" format=\"appended\" offset=\"")
+        .uint(next_offset(vec_bytes))
+        .text("\"/>\n");
+  }
+  if (g.scalars) {
+    s.text("        <DataArray type=\"Float64\" Name=\"jacobian\" NumberOfComponents=\"1\" format=\"appended\" offset=\"")
+        .uint(next_offset(scal_bytes))
+        .text("\"/>\n");
+  }
+  s.text("      </PointData>\n      <Points>\n"
+         "        <DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" format=\"appended\" offset=\"")
+      .uint(next_offset(vec_bytes))
+      .text("\"/>\n      </Points>\n    </Piece>\n  </StructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _");
+  auto vec_array = [&](const Vec3* v) {
+    s.little(vec_bytes);
+    g.each_i_fastest([&](std::size_t q) {
+      s.little(v[q].x).little(v[q].y).little(v[q].z);
+      s.end_record();
+    });
+  };
+  if (g.vectors) vec_array(g.vectors);
+  if (g.scalars) {
+    s.little(scal_bytes);
+    g.each_i_fastest([&](std::size_t q) {
+      s.little(g.scalars[q]);
+      s.end_record();
+    });
+  }
+  vec_array(g.points);
+  s.text("\n  </AppendedData>\n</VTKFile>\n");
+  s.flush();
+}
+
+/// Plot3D grid file, ASCII, 3D, multi-grid with one grid, whole (not planes): the
+/// block count, the dimensions, then every x (i fastest), every y, every z.
+void write_plot3d(std::ostream& os, const Structured& g) {
+  Sink s(os);
+  s.text("1\n").uint(g.nu).ch(' ').uint(g.nv).ch(' ').uint(g.nw).ch('\n');
+  for (int c = 0; c < 3; ++c) {
+    std::size_t col = 0;
+    g.each_i_fastest([&](std::size_t q) {
+      if (col) s.ch(' ');
+      s.digits17(g.points[q][c]);
+      if (++col == 4) {
+        s.ch('\n');
+        col = 0;
+      }
+      s.end_record();
+    });
+    if (col) s.ch('\n');
+  }
+  s.flush();
+}
+
+/// Plot3D function file (multi-grid, ASCII): the block count, "ni nj nk nvars",
+/// then the values, i fastest.
+void write_plot3d_function(std::ostream& os, const Structured& g) {
+  Sink s(os);
+  s.text("1\n").uint(g.nu).ch(' ').uint(g.nv).ch(' ').uint(g.nw).text(" 1\n");
+  std::size_t col = 0;
+  g.each_i_fastest([&](std::size_t q) {
+    if (col) s.ch(' ');
+    s.digits17(g.scalars[q]);
+    if (++col == 4) {
+      s.ch('\n');
+      col = 0;
+    }
+    s.end_record();
+  });
+  if (col) s.ch('\n');
+  s.flush();
+}
+
+template <std::size_t N>
+void check_extension(const fs::path& path, const std::string& ext, const std::array<std::string_view, N>& formats,
+                     const char* kind) {
+  if (std::find(formats.begin(), formats.end(), ext) != formats.end()) return;
+  if (ext.empty()) {
+    detail::fail(errc::wrong_type, "cannot write ", quoted(path), ": no extension to choose the ", kind,
+                 " mesh format by (supported: ", list(formats), ")");
+  }
+  if (std::find(surface_formats.begin(), surface_formats.end(), ext) != surface_formats.end()) {
+    detail::fail(errc::wrong_type, "cannot write ", quoted(path), ": '", ext, "' holds surfaces, not ", kind,
+                 " grids (supported for ", kind, "s: ", list(formats), ")");
+  }
+  detail::fail(errc::wrong_type, "cannot write ", quoted(path), ": unknown ", kind, " mesh format '", ext,
+               "' (supported: ", list(formats), ")");
+}
+
+void write_structured(const fs::path& path, const std::string& ext, const Structured& g) {
+  if (ext == ".vtk") {
+    write_atomically(path, [&](std::ostream& os) { write_legacy_vtk(os, g); });
+  } else if (ext == ".vts") {
+    write_atomically(path, [&](std::ostream& os) { write_vts(os, g); });
+  } else {
+    if (g.scalars) {
+      // Plot3D grids hold coordinates only; fields go to a function file.
+      fs::path function_path = path;
+      function_path.replace_extension(".f");
+      check_writable(path);
+      write_atomically(function_path, [&](std::ostream& os) { write_plot3d_function(os, g); });
+    }
+    write_atomically(path, [&](std::ostream& os) { write_plot3d(os, g); });
+  }
+}
+
+}  // namespace
+
+bool is_mesh_format(std::string_view extension) noexcept {
+  try {
+    const std::string ext = normalized(extension);
+    return std::find(surface_formats.begin(), surface_formats.end(), ext) != surface_formats.end();
+  } catch (...) {
+    return false;
+  }
+}
+
+void write_surface_mesh(const fs::path& path, const SurfaceMesh& mesh) {
+  const std::string ext = lower_extension(path);
+  check_extension(path, ext, surface_formats, "surface");
+  const PointGrid& g = mesh.points;
+  if (g.empty()) {
+    detail::fail(errc::size_mismatch, "cannot write ", quoted(path), ": the surface mesh has no points (",
+                 g.extent(0), " x ", g.extent(1), ")");
+  }
+  if (!mesh.normals.empty() && mesh.normals.shape() != g.shape()) {
+    detail::fail(errc::size_mismatch, "cannot write ", quoted(path), ": ", mesh.normals.extent(0), " x ",
+                 mesh.normals.extent(1), " normals for ", g.extent(0), " x ", g.extent(1), " points");
+  }
+
+  if (ext == ".obj") {
+    write_atomically(path, [&](std::ostream& os) { write_obj(os, mesh); });
+  } else if (ext == ".stl") {
+    const std::uint32_t triangles = stl_triangle_count(g, path);
+    write_atomically(path, [&](std::ostream& os) { write_stl(os, mesh, triangles); });
+  } else if (ext == ".ply") {
+    write_atomically(path, [&](std::ostream& os) { write_ply(os, mesh); });
+  } else {
+    Structured s;
+    s.nu = g.extent(0);
+    s.nv = g.extent(1);
+    s.points = g.data();
+    s.vectors = mesh.normals.empty() ? nullptr : mesh.normals.data();
+    s.kind = "surface";
+    write_structured(path, ext, s);
+  }
+}
+
+void write_volume_mesh(const fs::path& path, const PointGrid3& points, const Grid<double, 3>& jacobian) {
+  const std::string ext = lower_extension(path);
+  check_extension(path, ext, volume_formats, "volume");
+  if (points.empty()) {
+    detail::fail(errc::size_mismatch, "cannot write ", quoted(path), ": the volume grid has no points (",
+                 points.extent(0), " x ", points.extent(1), " x ", points.extent(2), ")");
+  }
+  if (!jacobian.empty() && jacobian.shape() != points.shape()) {
+    detail::fail(errc::size_mismatch, "cannot write ", quoted(path), ": jacobian of shape ", jacobian.extent(0),
+                 " x ", jacobian.extent(1), " x ", jacobian.extent(2), " for ", points.extent(0), " x ",
+                 points.extent(1), " x ", points.extent(2), " points");
+  }
+  Structured s;
+  s.nu = points.extent(0);
+  s.nv = points.extent(1);
+  s.nw = points.extent(2);
+  s.points = points.data();
+  s.scalars = jacobian.empty() ? nullptr : jacobian.data();
+  s.kind = "volume";
+  write_structured(path, ext, s);
+}
+
+}  // namespace interpatch::io

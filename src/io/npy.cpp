@@ -1,1 +1,443 @@
-// (being written)
+#include "interpatch/io/npy.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <charconv>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "detail/text.hpp"
+#include "interpatch/io/atomic_file.hpp"
+#include "interpatch/memory.hpp"
+
+namespace interpatch::io {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr char magic[6] = {'\x93', 'N', 'U', 'M', 'P', 'Y'};
+// NumPy itself refuses headers longer than 10000 bytes unless told otherwise; a
+// megabyte leaves room for any plausible shape while stopping absurd lengths.
+constexpr std::size_t max_header = std::size_t{1} << 20;
+
+std::string shape_text(const std::vector<std::size_t>& shape) {
+  std::string s = "(";
+  for (std::size_t i = 0; i < shape.size(); ++i) {
+    if (i) s += ", ";
+    s += std::to_string(shape[i]);
+  }
+  if (shape.size() == 1) s += ",";
+  return s + ")";
+}
+
+// ---------------------------------------------------------------------------
+// The header is a Python dict literal; this parser accepts what NumPy's
+// ast.literal_eval-based reader accepts for the three keys it defines.
+
+struct Header {
+  std::string descr;
+  bool fortran_order = false;
+  std::vector<std::size_t> shape;
+};
+
+class HeaderParser {
+ public:
+  HeaderParser(std::string_view text, const fs::path& file) : s_(text), file_(file) {}
+
+  Header parse() {
+    Header h;
+    bool have_descr = false, have_order = false, have_shape = false;
+    skip_space();
+    expect('{');
+    for (;;) {
+      skip_space();
+      if (peek() == '}') {
+        ++pos_;
+        break;
+      }
+      const std::size_t key_pos = pos_;
+      const std::string key = string_literal("a key");
+      skip_space();
+      expect(':');
+      skip_space();
+      auto seen = [&](bool& flag) {
+        if (flag) fail_at(key_pos, "key '" + key + "' appears twice");
+        flag = true;
+      };
+      if (key == "descr") {
+        seen(have_descr);
+        if (peek() == '[') {
+          detail::fail(errc::malformed_file, file_.string(),
+                       ": structured dtype is not supported; use float64 or float32");
+        }
+        h.descr = string_literal("a dtype string");
+      } else if (key == "fortran_order") {
+        seen(have_order);
+        h.fortran_order = boolean();
+      } else if (key == "shape") {
+        seen(have_shape);
+        h.shape = tuple();
+      } else {
+        fail_at(key_pos, "unexpected key '" + key + "' (NPY headers hold 'descr', 'fortran_order', 'shape')");
+      }
+      skip_space();
+      if (peek() == ',') {
+        ++pos_;
+      } else if (peek() != '}') {
+        fail_at(pos_, "expected ',' or '}'");
+      }
+    }
+    skip_space();
+    if (pos_ != s_.size()) fail_at(pos_, "unexpected text after the closing '}'");
+    if (!have_descr) fail_missing("descr");
+    if (!have_order) fail_missing("fortran_order");
+    if (!have_shape) fail_missing("shape");
+    return h;
+  }
+
+ private:
+  [[nodiscard]] char peek() const { return pos_ < s_.size() ? s_[pos_] : '\0'; }
+
+  void skip_space() {
+    while (pos_ < s_.size() && (s_[pos_] == ' ' || s_[pos_] == '\t' || s_[pos_] == '\n' || s_[pos_] == '\r')) ++pos_;
+  }
+
+  void expect(char c) {
+    if (peek() != c) fail_at(pos_, std::string("expected '") + c + "'");
+    ++pos_;
+  }
+
+  std::string string_literal(const char* what) {
+    const char q = peek();
+    if (q != '\'' && q != '"') fail_at(pos_, std::string("expected ") + what + " in quotes");
+    const std::size_t end = s_.find(q, pos_ + 1);
+    if (end == std::string_view::npos) fail_at(pos_, "unterminated string");
+    std::string v(s_.substr(pos_ + 1, end - pos_ - 1));
+    pos_ = end + 1;
+    return v;
+  }
+
+  bool boolean() {
+    if (s_.substr(pos_, 4) == "True") {
+      pos_ += 4;
+      return true;
+    }
+    if (s_.substr(pos_, 5) == "False") {
+      pos_ += 5;
+      return false;
+    }
+    fail_at(pos_, "expected True or False for 'fortran_order'");
+  }
+
+  std::vector<std::size_t> tuple() {
+    std::vector<std::size_t> dims;
+    expect('(');
+    for (;;) {
+      skip_space();
+      if (peek() == ')') {
+        ++pos_;
+        break;
+      }
+      const std::size_t start = pos_;
+      std::uint64_t v = 0;
+      const auto r = std::from_chars(s_.data() + pos_, s_.data() + s_.size(), v);
+      if (r.ec == std::errc::result_out_of_range) {
+        detail::fail(errc::too_large, file_.string(), ": dimension ", std::string(s_.substr(start, static_cast<std::size_t>(r.ptr - (s_.data() + start)))),
+                     " in the shape is too large");
+      }
+      if (r.ec != std::errc()) fail_at(start, "expected a non-negative integer in 'shape'");
+      pos_ = static_cast<std::size_t>(r.ptr - s_.data());
+      if (peek() == 'L' || peek() == 'l') ++pos_;  // Python 2 long literals, as old NumPy wrote them
+      if (v > std::numeric_limits<std::size_t>::max()) detail::fail(errc::too_large, file_.string(), ": dimension ", v, " is too large");
+      dims.push_back(static_cast<std::size_t>(v));
+      skip_space();
+      if (peek() == ',') {
+        ++pos_;
+      } else if (peek() != ')') {
+        fail_at(pos_, "expected ',' or ')' in 'shape'");
+      }
+    }
+    return dims;
+  }
+
+  [[noreturn]] void fail_at(std::size_t at, const std::string& what) const {
+    detail::fail(errc::malformed_file, file_.string(), ": malformed NPY header: ", what, " at character ", at,
+                 " of \"", excerpt(), "\"");
+  }
+  [[noreturn]] void fail_missing(const char* key) const {
+    detail::fail(errc::malformed_file, file_.string(), ": malformed NPY header: key '", key, "' is missing in \"",
+                 excerpt(), "\"");
+  }
+  [[nodiscard]] std::string excerpt() const {
+    std::string e;
+    for (char c : s_.substr(0, 200)) {
+      if (c == '\n') e += "\\n";
+      else if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) e += '?';
+      else e += c;
+    }
+    while (!e.empty() && e.back() == ' ') e.pop_back();
+    if (s_.size() > 200) e += "...";
+    return e;
+  }
+
+  std::string_view s_;
+  const fs::path& file_;
+  std::size_t pos_ = 0;
+};
+
+// ---------------------------------------------------------------------------
+// Element decoding.
+
+struct Dtype {
+  std::size_t size = 8;  // 4 or 8
+  bool big_endian = false;
+};
+
+Dtype parse_dtype(const std::string& descr, const fs::path& file) {
+  auto unsupported = [&]() {
+    detail::fail(errc::malformed_file, file.string(), ": dtype '", descr,
+                 "' is not supported; use float64 or float32");
+  };
+  if (descr.size() != 3) unsupported();
+  Dtype d;
+  switch (descr[0]) {
+    case '<': d.big_endian = false; break;
+    case '>': d.big_endian = true; break;
+    case '=': d.big_endian = std::endian::native == std::endian::big; break;
+    default: unsupported();
+  }
+  if (descr[1] != 'f') unsupported();
+  if (descr[2] == '8') d.size = 8;
+  else if (descr[2] == '4') d.size = 4;
+  else unsupported();
+  return d;
+}
+
+template <class U>
+U byteswap(U v) noexcept {
+  U r = 0;
+  for (std::size_t i = 0; i < sizeof(U); ++i) {
+    r = static_cast<U>((r << 8) | (v & 0xffu));
+    v = static_cast<U>(v >> 8);
+  }
+  return r;
+}
+
+/// One element from its bytes in the file.
+inline double decode(const unsigned char* p, const Dtype& d) noexcept {
+  const bool swap = d.big_endian != (std::endian::native == std::endian::big);
+  if (d.size == 8) {
+    std::uint64_t u;
+    std::memcpy(&u, p, 8);
+    if (swap) u = byteswap(u);
+    return std::bit_cast<double>(u);
+  }
+  std::uint32_t u;
+  std::memcpy(&u, p, 4);
+  if (swap) u = byteswap(u);
+  return static_cast<double>(std::bit_cast<float>(u));
+}
+
+std::uint32_t read_le(const unsigned char* p, std::size_t n) {
+  std::uint32_t v = 0;
+  for (std::size_t i = n; i-- > 0;) v = (v << 8) | p[i];
+  return v;
+}
+
+[[noreturn]] void fail_read(const fs::path& path, int err) {
+  detail::fail(errc::file_unreadable, "cannot read '", path.string(), "': ",
+               err != 0 ? std::strerror(err) : "read error");
+}
+
+void read_exact(std::ifstream& in, char* dst, std::size_t n, const fs::path& path) {
+  while (n > 0) {
+    const std::size_t step = std::min<std::size_t>(n, std::size_t{1} << 30);
+    errno = 0;
+    in.read(dst, static_cast<std::streamsize>(step));
+    if (static_cast<std::size_t>(in.gcount()) != step) fail_read(path, errno);
+    dst += step;
+    n -= step;
+  }
+}
+
+}  // namespace
+
+NpyArray read_npy(const fs::path& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) detail::fail(errc::file_unreadable, "cannot read '", path.string(), "': it is a directory");
+  errno = 0;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const int e = errno;
+    detail::fail(errc::file_unreadable, "cannot open '", path.string(), "': ",
+                 e != 0 ? std::strerror(e) : "open failed");
+  }
+  in.seekg(0, std::ios::end);
+  const auto end = in.tellg();
+  in.seekg(0, std::ios::beg);
+  if (end < 0 || !in) fail_read(path, errno);
+  const auto file_size = static_cast<std::uint64_t>(end);
+
+  const std::string name = path.string();
+  unsigned char pre[12] = {};
+  if (file_size < 10) {
+    detail::fail(errc::malformed_file, name, ": not an NPY file (", file_size, " bytes, shorter than the NPY preamble)");
+  }
+  read_exact(in, reinterpret_cast<char*>(pre), 10, path);
+  if (std::memcmp(pre, magic, sizeof magic) != 0) {
+    detail::fail(errc::malformed_file, name, ": not an NPY file (bad magic: the file does not start with \\x93NUMPY)");
+  }
+  const int major = pre[6], minor = pre[7];
+  std::size_t prefix = 10, len_bytes = 2;
+  if (major == 2 || major == 3) {
+    prefix = 12;
+    len_bytes = 4;
+    if (file_size < 12) detail::fail(errc::malformed_file, name, ": truncated NPY preamble (", file_size, " bytes)");
+    read_exact(in, reinterpret_cast<char*>(pre) + 10, 2, path);
+  } else if (major != 1) {
+    detail::fail(errc::malformed_file, name, ": NPY format version ", major, ".", minor,
+                 " is not supported (1.0, 2.0 and 3.0 are)");
+  }
+  const std::size_t header_len = read_le(pre + 8, len_bytes);
+  if (header_len > max_header) {
+    detail::fail(errc::malformed_file, name, ": malformed NPY header: declared length ", header_len,
+                 " bytes is implausible");
+  }
+  if (prefix + header_len > file_size) {
+    detail::fail(errc::malformed_file, name, ": truncated NPY header: declares ", header_len, " bytes, file has ",
+                 file_size - prefix, " after the preamble");
+  }
+  std::string text(header_len, '\0');
+  read_exact(in, text.data(), header_len, path);
+  const Header h = HeaderParser(text, path).parse();
+  const Dtype dt = parse_dtype(h.descr, path);
+
+  // Sizes, before allocating anything for the data.
+  std::size_t count = 1;
+  for (std::size_t d : h.shape) {
+    if (d != 0 && count > std::numeric_limits<std::size_t>::max() / d) {
+      detail::fail(errc::too_large, name, ": shape ", shape_text(h.shape), " has more elements than can be addressed");
+    }
+    count *= d;
+  }
+  if (count > std::numeric_limits<std::size_t>::max() / 8) {
+    detail::fail(errc::too_large, name, ": shape ", shape_text(h.shape), " needs more bytes than can be addressed");
+  }
+  require_memory(count, sizeof(double), name + ": array of shape " + shape_text(h.shape));
+  const std::uint64_t need = static_cast<std::uint64_t>(count) * dt.size;
+  const std::uint64_t have = file_size - prefix - header_len;
+  if (have < need) {
+    detail::fail(errc::malformed_file, name, ": truncated: shape ", shape_text(h.shape), " needs ", need,
+                 " bytes of data, found ", have);
+  }
+  if (have > need) {
+    detail::fail(errc::malformed_file, name, ": ", have - need, " bytes of extra data: shape ", shape_text(h.shape),
+                 " needs ", need, " bytes of data, found ", have);
+  }
+
+  NpyArray out;
+  out.shape = h.shape;
+  out.data.resize(count);
+  const bool fortran = h.fortran_order && h.shape.size() > 1;
+  const bool native = dt.big_endian == (std::endian::native == std::endian::big);
+
+  if (!fortran && dt.size == 8) {
+    // The common case: the file's bytes are the result, up to byte order.
+    read_exact(in, reinterpret_cast<char*>(out.data.data()), count * 8, path);
+    if (!native) {
+      for (double& v : out.data) v = std::bit_cast<double>(byteswap(std::bit_cast<std::uint64_t>(v)));
+    }
+    return out;
+  }
+
+  // Decode in chunks; Fortran order (first index fastest) is scattered into C order.
+  const std::size_t rank = h.shape.size();
+  std::vector<std::size_t> stride(rank, 1), index(rank, 0);
+  for (std::size_t a = rank; a-- > 1;) stride[a - 1] = stride[a] * h.shape[a];
+  std::size_t offset = 0;  // C-order offset of `index`
+  auto advance = [&]() {
+    if (!fortran) {
+      ++offset;
+      return;
+    }
+    for (std::size_t a = 0; a < rank; ++a) {
+      offset += stride[a];
+      if (++index[a] < h.shape[a]) return;
+      offset -= stride[a] * h.shape[a];
+      index[a] = 0;
+    }
+  };
+
+  constexpr std::size_t chunk_elems = std::size_t{1} << 16;
+  std::vector<unsigned char> buf(std::min(count, chunk_elems) * dt.size);
+  for (std::size_t done = 0; done < count;) {
+    const std::size_t n = std::min(count - done, chunk_elems);
+    read_exact(in, reinterpret_cast<char*>(buf.data()), n * dt.size, path);
+    for (std::size_t k = 0; k < n; ++k) {
+      out.data[offset] = decode(buf.data() + k * dt.size, dt);
+      advance();
+    }
+    done += n;
+  }
+  return out;
+}
+
+void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::span<const double> data) {
+  const std::vector<std::size_t> dims(shape.begin(), shape.end());
+  std::size_t count = 1;
+  bool overflow = false;
+  for (std::size_t d : dims) {
+    if (d != 0 && count > std::numeric_limits<std::size_t>::max() / d) overflow = true;
+    count *= d;
+  }
+  if (overflow || count != data.size()) {
+    detail::fail(errc::size_mismatch, "cannot write '", path.string(), "': shape ", shape_text(dims),
+                 overflow ? std::string(" overflows") : " has " + std::to_string(count) + " elements", ", data has ",
+                 data.size());
+  }
+
+  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': " + shape_text(dims) + ", }";
+  // Version 1.0 holds header lengths below 65536; only an absurd rank needs 2.0.
+  const bool v1 = header.size() + 1 + 10 + 64 <= 65535;
+  const std::size_t prefix = v1 ? 10 : 12;
+  const std::size_t total = (prefix + header.size() + 1 + 63) / 64 * 64;
+  header.append(total - prefix - header.size() - 1, ' ');
+  header += '\n';
+
+  write_atomically(path, [&](std::ostream& os) {
+    char pre[12];
+    std::memcpy(pre, magic, sizeof magic);
+    pre[6] = static_cast<char>(v1 ? 1 : 2);
+    pre[7] = 0;
+    std::size_t len = header.size();
+    for (std::size_t i = 0; i < (v1 ? 2u : 4u); ++i, len >>= 8) pre[8 + i] = static_cast<char>(len & 0xffu);
+    os.write(pre, static_cast<std::streamsize>(prefix));
+    os.write(header.data(), static_cast<std::streamsize>(header.size()));
+    if constexpr (std::endian::native == std::endian::little) {
+      const char* bytes = reinterpret_cast<const char*>(data.data());
+      std::size_t left = data.size() * sizeof(double);
+      while (left > 0) {
+        const std::size_t step = std::min<std::size_t>(left, std::size_t{1} << 26);
+        os.write(bytes, static_cast<std::streamsize>(step));
+        bytes += step;
+        left -= step;
+      }
+    } else {
+      std::vector<std::uint64_t> chunk(std::min<std::size_t>(data.size(), std::size_t{1} << 16));
+      for (std::size_t done = 0; done < data.size();) {
+        const std::size_t n = std::min(chunk.size(), data.size() - done);
+        for (std::size_t k = 0; k < n; ++k) chunk[k] = byteswap(std::bit_cast<std::uint64_t>(data[done + k]));
+        os.write(reinterpret_cast<const char*>(chunk.data()), static_cast<std::streamsize>(n * 8));
+        done += n;
+      }
+    }
+  });
+}
+
+}  // namespace interpatch::io

@@ -10,13 +10,19 @@
 namespace interpatch::io {
 
 /// Refuses an output path before any work is done: its directory must exist (it is
-/// never created) and be writable, and the path must not be a directory.
+/// never created) and be writable, and the path must not be a directory or another
+/// non-regular file. Creates nothing.
 /// @throws error file_unwritable naming the path and the reason.
 void check_writable(const std::filesystem::path& path);
 
-/// Runs `write` on a stream to a temporary file beside `path`, flushes and syncs
-/// it, then renames it onto `path`. If `write` throws or any write fails, the
-/// temporary file is removed, `path` is left as it was, and the error propagates.
+/// Runs `write` on a stream to a temporary file beside `path` (".name.tmp.XXXXXX"),
+/// flushes and syncs it, then renames it onto `path`. If `write` throws or any
+/// write fails, the temporary file is removed, `path` is left as it was, and the
+/// error propagates: the writer's own exception unchanged, a failed write (disk
+/// full, file too large) as file_unwritable naming the path and the reason; the
+/// stream throws on the first failure, so a writer stops early. The result gets
+/// the permissions of the file it replaces, or 0666 minus the umask when new; a
+/// symbolic link at `path` is kept and the file it points to replaced.
 ///
 /// Example:
 /// @code

@@ -11,19 +11,30 @@
 
 namespace interpatch::io {
 
-/// Reads one point per line (`x,y,z`, spaces allowed around fields); an optional
-/// first header line that does not parse as numbers is skipped; blank lines at
-/// the end are ignored.
+/// Reads one point per line (`x,y,z`, spaces or tabs allowed around fields, `\r\n`
+/// line ends, a UTF-8 byte order mark). Numbers are parsed independently of the
+/// locale (std::from_chars; a leading '+' and surrounding double quotes allowed).
+/// The first line is a header, and skipped, when none of its fields is or starts
+/// like a number (`x,y,z`); blank lines and lines starting with '#' (as
+/// numpy.savetxt writes its header) are ignored. Rows in messages are line numbers
+/// in the file, columns are field numbers, both from 1.
+///
+/// Example:
+/// @code
+///   auto pts = interpatch::io::read_csv_points("grid.csv", 40 * 50);  // C order of shape (40, 50)
+/// @endcode
 /// @throws error file_unreadable, malformed_file ("file:row:column: 'abc' is not a
-///   number", wrong field count), not_finite (NaN or Inf, naming file:row:column),
-///   size_mismatch (point count differs from `expected`, when expected > 0).
+///   number", "file:row:column: 2 fields found, 3 expected"), not_finite (NaN, Inf or
+///   overflow, naming file:row:column), size_mismatch (point count differs from
+///   `expected`, when expected > 0; both counts named).
 [[nodiscard]] std::vector<Vec3> read_csv_points(const std::filesystem::path& path, std::size_t expected = 0);
 
 /// Writes an evaluation grid: a header `u,v,x,y,z` (one name per parameter axis,
 /// then x,y,z), then one row per point in C order (first axis outermost). `params`
 /// holds one parameter list per axis; points.size() is the product of their sizes.
 /// Numbers are written with 17 significant digits, so they read back exactly.
-/// Written atomically. @throws error file_unwritable, size_mismatch.
+/// Written atomically. @throws error file_unwritable, size_mismatch (params.size()
+/// not 1..3, or points.size() not the product of the parameter counts).
 void write_csv_grid(const std::filesystem::path& path, std::span<const std::vector<double>> params,
                     std::span<const Vec3> points);
 

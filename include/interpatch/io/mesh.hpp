@@ -21,19 +21,34 @@ struct SurfaceMesh {
 /// .obj (Wavefront, quads with normals and uv), .stl (binary, triangles),
 /// .ply (binary little endian, vertices with normals, quads), .vtk (legacy
 /// binary STRUCTURED_GRID), .vts (VTK XML StructuredGrid), .xyz (Plot3D, one
-/// block, ASCII).
+/// block, ASCII). `extension` may be given with or without the dot, in any case.
 [[nodiscard]] bool is_mesh_format(std::string_view extension) noexcept;
 
-/// Writes the mesh atomically in the format named by the path's extension.
-/// Degenerate quads (a pole row) become triangles or are dropped where the format
-/// needs non-degenerate faces (STL).
-/// @throws error wrong_type (unknown extension), file_unwritable.
+/// Writes the mesh atomically in the format named by the path's extension (case
+/// does not matter). Faces are the grid cells, counterclockwise in (u, v) so that
+/// their normals point along S_u x S_v. A cell with two coincident corners (next to
+/// a pole row) is written as a triangle, a cell with no area left is dropped; STL
+/// splits quads into two triangles and drops those of zero area. Structured
+/// formats (.vtk, .vts, .xyz) keep every point, u index fastest.
+///
+/// Example:
+/// @code
+///   interpatch::io::SurfaceMesh m{interpatch::PointGrid({64, 64}), {}};
+///   // ... fill m.points ...
+///   interpatch::io::write_surface_mesh("patch.obj", m);
+/// @endcode
+/// @throws error wrong_type (unknown extension), size_mismatch (no points, or
+///   normals not of the points' shape), too_large (more than 2^32 - 1 STL
+///   triangles), file_unwritable.
 void write_surface_mesh(const std::filesystem::path& path, const SurfaceMesh& mesh);
 
 /// Writes a structured NU × NV × NW grid of points (a volume mesh, first index
-/// along u) to .vtk (legacy STRUCTURED_GRID), .vts or .xyz (Plot3D); `scalars`,
-/// if not empty, is written as a point field named "jacobian".
-/// @throws error wrong_type (unknown extension), file_unwritable.
+/// along u) to .vtk (legacy STRUCTURED_GRID), .vts or .xyz (Plot3D); `jacobian`,
+/// if not empty, is written as a point field named "jacobian". Plot3D grid files
+/// hold coordinates only, so for .xyz the field goes to a Plot3D function file
+/// beside it (same name, extension .f: block count, "ni nj nk 1", values).
+/// @throws error wrong_type (unknown extension, or a surface-only format),
+///   size_mismatch (no points, or a jacobian of another shape), file_unwritable.
 void write_volume_mesh(const std::filesystem::path& path, const PointGrid3& points,
                        const Grid<double, 3>& jacobian = {});
 

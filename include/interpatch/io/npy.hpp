@@ -16,14 +16,22 @@ struct NpyArray {
 };
 
 /// Reads float64 or float32 (widened), little or big endian, C or Fortran order;
-/// the result is always C order.
+/// the result is always C order. The header dict may list its keys in any order,
+/// with any spacing and trailing commas. Values are returned as stored (NaN
+/// included); checking them is the caller's business.
+///
+/// Example:
+/// @code
+///   interpatch::io::NpyArray a = interpatch::io::read_npy("grid.npy");  // e.g. shape {40, 50, 3}
+/// @endcode
 /// @throws error file_unreadable (cannot open or read), malformed_file (bad magic,
 ///   bad header, unsupported dtype, data shorter or longer than the shape says —
 ///   naming the file and the sizes), too_large (the shape needs more memory than
 ///   available; refused before allocating).
 [[nodiscard]] NpyArray read_npy(const std::filesystem::path& path);
 
-/// Writes little-endian float64 in C order, atomically.
+/// Writes little-endian float64 in C order, format version 1.0 (header padded to
+/// 64 bytes as NumPy does), atomically.
 /// @throws error file_unwritable, size_mismatch (data size is not the product of shape).
 void write_npy(const std::filesystem::path& path, std::span<const std::size_t> shape, std::span<const double> data);
 

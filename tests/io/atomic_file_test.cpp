@@ -1,0 +1,270 @@
+#include "interpatch/io/atomic_file.hpp"
+
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "test_util.hpp"
+
+namespace interpatch::io {
+namespace {
+namespace fs = std::filesystem;
+
+/// A fresh directory under the system temp directory, removed with its contents.
+class TempDir {
+ public:
+  TempDir() {
+    static std::atomic<int> counter{0};
+    path_ = fs::temp_directory_path() /
+            ("interpatch-atomic-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    fs::create_directories(path_);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  ~TempDir() {
+    std::error_code ec;
+    fs::permissions(path_, fs::perms::owner_all, fs::perm_options::add, ec);
+    fs::remove_all(path_, ec);
+  }
+  [[nodiscard]] fs::path operator/(const std::string& name) const { return path_ / name; }
+  [[nodiscard]] const fs::path& path() const { return path_; }
+
+  /// Names of everything in the directory, temporary files included.
+  [[nodiscard]] std::vector<std::string> entries() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(path_)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+
+ private:
+  fs::path path_;
+};
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void write_text(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+}
+
+mode_t mode_of(const fs::path& p) {
+  struct stat st {};
+  EXPECT_EQ(::stat(p.c_str(), &st), 0);
+  return st.st_mode & 07777;
+}
+
+/// Sets the umask for the life of the object.
+class UmaskGuard {
+ public:
+  explicit UmaskGuard(mode_t mask) : old_(::umask(mask)) {}
+  UmaskGuard(const UmaskGuard&) = delete;
+  UmaskGuard& operator=(const UmaskGuard&) = delete;
+  ~UmaskGuard() { ::umask(old_); }
+
+ private:
+  mode_t old_;
+};
+
+TEST(AtomicFile, WritesNewFile) {
+  TempDir dir;
+  write_atomically(dir / "out.txt", [](std::ostream& os) { os << "hello\n" << 42 << '\n'; });
+  EXPECT_EQ(read_text(dir / "out.txt"), "hello\n42\n");
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"out.txt"});  // no temporary file left
+}
+
+TEST(AtomicFile, ReplacesExistingFile) {
+  TempDir dir;
+  write_text(dir / "out.txt", "old content that is longer than the new one\n");
+  write_atomically(dir / "out.txt", [](std::ostream& os) { os << "new\n"; });
+  EXPECT_EQ(read_text(dir / "out.txt"), "new\n");
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"out.txt"});
+}
+
+TEST(AtomicFile, RelativePathInCurrentDirectory) {
+  TempDir dir;
+  const fs::path old = fs::current_path();
+  fs::current_path(dir.path());
+  write_atomically("plain.txt", [](std::ostream& os) { os << "x"; });
+  fs::current_path(old);
+  EXPECT_EQ(read_text(dir / "plain.txt"), "x");
+}
+
+TEST(AtomicFile, LargeOutputInManyPieces) {
+  TempDir dir;
+  std::string expected;
+  auto g = test::rng(31);
+  for (int i = 0; i < 200000; ++i) expected += std::to_string(g()) + (i % 7 == 0 ? "\n" : " ");
+  const std::string block(5u << 20, 'b');  // larger than the write buffer
+  expected += block;
+  write_atomically(dir / "big.txt", [&](std::ostream& os) {
+    std::size_t pos = 0;
+    for (std::size_t n = 1; pos < expected.size() - block.size(); n = n * 3 % 1001 + 1) {
+      const std::size_t take = std::min(n, expected.size() - block.size() - pos);
+      os.write(expected.data() + pos, static_cast<std::streamsize>(take));
+      pos += take;
+    }
+    os << block;
+  });
+  EXPECT_TRUE(read_text(dir / "big.txt") == expected);
+}
+
+TEST(AtomicFile, ThrowingWriterLeavesNoFile) {
+  TempDir dir;
+  EXPECT_THROW(write_atomically(dir / "out.txt",
+                                [](std::ostream& os) {
+                                  os << std::string(3u << 20, 'x');  // some of it reached the disk
+                                  throw std::runtime_error("writer failed");
+                                }),
+               std::runtime_error);
+  EXPECT_FALSE(fs::exists(dir / "out.txt"));
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+TEST(AtomicFile, ThrowingWriterKeepsExistingFile) {
+  TempDir dir;
+  write_text(dir / "out.txt", "precious\n");
+  EXPECT_ERRC(write_atomically(dir / "out.txt",
+                               [](std::ostream& os) {
+                                 os << "half a file";
+                                 throw error(errc::not_finite, "point 7 is nan");
+                               }),
+              not_finite, "point 7 is nan");  // the writer's error, unchanged
+  EXPECT_EQ(read_text(dir / "out.txt"), "precious\n");
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"out.txt"});
+}
+
+TEST(AtomicFile, StreamFailureBecomesFileUnwritable) {
+  TempDir dir;
+  write_text(dir / "out.txt", "precious\n");
+  EXPECT_ERRC(write_atomically(dir / "out.txt", [](std::ostream& os) { os.setstate(std::ios::badbit); }),
+              file_unwritable, "out.txt");
+  EXPECT_EQ(read_text(dir / "out.txt"), "precious\n");
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"out.txt"});
+}
+
+TEST(AtomicFile, WriteErrorFromTheSystemBecomesFileUnwritable) {
+  // A file size limit makes write() fail with EFBIG, as a full disk fails with ENOSPC.
+  TempDir dir;
+  write_text(dir / "out.txt", "precious\n");
+  rlimit old{};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
+  rlimit small = old;
+  small.rlim_cur = 4096;
+  auto* old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+  bool threw = false;
+  try {
+    write_atomically(dir / "out.txt", [](std::ostream& os) {
+      for (int i = 0; i < 1000; ++i) os << std::string(10000, 'y');
+    });
+  } catch (const error& e) {
+    threw = true;
+    ::setrlimit(RLIMIT_FSIZE, &old);
+    EXPECT_EQ(e.code(), errc::file_unwritable) << e.what();
+    EXPECT_NE(std::string(e.what()).find("out.txt': File too large"), std::string::npos) << e.what();
+  }
+  ::setrlimit(RLIMIT_FSIZE, &old);
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_TRUE(threw);
+  EXPECT_EQ(read_text(dir / "out.txt"), "precious\n");
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"out.txt"});
+}
+
+TEST(AtomicFile, NewFilePermissionsFollowUmaskNotMkstemp) {
+  TempDir dir;
+  {
+    UmaskGuard mask(022);
+    write_atomically(dir / "a.txt", [](std::ostream& os) { os << "a"; });
+  }
+  EXPECT_EQ(mode_of(dir / "a.txt"), 0644u);
+  {
+    UmaskGuard mask(027);
+    write_atomically(dir / "b.txt", [](std::ostream& os) { os << "b"; });
+  }
+  EXPECT_EQ(mode_of(dir / "b.txt"), 0640u);
+}
+
+TEST(AtomicFile, ReplacedFileKeepsItsPermissions) {
+  TempDir dir;
+  write_text(dir / "secret.txt", "old");
+  fs::permissions(dir / "secret.txt", fs::perms::owner_read | fs::perms::owner_write);
+  write_atomically(dir / "secret.txt", [](std::ostream& os) { os << "new"; });
+  EXPECT_EQ(mode_of(dir / "secret.txt"), 0600u);
+  EXPECT_EQ(read_text(dir / "secret.txt"), "new");
+}
+
+TEST(AtomicFile, WritingThroughSymlinkReplacesTheTarget) {
+  TempDir dir;
+  write_text(dir / "target.txt", "old");
+  fs::create_symlink("target.txt", dir / "link.txt");
+  write_atomically(dir / "link.txt", [](std::ostream& os) { os << "new"; });
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir / "link.txt")));
+  EXPECT_EQ(read_text(dir / "target.txt"), "new");
+}
+
+TEST(AtomicFile, CheckWritableAcceptsNewAndExistingFiles) {
+  TempDir dir;
+  EXPECT_NO_THROW(check_writable(dir / "new.txt"));
+  write_text(dir / "old.txt", "x");
+  EXPECT_NO_THROW(check_writable(dir / "old.txt"));
+  EXPECT_TRUE(dir.entries() == std::vector<std::string>{"old.txt"});  // checking creates nothing
+}
+
+TEST(AtomicFile, CheckWritableMissingDirectoryIsNotCreated) {
+  TempDir dir;
+  EXPECT_ERRC(check_writable(dir / "missing" / "out.txt"), file_unwritable,
+              "out.txt': directory '" + (dir / "missing").string() + "' does not exist");
+  EXPECT_FALSE(fs::exists(dir / "missing"));
+  EXPECT_ERRC(write_atomically(dir / "missing" / "out.txt", [](std::ostream& os) { os << "x"; }), file_unwritable,
+              "does not exist");
+  EXPECT_FALSE(fs::exists(dir / "missing"));
+}
+
+TEST(AtomicFile, CheckWritableRefusesDirectoryPath) {
+  TempDir dir;
+  fs::create_directory(dir / "sub");
+  EXPECT_ERRC(check_writable(dir / "sub"), file_unwritable, "sub': it is a directory");
+  EXPECT_ERRC(write_atomically(dir / "sub", [](std::ostream& os) { os << "x"; }), file_unwritable, "is a directory");
+  EXPECT_TRUE(fs::is_directory(dir / "sub"));
+}
+
+TEST(AtomicFile, CheckWritableRefusesFileAsDirectory) {
+  TempDir dir;
+  write_text(dir / "plain", "x");
+  EXPECT_ERRC(check_writable(dir / "plain" / "out.txt"), file_unwritable, "plain' is not a directory");
+}
+
+TEST(AtomicFile, CheckWritableRefusesEmptyPathAndSpecialFiles) {
+  EXPECT_ERRC(check_writable(""), file_unwritable, "empty");
+  TempDir dir;
+  ASSERT_EQ(::mkfifo((dir / "fifo").c_str(), 0600), 0);
+  EXPECT_ERRC(check_writable(dir / "fifo"), file_unwritable, "fifo': it exists and is not a regular file");
+}
+
+TEST(AtomicFile, CheckWritableRefusesReadOnlyDirectory) {
+  if (::geteuid() == 0) GTEST_SKIP() << "root writes into read-only directories";
+  TempDir dir;
+  fs::create_directory(dir / "ro");
+  fs::permissions(dir / "ro", fs::perms::owner_read | fs::perms::owner_exec);
+  EXPECT_ERRC(check_writable(dir / "ro" / "out.txt"), file_unwritable, "is not writable (Permission denied)");
+  fs::permissions(dir / "ro", fs::perms::owner_all);
+}
+
+}  // namespace
+}  // namespace interpatch::io

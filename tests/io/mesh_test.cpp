@@ -1,0 +1,684 @@
+#include "interpatch/io/mesh.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "test_util.hpp"
+
+namespace interpatch::io {
+namespace {
+namespace fs = std::filesystem;
+
+/// A fresh directory under the system temp directory, removed with its contents.
+class TempDir {
+ public:
+  TempDir() {
+    static std::atomic<int> counter{0};
+    path_ = fs::temp_directory_path() /
+            ("interpatch-mesh-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    fs::create_directories(path_);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  [[nodiscard]] fs::path operator/(const std::string& name) const { return path_ / name; }
+  [[nodiscard]] std::size_t count() const {
+    return static_cast<std::size_t>(std::distance(fs::directory_iterator(path_), fs::directory_iterator()));
+  }
+
+ private:
+  fs::path path_;
+};
+
+std::string read_bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// --- Test data ------------------------------------------------------------------------
+
+/// A paraboloid cap z = 1 - r^2 over three quarters of a turn, sampled at
+/// nu radii (the first is 0: a pole row of identical points) and nv angles.
+SurfaceMesh cap(std::size_t nu, std::size_t nv, std::size_t pole_rows = 1) {
+  SurfaceMesh m;
+  m.points = PointGrid({nu, nv});
+  m.normals = PointGrid({nu, nv});
+  for (std::size_t i = 0; i < nu; ++i) {
+    const double r = i < pole_rows ? 0.0 : static_cast<double>(i) / static_cast<double>(nu - 1);
+    for (std::size_t j = 0; j < nv; ++j) {
+      const double t = 1.5 * std::numbers::pi * static_cast<double>(j) / static_cast<double>(nv - 1);
+      const Vec3 p = i < pole_rows ? Vec3{0, 0, 1} : Vec3{r * std::cos(t), r * std::sin(t), 1 - r * r};
+      m.points(i, j) = p;
+      const Vec3 n{2 * p.x, 2 * p.y, 1};
+      m.normals(i, j) = n / norm(n);
+    }
+  }
+  return m;
+}
+
+/// The faces the writers must produce, worked out here independently: vertex
+/// indices in C order, a triangle for each cell touching a single pole row, no
+/// face for a cell between two pole rows.
+std::vector<std::vector<std::size_t>> expected_faces(std::size_t nu, std::size_t nv, std::size_t pole_rows) {
+  std::vector<std::vector<std::size_t>> faces;
+  for (std::size_t i = 0; i + 1 < nu; ++i)
+    for (std::size_t j = 0; j + 1 < nv; ++j) {
+      const std::size_t a = i * nv + j, b = (i + 1) * nv + j, c = (i + 1) * nv + j + 1, d = i * nv + j + 1;
+      if (i + 1 < pole_rows) continue;
+      if (i + 1 == pole_rows) faces.push_back({a, b, c});
+      else faces.push_back({a, b, c, d});
+    }
+  return faces;
+}
+
+PointGrid3 box(std::size_t nu, std::size_t nv, std::size_t nw, Grid<double, 3>* jac) {
+  PointGrid3 g({nu, nv, nw});
+  if (jac) *jac = Grid<double, 3>({nu, nv, nw});
+  for (std::size_t i = 0; i < nu; ++i)
+    for (std::size_t j = 0; j < nv; ++j)
+      for (std::size_t k = 0; k < nw; ++k) {
+        const double u = static_cast<double>(i) / 3.0, v = static_cast<double>(j) / 7.0, w = static_cast<double>(k) / 11.0;
+        g(i, j, k) = {u + 0.1 * v * w, 2 * v + std::sin(u), 3 * w + u * v};
+        if (jac) (*jac)(i, j, k) = 1.0 + u - 0.5 * v + w / 3.0;
+      }
+  return g;
+}
+
+// --- Readers used to check the files ---------------------------------------------------
+
+template <class T>
+T get(const std::string& s, std::size_t off, std::endian order) {
+  EXPECT_LE(off + sizeof(T), s.size());
+  char b[sizeof(T)];
+  std::memcpy(b, s.data() + std::min(off, s.size() - sizeof(T)), sizeof(T));
+  if (order != std::endian::native) std::reverse(b, b + sizeof(T));
+  T v;
+  std::memcpy(&v, b, sizeof(T));
+  return v;
+}
+template <class T>
+T le(const std::string& s, std::size_t off) { return get<T>(s, off, std::endian::little); }
+template <class T>
+T be(const std::string& s, std::size_t off) { return get<T>(s, off, std::endian::big); }
+
+double number(std::string_view s) {
+  double v = 0;
+  const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+  EXPECT_TRUE(r.ec == std::errc() && r.ptr == s.data() + s.size()) << "'" << s << "'";
+  return v;
+}
+
+std::vector<std::string> tokens(const std::string& line, char sep = ' ') {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : line) {
+    if (c == sep || c == '\n' || c == '\t') {
+      if (!cur.empty()) out.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  if (!cur.empty()) out.push_back(cur);
+  return out;
+}
+
+std::vector<std::string> lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) out.push_back(l);
+  return out;
+}
+
+/// Reads text lines from a position in a byte string, for headers before binary data.
+class Cursor {
+ public:
+  explicit Cursor(const std::string& s, std::size_t pos = 0) : s_(s), pos_(pos) {}
+  std::string line() {
+    const auto nl = s_.find('\n', pos_);
+    if (nl == std::string::npos) {
+      ADD_FAILURE() << "missing line at byte " << pos_;
+      pos_ = s_.size();
+      return "<missing>";
+    }
+    std::string l = s_.substr(pos_, nl - pos_);
+    pos_ = nl + 1;
+    return l;
+  }
+  std::size_t skip(std::size_t n) {
+    const std::size_t at = pos_;
+    pos_ += n;
+    return at;
+  }
+  [[nodiscard]] std::size_t pos() const { return pos_; }
+
+ private:
+  const std::string& s_;
+  std::size_t pos_;
+};
+
+// --- Surface formats --------------------------------------------------------------------
+
+TEST(Mesh, ObjHasVerticesUvNormalsAndQuadsWithPoleTriangles) {
+  TempDir dir;
+  const std::size_t nu = 5, nv = 6;
+  const SurfaceMesh m = cap(nu, nv);
+  write_surface_mesh(dir / "cap.obj", m);
+  std::vector<Vec3> v, vn;
+  std::vector<std::array<double, 2>> vt;
+  std::vector<std::vector<std::size_t>> faces;
+  for (const auto& l : lines(read_bytes(dir / "cap.obj"))) {
+    const auto t = tokens(l);
+    if (t.empty() || t[0] == "#") continue;
+    if (t[0] == "v") {
+      ASSERT_EQ(t.size(), 4u) << l;
+      v.push_back({number(t[1]), number(t[2]), number(t[3])});
+    } else if (t[0] == "vt") {
+      ASSERT_EQ(t.size(), 3u) << l;
+      vt.push_back({number(t[1]), number(t[2])});
+    } else if (t[0] == "vn") {
+      ASSERT_EQ(t.size(), 4u) << l;
+      vn.push_back({number(t[1]), number(t[2]), number(t[3])});
+    } else if (t[0] == "f") {
+      std::vector<std::size_t> f;
+      for (std::size_t k = 1; k < t.size(); ++k) {
+        const auto parts = tokens(t[k], '/');
+        ASSERT_EQ(parts.size(), 3u) << l;
+        EXPECT_EQ(parts[0], parts[1]);
+        EXPECT_EQ(parts[0], parts[2]);
+        f.push_back(static_cast<std::size_t>(std::stoul(parts[0])) - 1);
+      }
+      faces.push_back(f);
+    } else {
+      ADD_FAILURE() << "unexpected OBJ line: " << l;
+    }
+  }
+  ASSERT_EQ(v.size(), nu * nv);
+  ASSERT_EQ(vt.size(), nu * nv);
+  ASSERT_EQ(vn.size(), nu * nv);
+  for (std::size_t i = 0; i < nu; ++i)
+    for (std::size_t j = 0; j < nv; ++j) {
+      const std::size_t q = i * nv + j;
+      EXPECT_EQ(v[q], m.points(i, j)) << q;  // shortest round-trip text: exact
+      EXPECT_EQ(vn[q], m.normals(i, j)) << q;
+      EXPECT_EQ(vt[q][0], static_cast<double>(i) / (nu - 1));
+      EXPECT_EQ(vt[q][1], static_cast<double>(j) / (nv - 1));
+    }
+  EXPECT_EQ(faces, expected_faces(nu, nv, 1));
+}
+
+TEST(Mesh, ObjWithoutNormalsAndFullyDegenerateCellsDropped) {
+  TempDir dir;
+  SurfaceMesh m = cap(5, 4, 2);  // two pole rows: the cells between them have no area
+  m.normals = {};
+  write_surface_mesh(dir / "cap.obj", m);
+  std::vector<std::vector<std::size_t>> faces;
+  std::size_t vn = 0;
+  for (const auto& l : lines(read_bytes(dir / "cap.obj"))) {
+    const auto t = tokens(l);
+    if (!t.empty() && t[0] == "vn") ++vn;
+    if (t.empty() || t[0] != "f") continue;
+    std::vector<std::size_t> f;
+    for (std::size_t k = 1; k < t.size(); ++k) {
+      const auto parts = tokens(t[k], '/');
+      ASSERT_EQ(parts.size(), 2u) << l;
+      f.push_back(static_cast<std::size_t>(std::stoul(parts[0])) - 1);
+    }
+    faces.push_back(f);
+  }
+  EXPECT_EQ(vn, 0u);
+  EXPECT_EQ(faces, expected_faces(5, 4, 2));
+  EXPECT_EQ(faces.size(), 3u + 2u * 3u);
+}
+
+TEST(Mesh, StlIsBinaryWithOrientedUnitNormalsAndNoDegenerateTriangles) {
+  TempDir dir;
+  const std::size_t nu = 5, nv = 6;
+  const SurfaceMesh m = cap(nu, nv);
+  write_surface_mesh(dir / "cap.stl", m);
+  const std::string s = read_bytes(dir / "cap.stl");
+  ASSERT_GE(s.size(), 84u);
+  const std::string header = s.substr(0, 80);
+  EXPECT_NE(header.substr(0, 5), "solid");  // would read as ASCII STL
+  EXPECT_NE(header.find("interpatch"), std::string::npos);
+  const auto count = le<std::uint32_t>(s, 80);
+  // Each quad is two triangles, each pole cell one.
+  std::size_t expected = 0;
+  for (const auto& f : expected_faces(nu, nv, 1)) expected += f.size() - 2;
+  EXPECT_EQ(count, expected);
+  ASSERT_EQ(s.size(), 84u + 50u * count);
+
+  // Every triangle is a fan triangle of an expected face, in single precision.
+  auto f32 = [&](std::size_t q) {
+    const Vec3& p = m.points.data()[q];
+    return Vec3{static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)};
+  };
+  std::vector<std::array<Vec3, 3>> want;
+  for (const auto& f : expected_faces(nu, nv, 1))
+    for (std::size_t k = 1; k + 1 < f.size(); ++k) want.push_back({f32(f[0]), f32(f[k]), f32(f[k + 1])});
+  ASSERT_EQ(want.size(), count);
+  for (std::size_t t = 0; t < count; ++t) {
+    const std::size_t off = 84 + 50 * t;
+    const Vec3 n{le<float>(s, off), le<float>(s, off + 4), le<float>(s, off + 8)};
+    std::array<Vec3, 3> tri;
+    for (std::size_t c = 0; c < 3; ++c)
+      tri[c] = {le<float>(s, off + 12 + 12 * c), le<float>(s, off + 16 + 12 * c), le<float>(s, off + 20 + 12 * c)};
+    EXPECT_EQ(tri, want[t]) << t;
+    EXPECT_EQ(le<std::uint16_t>(s, off + 48), 0u);
+    EXPECT_NEAR(norm(n), 1.0, 1e-6);
+    const Vec3 geo = cross(tri[1] - tri[0], tri[2] - tri[0]);
+    EXPECT_GT(dot(geo / norm(geo), n), 0.9999) << t;
+    EXPECT_GT(n.z, 0.0) << t;  // S_u x S_v points up on this cap
+  }
+}
+
+TEST(Mesh, StlDropsZeroAreaTriangles) {
+  TempDir dir;
+  // A flat strip whose middle row is collinear with the first: the cells are
+  // non-degenerate quads, but a grid folded onto a line has no area at all.
+  SurfaceMesh m;
+  m.points = PointGrid({3, 2});
+  m.points(0, 0) = {0, 0, 0};
+  m.points(0, 1) = {1, 0, 0};
+  m.points(1, 0) = {2, 0, 0};
+  m.points(1, 1) = {3, 0, 0};
+  m.points(2, 0) = {0, 1, 0};
+  m.points(2, 1) = {1, 1, 0};
+  write_surface_mesh(dir / "line.stl", m);
+  const std::string s = read_bytes(dir / "line.stl");
+  // Cell 0 lies on the x axis: both triangles dropped. Cell 1 has area.
+  EXPECT_EQ(le<std::uint32_t>(s, 80), 2u);
+  EXPECT_EQ(s.size(), 84u + 100u);
+}
+
+TEST(Mesh, PlyBinaryLittleEndianWithNormalsAndFaces) {
+  TempDir dir;
+  const std::size_t nu = 5, nv = 6;
+  const SurfaceMesh m = cap(nu, nv);
+  write_surface_mesh(dir / "cap.ply", m);
+  const std::string s = read_bytes(dir / "cap.ply");
+  const auto end = s.find("end_header\n");
+  ASSERT_NE(end, std::string::npos);
+  std::vector<std::string> header;
+  for (const auto& l : lines(s.substr(0, end + 11)))
+    if (l.rfind("comment", 0) != 0) header.push_back(l);
+  const auto faces = expected_faces(nu, nv, 1);
+  const std::vector<std::string> want = {"ply",
+                                         "format binary_little_endian 1.0",
+                                         "element vertex 30",
+                                         "property double x",
+                                         "property double y",
+                                         "property double z",
+                                         "property double nx",
+                                         "property double ny",
+                                         "property double nz",
+                                         "element face " + std::to_string(faces.size()),
+                                         "property list uchar int vertex_indices",
+                                         "end_header"};
+  EXPECT_EQ(header, want);
+  std::size_t off = end + 11;
+  for (std::size_t q = 0; q < nu * nv; ++q, off += 48) {
+    EXPECT_EQ((Vec3{le<double>(s, off), le<double>(s, off + 8), le<double>(s, off + 16)}), m.points.data()[q]);
+    EXPECT_EQ((Vec3{le<double>(s, off + 24), le<double>(s, off + 32), le<double>(s, off + 40)}), m.normals.data()[q]);
+  }
+  for (const auto& f : faces) {
+    ASSERT_EQ(static_cast<std::size_t>(static_cast<unsigned char>(s[off])), f.size());
+    ++off;
+    for (std::size_t k = 0; k < f.size(); ++k, off += 4) EXPECT_EQ(le<std::int32_t>(s, off), static_cast<std::int32_t>(f[k]));
+  }
+  EXPECT_EQ(off, s.size());
+}
+
+TEST(Mesh, PlyWithoutNormals) {
+  TempDir dir;
+  SurfaceMesh m = cap(3, 3);
+  m.normals = {};
+  write_surface_mesh(dir / "n.ply", m);
+  const std::string s = read_bytes(dir / "n.ply");
+  EXPECT_EQ(s.find("property double nx"), std::string::npos);
+  const auto end = s.find("end_header\n") + 11;
+  // 9 vertices of 24 bytes, 2 triangles (1 + 3 indices) and 2 quads (1 + 4 indices).
+  EXPECT_EQ(s.size() - end, 9u * 24u + 2u * 13u + 2u * 17u);
+}
+
+/// Points (and optional 3-vector and scalar fields) of a legacy VTK structured grid.
+struct VtkGrid {
+  std::array<std::size_t, 3> dims{};
+  std::vector<Vec3> points, normals;
+  std::vector<double> scalars;
+};
+
+VtkGrid read_legacy_vtk(const std::string& s) {
+  VtkGrid g;
+  Cursor c(s);
+  EXPECT_EQ(c.line(), "# vtk DataFile Version 3.0");
+  EXPECT_NE(c.line().find("interpatch"), std::string::npos);
+  EXPECT_EQ(c.line(), "BINARY");
+  EXPECT_EQ(c.line(), "DATASET STRUCTURED_GRID");
+  const auto d = tokens(c.line());
+  EXPECT_EQ(d.size(), 4u);
+  EXPECT_EQ(d[0], "DIMENSIONS");
+  for (std::size_t a = 0; a < 3; ++a) g.dims[a] = std::stoul(d[a + 1]);
+  const std::size_t n = g.dims[0] * g.dims[1] * g.dims[2];
+  EXPECT_EQ(c.line(), "POINTS " + std::to_string(n) + " double");
+  auto vectors = [&](std::vector<Vec3>& out) {
+    const std::size_t at = c.skip(24 * n);
+    for (std::size_t q = 0; q < n; ++q)
+      out.push_back({be<double>(s, at + 24 * q), be<double>(s, at + 24 * q + 8), be<double>(s, at + 24 * q + 16)});
+    EXPECT_EQ(c.line(), "");  // newline after the binary block
+  };
+  vectors(g.points);
+  while (c.pos() < s.size()) {
+    const std::string l = c.line();
+    if (l.empty()) continue;
+    if (l.rfind("POINT_DATA", 0) == 0) {
+      EXPECT_EQ(l, "POINT_DATA " + std::to_string(n));
+    } else if (l == "NORMALS normals double") {
+      vectors(g.normals);
+    } else if (l == "SCALARS jacobian double 1") {
+      EXPECT_EQ(c.line(), "LOOKUP_TABLE default");
+      const std::size_t at = c.skip(8 * n);
+      for (std::size_t q = 0; q < n; ++q) g.scalars.push_back(be<double>(s, at + 8 * q));
+      EXPECT_EQ(c.line(), "");
+    } else {
+      ADD_FAILURE() << "unexpected VTK line: " << l;
+      break;
+    }
+  }
+  return g;
+}
+
+TEST(Mesh, LegacyVtkStructuredGridBigEndianUFastest) {
+  TempDir dir;
+  const std::size_t nu = 5, nv = 6;
+  const SurfaceMesh m = cap(nu, nv);
+  write_surface_mesh(dir / "cap.vtk", m);
+  const VtkGrid g = read_legacy_vtk(read_bytes(dir / "cap.vtk"));
+  EXPECT_EQ(g.dims, (std::array<std::size_t, 3>{nu, nv, 1}));
+  ASSERT_EQ(g.points.size(), nu * nv);
+  ASSERT_EQ(g.normals.size(), nu * nv);
+  for (std::size_t j = 0; j < nv; ++j)
+    for (std::size_t i = 0; i < nu; ++i) {
+      EXPECT_EQ(g.points[i + nu * j], m.points(i, j));
+      EXPECT_EQ(g.normals[i + nu * j], m.normals(i, j));
+    }
+  EXPECT_TRUE(g.scalars.empty());
+}
+
+/// Arrays of a VTK XML StructuredGrid written with raw appended data.
+struct VtsGrid {
+  std::array<std::size_t, 6> extent{};
+  std::map<std::string, std::vector<double>> arrays;  // by Name, components interleaved
+  std::map<std::string, int> components;
+};
+
+std::string attribute(const std::string& tag, const std::string& name) {
+  const auto at = tag.find(" " + name + "=\"");
+  if (at == std::string::npos) return {};
+  const auto start = at + name.size() + 3;
+  return tag.substr(start, tag.find('"', start) - start);
+}
+
+VtsGrid read_vts(const std::string& s) {
+  VtsGrid g;
+  EXPECT_EQ(s.rfind("<?xml version=\"1.0\"?>\n<VTKFile type=\"StructuredGrid\"", 0), 0u);
+  const std::string file_tag = s.substr(s.find("<VTKFile"), s.find('>', s.find("<VTKFile")) - s.find("<VTKFile"));
+  EXPECT_EQ(attribute(file_tag, "byte_order"), "LittleEndian");
+  EXPECT_EQ(attribute(file_tag, "header_type"), "UInt64");
+  const auto grid_at = s.find("<StructuredGrid ");
+  const std::string whole = attribute(s.substr(grid_at, s.find('>', grid_at) - grid_at), "WholeExtent");
+  const auto piece_at = s.find("<Piece ");
+  EXPECT_EQ(attribute(s.substr(piece_at, s.find('>', piece_at) - piece_at), "Extent"), whole);
+  const auto e = tokens(whole);
+  EXPECT_EQ(e.size(), 6u);
+  for (std::size_t k = 0; k < 6 && k < e.size(); ++k) g.extent[k] = std::stoul(e[k]);
+  const std::size_t n = (g.extent[1] - g.extent[0] + 1) * (g.extent[3] - g.extent[2] + 1) * (g.extent[5] - g.extent[4] + 1);
+  const auto app = s.find("<AppendedData encoding=\"raw\">");
+  EXPECT_NE(app, std::string::npos);
+  const std::size_t base = s.find('_', app) + 1;
+  for (std::size_t at = s.find("<DataArray"); at < app; at = s.find("<DataArray", at + 1)) {
+    const std::string tag = s.substr(at, s.find('>', at) - at);
+    EXPECT_EQ(attribute(tag, "type"), "Float64");
+    EXPECT_EQ(attribute(tag, "format"), "appended");
+    const std::string name = attribute(tag, "Name");
+    const int comps = attribute(tag, "NumberOfComponents").empty() ? 1 : std::stoi(attribute(tag, "NumberOfComponents"));
+    const std::size_t off = base + std::stoul(attribute(tag, "offset"));
+    const auto bytes = le<std::uint64_t>(s, off);
+    EXPECT_EQ(bytes, 8u * static_cast<std::size_t>(comps) * n) << name;
+    std::vector<double> values;
+    for (std::size_t k = 0; k < bytes / 8; ++k) values.push_back(le<double>(s, off + 8 + 8 * k));
+    g.arrays[name] = values;
+    g.components[name] = comps;
+  }
+  EXPECT_NE(s.find("</AppendedData>\n</VTKFile>", base), std::string::npos);
+  return g;
+}
+
+TEST(Mesh, VtsAppendedRawStructuredGrid) {
+  TempDir dir;
+  const std::size_t nu = 5, nv = 6;
+  const SurfaceMesh m = cap(nu, nv);
+  write_surface_mesh(dir / "cap.vts", m);
+  const std::string s = read_bytes(dir / "cap.vts");
+  EXPECT_NE(s.find("WholeExtent=\"0 4 0 5 0 0\""), std::string::npos);
+  const VtsGrid g = read_vts(s);
+  ASSERT_EQ(g.arrays.count("Points"), 1u);
+  ASSERT_EQ(g.arrays.count("Normals"), 1u);
+  EXPECT_EQ(g.components.at("Points"), 3);
+  const auto& p = g.arrays.at("Points");
+  const auto& n = g.arrays.at("Normals");
+  ASSERT_EQ(p.size(), 3 * nu * nv);
+  for (std::size_t j = 0; j < nv; ++j)
+    for (std::size_t i = 0; i < nu; ++i) {
+      const std::size_t q = 3 * (i + nu * j);
+      EXPECT_EQ((Vec3{p[q], p[q + 1], p[q + 2]}), m.points(i, j));
+      EXPECT_EQ((Vec3{n[q], n[q + 1], n[q + 2]}), m.normals(i, j));
+    }
+}
+
+/// The single grid of a Plot3D ASCII multi-grid file.
+struct Plot3d {
+  std::array<std::size_t, 3> dims{};
+  std::vector<Vec3> points;  // i fastest
+};
+
+Plot3d read_plot3d(const std::string& text) {
+  const auto t = tokens(text);
+  Plot3d g;
+  EXPECT_GE(t.size(), 4u);
+  EXPECT_EQ(t[0], "1");  // number of grids
+  for (std::size_t a = 0; a < 3; ++a) g.dims[a] = std::stoul(t[1 + a]);
+  const std::size_t n = g.dims[0] * g.dims[1] * g.dims[2];
+  EXPECT_EQ(t.size(), 4 + 3 * n);
+  if (t.size() != 4 + 3 * n) return g;
+  g.points.resize(n);
+  for (std::size_t c = 0; c < 3; ++c)
+    for (std::size_t q = 0; q < n; ++q) g.points[q][static_cast<int>(c)] = number(t[4 + c * n + q]);
+  const auto first = lines(text);
+  EXPECT_EQ(first[0], "1");
+  EXPECT_EQ(first[1], std::to_string(g.dims[0]) + " " + std::to_string(g.dims[1]) + " " + std::to_string(g.dims[2]));
+  return g;
+}
+
+TEST(Mesh, Plot3dAsciiWholeMultiGrid) {
+  TempDir dir;
+  const std::size_t nu = 5, nv = 6;
+  const SurfaceMesh m = cap(nu, nv);
+  write_surface_mesh(dir / "cap.xyz", m);
+  const Plot3d g = read_plot3d(read_bytes(dir / "cap.xyz"));
+  EXPECT_EQ(g.dims, (std::array<std::size_t, 3>{nu, nv, 1}));
+  for (std::size_t j = 0; j < nv; ++j)
+    for (std::size_t i = 0; i < nu; ++i) EXPECT_EQ(g.points[i + nu * j], m.points(i, j));  // 17 digits: exact
+  EXPECT_EQ(dir.count(), 1u);  // no function file without a field
+}
+
+TEST(Mesh, ExtensionIsCaseInsensitive) {
+  TempDir dir;
+  const SurfaceMesh m = cap(3, 4);
+  write_surface_mesh(dir / "CAP.OBJ", m);
+  write_surface_mesh(dir / "Cap.Vtk", m);
+  EXPECT_NE(read_bytes(dir / "CAP.OBJ").find("\nv "), std::string::npos);
+  EXPECT_EQ(read_legacy_vtk(read_bytes(dir / "Cap.Vtk")).points.size(), 12u);
+}
+
+TEST(Mesh, LargeGridStreamsInChunks) {
+  // Several megabytes per file: crosses the writers' flush threshold many times.
+  TempDir dir;
+  const std::size_t nu = 301, nv = 257;
+  const SurfaceMesh m = cap(nu, nv);
+  write_surface_mesh(dir / "big.vtk", m);
+  const VtkGrid g = read_legacy_vtk(read_bytes(dir / "big.vtk"));
+  ASSERT_EQ(g.points.size(), nu * nv);
+  for (std::size_t j = 0; j < nv; j += 13)
+    for (std::size_t i = 0; i < nu; i += 7) EXPECT_EQ(g.points[i + nu * j], m.points(i, j));
+  write_surface_mesh(dir / "big.stl", m);
+  const std::string s = read_bytes(dir / "big.stl");
+  EXPECT_EQ(le<std::uint32_t>(s, 80), (nv - 1) + 2 * (nu - 2) * (nv - 1));
+  EXPECT_EQ(s.size(), 84 + 50 * static_cast<std::size_t>(le<std::uint32_t>(s, 80)));
+  write_surface_mesh(dir / "big.obj", m);
+  const std::string obj = read_bytes(dir / "big.obj");
+  EXPECT_EQ(static_cast<std::size_t>(std::count(obj.begin(), obj.end(), '\n')),
+            1 + 3 * nu * nv + (nu - 1) * (nv - 1));
+}
+
+TEST(Mesh, SingleRowHasPointsButNoFaces) {
+  TempDir dir;
+  SurfaceMesh m = cap(2, 5);
+  m.points = PointGrid({1, 5}, Vec3{});
+  for (std::size_t j = 0; j < 5; ++j) m.points(0, j) = {static_cast<double>(j), 0, 0};
+  m.normals = {};
+  write_surface_mesh(dir / "row.stl", m);
+  EXPECT_EQ(le<std::uint32_t>(read_bytes(dir / "row.stl"), 80), 0u);
+  write_surface_mesh(dir / "row.vts", m);
+  EXPECT_EQ(read_vts(read_bytes(dir / "row.vts")).arrays.at("Points").size(), 15u);
+}
+
+// --- Volumes -------------------------------------------------------------------------
+
+TEST(Mesh, VolumeLegacyVtkWithJacobian) {
+  TempDir dir;
+  Grid<double, 3> jac;
+  const PointGrid3 g = box(3, 4, 5, &jac);
+  write_volume_mesh(dir / "box.vtk", g, jac);
+  const VtkGrid v = read_legacy_vtk(read_bytes(dir / "box.vtk"));
+  EXPECT_EQ(v.dims, (std::array<std::size_t, 3>{3, 4, 5}));
+  ASSERT_EQ(v.points.size(), 60u);
+  ASSERT_EQ(v.scalars.size(), 60u);
+  EXPECT_TRUE(v.normals.empty());
+  for (std::size_t k = 0; k < 5; ++k)
+    for (std::size_t j = 0; j < 4; ++j)
+      for (std::size_t i = 0; i < 3; ++i) {
+        EXPECT_EQ(v.points[i + 3 * (j + 4 * k)], g(i, j, k));
+        EXPECT_EQ(v.scalars[i + 3 * (j + 4 * k)], jac(i, j, k));
+      }
+  // Without the field, no POINT_DATA section.
+  write_volume_mesh(dir / "plain.vtk", g);
+  EXPECT_EQ(read_bytes(dir / "plain.vtk").find("POINT_DATA"), std::string::npos);
+}
+
+TEST(Mesh, VolumeVtsWithJacobian) {
+  TempDir dir;
+  Grid<double, 3> jac;
+  const PointGrid3 g = box(3, 4, 5, &jac);
+  write_volume_mesh(dir / "box.vts", g, jac);
+  const std::string s = read_bytes(dir / "box.vts");
+  EXPECT_NE(s.find("WholeExtent=\"0 2 0 3 0 4\""), std::string::npos);
+  EXPECT_NE(s.find("Scalars=\"jacobian\""), std::string::npos);
+  const VtsGrid v = read_vts(s);
+  ASSERT_EQ(v.arrays.count("jacobian"), 1u);
+  EXPECT_EQ(v.arrays.count("Normals"), 0u);
+  const auto& p = v.arrays.at("Points");
+  const auto& d = v.arrays.at("jacobian");
+  for (std::size_t k = 0; k < 5; ++k)
+    for (std::size_t j = 0; j < 4; ++j)
+      for (std::size_t i = 0; i < 3; ++i) {
+        const std::size_t q = i + 3 * (j + 4 * k);
+        EXPECT_EQ((Vec3{p[3 * q], p[3 * q + 1], p[3 * q + 2]}), g(i, j, k));
+        EXPECT_EQ(d[q], jac(i, j, k));
+      }
+}
+
+TEST(Mesh, VolumePlot3dWithFunctionFile) {
+  TempDir dir;
+  Grid<double, 3> jac;
+  const PointGrid3 g = box(3, 4, 5, &jac);
+  write_volume_mesh(dir / "box.xyz", g, jac);
+  const Plot3d v = read_plot3d(read_bytes(dir / "box.xyz"));
+  EXPECT_EQ(v.dims, (std::array<std::size_t, 3>{3, 4, 5}));
+  for (std::size_t k = 0; k < 5; ++k)
+    for (std::size_t j = 0; j < 4; ++j)
+      for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(v.points[i + 3 * (j + 4 * k)], g(i, j, k));
+  // The jacobian goes to the Plot3D function file beside the grid.
+  const auto f = tokens(read_bytes(dir / "box.f"));
+  ASSERT_EQ(f.size(), 5u + 60u);
+  EXPECT_EQ(f[0], "1");
+  EXPECT_EQ(f[1] + " " + f[2] + " " + f[3] + " " + f[4], "3 4 5 1");
+  for (std::size_t k = 0; k < 5; ++k)
+    for (std::size_t j = 0; j < 4; ++j)
+      for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(number(f[5 + i + 3 * (j + 4 * k)]), jac(i, j, k));
+}
+
+// --- Errors -------------------------------------------------------------------------
+
+TEST(Mesh, UnknownExtensionIsWrongType) {
+  TempDir dir;
+  const SurfaceMesh m = cap(3, 3);
+  EXPECT_ERRC(write_surface_mesh(dir / "m.foo", m), wrong_type,
+              "unknown surface mesh format '.foo' (supported: .obj, .stl, .ply, .vtk, .vts, .xyz)");
+  EXPECT_ERRC(write_surface_mesh(dir / "m", m), wrong_type, "no extension");
+  const PointGrid3 g = box(2, 2, 2, nullptr);
+  EXPECT_ERRC(write_volume_mesh(dir / "v.obj", g), wrong_type, "'.obj' holds surfaces, not volume grids");
+  EXPECT_ERRC(write_volume_mesh(dir / "v.npy", g), wrong_type, "'.npy' (supported: .vtk, .vts, .xyz)");
+  EXPECT_EQ(dir.count(), 0u);
+}
+
+TEST(Mesh, IsMeshFormat) {
+  for (const char* e : {".obj", ".stl", ".ply", ".vtk", ".vts", ".xyz", "obj", ".OBJ", "Vts"}) EXPECT_TRUE(is_mesh_format(e)) << e;
+  for (const char* e : {".npy", ".csv", ".json", "", ".", ".objx", ".step"}) EXPECT_FALSE(is_mesh_format(e)) << e;
+}
+
+TEST(Mesh, ShapeMismatchesAreRefused) {
+  TempDir dir;
+  SurfaceMesh m = cap(3, 4);
+  m.normals = PointGrid({4, 3});
+  EXPECT_ERRC(write_surface_mesh(dir / "m.obj", m), size_mismatch, "4 x 3 normals for 3 x 4 points");
+  EXPECT_ERRC(write_surface_mesh(dir / "e.obj", SurfaceMesh{}), size_mismatch, "no points");
+  Grid<double, 3> jac({2, 2, 3});
+  const PointGrid3 g = box(2, 2, 2, nullptr);
+  EXPECT_ERRC(write_volume_mesh(dir / "v.vtk", g, jac), size_mismatch, "jacobian of shape 2 x 2 x 3 for 2 x 2 x 2 points");
+  EXPECT_ERRC(write_volume_mesh(dir / "v.vtk", PointGrid3{}), size_mismatch, "no points");
+  EXPECT_EQ(dir.count(), 0u);
+}
+
+TEST(Mesh, UnwritablePath) {
+  TempDir dir;
+  const SurfaceMesh m = cap(3, 3);
+  EXPECT_ERRC(write_surface_mesh(dir / "missing" / "m.stl", m), file_unwritable, "does not exist");
+  Grid<double, 3> jac;
+  const PointGrid3 g = box(2, 2, 2, &jac);
+  EXPECT_ERRC(write_volume_mesh(dir / "missing" / "v.xyz", g, jac), file_unwritable, "does not exist");
+  EXPECT_FALSE(fs::exists(dir / "missing"));
+}
+
+}  // namespace
+}  // namespace interpatch::io

@@ -1,0 +1,437 @@
+#include "interpatch/io/npy.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <bit>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "test_util.hpp"
+
+namespace interpatch::io {
+namespace {
+namespace fs = std::filesystem;
+
+/// A fresh directory under the system temp directory, removed with its contents.
+class TempDir {
+ public:
+  TempDir() {
+    static std::atomic<int> counter{0};
+    path_ = fs::temp_directory_path() /
+            ("interpatch-npy-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    fs::create_directories(path_);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  [[nodiscard]] fs::path operator/(const std::string& name) const { return path_ / name; }
+  [[nodiscard]] const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+std::string read_bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void write_bytes(const fs::path& p, const std::string& bytes) {
+  std::ofstream out(p, std::ios::binary);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+/// An NPY file as NumPy lays it out: magic, version, header length, the dict padded
+/// with spaces and ended by '\n' to a multiple of 64 bytes, then the data.
+std::string make_npy(const std::string& dict, const std::string& data, int major = 1, int minor = 0) {
+  const std::size_t prefix = major == 1 ? 10 : 12;
+  std::string header = dict;
+  const std::size_t total = (prefix + header.size() + 1 + 63) / 64 * 64;
+  header.append(total - prefix - header.size() - 1, ' ');
+  header += '\n';
+  std::string out = "\x93NUMPY";
+  out += static_cast<char>(major);
+  out += static_cast<char>(minor);
+  std::size_t len = header.size();
+  for (std::size_t i = 0; i < (major == 1 ? 2u : 4u); ++i, len >>= 8) out += static_cast<char>(len & 0xff);
+  return out + header + data;
+}
+
+template <class T>
+std::string le_bytes(const std::vector<T>& v) {
+  std::string s;
+  for (T x : v) {
+    char b[sizeof(T)];
+    std::memcpy(b, &x, sizeof(T));
+    if constexpr (std::endian::native == std::endian::big) std::reverse(b, b + sizeof(T));
+    s.append(b, sizeof(T));
+  }
+  return s;
+}
+
+template <class T>
+std::string be_bytes(const std::vector<T>& v) {
+  std::string s = le_bytes(v);
+  for (std::size_t i = 0; i < s.size(); i += sizeof(T)) std::reverse(s.begin() + static_cast<std::ptrdiff_t>(i), s.begin() + static_cast<std::ptrdiff_t>(i + sizeof(T)));
+  return s;
+}
+
+std::vector<double> iota_values(std::size_t n, double scale = 0.25) {
+  std::vector<double> v(n);
+  for (std::size_t i = 0; i < n; ++i) v[i] = scale * static_cast<double>(i) - 3.0;
+  return v;
+}
+
+// --- Round trips -------------------------------------------------------------
+
+TEST(Npy, RoundTripIsBitExact) {
+  TempDir dir;
+  auto g = test::rng(11);
+  std::vector<double> data(4 * 5 * 3);
+  for (double& v : data) v = test::uniform(g, -1e6, 1e6);
+  // Values that text formats mangle: signed zero, subnormal, extremes.
+  data[0] = -0.0;
+  data[1] = std::numeric_limits<double>::denorm_min();
+  data[2] = std::numeric_limits<double>::max();
+  data[3] = std::numeric_limits<double>::lowest();
+  data[4] = 0.1;
+  const std::vector<std::size_t> shape = {4, 5, 3};
+  write_npy(dir / "a.npy", shape, data);
+  const NpyArray a = read_npy(dir / "a.npy");
+  EXPECT_EQ(a.shape, shape);
+  ASSERT_EQ(a.data.size(), data.size());
+  EXPECT_EQ(std::memcmp(a.data.data(), data.data(), data.size() * sizeof(double)), 0);
+}
+
+TEST(Npy, WrittenHeaderIsVersion1LittleEndianPaddedTo64) {
+  TempDir dir;
+  const std::vector<std::size_t> shape = {2, 3};
+  const auto data = iota_values(6);
+  write_npy(dir / "h.npy", shape, data);
+  const std::string bytes = read_bytes(dir / "h.npy");
+  ASSERT_GE(bytes.size(), 10u);
+  EXPECT_EQ(bytes.substr(0, 6), "\x93NUMPY");
+  EXPECT_EQ(bytes[6], 1);
+  EXPECT_EQ(bytes[7], 0);
+  const std::size_t hlen = static_cast<unsigned char>(bytes[8]) | (static_cast<std::size_t>(static_cast<unsigned char>(bytes[9])) << 8);
+  EXPECT_EQ((10 + hlen) % 64, 0u);
+  const std::string header = bytes.substr(10, hlen);
+  EXPECT_EQ(header.back(), '\n');
+  EXPECT_NE(header.find("'descr': '<f8'"), std::string::npos) << header;
+  EXPECT_NE(header.find("'fortran_order': False"), std::string::npos) << header;
+  EXPECT_NE(header.find("'shape': (2, 3)"), std::string::npos) << header;
+  EXPECT_EQ(bytes.size(), 10 + hlen + 6 * 8);
+  EXPECT_EQ(bytes.substr(10 + hlen), le_bytes(data));
+}
+
+TEST(Npy, RoundTripScalarOneDimensionalAndEmpty) {
+  TempDir dir;
+  {
+    const std::vector<std::size_t> shape = {};
+    const std::vector<double> data = {42.5};
+    write_npy(dir / "s.npy", shape, data);
+    const auto a = read_npy(dir / "s.npy");
+    EXPECT_TRUE(a.shape.empty());
+    EXPECT_EQ(a.data, data);
+    EXPECT_NE(read_bytes(dir / "s.npy").find("'shape': ()"), std::string::npos);
+  }
+  {
+    const std::vector<std::size_t> shape = {7};
+    const auto data = iota_values(7);
+    write_npy(dir / "v.npy", shape, data);
+    const auto a = read_npy(dir / "v.npy");
+    EXPECT_EQ(a.shape, shape);
+    EXPECT_EQ(a.data, data);
+    EXPECT_NE(read_bytes(dir / "v.npy").find("'shape': (7,)"), std::string::npos);
+  }
+  {
+    const std::vector<std::size_t> shape = {0, 3};
+    write_npy(dir / "e.npy", shape, std::span<const double>());
+    const auto a = read_npy(dir / "e.npy");
+    EXPECT_EQ(a.shape, shape);
+    EXPECT_TRUE(a.data.empty());
+  }
+}
+
+TEST(Npy, RoundTripLargeArray) {
+  // Larger than the writer's chunk and the reader's buffers.
+  TempDir dir;
+  const std::vector<std::size_t> shape = {300, 400, 3};
+  auto g = test::rng(12);
+  std::vector<double> data(300 * 400 * 3);
+  for (double& v : data) v = test::uniform(g);
+  write_npy(dir / "big.npy", shape, data);
+  const auto a = read_npy(dir / "big.npy");
+  EXPECT_EQ(a.shape, shape);
+  EXPECT_TRUE(a.data == data);
+}
+
+// --- Hand-made files in the variants NumPy produces ------------------------------
+
+TEST(Npy, ReadsFloat32Widened) {
+  TempDir dir;
+  const std::vector<float> f = {1.5f, -2.25f, 0.1f, 3e38f, -0.0f, 7.0f};
+  write_bytes(dir / "f4.npy", make_npy("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }", le_bytes(f)));
+  const auto a = read_npy(dir / "f4.npy");
+  EXPECT_EQ(a.shape, (std::vector<std::size_t>{2, 3}));
+  ASSERT_EQ(a.data.size(), 6u);
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(a.data[i], static_cast<double>(f[i])) << i;
+  EXPECT_TRUE(std::signbit(a.data[4]));
+}
+
+TEST(Npy, ReadsBigEndianFloat64AndFloat32) {
+  TempDir dir;
+  const auto d = iota_values(12, 0.3);
+  write_bytes(dir / "be8.npy", make_npy("{'descr': '>f8', 'fortran_order': False, 'shape': (4, 3), }", be_bytes(d)));
+  const auto a = read_npy(dir / "be8.npy");
+  EXPECT_EQ(a.shape, (std::vector<std::size_t>{4, 3}));
+  EXPECT_EQ(a.data, d);
+
+  const std::vector<float> f = {1.0f, 2.5f, -3.75f};
+  write_bytes(dir / "be4.npy", make_npy("{'descr': '>f4', 'fortran_order': False, 'shape': (3,), }", be_bytes(f)));
+  const auto b = read_npy(dir / "be4.npy");
+  EXPECT_EQ(b.data, (std::vector<double>{1.0, 2.5, -3.75}));
+}
+
+TEST(Npy, ReadsNativeByteOrder) {
+  TempDir dir;
+  const auto d = iota_values(3);
+  std::string raw(reinterpret_cast<const char*>(d.data()), d.size() * sizeof(double));
+  write_bytes(dir / "n.npy", make_npy("{'descr': '=f8', 'fortran_order': False, 'shape': (3,), }", raw));
+  EXPECT_EQ(read_npy(dir / "n.npy").data, d);
+}
+
+TEST(Npy, FortranOrderIsTransposedToCOrder) {
+  TempDir dir;
+  // a[i][j] = 10 i + j for shape (2, 3); Fortran order stores i fastest.
+  const std::vector<double> fortran = {0, 10, 1, 11, 2, 12};
+  write_bytes(dir / "f.npy", make_npy("{'descr': '<f8', 'fortran_order': True, 'shape': (2, 3), }", le_bytes(fortran)));
+  const auto a = read_npy(dir / "f.npy");
+  EXPECT_EQ(a.shape, (std::vector<std::size_t>{2, 3}));
+  EXPECT_EQ(a.data, (std::vector<double>{0, 1, 2, 10, 11, 12}));
+}
+
+TEST(Npy, FortranOrderRank3Float32BigEndian) {
+  TempDir dir;
+  const std::size_t n0 = 3, n1 = 4, n2 = 5;
+  std::vector<float> fortran;  // value 100 i + 10 j + k, stored with i fastest
+  for (std::size_t k = 0; k < n2; ++k)
+    for (std::size_t j = 0; j < n1; ++j)
+      for (std::size_t i = 0; i < n0; ++i) fortran.push_back(static_cast<float>(100 * i + 10 * j + k));
+  write_bytes(dir / "f3.npy",
+              make_npy("{'shape': (3, 4, 5), 'fortran_order': True, 'descr': '>f4'}", be_bytes(fortran)));
+  const auto a = read_npy(dir / "f3.npy");
+  ASSERT_EQ(a.shape, (std::vector<std::size_t>{3, 4, 5}));
+  for (std::size_t i = 0; i < n0; ++i)
+    for (std::size_t j = 0; j < n1; ++j)
+      for (std::size_t k = 0; k < n2; ++k)
+        EXPECT_EQ(a.data[(i * n1 + j) * n2 + k], static_cast<double>(100 * i + 10 * j + k));
+}
+
+TEST(Npy, FortranOrderOneDimensionalIsPlain) {
+  TempDir dir;
+  const auto d = iota_values(5);
+  write_bytes(dir / "f1.npy", make_npy("{'descr': '<f8', 'fortran_order': True, 'shape': (5,), }", le_bytes(d)));
+  EXPECT_EQ(read_npy(dir / "f1.npy").data, d);
+}
+
+TEST(Npy, ReadsVersion2And3Headers) {
+  TempDir dir;
+  const auto d = iota_values(6);
+  for (int major : {2, 3}) {
+    const fs::path p = dir / ("v" + std::to_string(major) + ".npy");
+    write_bytes(p, make_npy("{'descr': '<f8', 'fortran_order': False, 'shape': (3, 2), }", le_bytes(d), major));
+    const auto a = read_npy(p);
+    EXPECT_EQ(a.shape, (std::vector<std::size_t>{3, 2})) << major;
+    EXPECT_EQ(a.data, d) << major;
+  }
+}
+
+TEST(Npy, HeaderSpellingVariants) {
+  TempDir dir;
+  const auto d = iota_values(6);
+  const char* dicts[] = {
+      "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), }",  // NumPy's own
+      "{'descr':'<f8','fortran_order':False,'shape':(2,3)}",          // no spaces, no trailing comma
+      "{ 'shape' : ( 2 , 3 , ) , 'descr' : '<f8' , 'fortran_order' : False , }",  // spaces, trailing commas
+      "{\"descr\": \"<f8\", \"fortran_order\": False, \"shape\": (2, 3)}",        // double quotes
+      "{'descr': '<f8', 'fortran_order': False, 'shape': (2L, 3L), }",            // Python 2 longs
+  };
+  int n = 0;
+  for (const char* dict : dicts) {
+    const fs::path p = dir / ("h" + std::to_string(n++) + ".npy");
+    write_bytes(p, make_npy(dict, le_bytes(d)));
+    const auto a = read_npy(p);
+    EXPECT_EQ(a.shape, (std::vector<std::size_t>{2, 3})) << dict;
+    EXPECT_EQ(a.data, d) << dict;
+  }
+  // A trailing comma in a one-element shape.
+  write_bytes(dir / "t.npy", make_npy("{'descr': '<f8', 'fortran_order': False, 'shape': (6,), }", le_bytes(d)));
+  EXPECT_EQ(read_npy(dir / "t.npy").shape, (std::vector<std::size_t>{6}));
+  // Old NumPy padded to 16 bytes, not 64: the reader does not insist on either.
+  std::string odd = "\x93NUMPY";
+  odd += '\x01';
+  odd += '\x00';
+  const std::string h = "{'descr': '<f8', 'fortran_order': False, 'shape': (6,)}\n";
+  odd += static_cast<char>(h.size());
+  odd += '\0';
+  write_bytes(dir / "odd.npy", odd + h + le_bytes(d));
+  EXPECT_EQ(read_npy(dir / "odd.npy").data, d);
+}
+
+// --- Errors ---------------------------------------------------------------------
+
+TEST(Npy, BadMagicIsMalformed) {
+  TempDir dir;
+  write_bytes(dir / "bad.npy", "PK\x03\x04 this is a zip file, not an npy file");
+  EXPECT_ERRC((void)read_npy(dir / "bad.npy"), malformed_file, "bad.npy: not an NPY file (bad magic");
+  write_bytes(dir / "short.npy", "\x93NUM");
+  EXPECT_ERRC((void)read_npy(dir / "short.npy"), malformed_file, "short.npy: not an NPY file (4 bytes");
+}
+
+TEST(Npy, UnsupportedVersionIsMalformed) {
+  TempDir dir;
+  write_bytes(dir / "v4.npy", make_npy("{'descr': '<f8', 'fortran_order': False, 'shape': (1,), }", le_bytes(iota_values(1)), 4));
+  EXPECT_ERRC((void)read_npy(dir / "v4.npy"), malformed_file, "NPY format version 4.0 is not supported");
+}
+
+TEST(Npy, BadHeaderIsMalformed) {
+  TempDir dir;
+  const std::string d = le_bytes(iota_values(2));
+  struct Case {
+    const char* dict;
+    const char* fragment;
+  };
+  const Case cases[] = {
+      {"{'descr': '<f8', 'shape': (2,), }", "key 'fortran_order' is missing"},
+      {"{'fortran_order': False, 'shape': (2,), }", "key 'descr' is missing"},
+      {"{'descr': '<f8', 'fortran_order': False, }", "key 'shape' is missing"},
+      {"{'descr': '<f8', 'fortran_order': false, 'shape': (2,), }", "expected True or False"},
+      {"{'descr': '<f8', 'fortran_order': False, 'shape': (2,), 'extra': 1}", "unexpected key 'extra'"},
+      {"{'descr': '<f8', 'descr': '<f8', 'fortran_order': False, 'shape': (2,)}", "key 'descr' appears twice"},
+      {"{'descr': '<f8', 'fortran_order': False, 'shape': (-2,), }", "expected a non-negative integer"},
+      {"{'descr': '<f8', 'fortran_order': False, 'shape': [2], }", "expected '('"},
+      {"{'descr': '<f8 , 'fortran_order': False, 'shape': (2,)", "malformed NPY header"},
+      {"'descr': '<f8', 'fortran_order': False, 'shape': (2,)", "expected '{'"},
+      {"{'descr': '<f8' 'fortran_order': False, 'shape': (2,)}", "expected ',' or '}'"},
+      {"{'descr': '<f8', 'fortran_order': False, 'shape': (2,)} junk", "unexpected text after the closing '}'"},
+  };
+  int n = 0;
+  for (const Case& c : cases) {
+    const std::string name = "h" + std::to_string(n++) + ".npy";
+    write_bytes(dir / name, make_npy(c.dict, d));
+    EXPECT_ERRC((void)read_npy(dir / name), malformed_file, c.fragment);
+    EXPECT_ERRC((void)read_npy(dir / name), malformed_file, name + ": malformed NPY header");
+  }
+}
+
+TEST(Npy, HeaderLongerThanFileIsMalformed) {
+  TempDir dir;
+  std::string bytes = make_npy("{'descr': '<f8', 'fortran_order': False, 'shape': (1,), }", "");
+  bytes.resize(40);
+  write_bytes(dir / "cut.npy", bytes);
+  EXPECT_ERRC((void)read_npy(dir / "cut.npy"), malformed_file, "cut.npy: truncated NPY header: declares 118 bytes");
+}
+
+TEST(Npy, UnsupportedDtypeIsMalformed) {
+  TempDir dir;
+  const std::string d = le_bytes(std::vector<std::int32_t>{1, 2, 3, 4});
+  for (const char* dtype : {"<i4", "|f8", "<c16", "<f2", "|u1", "O", "<U3"}) {
+    write_bytes(dir / "i.npy",
+                make_npy(std::string("{'descr': '") + dtype + "', 'fortran_order': False, 'shape': (4,), }", d));
+    EXPECT_ERRC((void)read_npy(dir / "i.npy"), malformed_file,
+                std::string("i.npy: dtype '") + dtype + "' is not supported; use float64 or float32");
+  }
+  write_bytes(dir / "s.npy", make_npy("{'descr': [('x', '<f8'), ('y', '<f8')], 'fortran_order': False, 'shape': (1,), }",
+                                      le_bytes(iota_values(2))));
+  EXPECT_ERRC((void)read_npy(dir / "s.npy"), malformed_file, "structured dtype is not supported");
+}
+
+TEST(Npy, TruncatedDataNamesShapeAndSizes) {
+  TempDir dir;
+  write_bytes(dir / "file.npy", make_npy("{'descr': '<f8', 'fortran_order': False, 'shape': (4, 5, 3), }",
+                                         std::string(100, '\0')));
+  EXPECT_ERRC((void)read_npy(dir / "file.npy"), malformed_file,
+              "file.npy: truncated: shape (4, 5, 3) needs 480 bytes of data, found 100");
+  write_bytes(dir / "f4.npy", make_npy("{'descr': '<f4', 'fortran_order': False, 'shape': (10,), }",
+                                       std::string(39, '\0')));
+  EXPECT_ERRC((void)read_npy(dir / "f4.npy"), malformed_file, "shape (10,) needs 40 bytes of data, found 39");
+}
+
+TEST(Npy, ExtraDataIsMalformed) {
+  TempDir dir;
+  write_bytes(dir / "x.npy", make_npy("{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), }",
+                                      le_bytes(iota_values(7))));
+  EXPECT_ERRC((void)read_npy(dir / "x.npy"), malformed_file,
+              "x.npy: 8 bytes of extra data: shape (2, 3) needs 48 bytes of data, found 56");
+}
+
+TEST(Npy, UnreadableFile) {
+  TempDir dir;
+  EXPECT_ERRC((void)read_npy(dir / "missing.npy"), file_unreadable, "missing.npy': No such file or directory");
+  EXPECT_ERRC((void)read_npy(dir.path()), file_unreadable, "it is a directory");
+  if (::geteuid() != 0) {  // root reads anything
+    write_bytes(dir / "locked.npy", make_npy("{'descr': '<f8', 'fortran_order': False, 'shape': (1,), }",
+                                             le_bytes(iota_values(1))));
+    fs::permissions(dir / "locked.npy", fs::perms::none);
+    EXPECT_ERRC((void)read_npy(dir / "locked.npy"), file_unreadable, "Permission denied");
+  }
+}
+
+TEST(Npy, DeclaredShapeTooLargeIsRefusedBeforeAllocating) {
+  TempDir dir;
+  // 2.4 TB of doubles declared in a file of a few bytes: too_large, not a bad_alloc
+  // and not "truncated".
+  write_bytes(dir / "huge.npy", make_npy("{'descr': '<f8', 'fortran_order': False, 'shape': (100000000000, 3), }",
+                                         le_bytes(iota_values(3))));
+  EXPECT_ERRC((void)read_npy(dir / "huge.npy"), too_large, "huge.npy: array of shape (100000000000, 3) needs 2.4 TB");
+  // Element count overflows size_t.
+  write_bytes(dir / "over.npy", make_npy("{'descr': '<f8', 'fortran_order': False, 'shape': (4294967296, 4294967296, 3), }",
+                                         le_bytes(iota_values(3))));
+  EXPECT_ERRC((void)read_npy(dir / "over.npy"), too_large, "shape (4294967296, 4294967296, 3)");
+  // A dimension beyond 64 bits.
+  write_bytes(dir / "dim.npy", make_npy("{'descr': '<f8', 'fortran_order': False, 'shape': (123456789012345678901234,), }",
+                                        le_bytes(iota_values(3))));
+  EXPECT_ERRC((void)read_npy(dir / "dim.npy"), too_large, "dimension 123456789012345678901234");
+}
+
+TEST(Npy, WriteSizeMismatch) {
+  TempDir dir;
+  const std::vector<std::size_t> shape = {2, 3};
+  const auto d = iota_values(5);
+  EXPECT_ERRC(write_npy(dir / "m.npy", shape, d), size_mismatch, "shape (2, 3) has 6 elements, data has 5");
+  EXPECT_FALSE(fs::exists(dir / "m.npy"));
+}
+
+TEST(Npy, WriteToMissingDirectoryIsUnwritable) {
+  TempDir dir;
+  const std::vector<std::size_t> shape = {1};
+  const std::vector<double> d = {1.0};
+  EXPECT_ERRC(write_npy(dir / "nope" / "a.npy", shape, d), file_unwritable, "does not exist");
+  EXPECT_FALSE(fs::exists(dir / "nope"));
+}
+
+TEST(Npy, FailedWriteKeepsTheOldFile) {
+  TempDir dir;
+  const std::vector<std::size_t> shape = {3};
+  const std::vector<double> good = {1, 2, 3};
+  write_npy(dir / "keep.npy", shape, good);
+  const std::vector<double> bad = {1, 2};
+  EXPECT_ERRC(write_npy(dir / "keep.npy", shape, bad), size_mismatch, "keep.npy");
+  EXPECT_EQ(read_npy(dir / "keep.npy").data, good);
+}
+
+}  // namespace
+}  // namespace interpatch::io
