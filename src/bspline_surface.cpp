@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 
+#include "detail/parallel.hpp"
 #include "detail/text.hpp"
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/memory.hpp"
@@ -181,9 +182,11 @@ PointGrid BSplineSurface::evaluate(std::span<const double> us, std::span<const d
   const bool rat = rational();
   // Rows in chunks so progress comes from the calling thread between them.
   constexpr std::size_t chunk = 64;
+  // Starting the second thread costs milliseconds here: small grids stay on one.
+  const bool threads = us.size() * (nv + ncv) >= detail::parallel_min_work;
   for (std::size_t r0 = 0; r0 < us.size(); r0 += chunk) {
     const auto r1 = static_cast<long long>(std::min(us.size(), r0 + chunk));
-#pragma omp parallel
+#pragma omp parallel if (threads)
     {
       // One contracted row of homogeneous points per thread, reused for every u.
       std::vector<std::array<double, 4>> row(ncv);
@@ -235,7 +238,7 @@ Grid<SurfaceDerivatives, 2> BSplineSurface::evaluate_derivatives(std::span<const
   Grid<SurfaceDerivatives, 2> out({us.size(), nv});
   const bool rat = rational();
   const auto nu = static_cast<long long>(us.size());
-#pragma omp parallel
+#pragma omp parallel if (us.size() * (nv + ncv) >= detail::parallel_min_work)
   {
     // rows[k][l]: the net contracted with the k-th u-derivative of the basis.
     std::vector<std::array<double, 4>> rows[3];

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "detail/parallel.hpp"
 #include "detail/text.hpp"
 #include "interpatch/memory.hpp"
 
@@ -27,7 +28,7 @@ PointGrid Surface::evaluate(std::span<const double> us, std::span<const double> 
   const auto nu = static_cast<long long>(us.size());
   for (long long r0 = 0; r0 < nu; r0 += 64) {
     const long long r1 = std::min(nu, r0 + 64);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (us.size() * vs.size() >= detail::parallel_min_work / 16)
     for (long long i = r0; i < r1; ++i)
       for (std::size_t j = 0; j < vs.size(); ++j)
         out(static_cast<std::size_t>(i), j) = point(us[static_cast<std::size_t>(i)], vs[j]);
@@ -43,7 +44,7 @@ Grid<SurfaceDerivatives, 2> Surface::evaluate_derivatives(std::span<const double
   require_memory(us.size() * vs.size(), sizeof(SurfaceDerivatives), "surface derivative grid");
   Grid<SurfaceDerivatives, 2> out({us.size(), vs.size()});
   const auto nu = static_cast<long long>(us.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (us.size() * vs.size() >= detail::parallel_min_work / 16)
   for (long long i = 0; i < nu; ++i)
     for (std::size_t j = 0; j < vs.size(); ++j)
       out(static_cast<std::size_t>(i), j) = derivatives(us[static_cast<std::size_t>(i)], vs[j]);

@@ -1,5 +1,7 @@
 #include "detail/banded.hpp"
 
+#include "detail/parallel.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <utility>
@@ -79,7 +81,7 @@ void solve_along_axis(const BandedLU& lu, double* data, const std::size_t* shape
   constexpr std::size_t slice = 512;
   const std::size_t slices = (inner + slice - 1) / slice;
   const auto tasks = static_cast<long long>(outer * slices);
-#pragma omp parallel for schedule(static) if (tasks > 1 && block * outer > 4096)
+#pragma omp parallel for schedule(static) if (tasks > 1 && block * outer >= parallel_min_work)
   for (long long t = 0; t < tasks; ++t) {
     const std::size_t o = static_cast<std::size_t>(t) / slices;
     const std::size_t s = static_cast<std::size_t>(t) % slices;
