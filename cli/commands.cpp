@@ -1,1 +1,228 @@
-// (being written)
+#include "commands.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cstdio>
+#include <iostream>
+#include <limits>
+#include <span>
+#include <string>
+#include <system_error>
+#include <variant>
+#include <vector>
+
+#include "interpatch/error.hpp"
+#include "interpatch/evaluate.hpp"
+#include "interpatch/io/atomic_file.hpp"
+#include "interpatch/io/csv.hpp"
+#include "interpatch/io/json_out.hpp"
+#include "interpatch/io/mesh.hpp"
+#include "interpatch/io/npy.hpp"
+#include "interpatch/memory.hpp"
+#include "progress.hpp"
+
+namespace interpatch::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string lower_extension(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+// A count on the command line: digits only. nullopt for anything else; the
+// largest size_t for a count too large to represent.
+std::optional<std::size_t> parse_count(std::string_view s) {
+  if (s.empty() || !std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c) != 0; }))
+    return std::nullopt;
+  std::size_t v = 0;
+  const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (r.ec == std::errc::result_out_of_range) return std::numeric_limits<std::size_t>::max();
+  if (r.ec != std::errc() || r.ptr != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
+// Only surfaces exist so far; a volume alternative will get its own branch.
+const BSplineSurface& surface_of(const io::Construction& c) { return std::get<BSplineSurface>(c.exact); }
+
+std::string what_size(std::size_t a, std::size_t b) { return std::to_string(a) + "x" + std::to_string(b); }
+
+}  // namespace
+
+Resolution parse_resolution(std::string_view text) {
+  const auto x = text.find_first_of("xX");
+  const auto bad = [&](std::string_view why) {
+    return usage_error("--res '" + std::string(text) + "': " + std::string(why));
+  };
+  if (x == std::string_view::npos) throw bad("expected NUxNV, e.g. 64x64 (vertices along u and v)");
+  if (text.find_first_of("xX", x + 1) != std::string_view::npos)
+    throw bad("a surface mesh takes two counts, NUxNV (NUxNVxNW is for volumes)");
+  const auto nu = parse_count(text.substr(0, x)), nv = parse_count(text.substr(x + 1));
+  if (!nu || !nv) throw bad("expected NUxNV with whole numbers, e.g. 64x64");
+  if (*nu < 2 || *nv < 2) throw bad("a mesh needs at least 2 vertices along each direction");
+  return {*nu, *nv};
+}
+
+std::size_t parse_grid(std::string_view text) {
+  const auto k = parse_count(text);
+  if (!k) throw usage_error("--grid '" + std::string(text) + "': expected a whole number K >= 2 (a KxK grid)");
+  if (*k < 2) throw usage_error("--grid " + std::string(text) + ": a grid needs at least 2 points along each direction");
+  return *k;
+}
+
+void check_build_output(const fs::path& out) {
+  const std::string ext = lower_extension(out);
+  if (ext == ".json") return;
+  if (ext == ".step" || ext == ".stp" || ext == ".igs" || ext == ".iges")
+    throw usage_error("output format " + ext + " is not available in this build; use .json");
+  throw usage_error("cannot tell the output format of '" + out.string() + "': build writes .json");
+}
+
+void check_mesh_output(const fs::path& out) {
+  if (io::is_mesh_format(out.extension().string())) return;
+  throw usage_error("cannot tell the mesh format of '" + out.string() + "': use .obj, .stl, .ply, .vtk, .vts or .xyz");
+}
+
+void check_eval_output(const fs::path& out) {
+  const std::string ext = lower_extension(out);
+  if (ext == ".npy" || ext == ".csv") return;
+  throw usage_error("cannot tell the output format of '" + out.string() + "': eval writes .npy or .csv");
+}
+
+void check_info_output(const fs::path& out) {
+  if (lower_extension(out) == ".json") return;
+  throw usage_error("cannot tell the output format of '" + out.string() + "': info writes .json");
+}
+
+void require_eval_memory(std::size_t k, const fs::path& out) {
+  const std::string what = "evaluation grid " + (k == std::numeric_limits<std::size_t>::max() ? std::string("beyond 2^64") : what_size(k, k));
+  if (k >= (std::size_t{1} << 32)) throw error(errc::too_large, what + ": more points than can be addressed");
+  // The points, plus a float64 copy for .npy or the text of a row for .csv.
+  const std::size_t per_point = lower_extension(out) == ".npy" ? 2 * sizeof(Vec3) : sizeof(Vec3) + 8;
+  require_memory(k * k, per_point, what);
+}
+
+void require_mesh_memory(const Resolution& res) {
+  const std::string what = "mesh of " + what_size(res.nu, res.nv) + " vertices";
+  if (res.nu >= (std::size_t{1} << 32) || res.nv >= (std::size_t{1} << 32))
+    throw error(errc::too_large, what + ": more vertices than can be addressed");
+  // Points and normals, plus room for the writers' faces (two triangles per vertex in STL).
+  require_memory(res.nu * res.nv, 2 * sizeof(Vec3) + 2 * 50, what);
+}
+
+void write_build(const io::Construction& c, const fs::path& out) { io::write_exact_json(out, c.exact); }
+
+void write_mesh(const io::Construction& c, const fs::path& out, const Resolution& res) {
+  const BSplineSurface& s = surface_of(c);
+  const auto [u0, u1] = s.domain_u();
+  const auto [v0, v1] = s.domain_v();
+  const std::vector<double> us = linspace(u0, u1, res.nu), vs = linspace(v0, v1, res.nv);
+  io::SurfaceMesh mesh{PointGrid({res.nu, res.nv}), PointGrid({res.nu, res.nv})};
+  ProgressLine progress("meshing");
+  // Derivatives a block of rows at a time: the full grid of them would be six
+  // times the size of the mesh.
+  const std::size_t block = std::max<std::size_t>(1, (std::size_t{1} << 15) / res.nv);
+  for (std::size_t i0 = 0; i0 < res.nu; i0 += block) {
+    const std::size_t nb = std::min(block, res.nu - i0);
+    const auto d = s.evaluate_derivatives(std::span<const double>(us).subspan(i0, nb), vs);
+    for (std::size_t i = 0; i < nb; ++i)
+      for (std::size_t j = 0; j < res.nv; ++j) {
+        mesh.points(i0 + i, j) = d(i, j).s;
+        mesh.normals(i0 + i, j) = unit_normal(d(i, j));
+      }
+    progress.update(static_cast<double>(i0 + nb) / static_cast<double>(res.nu));
+  }
+  progress.clear();
+  io::write_surface_mesh(out, mesh);
+}
+
+void write_eval(const io::Construction& c, const fs::path& out, std::size_t k) {
+  const BSplineSurface& s = surface_of(c);
+  const auto [u0, u1] = s.domain_u();
+  const auto [v0, v1] = s.domain_v();
+  std::vector<std::vector<double>> params{linspace(u0, u1, k), linspace(v0, v1, k)};
+  ProgressLine progress("evaluating");
+  const PointGrid g = s.evaluate(params[0], params[1], progress.callback());
+  progress.clear();
+  if (lower_extension(out) == ".npy") {
+    std::vector<double> flat(3 * g.size());
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      const Vec3& p = g.data()[i];
+      flat[3 * i] = p.x;
+      flat[3 * i + 1] = p.y;
+      flat[3 * i + 2] = p.z;
+    }
+    const std::size_t shape[3] = {k, k, 3};
+    io::write_npy(out, shape, flat);
+  } else {
+    io::write_csv_grid(out, params, std::span<const Vec3>(g.data(), g.size()));
+  }
+}
+
+nlohmann::ordered_json info(const io::Construction& c) {
+  ProgressLine progress("checking");
+  return io::info_json(c, progress.callback());
+}
+
+io::Construction build_spec(const fs::path& spec) {
+  ProgressLine progress("building");
+  return io::build_file(spec, progress.callback());
+}
+
+void report_warnings(const io::Construction& c) {
+  for (const std::string& w : c.warnings) std::fprintf(stderr, "interpatch: warning: %s\n", w.c_str());
+}
+
+int build_command(const fs::path& spec, const fs::path& out) {
+  check_build_output(out);
+  io::check_writable(out);
+  const io::Construction c = build_spec(spec);
+  write_build(c, out);
+  report_warnings(c);
+  return 0;
+}
+
+int mesh_command(const fs::path& spec, const fs::path& out, std::string_view res_text) {
+  const Resolution res = parse_resolution(res_text);
+  check_mesh_output(out);
+  io::check_writable(out);
+  require_mesh_memory(res);
+  const io::Construction c = build_spec(spec);
+  write_mesh(c, out, res);
+  report_warnings(c);
+  return 0;
+}
+
+int eval_command(const fs::path& spec, const fs::path& out, std::string_view grid) {
+  const std::size_t k = parse_grid(grid);
+  check_eval_output(out);
+  io::check_writable(out);
+  require_eval_memory(k, out);
+  const io::Construction c = build_spec(spec);
+  write_eval(c, out, k);
+  report_warnings(c);
+  return 0;
+}
+
+int info_command(const fs::path& spec, const std::optional<fs::path>& out) {
+  if (out) {
+    check_info_output(*out);
+    io::check_writable(*out);
+  }
+  const io::Construction c = build_spec(spec);
+  const std::string text = io::pretty_json(info(c));
+  if (out) {
+    io::write_atomically(*out, [&](std::ostream& os) { os << text; });
+  } else {
+    std::cout << text << std::flush;
+    if (!std::cout) throw error(errc::file_unwritable, "standard output: write failed");
+  }
+  report_warnings(c);
+  return 0;
+}
+
+}  // namespace interpatch::cli

@@ -1,1 +1,321 @@
-// (being written)
+// `interpatch demo`: every construction on built-in examples. Each example's spec
+// (and the data files it refers to) is written into the output directory first and
+// read back from there, so the demo goes through exactly the path a user's spec
+// takes; then every output the command line offers is written beside it.
+
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "commands.hpp"
+#include "interpatch/error.hpp"
+#include "interpatch/grid.hpp"
+#include "interpatch/io/atomic_file.hpp"
+#include "interpatch/io/json_out.hpp"
+#include "interpatch/io/npy.hpp"
+
+namespace interpatch::cli {
+
+namespace fs = std::filesystem;
+using ojson = nlohmann::ordered_json;
+
+namespace {
+
+constexpr double pi = std::numbers::pi;
+
+// A fixed pseudo-random value in [-0.5, 0.5) per grid node: "measurement noise"
+// that is the same on every run and every machine.
+double noise(std::size_t i, std::size_t j) {
+  std::uint64_t h = (i + 1) * 0x9e3779b97f4a7c15ULL ^ (j + 7) * 0xc2b2ae3d27d4eb4fULL;
+  h ^= h >> 33;
+  h *= 0xff51afd7ed558ccdULL;
+  h ^= h >> 33;
+  return static_cast<double>(h % 100000) / 100000.0 - 0.5;
+}
+
+double round_to(double v, double step) { return std::round(v / step) * step; }
+
+// A hemisphere of radius r: u from the pole (a row of n+1 equal points) to the
+// equator, v once around (the first and last columns coincide).
+PointGrid hemisphere(std::size_t nu, std::size_t nv, double r) {
+  PointGrid g({nu, nv});
+  for (std::size_t i = 0; i < nu; ++i)
+    for (std::size_t j = 0; j < nv; ++j) {
+      const double theta = 0.5 * pi * static_cast<double>(i) / static_cast<double>(nu - 1);
+      const double phi = 2 * pi * static_cast<double>(j) / static_cast<double>(nv - 1);
+      g(i, j) = i == 0 ? Vec3{0, 0, r} : Vec3{r * std::sin(theta) * std::cos(phi), r * std::sin(theta) * std::sin(phi), r * std::cos(theta)};
+    }
+  return g;
+}
+
+// Heights surveyed on a 40 m × 30 m grid, to the centimetre: a ridge, a knoll, noise.
+PointGrid terrain() {
+  PointGrid g({7, 13});
+  for (std::size_t i = 0; i < 7; ++i)
+    for (std::size_t j = 0; j < 13; ++j) {
+      const double x = static_cast<double>(i), y = static_cast<double>(j);
+      const double z = 312 + 24 * std::sin(0.9 * x + 0.4) * std::cos(0.42 * y) +
+                       9 * std::exp(-((x - 4) * (x - 4) + (y - 8) * (y - 8) / 4) / 3) + 1.5 * noise(i, j);
+      g(i, j) = {40 * x, 30 * y, round_to(z, 0.01)};
+    }
+  return g;
+}
+
+PointGrid wave() {
+  PointGrid g({6, 9});
+  for (std::size_t i = 0; i < 6; ++i)
+    for (std::size_t j = 0; j < 9; ++j) {
+      const double x = 0.8 * static_cast<double>(i), y = 0.6 * static_cast<double>(j);
+      g(i, j) = {x, y, 0.5 * std::sin(1.1 * x) * std::cos(0.9 * y)};
+    }
+  return g;
+}
+
+PointGrid saddle() {
+  PointGrid g({8, 8});
+  for (std::size_t i = 0; i < 8; ++i)
+    for (std::size_t j = 0; j < 8; ++j) {
+      const double x = -1 + 2 * static_cast<double>(i) / 7, y = -1 + 2 * static_cast<double>(j) / 7;
+      g(i, j) = {x, y, x * x - y * y + 0.3 * x * y * y * y};
+    }
+  return g;
+}
+
+// Half a cylinder of radius 2: u around (11 points), v along the axis (5 points).
+PointGrid half_cylinder() {
+  PointGrid g({11, 5});
+  for (std::size_t i = 0; i < 11; ++i)
+    for (std::size_t j = 0; j < 5; ++j) {
+      const double a = pi * static_cast<double>(i) / 10;
+      g(i, j) = {2 * std::cos(a), 2 * std::sin(a), 0.5 * static_cast<double>(j)};
+    }
+  return g;
+}
+
+// A strip 1 wide and 3 long with a quarter twist: u across (5), v along (9).
+PointGrid twisted_strip() {
+  PointGrid g({5, 9});
+  for (std::size_t i = 0; i < 5; ++i)
+    for (std::size_t j = 0; j < 9; ++j) {
+      const double s = -0.5 + static_cast<double>(i) / 4, t = static_cast<double>(j) / 8, a = 0.5 * pi * t;
+      g(i, j) = {3 * t, s * std::cos(a), s * std::sin(a)};
+    }
+  return g;
+}
+
+ojson grid_json(const PointGrid& g) {
+  ojson rows = ojson::array();
+  for (std::size_t i = 0; i < g.extent(0); ++i) {
+    ojson row = ojson::array();
+    for (std::size_t j = 0; j < g.extent(1); ++j) row.push_back({g(i, j).x, g(i, j).y, g(i, j).z});
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+bool is_point_grid(const ojson& v) {
+  return v.is_array() && !v.empty() && v[0].is_array() && !v[0].empty() && v[0][0].is_array();
+}
+
+// A spec as people write them: one member per line, one grid row per line.
+std::string spec_text(const ojson& spec) {
+  std::string s = "{\n";
+  bool first = true;
+  for (auto it = spec.begin(); it != spec.end(); ++it) {
+    s += first ? "  " : ",\n  ";
+    first = false;
+    s += ojson(it.key()).dump() + ": ";
+    if (is_point_grid(it.value())) {
+      s += "[\n";
+      for (std::size_t i = 0; i < it.value().size(); ++i) s += (i ? ",\n    " : "    ") + it.value()[i].dump();
+      s += "\n  ]";
+    } else {
+      s += it.value().dump();
+    }
+  }
+  return s + "\n}\n";
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  io::write_atomically(path, [&](std::ostream& os) { os << text; });
+}
+
+std::string number_text(double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+void write_points_npy(const fs::path& path, const PointGrid& g) {
+  std::vector<double> flat;
+  flat.reserve(3 * g.size());
+  for (const Vec3& p : g.values()) flat.insert(flat.end(), {p.x, p.y, p.z});
+  const std::size_t shape[3] = {g.extent(0), g.extent(1), 3};
+  io::write_npy(path, shape, flat);
+}
+
+void write_points_csv(const fs::path& path, const PointGrid& g) {
+  std::string text = "x,y,z\n";
+  for (const Vec3& p : g.values()) text += number_text(p.x) + "," + number_text(p.y) + "," + number_text(p.z) + "\n";
+  write_text(path, text);
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+struct Example {
+  std::string name;
+  std::string about;
+  ojson spec;                                    // written as NAME.spec.json
+  std::function<void(const fs::path&)> data;     // data files the spec refers to
+  std::string spec_file;                         // or: an existing file in DIR is the spec
+  bool every_mesh_format = false;
+};
+
+std::vector<Example> examples() {
+  std::vector<Example> ex;
+  ex.push_back({"hemisphere", "bicubic, centripetal, through a 9x17 grid with a pole row",
+                {{"type", "interpolate"},
+                 {"comment", "A unit hemisphere: u from the pole (a row of equal points) to the equator, v around."},
+                 {"degree", 3},
+                 {"param", "centripetal"},
+                 {"points", grid_json(hemisphere(9, 17, 1.0))}},
+                nullptr, "", true});
+  ex.push_back({"terrain", "bicubic, chord length, through 7x13 surveyed heights",
+                {{"type", "interpolate"},
+                 {"comment", "Heights surveyed every 40 m (u) by 30 m (v), to the centimetre."},
+                 {"param", "chord"},
+                 {"points", grid_json(terrain())}},
+                nullptr, "", false});
+  ex.push_back({"wave", "degrees (2, 3), uniform parameters, 6x9 grid",
+                {{"type", "interpolate"},
+                 {"comment", "A wave: quadratic along u, cubic along v, uniformly spaced parameters."},
+                 {"degree", {2, 3}},
+                 {"param", "uniform"},
+                 {"points", grid_json(wave())}},
+                nullptr, "", false});
+  ex.push_back({"saddle", "degrees (5, 5) through an 8x8 grid",
+                {{"type", "interpolate"},
+                 {"comment", "A saddle through an 8x8 grid, degree 5 in both directions (C4)."},
+                 {"degree", {5, 5}},
+                 {"points", grid_json(saddle())}},
+                nullptr, "", false});
+  ex.push_back({"half_cylinder", "11x5 grid read from half_cylinder.npy",
+                {{"type", "interpolate"},
+                 {"comment", "Half a cylinder, 11 points around (u) by 5 along the axis (v), from the .npy beside this file."},
+                 {"degree", {3, 3}},
+                 {"points", {{"npy", "half_cylinder.npy"}}}},
+                [](const fs::path& dir) { write_points_npy(dir / "half_cylinder.npy", half_cylinder()); }, "", false});
+  ex.push_back({"twisted_strip", "5x9 grid read from twisted_strip.csv",
+                {{"type", "interpolate"},
+                 {"comment", "A strip with a quarter twist, 5 points across (u) by 9 along (v), one x,y,z line per point "
+                             "in C order in the .csv beside this file."},
+                 {"param", "centripetal"},
+                 {"points", {{"csv", "twisted_strip.csv"}, {"shape", {5, 9, 3}}}}},
+                [](const fs::path& dir) { write_points_csv(dir / "twisted_strip.csv", twisted_strip()); }, "", false});
+  ex.push_back({"terrain_exact", "terrain.bspline.json (the build output) read back as a bspline_surface spec", nullptr,
+                nullptr, "terrain.bspline.json", false});
+  return ex;
+}
+
+// The output directory is created (one level) when missing; its parent must exist.
+fs::path prepare(fs::path dir) {
+  if (!dir.has_filename()) dir = dir.parent_path();
+  if (dir.empty()) dir = ".";
+  std::error_code ec;
+  if (fs::is_directory(dir, ec)) return dir;
+  if (fs::exists(dir, ec))
+    throw error(errc::file_unwritable, "'" + dir.string() + "': cannot write the demo there: not a directory");
+  const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
+  if (!fs::is_directory(parent, ec))
+    throw error(errc::file_unwritable,
+                "'" + dir.string() + "': cannot create it: its parent directory '" + parent.string() + "' does not exist");
+  if (!fs::create_directory(dir, ec) && ec)
+    throw error(errc::file_unwritable, "'" + dir.string() + "': cannot create it: " + ec.message());
+  return dir;
+}
+
+std::string short_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2g", v);
+  return buf;
+}
+
+}  // namespace
+
+int demo_command(const fs::path& requested) {
+  const fs::path dir = prepare(requested);
+  constexpr std::size_t eval_grid = 33;
+  const Resolution res{64, 64};
+
+  std::size_t files = 0;
+  std::string summary;
+  for (const Example& ex : examples()) {
+    std::vector<std::string> written;
+    fs::path spec_path;
+    if (ex.spec_file.empty()) {
+      if (ex.data) {
+        ex.data(dir);
+        const auto& pts = ex.spec.at("points");
+        written.push_back(pts.contains("npy") ? pts["npy"].get<std::string>() : pts["csv"].get<std::string>());
+      }
+      spec_path = dir / (ex.name + ".spec.json");
+      write_text(spec_path, spec_text(ex.spec));
+      written.push_back(spec_path.filename().string());
+    } else {
+      spec_path = dir / ex.spec_file;
+    }
+
+    const io::Construction c = build_spec(spec_path);
+    const auto out = [&](const std::string& suffix) {
+      written.push_back(ex.name + suffix);
+      return dir / (ex.name + suffix);
+    };
+    write_build(c, out(".bspline.json"));
+    write_eval(c, out(".eval.npy"), eval_grid);
+    write_eval(c, out(".eval.csv"), eval_grid);
+    write_mesh(c, out(".obj"), res);
+    write_mesh(c, out(".vtk"), res);
+    if (ex.every_mesh_format)
+      for (const char* ext : {".ply", ".stl", ".vts", ".xyz"}) write_mesh(c, out(ext), res);
+    const ojson description = info(c);
+    write_text(out(".info.json"), io::pretty_json(description));
+    report_warnings(c);
+
+    const auto& err = description["max_data_error"];
+    std::string line = "  " + ex.name + std::string(ex.name.size() < 15 ? 15 - ex.name.size() : 1, ' ') + c.type + ": " +
+                       ex.about + "\n      " + std::to_string(description["control_points"][0].get<std::size_t>()) + "x" +
+                       std::to_string(description["control_points"][1].get<std::size_t>()) + " control points, degree " +
+                       std::to_string(description["degree"][0].get<int>()) + "x" +
+                       std::to_string(description["degree"][1].get<int>()) + ", continuity " +
+                       description["continuity"]["u"].get<std::string>() + "/" +
+                       description["continuity"]["v"].get<std::string>();
+    if (err.is_object())
+      line += ", max error at the data " + short_number(err["absolute"].get<double>()) + " (relative " +
+              short_number(err["relative"].get<double>()) + ")";
+    if (!ex.spec_file.empty()) {
+      const bool same = read_text(spec_path) == read_text(dir / (ex.name + ".bspline.json"));
+      line += same ? ", rebuilt identically" : ", rebuilt with differences";
+    }
+    line += "\n      ";
+    for (std::size_t i = 0; i < written.size(); ++i) line += (i ? " " : "") + written[i];
+    summary += line + "\n";
+    files += written.size();
+  }
+  std::printf("interpatch demo: %zu examples\n%soutputs in %s: %zu files\n", examples().size(), summary.c_str(),
+              dir.string().c_str(), files);
+  return 0;
+}
+
+}  // namespace interpatch::cli

@@ -1,1 +1,98 @@
-int main() { return 0; }
+// The interpatch command (SPEC section 5): build, mesh, eval, info, demo.
+// Exit status: 0 ok, 2 bad usage, 3 invalid input, 4 files, 5 too large, 1 else;
+// every failure prints exactly one line on stderr, "interpatch: <message>".
+
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <new>
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+#include "interpatch/error.hpp"
+
+namespace {
+
+// One line, whatever the message holds.
+int fail_with(int status, std::string message) {
+  for (char& c : message)
+    if (c == '\n' || c == '\r') c = ' ';
+  std::fprintf(stderr, "interpatch: %s\n", message.c_str());
+  return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  namespace cli = interpatch::cli;
+
+  CLI::App app{"interpatch: interpolating curves, surfaces and solids.\n"
+               "Reads a SPEC.json describing a construction; writes its exact B-spline form,\n"
+               "meshes, evaluation grids and a description.",
+               "interpatch"};
+  app.require_subcommand(1);
+  app.footer("Exit status: 0 ok, 2 bad usage, 3 invalid input, 4 unreadable/unwritable file, 5 too large, 1 other.");
+
+  std::string spec, out, res = "64x64", grid, demo_dir = "interpatch-demo";
+
+  CLI::App* build = app.add_subcommand("build", "Write the exact B-spline form of SPEC.json (.json)");
+  build->add_option("SPEC", spec, "The spec file (SPEC.json)")->required();
+  build->add_option("-o,--output", out, "Output file: .json")->required();
+
+  CLI::App* mesh = app.add_subcommand("mesh", "Tessellate the construction (.obj .stl .ply .vtk .vts .xyz)");
+  mesh->add_option("SPEC", spec, "The spec file (SPEC.json)")->required();
+  mesh->add_option("-o,--output", out, "Output file: .obj, .stl, .ply, .vtk, .vts or .xyz (Plot3D)")->required();
+  mesh->add_option("--res", res, "Vertices along u and v, NUxNV")->capture_default_str();
+
+  CLI::App* eval = app.add_subcommand("eval", "Evaluate on a uniform KxK grid over [0,1]^2 (.npy or .csv)");
+  eval->add_option("SPEC", spec, "The spec file (SPEC.json)")->required();
+  eval->add_option("--grid", grid, "K: points along each direction")->required();
+  eval->add_option("-o,--output", out, "Output file: .npy (K,K,3), u index first, or .csv (u,v,x,y,z)")->required();
+
+  CLI::App* info = app.add_subcommand("info", "Describe the construction as one JSON object on stdout");
+  info->add_option("SPEC", spec, "The spec file (SPEC.json)")->required();
+  std::optional<std::string> info_out;
+  info->add_option("-o,--output", info_out, "Write the object to this .json file instead of stdout");
+
+  CLI::App* demo = app.add_subcommand("demo", "Run every construction on built-in examples");
+  demo->add_option("-o,--output", demo_dir, "Directory for the outputs (created if missing; its parent must exist)")
+      ->capture_default_str();
+
+  // CLI11 would call an unknown command an extra argument after a missing one.
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::string first = argv[1];
+    if (first != "build" && first != "mesh" && first != "eval" && first != "info" && first != "demo")
+      return fail_with(2, "unknown command '" + first + "'; the commands are build, mesh, eval, info, demo (see interpatch --help)");
+  }
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help
+    return fail_with(2, std::string(e.what()) + " (see interpatch --help)");
+  }
+
+  try {
+    if (*build) return cli::build_command(spec, out);
+    if (*mesh) return cli::mesh_command(spec, out, res);
+    if (*eval) return cli::eval_command(spec, out, grid);
+    if (*info) {
+      std::optional<std::filesystem::path> o;
+      if (info_out) o = *info_out;
+      return cli::info_command(spec, o);
+    }
+    if (*demo) return cli::demo_command(demo_dir);
+    return fail_with(2, "no command given (see interpatch --help)");
+  } catch (const interpatch::error& e) {
+    return fail_with(interpatch::exit_status(e.code()), e.what());
+  } catch (const cli::usage_error& e) {
+    return fail_with(2, e.what());
+  } catch (const std::bad_alloc&) {
+    return fail_with(5, "out of memory");
+  } catch (const std::exception& e) {
+    return fail_with(1, e.what());
+  }
+}

@@ -1,1 +1,270 @@
-// (being written)
+#include "interpatch/io/json_out.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <span>
+#include <type_traits>
+#include <variant>
+
+#include "detail/text.hpp"
+#include "interpatch/bspline_surface.hpp"
+#include "interpatch/io/atomic_file.hpp"
+#include "interpatch/memory.hpp"
+
+namespace interpatch::io {
+
+using detail::cat;
+using detail::fail;
+using ojson = nlohmann::ordered_json;
+
+namespace {
+
+template <class>
+inline constexpr bool unhandled_exact_form = false;
+
+// Shortest text that reads back to the same double (std::to_chars without a
+// precision), which is always a valid JSON number for finite values.
+void put(std::string& out, double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, r.ptr);
+}
+
+void put(std::string& out, const Vec3& p) {
+  out += '[';
+  put(out, p.x);
+  out += ", ";
+  put(out, p.y);
+  out += ", ";
+  put(out, p.z);
+  out += ']';
+}
+
+void put(std::string& out, std::span<const double> v) {
+  out += '[';
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (i) out += ", ";
+    put(out, v[i]);
+  }
+  out += ']';
+}
+
+// One grid row per line: readable, and a 4096 × 4096 net never sits in memory as text.
+template <class T>
+void put_grid(std::ostream& os, const Grid<T, 2>& g) {
+  os << "[\n";
+  std::string row;
+  for (std::size_t i = 0; i < g.extent(0); ++i) {
+    row = "    [";
+    for (std::size_t j = 0; j < g.extent(1); ++j) {
+      if (j) row += ", ";
+      put(row, g(i, j));
+    }
+    row += i + 1 < g.extent(0) ? "],\n" : "]\n";
+    os << row;
+  }
+  os << "  ]";
+}
+
+void write_surface(std::ostream& os, const BSplineSurface& s) {
+  std::string head = cat("{\n  \"type\": \"bspline_surface\",\n  \"degree\": [", s.degree_u(), ", ", s.degree_v(),
+                         "],\n  \"knots\": {\n    \"u\": ");
+  put(head, s.knots_u().values());
+  head += ",\n    \"v\": ";
+  put(head, s.knots_v().values());
+  head += "\n  },\n  \"control_points\": ";
+  os << head;
+  put_grid(os, s.control_points());
+  if (s.rational()) {
+    os << ",\n  \"weights\": ";
+    put_grid(os, s.weights());
+  }
+  os << "\n}\n";
+}
+
+ojson vec(const Vec3& p) { return ojson::array({p.x, p.y, p.z}); }
+
+double round_ms(double ms) { return std::round(ms * 1000.0) / 1000.0; }
+
+struct Box {
+  Vec3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+          std::numeric_limits<double>::infinity()};
+  Vec3 hi = -lo;
+  void add(const Vec3& p) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]);
+      hi[k] = std::max(hi[k], p[k]);
+    }
+  }
+  [[nodiscard]] double diagonal() const { return lo.x <= hi.x ? norm(hi - lo) : 0.0; }
+};
+
+// The surface at the data parameters, a block of rows at a time.
+void surface_data_error(const BSplineSurface& s, const DataSet& d, DataError& e, std::size_t& done, std::size_t total,
+                        const progress_callback& progress) {
+  if (d.params.size() != 2)
+    fail(errc::internal, d.pointer, ": data for a surface needs 2 parameter lists, got ", d.params.size());
+  const auto& us = d.params[0];
+  const auto& vs = d.params[1];
+  const std::size_t nu = us.size(), nv = vs.size();
+  if (d.points.size() != nu * nv)
+    fail(errc::internal, d.pointer, ": ", d.points.size(), " data points for ", nu, " x ", nv, " parameters");
+  if (nv == 0) return;
+  const std::size_t block = std::max<std::size_t>(1, (std::size_t{1} << 16) / nv);
+  for (std::size_t i0 = 0; i0 < nu; i0 += block) {
+    const std::size_t nb = std::min(block, nu - i0);
+    const PointGrid p = s.evaluate(std::span<const double>(us).subspan(i0, nb), vs);
+    for (std::size_t i = 0; i < nb; ++i)
+      for (std::size_t j = 0; j < nv; ++j) {
+        const double dist = distance(p(i, j), d.points[(i0 + i) * nv + j]);
+        if (dist > e.absolute || e.pointer.empty()) {
+          e.absolute = dist;
+          e.pointer = cat(d.pointer, "/", i0 + i, "/", j);
+          e.params = {us[i0 + i], vs[j]};
+        }
+      }
+    done += nb * nv;
+    if (progress) progress(static_cast<double>(done) / static_cast<double>(total));
+  }
+}
+
+ojson surface_info(const BSplineSurface& s) {
+  ojson j;
+  j["kind"] = "surface";
+  j["exact_form"] = "bspline_surface";
+  j["degree"] = {s.degree_u(), s.degree_v()};
+  j["control_points"] = {s.control_points().extent(0), s.control_points().extent(1)};
+  j["rational"] = s.rational();
+  j["knots"] = {{"u", s.knots_u().values()}, {"v", s.knots_v().values()}};
+  j["continuity"] = {{"u", continuity_name(s.knots_u())}, {"v", continuity_name(s.knots_v())}};
+  const auto [u0, u1] = s.domain_u();
+  const auto [v0, v1] = s.domain_v();
+  j["domain"] = {{"u", {u0, u1}}, {"v", {v0, v1}}};
+  Box box;
+  for (const Vec3& p : s.control_points().values()) box.add(p);
+  j["bounding_box"] = {{"min", vec(box.lo)}, {"max", vec(box.hi)}, {"diagonal", box.diagonal()}};
+  return j;
+}
+
+bool is_flat(const ojson& j) {
+  return std::all_of(j.begin(), j.end(), [](const ojson& e) { return !e.is_structured(); });
+}
+
+void pretty(std::string& out, const ojson& j, std::size_t indent) {
+  if (j.is_array() && is_flat(j)) {
+    out += '[';
+    for (std::size_t i = 0; i < j.size(); ++i) out += (i ? ", " : "") + j[i].dump();
+    out += ']';
+    return;
+  }
+  if (!j.is_structured() || j.empty()) {
+    out += j.dump();
+    return;
+  }
+  const std::string pad(indent + 2, ' ');
+  out += j.is_array() ? "[\n" : "{\n";
+  bool first = true;
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    out += first ? pad : ",\n" + pad;
+    first = false;
+    if (j.is_object()) out += ojson(it.key()).dump() + ": ";
+    pretty(out, it.value(), indent + 2);
+  }
+  out += "\n" + std::string(indent, ' ') + (j.is_array() ? "]" : "}");
+}
+
+}  // namespace
+
+std::string pretty_json(const nlohmann::ordered_json& j) {
+  std::string out;
+  pretty(out, j, 0);
+  return out + "\n";
+}
+
+void write_exact_json(std::ostream& os, const ExactForm& exact) {
+  std::visit(
+      [&](const auto& form) {
+        using T = std::decay_t<decltype(form)>;
+        if constexpr (std::is_same_v<T, BSplineSurface>) write_surface(os, form);
+        else static_assert(unhandled_exact_form<T>, "write_exact_json: an exact form without a writer");
+      },
+      exact);
+}
+
+void write_exact_json(const std::filesystem::path& path, const ExactForm& exact) {
+  write_atomically(path, [&](std::ostream& os) { write_exact_json(os, exact); });
+}
+
+std::string continuity_name(const KnotVector& knots) {
+  if (knots.interior_breaks().empty()) return "Cinf";
+  return cat("C", knots.continuity());
+}
+
+std::optional<DataError> max_data_error(const Construction& c, const progress_callback& progress) {
+  if (c.data.empty()) return std::nullopt;
+  DataError e;
+  Box box;
+  std::size_t total = 0, done = 0;
+  for (const DataSet& d : c.data) {
+    total += d.points.size();
+    for (const Vec3& p : d.points) box.add(p);
+  }
+  if (total == 0) return std::nullopt;
+  for (const DataSet& d : c.data)
+    std::visit(
+        [&](const auto& form) {
+          using T = std::decay_t<decltype(form)>;
+          if constexpr (std::is_same_v<T, BSplineSurface>) surface_data_error(form, d, e, done, total, progress);
+          else static_assert(unhandled_exact_form<T>, "max_data_error: an exact form without an evaluator");
+        },
+        c.exact);
+  e.count = total;
+  e.diagonal = box.diagonal();
+  e.relative = e.diagonal > 0 ? e.absolute / e.diagonal
+                              : (e.absolute == 0 ? 0.0 : std::numeric_limits<double>::infinity());
+  return e;
+}
+
+nlohmann::ordered_json info_json(const Construction& c, const progress_callback& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::optional<DataError> err = max_data_error(c, progress);
+  const double check_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+
+  ojson j;
+  j["type"] = c.type;
+  std::visit(
+      [&](const auto& form) {
+        using T = std::decay_t<decltype(form)>;
+        if constexpr (std::is_same_v<T, BSplineSurface>) j.update(surface_info(form));
+        else static_assert(unhandled_exact_form<T>, "info_json: an exact form without a description");
+      },
+      c.exact);
+  if (err) {
+    j["max_data_error"] = {{"absolute", err->absolute}, {"relative", err->relative}, {"diagonal", err->diagonal},
+                           {"points", err->count},      {"at", err->pointer},       {"params", err->params}};
+  } else {
+    j["max_data_error"] = nullptr;
+  }
+  ojson data = ojson::array();
+  for (const DataSet& d : c.data) {
+    ojson shape = ojson::array(), params = ojson::object();
+    for (std::size_t a = 0; a < d.params.size(); ++a) {
+      shape.push_back(d.params[a].size());
+      params[a == 0 ? "u" : (a == 1 ? "v" : "w")] = d.params[a];
+    }
+    data.push_back({{"pointer", d.pointer}, {"shape", shape}, {"params", params}});
+  }
+  j["data"] = std::move(data);
+  j["parameters"] = c.parameters;
+  j["warnings"] = c.warnings;
+  j["timings"] = {{"parse_ms", round_ms(c.timings.parse_ms)},
+                  {"build_ms", round_ms(c.timings.build_ms)},
+                  {"check_ms", round_ms(check_ms)},
+                  {"total_ms", round_ms(c.timings.parse_ms + c.timings.build_ms + check_ms)}};
+  return j;
+}
+
+}  // namespace interpatch::io

@@ -1,1 +1,799 @@
-// (being written)
+#include "interpatch/io/spec.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <initializer_list>
+#include <iterator>
+#include <limits>
+#include <optional>
+
+#include "detail/text.hpp"
+#include "interpatch/error.hpp"
+#include "interpatch/hermite.hpp"
+#include "interpatch/interpolate.hpp"
+#include "interpatch/io/csv.hpp"
+#include "interpatch/io/npy.hpp"
+#include "interpatch/knot_vector.hpp"
+#include "interpatch/memory.hpp"
+
+namespace interpatch::io {
+
+using json = nlohmann::json;
+using detail::cat;
+using detail::fail;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+// ---------------------------------------------------------------------------
+// Places: JSON Pointers (RFC 6901) into the spec.
+
+std::string child(std::string_view ptr, std::string_view key) {
+  std::string s(ptr);
+  s += '/';
+  for (const char c : key) {
+    if (c == '~') s += "~0";
+    else if (c == '/') s += "~1";
+    else s += c;
+  }
+  return s;
+}
+
+std::string child(std::string_view ptr, std::size_t index) {
+  std::string s(ptr);
+  s += '/';
+  s += std::to_string(index);
+  return s;
+}
+
+std::string index_pointer(std::string_view ptr, const std::vector<std::size_t>& idx, std::size_t n) {
+  std::string s(ptr);
+  for (std::size_t k = 0; k < n; ++k) {
+    s += '/';
+    s += std::to_string(idx[k]);
+  }
+  return s;
+}
+
+// The empty pointer is the whole document; say so in words.
+std::string place(std::string_view ptr) { return ptr.empty() ? std::string("(top level)") : std::string(ptr); }
+
+const char* kind(const json& j) {
+  switch (j.type()) {
+    case json::value_t::null: return "null";
+    case json::value_t::boolean: return "a boolean";
+    case json::value_t::number_integer:
+    case json::value_t::number_unsigned:
+    case json::value_t::number_float: return "a number";
+    case json::value_t::string: return "a string";
+    case json::value_t::array: return "an array";
+    case json::value_t::object: return "an object";
+    default: return "a binary value";
+  }
+}
+
+[[noreturn]] void wrong_type(std::string_view ptr, std::string_view expected, const json& got) {
+  fail(errc::wrong_type, place(ptr), ": expected ", expected, ", got ", kind(got));
+}
+
+// Runs a library call; an error it throws keeps its code and gets the place in front.
+template <class F>
+decltype(auto) at(std::string_view ptr, F&& f) {
+  try {
+    return f();
+  } catch (const error& e) {
+    throw error(e.code(), cat(place(ptr), ": ", e.what()));
+  }
+}
+
+constexpr const char* axis_name(std::size_t a) { return a == 0 ? "u" : (a == 1 ? "v" : "w"); }
+constexpr const char* coord_name(int k) { return k == 0 ? "x" : (k == 1 ? "y" : "z"); }
+
+std::string shape_text(const std::vector<std::size_t>& shape) {
+  std::string s = "(";
+  for (std::size_t i = 0; i < shape.size(); ++i) s += (i ? ", " : "") + std::to_string(shape[i]);
+  return s + (shape.size() == 1 ? ",)" : ")");
+}
+
+// The product of extents, refusing (too_large) a product that overflows.
+std::size_t checked_product(const std::vector<std::size_t>& shape, std::string_view what) {
+  std::size_t n = 1;
+  for (const std::size_t e : shape) {
+    if (e != 0 && n > std::numeric_limits<std::size_t>::max() / e)
+      fail(errc::too_large, what, ": shape ", shape_text(shape), " has more entries than can be addressed");
+    n *= e;
+  }
+  return n;
+}
+
+// ---------------------------------------------------------------------------
+// What every reader shares: where relative files are, progress, warnings, timing.
+
+struct Context {
+  std::filesystem::path base_dir;
+  progress_callback progress;
+  std::vector<std::string> warnings;
+  Clock::time_point start = Clock::now();
+  std::optional<Clock::time_point> parsed_at;
+
+  // The spec is read and checked; what follows is the construction proper.
+  void parsed() { parsed_at = Clock::now(); }
+  void warn(std::string w) { warnings.push_back(std::move(w)); }
+  [[nodiscard]] std::filesystem::path resolve(const std::string& file) const {
+    const std::filesystem::path p(file);
+    return p.is_absolute() || base_dir.empty() ? p : base_dir / p;
+  }
+};
+
+// ---------------------------------------------------------------------------
+// Fields.
+
+const json* find_member(const json& obj, std::string_view key) {
+  const auto it = obj.find(std::string(key));
+  return it == obj.end() ? nullptr : &*it;
+}
+
+// A required member; its absence names the member's pointer and what it should hold.
+const json& member(const json& obj, std::string_view key, std::string_view ptr, std::string_view expected) {
+  const json* m = find_member(obj, key);
+  if (!m) fail(errc::missing_field, child(ptr, key), ": missing field (expected ", expected, ")");
+  return *m;
+}
+
+void expect_object(const json& j, std::string_view ptr, std::string_view expected) {
+  if (!j.is_object()) wrong_type(ptr, expected, j);
+}
+
+// Names a reader does not know are reported (a typo would otherwise be silently
+// ignored) but not refused: newer specs may carry options this build lacks.
+void check_fields(const json& obj, std::string_view ptr, std::initializer_list<std::string_view> known, Context& ctx) {
+  for (auto it = obj.begin(); it != obj.end(); ++it) {
+    const std::string& k = it.key();
+    if (k == "comment" || k == "description" || k == "name") continue;
+    if (std::find(known.begin(), known.end(), k) == known.end())
+      ctx.warn(cat(child(ptr, k), ": unknown field, ignored"));
+  }
+}
+
+double number(const json& j, std::string_view ptr) {
+  if (!j.is_number()) wrong_type(ptr, "a number", j);
+  const double v = j.get<double>();
+  if (!std::isfinite(v)) fail(errc::not_finite, place(ptr), ": value is ", v);
+  return v;
+}
+
+// An integer; a float with an integral value (3.0) is accepted.
+std::int64_t integer(const json& j, std::string_view ptr, std::string_view expected) {
+  if (j.is_number_unsigned()) {
+    const auto u = j.get<std::uint64_t>();
+    if (u > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
+      fail(errc::wrong_type, place(ptr), ": ", u, " is too large; expected ", expected);
+    return static_cast<std::int64_t>(u);
+  }
+  if (j.is_number_integer()) return j.get<std::int64_t>();
+  if (j.is_number_float()) {
+    const double d = j.get<double>();
+    if (std::isfinite(d) && d == std::floor(d) && std::fabs(d) < 9.0e15) return static_cast<std::int64_t>(d);
+    fail(errc::wrong_type, place(ptr), ": ", d, " is not an integer; expected ", expected);
+  }
+  wrong_type(ptr, expected, j);
+}
+
+std::vector<double> numbers(const json& j, std::string_view ptr, std::string_view expected = "an array of numbers") {
+  if (!j.is_array()) wrong_type(ptr, expected, j);
+  std::vector<double> v(j.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const json& x = j[i];
+    if (x.is_number()) {
+      v[i] = x.get<double>();
+      if (std::isfinite(v[i])) continue;
+    }
+    v[i] = number(x, child(ptr, i));  // throws with the entry's place
+  }
+  return v;
+}
+
+int degree_value(const json& j, std::string_view ptr) {
+  const std::int64_t d = integer(j, ptr, "an integer degree");
+  if (d < 1 || d > max_degree) fail(errc::invalid_degree, place(ptr), ": degree ", d, " is outside 1..", max_degree);
+  return static_cast<int>(d);
+}
+
+// "degree": p for every direction, or [p, q(, r)]; unset entries mean the default.
+std::vector<std::optional<int>> degrees(const json& obj, std::string_view ptr, std::size_t dims) {
+  std::vector<std::optional<int>> d(dims);
+  const json* j = find_member(obj, "degree");
+  if (!j) return d;
+  const std::string at_ = child(ptr, "degree");
+  if (j->is_array()) {
+    if (j->size() != dims)
+      fail(errc::size_mismatch, at_, ": expected ", dims, " degrees (one per direction ",
+           dims == 3 ? "u, v, w" : (dims == 2 ? "u, v" : "t"), "), got ", j->size());
+    for (std::size_t i = 0; i < dims; ++i) d[i] = degree_value((*j)[i], child(at_, i));
+  } else if (j->is_number()) {
+    const int v = degree_value(*j, at_);
+    for (auto& x : d) x = v;
+  } else {
+    wrong_type(at_, dims == 1 ? "an integer degree" : cat("an integer degree or an array of ", dims, " degrees"), *j);
+  }
+  return d;
+}
+
+std::string degree_pointer(const json& obj, std::string_view ptr, std::size_t axis) {
+  const json* j = find_member(obj, "degree");
+  const std::string d = child(ptr, "degree");
+  return j && j->is_array() ? child(d, axis) : d;
+}
+
+const char* param_name(Parametrization p) {
+  switch (p) {
+    case Parametrization::uniform: return "uniform";
+    case Parametrization::chord: return "chord";
+    case Parametrization::centripetal: return "centripetal";
+  }
+  return "chord";
+}
+
+Parametrization parametrization(const json& obj, std::string_view ptr) {
+  const json* p = find_member(obj, "param");
+  if (!p) return Parametrization::chord;
+  const std::string at_ = child(ptr, "param");
+  if (!p->is_string()) wrong_type(at_, "a string: uniform, chord or centripetal", *p);
+  const auto& s = p->get_ref<const std::string&>();
+  for (const auto v : {Parametrization::uniform, Parametrization::chord, Parametrization::centripetal})
+    if (s == param_name(v)) return v;
+  fail(errc::wrong_type, at_, ": unknown parametrization \"", s, "\"; expected uniform, chord or centripetal");
+}
+
+// ---------------------------------------------------------------------------
+// Rectangular arrays of nested lists.
+
+std::string grid_form(std::size_t rank, bool points) {
+  if (points && rank == 1) return "a list of points [[x, y, z], ...]";
+  return cat("a ", rank == 1 ? "list" : cat(rank, "-D grid"), " of ", points ? "points" : "numbers", ": lists nested ",
+             rank + (points ? 1 : 0), " deep");
+}
+
+// Walks lists nested `rank` deep whose every row has the length of the first one,
+// calling leaf(entry, idx) on each entry at depth `rank` in C order. `leaf_depth`
+// is how many more levels of lists an entry has (1 for a point [x, y, z], 0 for a
+// number); it only serves to tell a grid of the wrong rank from a ragged one.
+// Returns the shape.
+template <class Leaf>
+std::vector<std::size_t> walk_grid(const json& j, std::size_t rank, std::size_t leaf_depth, bool points,
+                                   std::string_view ptr, std::vector<std::size_t>& idx, Leaf&& leaf) {
+  std::vector<std::size_t> shape;
+  std::size_t depth = 0;
+  for (const json* node = &j; node->is_array(); node = &(*node)[0]) {
+    if (node->empty()) {
+      const std::vector<std::size_t> zeros(depth, 0);
+      fail(errc::too_few_points, place(index_pointer(ptr, zeros, depth)), ": empty list; expected ",
+           grid_form(rank, points));
+    }
+    if (depth < rank) shape.push_back(node->size());
+    ++depth;
+  }
+  if (depth != rank + leaf_depth) {
+    if (depth == 0) wrong_type(ptr, grid_form(rank, points), j);
+    fail(errc::wrong_type, place(ptr), ": expected ", grid_form(rank, points), ", got lists nested ", depth, " deep");
+  }
+  idx.assign(rank + leaf_depth, 0);
+  auto walk = [&](auto& self, const json& node, std::size_t level) -> void {
+    if (level == rank) {
+      leaf(node);
+      return;
+    }
+    if (!node.is_array())
+      fail(errc::wrong_type, place(index_pointer(ptr, idx, level)), ": expected a list of ",
+           level + 1 < rank ? "rows" : (points ? "points" : "numbers"), ", got ", kind(node));
+    if (node.size() != shape[level]) {
+      std::vector<std::size_t> first(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(level));
+      std::fill(first.begin(), first.end(), 0);
+      fail(errc::ragged_grid, place(index_pointer(ptr, idx, level)), ": has ", node.size(),
+           level + 1 < rank ? " rows" : (points ? " points" : " numbers"), ", but ",
+           place(index_pointer(ptr, first, level)), " has ", shape[level]);
+    }
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      idx[level] = i;
+      self(self, node[i], level + 1);
+    }
+  };
+  walk(walk, j, 0);
+  return shape;
+}
+
+PointArray inline_points(const json& j, std::size_t rank, std::string_view ptr) {
+  PointArray out;
+  std::vector<std::size_t> idx;
+  // Size the result from the first entries before walking; the walk checks the rest.
+  std::vector<std::size_t> first_shape;
+  for (const json* node = &j; node->is_array() && !node->empty() && first_shape.size() < rank; node = &(*node)[0])
+    first_shape.push_back(node->size());
+  if (first_shape.size() == rank) {
+    const std::size_t n = checked_product(first_shape, place(ptr));
+    require_memory(n, sizeof(Vec3), cat(place(ptr), ": ", n, " points"));
+    out.points.reserve(n);
+  }
+  out.shape = walk_grid(j, rank, 1, true, ptr, idx, [&](const json& node) {
+    if (!node.is_array()) fail(errc::wrong_type, index_pointer(ptr, idx, rank), ": expected a point [x, y, z], got ", kind(node));
+    if (node.size() != 3)
+      fail(errc::ragged_grid, index_pointer(ptr, idx, rank), ": a point must be 3 numbers [x, y, z], got ",
+           node.size(), node.size() == 1 ? " entry" : " entries");
+    Vec3 p;
+    for (int k = 0; k < 3; ++k) {
+      const json& c = node[static_cast<std::size_t>(k)];
+      idx[rank] = static_cast<std::size_t>(k);
+      if (!c.is_number())
+        fail(errc::wrong_type, index_pointer(ptr, idx, rank + 1), ": expected a number (coordinate ", coord_name(k),
+             "), got ", kind(c));
+      p[k] = c.get<double>();
+      if (!std::isfinite(p[k]))
+        fail(errc::not_finite, index_pointer(ptr, idx, rank + 1), ": coordinate ", coord_name(k), " is ", p[k]);
+    }
+    idx[rank] = 0;
+    out.points.push_back(p);
+  });
+  return out;
+}
+
+Grid<double, 2> inline_number_grid(const json& j, std::string_view ptr) {
+  std::vector<double> values;
+  std::vector<std::size_t> idx;
+  const auto shape = walk_grid(j, 2, 0, false, ptr, idx, [&](const json& node) {
+    if (!node.is_number()) fail(errc::wrong_type, index_pointer(ptr, idx, 2), ": expected a number, got ", kind(node));
+    const double v = node.get<double>();
+    if (!std::isfinite(v)) fail(errc::not_finite, index_pointer(ptr, idx, 2), ": value is ", v);
+    values.push_back(v);
+  });
+  return Grid<double, 2>({shape[0], shape[1]}, std::move(values));
+}
+
+std::string expected_shape(std::size_t rank) {
+  static constexpr const char* names[] = {"n", "m", "l"};
+  std::string s = "(";
+  for (std::size_t i = 0; i < rank; ++i) s += cat(names[std::min<std::size_t>(i, 2)], ", ");
+  return s + "3)";
+}
+
+// Data from a file: check every value is finite, naming it as if it were inline.
+PointArray points_from_values(const std::vector<std::size_t>& shape, const std::vector<double>& values,
+                              std::string_view ptr, const std::string& file) {
+  const std::size_t n = values.size() / 3;
+  require_memory(n, sizeof(Vec3), cat(place(ptr), ": ", n, " points from ", file));
+  PointArray out{shape, PointStorage(n)};
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 p{values[3 * i], values[3 * i + 1], values[3 * i + 2]};
+    if (!is_finite(p)) {
+      std::vector<std::size_t> idx(shape.size() + 1);
+      std::size_t r = i;
+      for (std::size_t a = shape.size(); a-- > 0;) {
+        idx[a] = r % shape[a];
+        r /= shape[a];
+      }
+      const int k = std::isfinite(p.x) ? (std::isfinite(p.y) ? 2 : 1) : 0;
+      idx[shape.size()] = static_cast<std::size_t>(k);
+      fail(errc::not_finite, index_pointer(ptr, idx, idx.size()), ": coordinate ", coord_name(k), " is ", p[k], " (in ",
+           file, ")");
+    }
+    out.points[i] = p;
+  }
+  return out;
+}
+
+std::string file_name(const json& obj, std::string_view key, std::string_view ptr) {
+  const json& f = member(obj, key, ptr, "a file name");
+  if (!f.is_string() || f.get_ref<const std::string&>().empty()) wrong_type(child(ptr, key), "a file name", f);
+  return f.get<std::string>();
+}
+
+PointArray npy_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx) {
+  check_fields(obj, ptr, {"npy"}, ctx);
+  const std::string file = file_name(obj, "npy", ptr);
+  NpyArray a = at(ptr, [&] { return read_npy(ctx.resolve(file)); });
+  if (a.shape.size() != rank + 1 || a.shape.back() != 3)
+    fail(errc::size_mismatch, place(ptr), ": ", file, " has shape ", shape_text(a.shape), "; expected ",
+         expected_shape(rank), ", ", rank == 1 ? "a list" : cat("a ", rank, "-D grid"), " of 3-vectors");
+  std::vector<std::size_t> shape(a.shape.begin(), a.shape.end() - 1);
+  for (std::size_t ax = 0; ax < shape.size(); ++ax)
+    if (shape[ax] == 0) fail(errc::too_few_points, place(ptr), ": ", file, " has shape ", shape_text(a.shape), ", no points");
+  if (a.data.size() != checked_product(a.shape, place(ptr)))
+    fail(errc::malformed_file, place(ptr), ": ", file, " holds ", a.data.size(), " numbers, its shape ",
+         shape_text(a.shape), " says ", checked_product(a.shape, place(ptr)));
+  return points_from_values(shape, a.data, ptr, file);
+}
+
+PointArray csv_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx) {
+  check_fields(obj, ptr, {"csv", "shape"}, ctx);
+  const std::string file = file_name(obj, "csv", ptr);
+  const std::string sptr = child(ptr, "shape");
+  const json& sj = member(obj, "shape", ptr, cat("the grid shape, e.g. ", expected_shape(rank)));
+  if (!sj.is_array()) wrong_type(sptr, cat("an array of ", rank, " extents (a trailing 3 may follow)"), sj);
+  std::vector<std::size_t> shape;
+  for (std::size_t i = 0; i < sj.size(); ++i) {
+    const std::int64_t e = integer(sj[i], child(sptr, i), "an integer extent");
+    if (e < 1) fail(errc::too_few_points, child(sptr, i), ": extent ", e, " is below 1");
+    shape.push_back(static_cast<std::size_t>(e));
+  }
+  if (shape.size() == rank + 1 && shape.back() == 3) shape.pop_back();
+  if (shape.size() != rank)
+    fail(errc::size_mismatch, sptr, ": shape ", shape_text(shape), " does not describe ", grid_form(rank, true),
+         "; expected [", rank == 1 ? "n" : (rank == 2 ? "n, m" : "n, m, l"), "] or [", rank == 1 ? "n" : (rank == 2 ? "n, m" : "n, m, l"),
+         ", 3]");
+  const std::size_t n = checked_product(shape, sptr);
+  require_memory(n, sizeof(Vec3), cat(place(ptr), ": ", n, " points from ", file));
+  const std::vector<Vec3> pts = at(ptr, [&] { return read_csv_points(ctx.resolve(file), n); });
+  if (pts.size() != n)
+    fail(errc::size_mismatch, place(ptr), ": ", file, " has ", pts.size(), " points, shape ", shape_text(shape), " needs ", n);
+  for (std::size_t i = 0; i < n; ++i)
+    if (!is_finite(pts[i])) fail(errc::not_finite, place(ptr), ": ", file, " point ", i, " is ", pts[i]);
+  return {shape, PointStorage(pts.begin(), pts.end())};
+}
+
+PointArray points_impl(const json& j, std::size_t rank, std::string_view ptr, Context& ctx) {
+  if (j.is_object()) {
+    const bool npy = j.contains("npy"), csv = j.contains("csv");
+    if (npy && csv) fail(errc::wrong_type, place(ptr), ": give either \"npy\" or \"csv\", not both");
+    if (npy) return npy_points(j, rank, ptr, ctx);
+    if (csv) return csv_points(j, rank, ptr, ctx);
+    fail(errc::missing_field, place(ptr), ": a point array given as an object needs \"npy\": file or \"csv\": file with \"shape\"");
+  }
+  return inline_points(j, rank, ptr);
+}
+
+// ---------------------------------------------------------------------------
+// Curves, each mapped onto [0, 1].
+
+BSplineCurve on_unit_domain(BSplineCurve c) {
+  const auto [a, b] = c.domain();
+  if (a == 0.0 && b == 1.0) return c;
+  return c.mapped(0.0, 1.0);
+}
+
+std::vector<Vec3> curve_points(const json& j, std::string_view ptr, Context& ctx) {
+  const PointArray a = points_impl(j, 1, ptr, ctx);
+  if (a.points.size() < 2) fail(errc::too_few_points, place(ptr), ": a curve needs at least 2 points, got ", a.points.size());
+  return {a.points.begin(), a.points.end()};
+}
+
+BSplineCurve interpolated_curve(const json& obj, std::string_view ptr, Context& ctx) {
+  check_fields(obj, ptr, {"interpolate", "degree", "param"}, ctx);
+  const std::string pts_at = child(ptr, "interpolate");
+  const std::vector<Vec3> pts = curve_points(obj.at("interpolate"), pts_at, ctx);
+  const auto degree = degrees(obj, ptr, 1)[0];
+  if (degree && static_cast<std::size_t>(*degree) >= pts.size())
+    fail(errc::too_few_points, degree_pointer(obj, ptr, 0), ": degree ", *degree, " needs at least ", *degree + 1,
+         " points, ", pts_at, " has ", pts.size());
+  const Parametrization param = parametrization(obj, ptr);
+  if (param != Parametrization::uniform)
+    for (std::size_t i = 1; i < pts.size(); ++i)
+      if (pts[i] == pts[i - 1])
+        fail(errc::zero_chord, child(pts_at, i), ": point ", i, " ", pts[i], " coincides with point ", i - 1,
+             " (a zero chord); ", param_name(param), " parameters need distinct consecutive points");
+  CurveInterpolationOptions options;
+  options.degree = degree;
+  options.param = param;
+  return at(ptr, [&] { return on_unit_domain(interpolate_curve(pts, options).curve); });
+}
+
+BSplineCurve bspline_curve(const json& b, std::string_view ptr, Context& ctx) {
+  expect_object(b, ptr, "an object {\"degree\", \"knots\", \"control_points\", \"weights\"}");
+  check_fields(b, ptr, {"degree", "knots", "control_points", "weights"}, ctx);
+  const int p = degree_value(member(b, "degree", ptr, "an integer degree"), child(ptr, "degree"));
+  const std::string kptr = child(ptr, "knots"), cptr = child(ptr, "control_points"), wptr = child(ptr, "weights");
+  std::vector<double> knots = numbers(member(b, "knots", ptr, "an array of knots"), kptr);
+  const PointStorage cps = points_impl(member(b, "control_points", ptr, "a list of points"), 1, cptr, ctx).points;
+  std::vector<Vec3> cp(cps.begin(), cps.end());
+  std::vector<double> w;
+  if (const json* wj = find_member(b, "weights")) w = numbers(*wj, wptr);
+  KnotVector k = at(kptr, [&] { return KnotVector(p, std::move(knots)); });
+  if (static_cast<std::size_t>(k.count()) != cp.size())
+    fail(errc::size_mismatch, cptr, ": ", k.size(), " knots of degree ", p, " need ", k.count(), " control points, got ",
+         cp.size());
+  if (!w.empty() && w.size() != cp.size())
+    fail(errc::size_mismatch, wptr, ": ", cp.size(), " control points need ", cp.size(), " weights, got ", w.size());
+  for (std::size_t i = 0; i < w.size(); ++i)
+    if (!(w[i] > 0)) fail(errc::invalid_weight, child(wptr, i), ": weight ", w[i], " is not positive");
+  return at(ptr, [&] { return on_unit_domain(BSplineCurve(std::move(k), std::move(cp), std::move(w))); });
+}
+
+BSplineCurve hermite_curve(const json& h, std::string_view ptr, Context& ctx) {
+  expect_object(h, ptr, "an object {\"points\", \"tangents\", \"params\"}");
+  check_fields(h, ptr, {"points", "tangents", "params"}, ctx);
+  const std::string pptr = child(ptr, "points"), tptr = child(ptr, "tangents"), uptr = child(ptr, "params");
+  std::vector<Vec3> pts = curve_points(member(h, "points", ptr, "a list of points"), pptr, ctx);
+  std::vector<Vec3> tangents;
+  if (const json* t = find_member(h, "tangents")) {
+    const PointStorage ts = points_impl(*t, 1, tptr, ctx).points;
+    tangents.assign(ts.begin(), ts.end());
+    if (tangents.size() != pts.size())
+      fail(errc::size_mismatch, tptr, ": ", pts.size(), " points need ", pts.size(), " tangents, got ", tangents.size());
+  }
+  std::vector<double> params;
+  if (const json* u = find_member(h, "params")) {
+    params = numbers(*u, uptr);
+    if (params.size() != pts.size())
+      fail(errc::size_mismatch, uptr, ": ", pts.size(), " points need ", pts.size(), " params, got ", params.size());
+    for (std::size_t i = 1; i < params.size(); ++i)
+      if (!(params[i] > params[i - 1]))
+        fail(errc::non_increasing, child(uptr, i), ": param ", params[i], " is not greater than the one before, ",
+             params[i - 1]);
+  }
+  return at(ptr, [&] {
+    return on_unit_domain(HermiteCurve(std::move(pts), std::move(tangents), std::move(params)).to_bspline());
+  });
+}
+
+BSplineCurve line_curve(const json& l, std::string_view ptr, Context& ctx) {
+  const PointStorage pts = points_impl(l, 1, ptr, ctx).points;
+  if (pts.size() != 2) fail(errc::size_mismatch, place(ptr), ": a line needs exactly 2 points [A, B], got ", pts.size());
+  // A == B is allowed: a collapsed boundary (a triangular patch) is a point.
+  return BSplineCurve(KnotVector(1, {0.0, 0.0, 1.0, 1.0}), {pts[0], pts[1]});
+}
+
+BSplineCurve curve_impl(const json& j, std::string_view ptr, Context& ctx) {
+  static constexpr std::array<std::string_view, 4> forms{"interpolate", "bspline", "hermite", "line"};
+  constexpr std::string_view expected =
+      "a curve: an object with one of \"interpolate\", \"bspline\", \"hermite\", \"line\"";
+  if (!j.is_object()) wrong_type(ptr, expected, j);
+  std::vector<std::string_view> present;
+  for (const auto f : forms)
+    if (j.contains(std::string(f))) present.push_back(f);
+  if (present.empty()) fail(errc::missing_field, place(ptr), ": expected ", expected);
+  if (present.size() > 1)
+    fail(errc::wrong_type, place(ptr), ": a curve has exactly one of \"interpolate\", \"bspline\", \"hermite\", \"line\"; got \"",
+         present[0], "\" and \"", present[1], "\"");
+  const std::string_view form = present[0];
+  if (form == "interpolate") return interpolated_curve(j, ptr, ctx);
+  check_fields(j, ptr, {form}, ctx);
+  const json& body = j.at(std::string(form));
+  const std::string bptr = child(ptr, form);
+  if (form == "bspline") return bspline_curve(body, bptr, ctx);
+  if (form == "hermite") return hermite_curve(body, bptr, ctx);
+  return line_curve(body, bptr, ctx);
+}
+
+// ---------------------------------------------------------------------------
+// Surfaces. Each construction type is one function from the spec to a
+// Construction, listed in `construction_types` below.
+
+BSplineSurface on_unit_domain(BSplineSurface s) {
+  const auto [u0, u1] = s.domain_u();
+  const auto [v0, v1] = s.domain_v();
+  if (u0 == 0.0 && u1 == 1.0 && v0 == 0.0 && v1 == 1.0) return s;
+  return s.mapped(0.0, 1.0, 0.0, 1.0);
+}
+
+std::vector<double> to_unit(std::vector<double> t, std::pair<double, double> domain) {
+  const auto [a, b] = domain;
+  if (a == 0.0 && b == 1.0) return t;
+  for (double& x : t) x = std::clamp((x - a) / (b - a), 0.0, 1.0);
+  return t;
+}
+
+Construction build_interpolate(const json& spec, Context& ctx) {
+  check_fields(spec, "", {"type", "points", "degree", "param"}, ctx);
+  PointArray pts = points_impl(member(spec, "points", "", "a grid of points, (n+1) x (m+1) x 3"), 2, "/points", ctx);
+  const auto degree = degrees(spec, "", 2);
+  const Parametrization param = parametrization(spec, "");
+  const std::size_t nu = pts.shape[0], nv = pts.shape[1];
+  for (std::size_t a = 0; a < 2; ++a) {
+    const std::size_t count = pts.shape[a];
+    if (count < 2)
+      fail(errc::too_few_points, "/points: the grid has ", count, " point", count == 1 ? "" : "s", " along ", axis_name(a),
+           " (shape ", nu, "x", nv, "); interpolation needs at least 2");
+    if (degree[a] && static_cast<std::size_t>(*degree[a]) >= count)
+      fail(errc::too_few_points, degree_pointer(spec, "", a), ": degree ", *degree[a], " along ", axis_name(a),
+           " needs at least ", *degree[a] + 1, " points, /points has ", count, " (shape ", nu, "x", nv, ")");
+  }
+  PointGrid grid({nu, nv}, std::move(pts.points));
+  DataSet data;
+  data.pointer = "/points";
+  require_memory(grid.size(), sizeof(Vec3), cat("/points: a copy of the ", nu, "x", nv, " data points for the error check"));
+  data.points.assign(grid.values().begin(), grid.values().end());
+
+  SurfaceInterpolationOptions options;
+  options.degree_u = degree[0];
+  options.degree_v = degree[1];
+  options.param = param;
+  options.progress = ctx.progress;
+  ctx.parsed();
+  SurfaceInterpolation r = at("/points", [&] { return interpolate_surface(std::move(grid), options); });
+
+  data.params = {to_unit(std::move(r.params_u), r.surface.domain_u()), to_unit(std::move(r.params_v), r.surface.domain_v())};
+  BSplineSurface s = on_unit_domain(std::move(r.surface));
+  nlohmann::ordered_json parameters = {{"grid", {nu, nv}}, {"degree", {s.degree_u(), s.degree_v()}}, {"param", param_name(param)}};
+  Construction c{"interpolate", std::move(s), {}, std::move(parameters), {}, {}};
+  c.data.push_back(std::move(data));
+  return c;
+}
+
+Construction build_bspline_surface(const json& spec, Context& ctx) {
+  check_fields(spec, "", {"type", "degree", "knots", "control_points", "weights"}, ctx);
+  member(spec, "degree", "", "an integer degree or [p, q]");
+  const auto degree = degrees(spec, "", 2);
+  const json& knots = member(spec, "knots", "", "an object {\"u\": [...], \"v\": [...]}");
+  expect_object(knots, "/knots", "an object {\"u\": [...], \"v\": [...]}");
+  check_fields(knots, "/knots", {"u", "v"}, ctx);
+  std::vector<double> ku = numbers(member(knots, "u", "/knots", "an array of knots"), "/knots/u");
+  std::vector<double> kv = numbers(member(knots, "v", "/knots", "an array of knots"), "/knots/v");
+  PointArray cp = points_impl(member(spec, "control_points", "", "a grid of control points, (n+1) x (m+1) x 3"), 2,
+                              "/control_points", ctx);
+  Grid<double, 2> weights;
+  if (const json* w = find_member(spec, "weights")) {
+    weights = inline_number_grid(*w, "/weights");
+    if (weights.extent(0) != cp.shape[0] || weights.extent(1) != cp.shape[1])
+      fail(errc::size_mismatch, "/weights: shape ", weights.extent(0), "x", weights.extent(1), " differs from ",
+           "/control_points, ", cp.shape[0], "x", cp.shape[1]);
+    for (std::size_t i = 0; i < weights.extent(0); ++i)
+      for (std::size_t j = 0; j < weights.extent(1); ++j)
+        if (!(weights(i, j) > 0))
+          fail(errc::invalid_weight, "/weights/", i, "/", j, ": weight ", weights(i, j), " is not positive");
+  }
+  KnotVector knots_u = at("/knots/u", [&] { return KnotVector(*degree[0], std::move(ku)); });
+  KnotVector knots_v = at("/knots/v", [&] { return KnotVector(*degree[1], std::move(kv)); });
+  const KnotVector* k[2] = {&knots_u, &knots_v};
+  for (std::size_t a = 0; a < 2; ++a)
+    if (static_cast<std::size_t>(k[a]->count()) != cp.shape[a])
+      fail(errc::size_mismatch, "/control_points: ", cp.shape[a], " control points along ", axis_name(a), " (shape ",
+           cp.shape[0], "x", cp.shape[1], "), but the ", k[a]->size(), " knots of degree ", k[a]->degree(), " in /knots/",
+           axis_name(a), " need ", k[a]->count());
+  ctx.parsed();
+  BSplineSurface s = at("/control_points", [&] {
+    return BSplineSurface(std::move(knots_u), std::move(knots_v), PointGrid({cp.shape[0], cp.shape[1]}, std::move(cp.points)),
+                          std::move(weights));
+  });
+  const auto [u0, u1] = s.domain_u();
+  const auto [v0, v1] = s.domain_v();
+  nlohmann::ordered_json parameters = {{"domain", {{"u", {u0, u1}}, {"v", {v0, v1}}}}};
+  return Construction{"bspline_surface", on_unit_domain(std::move(s)), {}, std::move(parameters), {}, {}};
+}
+
+struct ConstructionType {
+  std::string_view name;
+  Construction (*build)(const json& spec, Context& ctx);
+};
+
+// Adding a construction: one function above, one line here.
+constexpr ConstructionType construction_types[] = {
+    {"interpolate", build_interpolate},
+    {"bspline_surface", build_bspline_surface},
+};
+
+std::string type_list() {
+  std::string s;
+  for (const auto& t : construction_types) s += cat(s.empty() ? "" : ", ", t.name);
+  return s;
+}
+
+Construction build_impl(const json& spec, Context& ctx) {
+  if (!spec.is_object())
+    fail(errc::wrong_type, "(top level): the spec must be a JSON object with a \"type\", got ", kind(spec));
+  const json& t = member(spec, "type", "", cat("a string, one of ", type_list()));
+  if (!t.is_string()) wrong_type("/type", cat("a string, one of ", type_list()), t);
+  const auto& name = t.get_ref<const std::string&>();
+  const auto it = std::find_if(std::begin(construction_types), std::end(construction_types),
+                               [&](const ConstructionType& c) { return c.name == name; });
+  if (it == std::end(construction_types))
+    fail(errc::unknown_type, "/type: unknown type \"", name, "\"; known types: ", type_list());
+  Construction c = it->build(spec, ctx);
+  const auto done = Clock::now();
+  const auto parsed = ctx.parsed_at.value_or(done);
+  c.type = name;
+  c.warnings = std::move(ctx.warnings);
+  c.timings.parse_ms = ms_between(ctx.start, parsed);
+  c.timings.build_ms = ms_between(parsed, done);
+  return c;
+}
+
+std::pair<std::size_t, std::size_t> line_column(std::string_view text, std::size_t pos) {
+  pos = std::min(pos, text.size());
+  std::size_t line = 1, start = 0;
+  for (std::size_t i = 0; i < pos; ++i)
+    if (text[i] == '\n') {
+      ++line;
+      start = i + 1;
+    }
+  return {line, pos - start + 1};
+}
+
+}  // namespace
+
+std::vector<std::string_view> known_types() {
+  std::vector<std::string_view> v;
+  for (const auto& t : construction_types) v.push_back(t.name);
+  return v;
+}
+
+json parse_json(std::string_view text, std::string_view source) {
+  try {
+    return json::parse(text.begin(), text.end());
+  } catch (const json::parse_error& e) {
+    // e.byte is the 1-based offset of the last character read.
+    std::size_t pos = e.byte == 0 ? 0 : std::min<std::size_t>(e.byte - 1, text.size());
+    // A literal the lexer stopped in: back up to where the word starts.
+    std::size_t start = pos;
+    while (start > 0 && std::isalpha(static_cast<unsigned char>(text[start - 1]))) --start;
+    std::size_t end = start;
+    while (end < text.size() && std::isalpha(static_cast<unsigned char>(text[end]))) ++end;
+    const std::string_view word = text.substr(start, end - start);
+    if (word == "NaN" || word == "nan" || word == "Infinity" || word == "inf" || word == "infinity" || word == "Inf") {
+      const bool minus = start > 0 && text[start - 1] == '-';
+      const auto [line, col] = line_column(text, minus ? start - 1 : start);
+      fail(errc::not_finite, source, ":", line, ":", col, ": ", minus ? "-" : "", word,
+           " is not a JSON number; coordinates, knots and weights must be finite");
+    }
+    const auto [line, col] = line_column(text, pos);
+    std::string what = e.what();
+    // Keep nlohmann's description, drop its prefix with its own position.
+    if (const auto c = what.find("column "); c != std::string::npos)
+      if (const auto colon = what.find(": ", c); colon != std::string::npos) what = what.substr(colon + 2);
+    fail(errc::invalid_json, source, ":", line, ":", col, ": invalid JSON: ", what);
+  } catch (const json::out_of_range& e) {
+    // A number beyond the range of double (1e999); nlohmann names the token only.
+    const std::string what = e.what();
+    std::string token;
+    if (const auto q = what.find('\''); q != std::string::npos)
+      if (const auto q2 = what.find('\'', q + 1); q2 != std::string::npos) token = what.substr(q + 1, q2 - q - 1);
+    const std::size_t pos = token.empty() ? std::string_view::npos : text.find(token);
+    if (pos == std::string_view::npos) fail(errc::not_finite, source, ": a number is too large for a double");
+    const auto [line, col] = line_column(text, pos);
+    fail(errc::not_finite, source, ":", line, ":", col, ": number ", token, " is too large for a double");
+  }
+}
+
+json read_json_file(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::string name = path.string();
+  if (!std::filesystem::exists(path, ec)) fail(errc::file_unreadable, name, ": cannot read: no such file");
+  if (std::filesystem::is_directory(path, ec)) fail(errc::file_unreadable, name, ": cannot read: it is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(errc::file_unreadable, name, ": cannot open: ", std::strerror(errno));
+  const auto size = std::filesystem::file_size(path, ec);
+  // The parsed document takes a few times the text; refuse what cannot fit.
+  if (!ec) require_memory(static_cast<std::size_t>(size), 4, cat(name, ": a JSON spec of ", size, " bytes"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) fail(errc::file_unreadable, name, ": read error: ", std::strerror(errno));
+  return parse_json(text, name);
+}
+
+Construction build(const json& spec, const std::filesystem::path& base_dir, const progress_callback& progress) {
+  Context ctx;
+  ctx.base_dir = base_dir;
+  ctx.progress = progress;
+  return build_impl(spec, ctx);
+}
+
+Construction build_file(const std::filesystem::path& spec_path, const progress_callback& progress) {
+  Context ctx;  // starts the clock: reading the file counts as parsing
+  const json spec = read_json_file(spec_path);
+  ctx.base_dir = spec_path.parent_path();
+  ctx.progress = progress;
+  return build_impl(spec, ctx);
+}
+
+PointArray points_from_json(const json& j, std::size_t rank, const std::filesystem::path& base_dir, std::string_view pointer) {
+  if (rank < 1 || rank > 3) fail(errc::internal, "points_from_json: rank ", rank, " is outside 1..3");
+  Context ctx;
+  ctx.base_dir = base_dir;
+  return points_impl(j, rank, pointer, ctx);
+}
+
+BSplineCurve curve_from_json(const json& j, const std::filesystem::path& base_dir, std::string_view pointer) {
+  Context ctx;
+  ctx.base_dir = base_dir;
+  return curve_impl(j, pointer, ctx);
+}
+
+}  // namespace interpatch::io

@@ -1,0 +1,69 @@
+#pragma once
+// The interpatch subcommands (SPEC section 5), shared by main.cpp and the demo.
+// Each command checks its usage and its output path before any work, builds the
+// spec, and writes through the atomic writers. Errors propagate as exceptions:
+// interpatch::error (exit status from exit_status()), usage_error (exit 2).
+
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+#include "interpatch/io/spec.hpp"
+
+namespace interpatch::cli {
+
+/// Bad usage of the command line; the command exits with 2.
+class usage_error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Vertices per direction of a mesh.
+struct Resolution {
+  std::size_t nu = 64, nv = 64;
+};
+
+/// "NUxNV" (also "NUXNV"), both counts at least 2. @throws usage_error.
+Resolution parse_resolution(std::string_view text);
+
+/// "K", at least 2. A K too large to count is returned as the largest size_t, so
+/// the memory check refuses it (exit 5) rather than calling it bad usage.
+/// @throws usage_error.
+std::size_t parse_grid(std::string_view text);
+
+/// Refuse an output format the command does not write (usage_error), then an output
+/// path that cannot be written (error file_unwritable), before any work.
+void check_build_output(const std::filesystem::path& out);
+void check_mesh_output(const std::filesystem::path& out);
+void check_eval_output(const std::filesystem::path& out);
+void check_info_output(const std::filesystem::path& out);
+
+/// Refuse (error too_large) an evaluation grid or a mesh that cannot fit in memory.
+void require_eval_memory(std::size_t k, const std::filesystem::path& out);
+void require_mesh_memory(const Resolution& res);
+
+/// The outputs, from a built construction.
+void write_build(const io::Construction& c, const std::filesystem::path& out);
+void write_mesh(const io::Construction& c, const std::filesystem::path& out, const Resolution& res);
+void write_eval(const io::Construction& c, const std::filesystem::path& out, std::size_t k);
+nlohmann::ordered_json info(const io::Construction& c);
+
+/// Builds a spec file, showing progress on a terminal.
+io::Construction build_spec(const std::filesystem::path& spec);
+
+/// The subcommands; each returns the exit status of success (0).
+int build_command(const std::filesystem::path& spec, const std::filesystem::path& out);
+int mesh_command(const std::filesystem::path& spec, const std::filesystem::path& out, std::string_view res);
+int eval_command(const std::filesystem::path& spec, const std::filesystem::path& out, std::string_view grid);
+int info_command(const std::filesystem::path& spec, const std::optional<std::filesystem::path>& out);
+int demo_command(const std::filesystem::path& dir);
+
+/// Prints the warnings of a construction (ignored fields) on stderr.
+void report_warnings(const io::Construction& c);
+
+}  // namespace interpatch::cli

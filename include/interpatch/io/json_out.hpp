@@ -1,0 +1,80 @@
+#pragma once
+/// @file io/json_out.hpp
+/// What `interpatch build -o x.json` and `interpatch info` write: the exact form as
+/// a spec that reads back, and the description of a construction with its error
+/// at the data.
+
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "interpatch/io/spec.hpp"
+#include "interpatch/knot_vector.hpp"
+#include "interpatch/progress.hpp"
+
+namespace interpatch::io {
+
+/// Writes the exact form as a spec that build() reads back to the same surface. For
+/// a surface that is
+/// `{"type": "bspline_surface", "degree": [p, q], "knots": {"u": [...], "v": [...]},
+/// "control_points": [[[x, y, z], ...], ...], "weights": [[...], ...]}` with
+/// control_points (n+1) × (m+1) × 3 (first index along u) and weights only when
+/// rational. Numbers are written in the shortest form that reads back to the same
+/// double.
+///
+/// Example:
+/// @code
+///   interpatch::io::write_exact_json(std::cout, construction.exact);
+/// @endcode
+void write_exact_json(std::ostream& os, const ExactForm& exact);
+
+/// The same, written atomically to a file. @throws error file_unwritable.
+void write_exact_json(const std::filesystem::path& path, const ExactForm& exact);
+
+/// How far the exact form is from the data it interpolates.
+struct DataError {
+  double absolute = 0;   ///< the largest distance |S(params) − point|
+  double relative = 0;   ///< absolute / diagonal (0 when the diagonal is 0 and so is the error)
+  double diagonal = 0;   ///< diagonal of the bounding box of the data points
+  std::size_t count = 0; ///< data points checked
+  std::string pointer;   ///< JSON Pointer of the worst data point, e.g. "/points/3/7"
+  std::vector<double> params;  ///< the parameters of the worst data point
+};
+
+/// The largest distance between the exact form evaluated at the data parameters and
+/// the data points; nothing when the construction has no data (an exact spec).
+/// Evaluates in blocks of rows, so the check needs little memory beyond the data.
+/// @throws error too_large.
+[[nodiscard]] std::optional<DataError> max_data_error(const Construction& c, const progress_callback& progress = {});
+
+/// "C2" for a knot vector whose continuity (degree − highest interior multiplicity)
+/// is 2; "Cinf" when there are no interior knots (one polynomial or rational piece).
+[[nodiscard]] std::string continuity_name(const KnotVector& knots);
+
+/// The description `interpatch info` prints, computing the data error (its time is
+/// timings.check_ms):
+/// `{"type", "kind": "surface", "exact_form": "bspline_surface", "degree": [p, q],
+/// "control_points": [n+1, m+1], "rational", "knots": {"u", "v"},
+/// "continuity": {"u": "C2", "v": "C2"}, "domain", "bounding_box": {"min", "max",
+/// "diagonal"} (of the control net, which contains the surface),
+/// "max_data_error": {"absolute", "relative", "diagonal", "points", "at", "params"} or
+/// null, "data": [{"pointer", "shape", "params": {"u", "v"}}], "parameters",
+/// "warnings", "timings": {"parse_ms", "build_ms", "check_ms", "total_ms"}}`.
+/// @throws error too_large.
+[[nodiscard]] nlohmann::ordered_json info_json(const Construction& c, const progress_callback& progress = {});
+
+/// JSON text for people: two-space indentation, but arrays of plain values (a
+/// point, a knot vector) on one line. Ends with a newline.
+///
+/// Example:
+/// @code
+///   std::cout << interpatch::io::pretty_json(interpatch::io::info_json(c));
+/// @endcode
+[[nodiscard]] std::string pretty_json(const nlohmann::ordered_json& j);
+
+}  // namespace interpatch::io

@@ -1,0 +1,148 @@
+#pragma once
+/// @file io/spec.hpp
+/// Reading a SPEC.json (SPEC section 5) into a construction: the exact B-spline
+/// form, the data it interpolates, and the options in effect.
+///
+/// Every error names the place as a JSON Pointer into the spec (`/points/3/7/2`,
+/// `/boundary/u1/interpolate/3`), or a file with row and column, and the size of
+/// the problem. Errors raised by the library while building a part of the spec keep
+/// their code and get the pointer of that part put in front of their message.
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "interpatch/allocator.hpp"
+#include "interpatch/bspline_curve.hpp"
+#include "interpatch/bspline_surface.hpp"
+#include "interpatch/progress.hpp"
+#include "interpatch/vec3.hpp"
+
+namespace interpatch::io {
+
+/// Points in C order, in the storage grids use (so a grid takes them without a copy).
+using PointStorage = std::vector<Vec3, large_allocator<Vec3>>;
+
+/// Points a construction interpolates, as a tensor grid: `points` holds the data
+/// point for every combination of the parameters in `params` (one list per
+/// parameter axis: u, v[, w]), in C order, first axis slowest. The exact form
+/// evaluated at (params[0][i], params[1][j]) should reproduce points[i * nv + j].
+struct DataSet {
+  std::vector<std::vector<double>> params;
+  PointStorage points;
+  /// JSON Pointer of the spec field the points came from, e.g. "/points"; the
+  /// pointer of one point appends its indices ("/points/3/7").
+  std::string pointer;
+};
+
+/// The exact B-spline form of a construction, over [0,1]² (a BSplineVolume over
+/// [0,1]³ joins when volumes do).
+using ExactForm = std::variant<BSplineSurface>;
+
+/// Wall-clock milliseconds spent on each stage.
+struct Timings {
+  double parse_ms = 0;  ///< reading the spec and its data files, checking fields
+  double build_ms = 0;  ///< the construction itself
+};
+
+/// A spec, built.
+struct Construction {
+  std::string type;        ///< the spec's "type"
+  ExactForm exact;         ///< exact B-spline form over the unit domain
+  std::vector<DataSet> data;  ///< what it interpolates (empty when given exactly)
+  /// The options in effect, defaults filled in (degree, param, grid shape, ...).
+  nlohmann::ordered_json parameters = nlohmann::ordered_json::object();
+  /// Fields that were ignored (unknown names), each "pointer: reason".
+  std::vector<std::string> warnings;
+  Timings timings;
+};
+
+/// The construction types a spec's "type" may name, in the order they are documented.
+[[nodiscard]] std::vector<std::string_view> known_types();
+
+/// Parses JSON text. `source` names the text in messages (the file name).
+/// NaN and Infinity literals, which some writers emit, are refused as non-finite
+/// values rather than as a syntax error.
+///
+/// Example:
+/// @code
+///   auto j = interpatch::io::parse_json(R"({"type": "interpolate"})", "spec.json");
+/// @endcode
+/// @throws error invalid_json ("spec.json:3:14: ..." with line and column),
+///   not_finite (a NaN/Infinity literal or a number too large for a double, with line and column).
+[[nodiscard]] nlohmann::json parse_json(std::string_view text, std::string_view source = "spec");
+
+/// Reads and parses a JSON file. @throws error file_unreadable, and what parse_json throws.
+[[nodiscard]] nlohmann::json read_json_file(const std::filesystem::path& path);
+
+/// Builds the construction a parsed spec describes. File references inside the spec
+/// (`{"npy": ...}`, `{"csv": ...}`) are relative to `base_dir`. `progress` gets
+/// the fraction done of long constructions.
+///
+/// Example:
+/// @code
+///   auto spec = nlohmann::json::parse(R"({"type": "interpolate", "degree": 1,
+///       "points": [[[0,0,0],[0,1,0]], [[1,0,0],[1,1,1]]]})");
+///   interpatch::io::Construction c = interpatch::io::build(spec);
+///   const auto& s = std::get<interpatch::BSplineSurface>(c.exact);  // bilinear, 2 × 2 control points
+/// @endcode
+/// @throws error unknown_type (listing the known types), missing_field and wrong_type
+///   (naming the pointer and the expected type), ragged_grid, not_finite, size_mismatch,
+///   file_unreadable and malformed_file (data files), too_large, and whatever the
+///   construction raises (too_few_points, invalid_degree, zero_chord, non_increasing,
+///   invalid_knots, invalid_weight, singular, ...), prefixed with the pointer.
+[[nodiscard]] Construction build(const nlohmann::json& spec, const std::filesystem::path& base_dir = {},
+                                 const progress_callback& progress = {});
+
+/// Reads a spec file and builds it; data files are found relative to the spec's
+/// directory. The time spent reading and parsing the file counts into parse_ms.
+/// @throws error file_unreadable, invalid_json, and what build() throws.
+[[nodiscard]] Construction build_file(const std::filesystem::path& spec_path, const progress_callback& progress = {});
+
+/// A point array read from a spec field: `shape` is the grid shape without the
+/// trailing 3, `points` the points in C order (first index slowest).
+struct PointArray {
+  std::vector<std::size_t> shape;
+  PointStorage points;
+};
+
+/// Reads a point array of the given rank (1: a list of points, 2: a grid, 3: a
+/// volume grid) from any of its three forms: nested lists of [x, y, z],
+/// `{"npy": "file.npy"}` (shape (..., 3)) or `{"csv": "file.csv", "shape": [...]}`
+/// (the shape with or without the trailing 3). `pointer` is the field's place in
+/// the spec, used in messages.
+///
+/// Example:
+/// @code
+///   auto a = interpatch::io::points_from_json(nlohmann::json::parse("[[0,0,0],[1,0,0]]"), 1);
+///   // a.shape == {2}
+/// @endcode
+/// @throws error wrong_type, ragged_grid (naming the short row and both lengths, or a
+///   point that is not 3 numbers), not_finite (naming the coordinate, /points/3/7/2),
+///   too_few_points (an empty list), size_mismatch (a file's shape), file_unreadable,
+///   malformed_file, too_large.
+[[nodiscard]] PointArray points_from_json(const nlohmann::json& j, std::size_t rank,
+                                          const std::filesystem::path& base_dir = {}, std::string_view pointer = "");
+
+/// Reads a curve in any of its forms (SPEC section 5) — `{"interpolate": points,
+/// "degree": p, "param": "chord"}`, `{"bspline": {"degree", "knots",
+/// "control_points", "weights"}}`, `{"hermite": {"points", "tangents", "params"}}`,
+/// `{"line": [A, B]}` — as a B-spline curve over [0, 1] (its own domain mapped
+/// linearly).
+///
+/// Example:
+/// @code
+///   auto c = interpatch::io::curve_from_json(nlohmann::json::parse(R"({"line": [[0,0,0], [2,0,0]]})"));
+///   // c.point(0.5) == (1, 0, 0)
+/// @endcode
+/// @throws error missing_field, wrong_type, and the codes of points_from_json and of
+///   the curve constructions, each naming its place under `pointer`.
+[[nodiscard]] BSplineCurve curve_from_json(const nlohmann::json& j, const std::filesystem::path& base_dir = {},
+                                           std::string_view pointer = "");
+
+}  // namespace interpatch::io

@@ -1,0 +1,489 @@
+// The interpatch command as other programs use it (SPEC section 5): the real binary,
+// run in a fresh directory, its outputs and exit statuses checked, and every failure
+// checked to be exactly one line on stderr that names the place.
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "test_util.hpp"
+
+namespace interpatch {
+namespace {
+
+#ifdef INTERPATCH_CLI
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void write_file(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+}
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (const char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+struct Result {
+  int status = -1;
+  std::string out, err;
+  double seconds = 0;
+};
+
+// A fresh working directory per test, and a separate one for the captured streams,
+// so that listing the working directory shows only what the command wrote.
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    static std::atomic<int> counter{0};
+    root_ = fs::temp_directory_path() / ("interpatch-cli-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    fs::create_directories(root_ / "work");
+    fs::create_directories(root_ / "capture");
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(root_, ec);
+  }
+
+  [[nodiscard]] fs::path work() const { return root_ / "work"; }
+  [[nodiscard]] fs::path at(const std::string& name) const { return work() / name; }
+
+  Result run(const std::vector<std::string>& args) const {
+    std::string cmd = "cd " + quote(work().string()) + " && " + quote(INTERPATCH_CLI);
+    for (const auto& a : args) cmd += " " + quote(a);
+    cmd += " >" + quote((root_ / "capture" / "out").string()) + " 2>" + quote((root_ / "capture" / "err").string()) +
+           " </dev/null";
+    const auto t0 = std::chrono::steady_clock::now();
+    const int rc = std::system(cmd.c_str());
+    Result r;
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+    r.out = read_file(root_ / "capture" / "out");
+    r.err = read_file(root_ / "capture" / "err");
+    return r;
+  }
+
+  [[nodiscard]] std::set<std::string> listing() const {
+    std::set<std::string> names;
+    for (const auto& e : fs::directory_iterator(work())) names.insert(e.path().filename().string());
+    return names;
+  }
+
+  // A valid 4x5 grid spec, written to NAME.
+  void write_grid_spec(const std::string& name, unsigned seed = 1, std::size_t nu = 4, std::size_t nv = 5) const {
+    write_file(at(name), grid_spec(seed, nu, nv).dump());
+  }
+
+  static json grid_json(const PointGrid& q) {
+    json rows = json::array();
+    for (std::size_t i = 0; i < q.extent(0); ++i) {
+      json row = json::array();
+      for (std::size_t j = 0; j < q.extent(1); ++j) row.push_back({q(i, j).x, q(i, j).y, q(i, j).z});
+      rows.push_back(row);
+    }
+    return rows;
+  }
+
+  static json grid_spec(unsigned seed, std::size_t nu, std::size_t nv) {
+    auto g = test::rng(seed);
+    return {{"type", "interpolate"}, {"points", grid_json(test::random_grid(g, nu, nv))}};
+  }
+
+  fs::path root_;
+};
+
+// Exactly one line, "interpatch: ...", containing every fragment.
+void expect_one_line_error(const Result& r, int status, std::initializer_list<std::string> fragments) {
+  EXPECT_EQ(r.status, status) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("interpatch: ", 0), 0u) << r.err;
+  EXPECT_EQ(r.err.back(), '\n') << r.err;
+  for (const auto& f : fragments) EXPECT_NE(r.err.find(f), std::string::npos) << "'" << r.err << "' lacks '" << f << "'";
+}
+
+// --- NPY as NumPy writes it -------------------------------------------------------
+
+struct Npy {
+  std::string descr;
+  bool fortran = true;
+  std::vector<std::size_t> shape;
+  std::vector<double> data;
+};
+
+Npy parse_npy(const std::string& bytes) {
+  Npy n;
+  EXPECT_EQ(bytes.substr(0, 6), "\x93NUMPY");
+  const int major = static_cast<unsigned char>(bytes[6]);
+  const std::size_t len_size = major == 1 ? 2 : 4;
+  std::size_t header_len = 0;
+  for (std::size_t i = 0; i < len_size; ++i) header_len |= static_cast<std::size_t>(static_cast<unsigned char>(bytes[8 + i])) << (8 * i);
+  const std::size_t start = 8 + len_size;
+  EXPECT_EQ((start + header_len) % 64, 0u);  // data aligned as NumPy does
+  const std::string header = bytes.substr(start, header_len);
+  // The text after `key` up to the first `close` past the first `open`.
+  const auto value = [&](const std::string& key, char open, char close) {
+    const auto k = header.find(key);
+    if (k == std::string::npos) return std::string();
+    const auto a = header.find(open, k + key.size());
+    const auto b = header.find(close, a + 1);
+    return a == std::string::npos || b == std::string::npos ? std::string() : header.substr(a + 1, b - a - 1);
+  };
+  n.descr = value("'descr':", '\'', '\'');
+  n.fortran = header.find("'fortran_order': True") != std::string::npos;
+  std::stringstream ss(value("'shape':", '(', ')'));
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (item.find_first_not_of(' ') != std::string::npos) n.shape.push_back(std::stoul(item));
+  const std::size_t count = (bytes.size() - start - header_len) / 8;
+  n.data.resize(count);
+  std::memcpy(n.data.data(), bytes.data() + start + header_len, count * 8);  // little endian host
+  return n;
+}
+
+// --- the subcommands on real specs ------------------------------------------------------
+
+TEST_F(CliTest, InfoPrintsOneObjectWithTheContractFields) {
+  write_grid_spec("s.json", 1, 6, 9);
+  const Result r = run({"info", "s.json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["type"], "interpolate");
+  EXPECT_EQ(j["kind"], "surface");
+  EXPECT_EQ(j["degree"], json({3, 3}));
+  EXPECT_EQ(j["control_points"], json({6, 9}));
+  EXPECT_EQ(j["knots"]["u"].size(), 10u);
+  EXPECT_EQ(j["knots"]["v"].size(), 13u);
+  EXPECT_LT(j["max_data_error"]["relative"].get<double>(), 1e-12);
+  EXPECT_EQ(j["continuity"], json({{"u", "C2"}, {"v", "C2"}}));
+  for (const char* t : {"parse_ms", "build_ms", "check_ms"}) EXPECT_TRUE(j["timings"][t].is_number()) << t;
+}
+
+TEST_F(CliTest, BuildWritesTheExactFormAndItRoundTrips) {
+  write_grid_spec("s.json", 2, 5, 7);
+  Result r = run({"build", "s.json", "-o", "exact.json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  const json exact = json::parse(read_file(at("exact.json")));
+  EXPECT_EQ(exact["type"], "bspline_surface");
+  EXPECT_EQ(exact["control_points"].size(), 5u);
+  EXPECT_EQ(exact["control_points"][0].size(), 7u);
+
+  // The written file is a spec: info on it and on the original agree exactly.
+  const json a = json::parse(run({"info", "s.json"}).out);
+  r = run({"info", "exact.json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json b = json::parse(r.out);
+  EXPECT_EQ(b["type"], "bspline_surface");
+  EXPECT_EQ(a["knots"], b["knots"]);
+  EXPECT_EQ(a["degree"], b["degree"]);
+  EXPECT_EQ(a["bounding_box"], b["bounding_box"]);
+  EXPECT_TRUE(b["max_data_error"].is_null());
+  // Built again, the exact form is the same text.
+  ASSERT_EQ(run({"build", "exact.json", "-o", "again.json"}).status, 0);
+  EXPECT_EQ(read_file(at("exact.json")), read_file(at("again.json")));
+}
+
+TEST_F(CliTest, EvalWritesNpyKxKx3LittleEndianCOrderUFirst) {
+  const json spec = grid_spec(3, 4, 6);
+  write_file(at("s.json"), spec.dump());
+  const Result r = run({"eval", "s.json", "--grid", "17", "-o", "g.npy"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Npy n = parse_npy(read_file(at("g.npy")));
+  EXPECT_EQ(n.descr, "<f8");
+  EXPECT_FALSE(n.fortran);
+  EXPECT_EQ(n.shape, std::vector<std::size_t>({17, 17, 3}));
+  ASSERT_EQ(n.data.size(), 17u * 17u * 3u);
+  // The corners of [0,1]^2 are the corner data points: [0][16] is u = 0, v = 1.
+  const auto& pts = spec["points"];
+  const auto value = [&](std::size_t i, std::size_t j, std::size_t k) { return n.data[(i * 17 + j) * 3 + k]; };
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_NEAR(value(0, 0, k), pts[0][0][k].get<double>(), 1e-12);
+    EXPECT_NEAR(value(0, 16, k), pts[0][5][k].get<double>(), 1e-12);
+    EXPECT_NEAR(value(16, 0, k), pts[3][0][k].get<double>(), 1e-12);
+    EXPECT_NEAR(value(16, 16, k), pts[3][5][k].get<double>(), 1e-12);
+  }
+}
+
+TEST_F(CliTest, EvalWritesCsvWithHeaderAndRowsUOutermost) {
+  write_grid_spec("s.json", 4);
+  const Result r = run({"eval", "s.json", "--grid", "5", "-o", "g.csv"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::istringstream in(read_file(at("g.csv")));
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "u,v,x,y,z");
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    std::vector<double> row;
+    std::stringstream ss(line);
+    std::string f;
+    while (std::getline(ss, f, ',')) row.push_back(std::stod(f));
+    EXPECT_EQ(row.size(), 5u) << line;
+    rows.push_back(row);
+  }
+  ASSERT_EQ(rows.size(), 25u);
+  EXPECT_EQ(rows[1][0], 0.0);   // u outermost: second row is u = 0, v = 0.25
+  EXPECT_EQ(rows[1][1], 0.25);
+  EXPECT_EQ(rows[5][0], 0.25);  // the next u
+  EXPECT_EQ(rows[5][1], 0.0);
+  EXPECT_EQ(rows[24][0], 1.0);
+  EXPECT_EQ(rows[24][1], 1.0);
+}
+
+TEST_F(CliTest, MeshWritesEveryFormatAtTheRequestedResolution) {
+  write_grid_spec("s.json", 5);
+  for (const char* ext : {".obj", ".stl", ".ply", ".vtk", ".vts", ".xyz"}) {
+    const std::string name = std::string("m") + ext;
+    const Result r = run({"mesh", "s.json", "-o", name, "--res", "9x7"});
+    ASSERT_EQ(r.status, 0) << ext << ": " << r.err;
+    EXPECT_GT(fs::file_size(at(name)), 100u) << ext;
+  }
+  const std::string obj = read_file(at("m.obj"));
+  std::istringstream in(obj);
+  std::string line;
+  std::size_t vertices = 0, normals = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("v ", 0) == 0) ++vertices;
+    if (line.rfind("vn ", 0) == 0) ++normals;
+  }
+  EXPECT_EQ(vertices, 63u);
+  EXPECT_EQ(normals, 63u);
+  EXPECT_NE(read_file(at("m.ply")).find("element vertex 63"), std::string::npos);
+  // The default resolution is 64x64.
+  ASSERT_EQ(run({"mesh", "s.json", "-o", "d.ply"}).status, 0);
+  EXPECT_NE(read_file(at("d.ply")).find("element vertex 4096"), std::string::npos);
+}
+
+TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
+  const Result r = run({"demo", "-o", "out"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("outputs in out"), std::string::npos) << r.out;
+  for (const char* name : {"hemisphere", "terrain", "wave", "saddle", "half_cylinder", "twisted_strip"}) {
+    for (const char* suffix : {".spec.json", ".bspline.json", ".eval.npy", ".eval.csv", ".obj", ".vtk", ".info.json"})
+      EXPECT_TRUE(fs::exists(at("out") / (std::string(name) + suffix))) << name << suffix;
+    const json info = json::parse(read_file(at("out") / (std::string(name) + ".info.json")));
+    EXPECT_LT(info["max_data_error"]["relative"].get<double>(), 1e-12) << name;
+  }
+  EXPECT_TRUE(fs::exists(at("out") / "half_cylinder.npy"));
+  EXPECT_TRUE(fs::exists(at("out") / "twisted_strip.csv"));
+  EXPECT_TRUE(fs::exists(at("out") / "hemisphere.stl"));
+  EXPECT_NE(r.out.find("rebuilt identically"), std::string::npos) << r.out;
+  const json exact = json::parse(read_file(at("out") / "wave.bspline.json"));
+  EXPECT_EQ(exact["degree"], json({2, 3}));
+  const json saddle = json::parse(read_file(at("out") / "saddle.info.json"));
+  EXPECT_EQ(saddle["degree"], json({5, 5}));
+  // A demo directory whose parent is missing is refused, not created.
+  expect_one_line_error(run({"demo", "-o", "no/such/dir"}), 4, {"no/such"});
+  EXPECT_FALSE(fs::exists(at("no")));
+}
+
+TEST_F(CliTest, CheckedInExamplesBuild) {
+  std::size_t count = 0;
+  for (const auto& e : fs::directory_iterator(INTERPATCH_EXAMPLES)) {
+    if (e.path().extension() != ".json") continue;
+    ++count;
+    const Result r = run({"info", e.path().string()});
+    ASSERT_EQ(r.status, 0) << e.path() << ": " << r.err;
+    const json j = json::parse(r.out);
+    if (!j["max_data_error"].is_null()) {
+      EXPECT_LT(j["max_data_error"]["relative"].get<double>(), 1e-12) << e.path();
+    }
+  }
+  EXPECT_GE(count, 3u);
+}
+
+// --- one test per exit status and error kind ---------------------------------------------
+
+TEST_F(CliTest, InvalidJsonExits3WithLineAndColumn) {
+  write_file(at("bad.json"), "{\"type\": \"interpolate\",\n  \"points\": [[[0,0,0]],]\n}");
+  expect_one_line_error(run({"info", "bad.json"}), 3, {"bad.json:2:", "invalid JSON"});
+}
+
+TEST_F(CliTest, UnknownTypeExits3ListingTheKnownTypes) {
+  write_file(at("s.json"), R"({"type": "coonz"})");
+  expect_one_line_error(run({"build", "s.json", "-o", "o.json"}), 3, {"/type", "coonz", "interpolate"});
+  EXPECT_FALSE(fs::exists(at("o.json")));
+}
+
+TEST_F(CliTest, MissingFieldExits3NamingThePointer) {
+  write_file(at("s.json"), R"({"type": "interpolate", "degree": 3})");
+  expect_one_line_error(run({"info", "s.json"}), 3, {"/points", "missing"});
+}
+
+TEST_F(CliTest, WrongTypeExits3NamingTheExpectedType) {
+  json spec = grid_spec(1, 4, 5);
+  spec["param"] = 3;
+  write_file(at("s.json"), spec.dump());
+  expect_one_line_error(run({"info", "s.json"}), 3, {"/param", "expected a string"});
+}
+
+TEST_F(CliTest, NanLiteralExits3WithLineAndColumn) {
+  write_file(at("s.json"), "{\"type\": \"interpolate\",\n \"points\": [[[0,0,0],[1,0,0]],[[0,1,0],[1,1,NaN]]]}");
+  expect_one_line_error(run({"info", "s.json"}), 3, {"s.json:2:", "NaN"});
+}
+
+TEST_F(CliTest, NanInADataFileExits3NamingTheCoordinate) {
+  // A (2, 3, 3) float64 .npy with a NaN at [1][2][0].
+  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3, 3), }";
+  header.append(64 - (10 + header.size() + 1) % 64, ' ');
+  header += '\n';
+  std::string bytes = std::string("\x93NUMPY\x01\x00", 8);
+  bytes += static_cast<char>(header.size() & 0xff);
+  bytes += static_cast<char>(header.size() >> 8);
+  bytes += header;
+  for (int k = 0; k < 18; ++k) {
+    double v = k == 15 ? std::nan("") : static_cast<double>(k * k % 7) + k;
+    char b[8];
+    std::memcpy(b, &v, 8);
+    bytes.append(b, 8);
+  }
+  write_file(at("grid.npy"), bytes);
+  write_file(at("s.json"), R"({"type": "interpolate", "points": {"npy": "grid.npy"}})");
+  expect_one_line_error(run({"info", "s.json"}), 3, {"/points/1/2/0", "nan"});
+}
+
+TEST_F(CliTest, RaggedGridExits3NamingTheRowAndBothLengths) {
+  json spec = grid_spec(1, 4, 5);
+  spec["points"][1].erase(0);
+  write_file(at("s.json"), spec.dump());
+  expect_one_line_error(run({"info", "s.json"}), 3, {"/points/1", "4", "5"});
+}
+
+TEST_F(CliTest, TooFewPointsForTheDegreeExits3) {
+  json spec = grid_spec(1, 3, 5);
+  spec["degree"] = {3, 3};
+  write_file(at("s.json"), spec.dump());
+  expect_one_line_error(run({"info", "s.json"}), 3, {"/degree/0", "degree 3", "3"});
+}
+
+TEST_F(CliTest, ZeroChordExits3) {
+  json spec = grid_spec(1, 4, 5);
+  spec["points"][2] = spec["points"][3];
+  write_file(at("s.json"), spec.dump());
+  expect_one_line_error(run({"info", "s.json"}), 3, {"/points"});
+}
+
+TEST_F(CliTest, UnreadableSpecExits4) {
+  expect_one_line_error(run({"info", "nope.json"}), 4, {"nope.json"});
+  fs::create_directory(at("dir.json"));
+  expect_one_line_error(run({"build", "dir.json", "-o", "o.json"}), 4, {"dir.json"});
+}
+
+TEST_F(CliTest, OutputInAMissingDirectoryExits4AndCreatesNothing) {
+  write_grid_spec("s.json");
+  const auto before = listing();
+  expect_one_line_error(run({"build", "s.json", "-o", "missing/o.json"}), 4, {"missing"});
+  expect_one_line_error(run({"mesh", "s.json", "-o", "missing/o.obj"}), 4, {"missing"});
+  expect_one_line_error(run({"eval", "s.json", "--grid", "5", "-o", "missing/o.npy"}), 4, {"missing"});
+  EXPECT_EQ(listing(), before);
+}
+
+TEST_F(CliTest, OutputPathCheckedBeforeTheSpecIsRead) {
+  // The spec is invalid too, but the unwritable output is refused first, before any work.
+  write_file(at("s.json"), "{");
+  expect_one_line_error(run({"build", "s.json", "-o", "missing/o.json"}), 4, {"missing"});
+}
+
+TEST_F(CliTest, AFailedRunLeavesAnExistingOutputUntouched) {
+  write_file(at("o.json"), "GOOD");
+  write_file(at("o.npy"), "GOOD");
+  write_file(at("o.obj"), "GOOD");
+  write_file(at("bad.json"), R"({"type": "interpolate", "points": [[[0,0,0],[1,0,0]],[[0,1,0]]]})");
+  const auto before = listing();
+  EXPECT_EQ(run({"build", "bad.json", "-o", "o.json"}).status, 3);
+  EXPECT_EQ(run({"eval", "bad.json", "--grid", "4", "-o", "o.npy"}).status, 3);
+  EXPECT_EQ(run({"mesh", "bad.json", "-o", "o.obj"}).status, 3);
+  EXPECT_EQ(read_file(at("o.json")), "GOOD");
+  EXPECT_EQ(read_file(at("o.npy")), "GOOD");
+  EXPECT_EQ(read_file(at("o.obj")), "GOOD");
+  EXPECT_EQ(listing(), before);  // no temporary files left behind
+  // A good run replaces it whole.
+  write_grid_spec("s.json");
+  ASSERT_EQ(run({"build", "s.json", "-o", "o.json"}).status, 0);
+  EXPECT_EQ(json::parse(read_file(at("o.json")))["type"], "bspline_surface");
+}
+
+TEST_F(CliTest, HugeGridExits5QuicklyBeforeAllocating) {
+  write_grid_spec("s.json");
+  Result r = run({"eval", "s.json", "--grid", "100000", "-o", "g.npy"});
+  expect_one_line_error(r, 5, {"100000x100000"});
+  EXPECT_LT(r.seconds, 5.0);
+  r = run({"eval", "s.json", "--grid", "123456789012345678901234567890", "-o", "g.csv"});
+  expect_one_line_error(r, 5, {"grid"});
+  r = run({"mesh", "s.json", "--res", "200000x200000", "-o", "m.obj"});
+  expect_one_line_error(r, 5, {"200000x200000"});
+  EXPECT_LT(r.seconds, 5.0);
+  EXPECT_FALSE(fs::exists(at("g.npy")));
+  EXPECT_FALSE(fs::exists(at("m.obj")));
+}
+
+TEST_F(CliTest, BadUsageExits2) {
+  write_grid_spec("s.json");
+  expect_one_line_error(run({}), 2, {"command"});
+  expect_one_line_error(run({"frobnicate", "s.json"}), 2, {"frobnicate"});
+  expect_one_line_error(run({"build", "s.json"}), 2, {"output"});
+  expect_one_line_error(run({"build", "-o", "o.json"}), 2, {"SPEC"});
+  expect_one_line_error(run({"build", "s.json", "-o", "o.json", "--bogus"}), 2, {"--bogus"});
+  expect_one_line_error(run({"build", "s.json", "-o", "o.txt"}), 2, {"o.txt"});
+  expect_one_line_error(run({"build", "s.json", "-o", "o.step"}), 2, {".step", "not available"});
+  expect_one_line_error(run({"mesh", "s.json", "-o", "o.foo"}), 2, {"o.foo"});
+  expect_one_line_error(run({"mesh", "s.json", "-o", "o.obj", "--res", "64"}), 2, {"--res", "64"});
+  expect_one_line_error(run({"mesh", "s.json", "-o", "o.obj", "--res", "1x8"}), 2, {"--res", "1x8"});
+  expect_one_line_error(run({"mesh", "s.json", "-o", "o.obj", "--res", "axb"}), 2, {"--res"});
+  expect_one_line_error(run({"mesh", "s.json", "-o", "o.obj", "--res", "8x8x8"}), 2, {"--res"});
+  expect_one_line_error(run({"eval", "s.json", "-o", "o.npy"}), 2, {"--grid"});
+  expect_one_line_error(run({"eval", "s.json", "--grid", "abc", "-o", "o.npy"}), 2, {"--grid", "abc"});
+  expect_one_line_error(run({"eval", "s.json", "--grid", "1", "-o", "o.npy"}), 2, {"--grid"});
+  expect_one_line_error(run({"eval", "s.json", "--grid", "-3", "-o", "o.npy"}), 2, {});
+  expect_one_line_error(run({"eval", "s.json", "--grid", "8", "-o", "o.txt"}), 2, {"o.txt"});
+  EXPECT_EQ(listing(), std::set<std::string>({"s.json"}));
+  const Result help = run({"--help"});
+  EXPECT_EQ(help.status, 0);
+  EXPECT_NE(help.out.find("build"), std::string::npos);
+}
+
+TEST_F(CliTest, UnknownFieldIsAWarningNotAFailure) {
+  json spec = grid_spec(1, 4, 5);
+  spec["degre"] = 2;
+  write_file(at("s.json"), spec.dump());
+  const Result r = run({"build", "s.json", "-o", "o.json"});
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.err.find("warning: /degre"), std::string::npos) << r.err;
+}
+
+#else
+
+TEST(Cli, NotBuilt) { GTEST_SKIP() << "the interpatch command is not part of this build"; }
+
+#endif
+
+}  // namespace
+}  // namespace interpatch

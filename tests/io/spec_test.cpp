@@ -1,0 +1,464 @@
+#include "interpatch/io/spec.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "interpatch/io/json_out.hpp"
+#include "interpatch/io/npy.hpp"
+#include "test_util.hpp"
+
+namespace interpatch::io {
+namespace {
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+class TempDir {
+ public:
+  TempDir() {
+    static std::atomic<int> counter{0};
+    path_ = fs::temp_directory_path() /
+            ("interpatch-spec-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    fs::create_directories(path_);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  [[nodiscard]] fs::path operator/(const std::string& name) const { return path_ / name; }
+  [[nodiscard]] const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+void write_text(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+}
+
+json grid_json(const PointGrid& g) {
+  json rows = json::array();
+  for (std::size_t i = 0; i < g.extent(0); ++i) {
+    json row = json::array();
+    for (std::size_t j = 0; j < g.extent(1); ++j) row.push_back({g(i, j).x, g(i, j).y, g(i, j).z});
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+json interpolate_spec(const PointGrid& g) { return {{"type", "interpolate"}, {"points", grid_json(g)}}; }
+
+// A small valid grid spec to break in one place per test.
+json small_spec() {
+  auto g = test::rng(7);
+  return interpolate_spec(test::random_grid(g, 4, 5));
+}
+
+double max_error_at_data(const Construction& c) {
+  const auto& s = std::get<BSplineSurface>(c.exact);
+  double e = 0;
+  for (const DataSet& d : c.data) {
+    const std::size_t nv = d.params[1].size();
+    for (std::size_t i = 0; i < d.params[0].size(); ++i)
+      for (std::size_t j = 0; j < nv; ++j)
+        e = std::max(e, distance(s.point(d.params[0][i], d.params[1][j]), d.points[i * nv + j]));
+  }
+  return e;
+}
+
+// --- grids through the interpolate type ----------------------------------------
+
+TEST(Spec, InterpolateReproducesTheDataOverRandomGrids) {
+  auto g = test::rng(1);
+  for (int trial = 0; trial < 20; ++trial) {
+    const std::size_t nu = 2 + static_cast<std::size_t>(trial % 7), nv = 2 + static_cast<std::size_t>((trial * 3) % 9);
+    const PointGrid q = test::random_grid(g, nu, nv);
+    json spec = interpolate_spec(q);
+    spec["param"] = trial % 3 == 0 ? "uniform" : (trial % 3 == 1 ? "chord" : "centripetal");
+    const Construction c = build(spec);
+    EXPECT_EQ(c.type, "interpolate");
+    const auto& s = std::get<BSplineSurface>(c.exact);
+    EXPECT_EQ(s.control_points().extent(0), nu);
+    EXPECT_EQ(s.control_points().extent(1), nv);
+    EXPECT_EQ(s.degree_u(), std::min<int>(3, static_cast<int>(nu) - 1));  // the default degree
+    EXPECT_EQ(s.degree_v(), std::min<int>(3, static_cast<int>(nv) - 1));
+    EXPECT_EQ(s.domain_u(), std::make_pair(0.0, 1.0));
+    EXPECT_EQ(s.domain_v(), std::make_pair(0.0, 1.0));
+    ASSERT_EQ(c.data.size(), 1u);
+    EXPECT_EQ(c.data[0].pointer, "/points");
+    EXPECT_EQ(c.data[0].points.size(), nu * nv);
+    EXPECT_LT(max_error_at_data(c), 1e-12 * test::bbox_diagonal(q.values()));
+    EXPECT_EQ(c.parameters["param"].get<std::string>(), spec["param"].get<std::string>());
+    EXPECT_TRUE(c.warnings.empty());
+  }
+}
+
+TEST(Spec, DegreeAsOneNumberOrOnePerDirection) {
+  auto g = test::rng(2);
+  json spec = interpolate_spec(test::random_grid(g, 6, 7));
+  spec["degree"] = 2;
+  auto s = std::get<BSplineSurface>(build(spec).exact);
+  EXPECT_EQ(s.degree_u(), 2);
+  EXPECT_EQ(s.degree_v(), 2);
+  spec["degree"] = {1, 5};
+  s = std::get<BSplineSurface>(build(spec).exact);
+  EXPECT_EQ(s.degree_u(), 1);
+  EXPECT_EQ(s.degree_v(), 5);
+  spec["degree"] = 3.0;  // an integral float is an integer
+  EXPECT_EQ(std::get<BSplineSurface>(build(spec).exact).degree_u(), 3);
+}
+
+TEST(Spec, UniformParametersAreEquallySpaced) {
+  auto g = test::rng(3);
+  json spec = interpolate_spec(test::random_grid(g, 5, 3));
+  spec["param"] = "uniform";
+  const Construction c = build(spec);
+  const std::vector<double> expected{0, 0.25, 0.5, 0.75, 1};
+  ASSERT_EQ(c.data[0].params[0].size(), 5u);
+  for (std::size_t i = 0; i < 5; ++i) EXPECT_NEAR(c.data[0].params[0][i], expected[i], 1e-15);
+}
+
+TEST(Spec, PoleRowIsAllowed) {
+  // A hemisphere-like grid: row 0 is one point repeated.
+  PointGrid q({5, 9});
+  for (std::size_t i = 0; i < 5; ++i)
+    for (std::size_t j = 0; j < 9; ++j) {
+      const double t = 0.4 * static_cast<double>(i), a = 0.785 * static_cast<double>(j);
+      q(i, j) = i == 0 ? Vec3{0, 0, 1} : Vec3{std::sin(t) * std::cos(a), std::sin(t) * std::sin(a), std::cos(t)};
+    }
+  json spec = interpolate_spec(q);
+  spec["param"] = "centripetal";
+  const Construction c = build(spec);
+  EXPECT_LT(max_error_at_data(c), 1e-12);
+}
+
+TEST(Spec, UnknownFieldsAreWarnedAboutNotRefused) {
+  json spec = small_spec();
+  spec["degre"] = 2;
+  spec["comment"] = "comments are fine";
+  const Construction c = build(spec);
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("/degre"), std::string::npos);
+}
+
+// --- the exact form reads back ------------------------------------------------
+
+TEST(Spec, BuildOutputRoundTripsExactly) {
+  auto g = test::rng(4);
+  for (int trial = 0; trial < 5; ++trial) {
+    json spec = interpolate_spec(test::random_grid(g, 3 + static_cast<std::size_t>(trial), 9 - static_cast<std::size_t>(trial)));
+    const Construction a = build(spec);
+    std::ostringstream text;
+    write_exact_json(text, a.exact);
+    const Construction b = build(parse_json(text.str()));
+    EXPECT_EQ(b.type, "bspline_surface");
+    const auto& sa = std::get<BSplineSurface>(a.exact);
+    const auto& sb = std::get<BSplineSurface>(b.exact);
+    EXPECT_EQ(sa.knots_u(), sb.knots_u());
+    EXPECT_EQ(sa.knots_v(), sb.knots_v());
+    EXPECT_EQ(sa.control_points().values(), sb.control_points().values());  // bit for bit
+    EXPECT_TRUE(b.data.empty());
+  }
+}
+
+TEST(Spec, BSplineSurfaceWithWeightsAndItsOwnDomain) {
+  // A quarter cylinder as a rational quadratic in u, linear in v, over [0,2] x [0,1].
+  const double w = std::sqrt(0.5);
+  json spec = {{"type", "bspline_surface"},
+               {"degree", {2, 1}},
+               {"knots", {{"u", {0, 0, 0, 2, 2, 2}}, {"v", {0, 0, 1, 1}}}},
+               {"control_points", {{{1, 0, 0}, {1, 0, 1}}, {{1, 1, 0}, {1, 1, 1}}, {{0, 1, 0}, {0, 1, 1}}}},
+               {"weights", {{1, 1}, {w, w}, {1, 1}}}};
+  const Construction c = build(spec);
+  const auto& s = std::get<BSplineSurface>(c.exact);
+  EXPECT_TRUE(s.rational());
+  EXPECT_EQ(s.domain_u(), std::make_pair(0.0, 1.0));  // mapped onto [0,1]
+  EXPECT_EQ(c.parameters["domain"]["u"], nlohmann::ordered_json({0.0, 2.0}));
+  for (double u : {0.0, 0.3, 0.5, 0.9}) EXPECT_NEAR(norm(s.point(u, 0.5) - Vec3{0, 0, 0.5}), 1.0, 1e-14);  // on the cylinder
+}
+
+// --- point arrays from files ---------------------------------------------------
+
+TEST(Spec, PointsFromNpyAndCsvBesideTheSpec) {
+  TempDir dir;
+  auto g = test::rng(5);
+  const PointGrid q = test::random_grid(g, 4, 6);
+  std::vector<double> flat;
+  for (const Vec3& p : q.values()) flat.insert(flat.end(), {p.x, p.y, p.z});
+  const std::size_t shape[3] = {4, 6, 3};
+  write_npy(dir / "grid.npy", shape, flat);
+  std::ostringstream csv;
+  csv.precision(17);
+  csv << "x,y,z\n";
+  for (const Vec3& p : q.values()) csv << p.x << "," << p.y << "," << p.z << "\n";
+  write_text(dir / "grid.csv", csv.str());
+
+  write_text(dir / "npy.json", R"({"type": "interpolate", "points": {"npy": "grid.npy"}})");
+  write_text(dir / "csv.json", R"({"type": "interpolate", "points": {"csv": "grid.csv", "shape": [4, 6]}})");
+  write_text(dir / "csv3.json", R"({"type": "interpolate", "points": {"csv": "grid.csv", "shape": [4, 6, 3]}})");
+  const Construction inline_ = build(interpolate_spec(q));
+  for (const char* name : {"npy.json", "csv.json", "csv3.json"}) {
+    const Construction c = build_file(dir / name);  // relative to the spec's directory
+    EXPECT_EQ(std::get<BSplineSurface>(c.exact).control_points().values(),
+              std::get<BSplineSurface>(inline_.exact).control_points().values())
+        << name;
+    EXPECT_GE(c.timings.parse_ms, 0.0);
+    EXPECT_GE(c.timings.build_ms, 0.0);
+  }
+}
+
+TEST(Spec, PointsFromJsonOfEachRank) {
+  const auto a = points_from_json(json::parse("[[0,0,0],[1,2,3]]"), 1);
+  EXPECT_EQ(a.shape, std::vector<std::size_t>({2}));
+  EXPECT_EQ(a.points[1], (Vec3{1, 2, 3}));
+  const auto b = points_from_json(json::parse("[[[[0,0,0]],[[1,0,0]]],[[[0,1,0]],[[1,1,0]]]]"), 3);
+  EXPECT_EQ(b.shape, std::vector<std::size_t>({2, 2, 1}));
+  EXPECT_EQ(b.points[2], (Vec3{0, 1, 0}));  // C order, first index slowest
+}
+
+// --- curves ----------------------------------------------------------------------
+
+TEST(SpecCurve, LineBsplineHermiteInterpolateAllOnTheUnitDomain) {
+  const auto line = curve_from_json(json::parse(R"({"line": [[0,0,0], [2,0,0]]})"));
+  EXPECT_EQ(line.domain(), std::make_pair(0.0, 1.0));
+  EXPECT_EQ(line.point(0.5), (Vec3{1, 0, 0}));
+
+  const auto b = curve_from_json(json::parse(
+      R"({"bspline": {"degree": 2, "knots": [2,2,2,3,4,4,4], "control_points": [[0,0,0],[1,1,0],[2,1,0],[3,0,0]]}})"));
+  EXPECT_EQ(b.domain(), std::make_pair(0.0, 1.0));
+  const BSplineCurve original(KnotVector(2, {2, 2, 2, 3, 4, 4, 4}), {{0, 0, 0}, {1, 1, 0}, {2, 1, 0}, {3, 0, 0}});
+  for (double t : {0.0, 0.25, 0.5, 0.8, 1.0}) EXPECT_LT(distance(b.point(t), original.point(2 + 2 * t)), 1e-14);
+
+  const auto h = curve_from_json(json::parse(
+      R"({"hermite": {"points": [[0,0,0],[1,1,0],[2,0,0]], "tangents": [[1,0,0],[1,0,0],[1,0,0]], "params": [0, 4, 10]}})"));
+  EXPECT_EQ(h.domain(), std::make_pair(0.0, 1.0));
+  EXPECT_LT(distance(h.point(0.4), Vec3{1, 1, 0}), 1e-14);
+  EXPECT_LT(distance(h.point(1.0), Vec3{2, 0, 0}), 1e-14);
+
+  const auto c = curve_from_json(json::parse(R"({"interpolate": [[0,0,0],[1,2,0],[3,3,0],[4,0,1]], "param": "uniform"})"));
+  EXPECT_LT(distance(c.point(1.0 / 3.0), Vec3{1, 2, 0}), 1e-13);
+  EXPECT_EQ(c.degree(), 3);
+  const auto c1 = curve_from_json(json::parse(R"({"interpolate": [[0,0,0],[1,2,0]]})"));
+  EXPECT_EQ(c1.degree(), 1);  // min(3, points - 1)
+}
+
+TEST(SpecCurve, ErrorsNameThePlaceUnderThePointer) {
+  EXPECT_ERRC((void)curve_from_json(json::parse(R"({"interpolate": [[0,0,0],[1,0,0],[2,0,0],[2,0,0],[3,1,0]]})"), {},
+                              "/boundary/u1"),
+              zero_chord, "/boundary/u1/interpolate/3:");
+  EXPECT_ERRC((void)curve_from_json(json::parse(R"({"interpolate": [[0,0,0],[1,0,0]], "degree": 2})"), {}, "/c"),
+              too_few_points, "/c/degree:");
+  EXPECT_ERRC((void)curve_from_json(json::parse(R"({"bspline": {"degree": 2, "knots": [0,0,1,1,1], "control_points": [[0,0,0],[1,0,0]]}})"),
+                              {}, "/c"),
+              invalid_knots, "/c/bspline/knots:");
+  EXPECT_ERRC((void)curve_from_json(json::parse(R"({"bspline": {"degree": 1, "knots": [0,0,1,1], "control_points": [[0,0,0],[1,0,0],[2,0,0]]}})"),
+                              {}, "/c"),
+              size_mismatch, "/c/bspline/control_points:");
+  EXPECT_ERRC((void)curve_from_json(json::parse(R"({"bspline": {"degree": 1, "knots": [0,0,1,1], "control_points": [[0,0,0],[1,0,0]], "weights": [1, -2]}})"),
+                              {}, "/c"),
+              invalid_weight, "/c/bspline/weights/1:");
+  EXPECT_ERRC((void)curve_from_json(json::parse(R"({"bspline": {"knots": [0,0,1,1], "control_points": [[0,0,0],[1,0,0]]}})"), {}, "/c"),
+              missing_field, "/c/bspline/degree:");
+  EXPECT_ERRC((void)curve_from_json(json::parse(R"({"hermite": {"points": [[0,0,0],[1,0,0],[2,0,0]], "params": [0, 1, 1]}})"), {}, "/c"),
+              non_increasing, "/c/hermite/params/2:");
+  EXPECT_ERRC((void)curve_from_json(json::parse(R"({"hermite": {"points": [[0,0,0]]}})"), {}, "/c"), too_few_points,
+              "/c/hermite/points:");
+  EXPECT_ERRC((void)curve_from_json(json::parse(R"({"line": [[0,0,0],[1,0,0],[2,0,0]]})"), {}, "/c"), size_mismatch, "/c/line:");
+  EXPECT_ERRC((void)curve_from_json(json::parse(R"({"line": [[0,0,0],[1,0,0]], "bspline": {}})"), {}, "/c"), wrong_type, "/c:");
+  EXPECT_ERRC((void)curve_from_json(json::parse(R"({"lines": [[0,0,0],[1,0,0]]})"), {}, "/c"), missing_field, "/c:");
+  EXPECT_ERRC((void)curve_from_json(json::parse(R"([[0,0,0],[1,0,0]])"), {}, "/c"), wrong_type, "/c:");
+}
+
+// --- one test per error kind of a surface spec --------------------------------------
+
+TEST(SpecErrors, InvalidJsonNamesLineAndColumn) {
+  EXPECT_ERRC((void)parse_json("{\n \"a\": [1,\n 2,, 3]}", "x.json"), invalid_json, "x.json:3:4:");
+  EXPECT_ERRC((void)parse_json("", "x.json"), invalid_json, "x.json:1:1:");
+  EXPECT_ERRC((void)parse_json("{\"type\": \"interpolate\"", "x.json"), invalid_json, "x.json:1:");
+}
+
+TEST(SpecErrors, NonFiniteLiteralsNameLineAndColumn) {
+  EXPECT_ERRC((void)parse_json("{\"a\": [1,\n 2, NaN]}", "x.json"), not_finite, "x.json:2:5: NaN");
+  EXPECT_ERRC((void)parse_json("{\"a\": [1,\n -Infinity]}", "x.json"), not_finite, "x.json:2:2: -Infinity");
+  EXPECT_ERRC((void)parse_json("{\"a\": [1,\n 2, 1e999]}", "x.json"), not_finite, "x.json:2:5: number 1e999");
+}
+
+TEST(SpecErrors, NotAnObject) { EXPECT_ERRC((void)build(json::parse("[1, 2]")), wrong_type, "JSON object"); }
+
+TEST(SpecErrors, MissingType) { EXPECT_ERRC((void)build(json::parse(R"({"points": []})")), missing_field, "/type:"); }
+
+TEST(SpecErrors, TypeNotAString) { EXPECT_ERRC((void)build(json::parse(R"({"type": 3})")), wrong_type, "/type:"); }
+
+TEST(SpecErrors, UnknownTypeListsTheKnownOnes) {
+  EXPECT_ERRC((void)build(json::parse(R"({"type": "coonz"})")), unknown_type, "\"coonz\"; known types: interpolate, bspline_surface");
+  EXPECT_EQ(known_types().front(), "interpolate");
+}
+
+TEST(SpecErrors, MissingPoints) {
+  EXPECT_ERRC((void)build(json::parse(R"({"type": "interpolate"})")), missing_field, "/points: missing field");
+}
+
+TEST(SpecErrors, MistypedFieldsNameTheExpectedType) {
+  json spec = small_spec();
+  spec["degree"] = "three";
+  EXPECT_ERRC((void)build(spec), wrong_type, "/degree: expected an integer degree or an array of 2 degrees, got a string");
+  spec["degree"] = 2.5;
+  EXPECT_ERRC((void)build(spec), wrong_type, "/degree:");
+  spec["degree"] = {2, 2, 2};
+  EXPECT_ERRC((void)build(spec), size_mismatch, "/degree: expected 2 degrees");
+  spec["degree"] = {2, 0};
+  EXPECT_ERRC((void)build(spec), invalid_degree, "/degree/1: degree 0");
+  spec.erase("degree");
+  spec["param"] = "arc";
+  EXPECT_ERRC((void)build(spec), wrong_type, "/param: unknown parametrization \"arc\"");
+  spec["param"] = 1;
+  EXPECT_ERRC((void)build(spec), wrong_type, "/param:");
+  spec.erase("param");
+  spec["points"] = "grid.npy";
+  EXPECT_ERRC((void)build(spec), wrong_type, "/points: expected a 2-D grid of points");
+}
+
+TEST(SpecErrors, RaggedGridNamesTheShortRowAndBothLengths) {
+  json spec = small_spec();  // 4 x 5
+  spec["points"][2].erase(4);
+  EXPECT_ERRC((void)build(spec), ragged_grid, "/points/2: has 4 points, but /points/0 has 5");
+}
+
+TEST(SpecErrors, PointThatIsNotThreeNumbers) {
+  json spec = small_spec();
+  spec["points"][1][2] = {1.0, 2.0};
+  EXPECT_ERRC((void)build(spec), ragged_grid, "/points/1/2: a point must be 3 numbers");
+  spec["points"][1][2] = {1.0, "2", 3.0};
+  EXPECT_ERRC((void)build(spec), wrong_type, "/points/1/2/1: expected a number");
+  spec["points"][1][2] = 7;
+  EXPECT_ERRC((void)build(spec), wrong_type, "/points/1/2: expected a point");
+}
+
+TEST(SpecErrors, NonFiniteCoordinateNamesItsPointer) {
+  json spec = small_spec();
+  spec["points"][3][4][2] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_ERRC((void)build(spec), not_finite, "/points/3/4/2: coordinate z is nan");
+  spec["points"][3][4][2] = 0.0;
+  spec["points"][0][1][0] = -std::numeric_limits<double>::infinity();
+  EXPECT_ERRC((void)build(spec), not_finite, "/points/0/1/0:");
+}
+
+TEST(SpecErrors, GridOfTheWrongRank) {
+  json spec = small_spec();
+  spec["points"] = json::parse("[[0,0,0],[1,0,0],[2,0,0]]");
+  EXPECT_ERRC((void)build(spec), wrong_type, "/points: expected a 2-D grid of points: lists nested 3 deep, got lists nested 2 deep");
+}
+
+TEST(SpecErrors, EmptyGridAndSingleRow) {
+  json spec = small_spec();
+  spec["points"] = json::array();
+  EXPECT_ERRC((void)build(spec), too_few_points, "/points: empty list");
+  spec["points"] = json::parse("[[[0,0,0],[1,0,0]]]");
+  EXPECT_ERRC((void)build(spec), too_few_points, "/points: the grid has 1 point along u");
+}
+
+TEST(SpecErrors, TooFewPointsForTheDegree) {
+  json spec = small_spec();  // 4 x 5
+  spec["degree"] = {4, 3};
+  EXPECT_ERRC((void)build(spec), too_few_points, "/degree/0: degree 4 along u needs at least 5 points, /points has 4");
+  spec["degree"] = 5;
+  EXPECT_ERRC((void)build(spec), too_few_points, "/degree: degree 5 along u");
+}
+
+TEST(SpecErrors, ZeroChordInEveryLine) {
+  json spec = small_spec();
+  spec["points"][2] = spec["points"][1];  // rows 1 and 2 coincide
+  EXPECT_ERRC((void)build(spec), zero_chord, "/points: ");
+}
+
+TEST(SpecErrors, NpyFileProblems) {
+  TempDir dir;
+  const std::size_t shape[3] = {2, 3, 3};
+  std::vector<double> data(18, 1.0);
+  for (std::size_t i = 0; i < 18; ++i) data[i] = static_cast<double>(i);
+  data[3 * (1 * 3 + 2) + 0] = std::numeric_limits<double>::quiet_NaN();
+  write_npy(dir / "nan.npy", shape, data);
+  const std::size_t flat_shape[2] = {6, 3};
+  write_npy(dir / "flat.npy", flat_shape, data);
+  const json nan_spec = {{"type", "interpolate"}, {"points", {{"npy", "nan.npy"}}}};
+  EXPECT_ERRC((void)build(nan_spec, dir.path()), not_finite, "/points/1/2/0: coordinate x is nan (in nan.npy)");
+  const json flat_spec = {{"type", "interpolate"}, {"points", {{"npy", "flat.npy"}}}};
+  EXPECT_ERRC((void)build(flat_spec, dir.path()), size_mismatch, "/points: flat.npy has shape (6, 3); expected (n, m, 3)");
+  const json missing = {{"type", "interpolate"}, {"points", {{"npy", "nope.npy"}}}};
+  EXPECT_ERRC((void)build(missing, dir.path()), file_unreadable, "/points: ");
+  write_text(dir / "garbage.npy", "not an npy file at all");
+  const json garbage = {{"type", "interpolate"}, {"points", {{"npy", "garbage.npy"}}}};
+  EXPECT_ERRC((void)build(garbage, dir.path()), malformed_file, "/points: ");
+}
+
+TEST(SpecErrors, CsvFileProblems) {
+  TempDir dir;
+  write_text(dir / "six.csv", "x,y,z\n0,0,0\n1,0,0\n2,0,0\n0,1,0\n1,1,1\n2,1,0\n");
+  json spec = {{"type", "interpolate"}, {"points", {{"csv", "six.csv"}, {"shape", {2, 3}}}}};
+  EXPECT_NO_THROW((void)build(spec, dir.path()));
+  spec["points"]["shape"] = {6};
+  EXPECT_ERRC((void)build(spec, dir.path()), size_mismatch, "/points/shape: shape (6,) does not describe");
+  spec["points"]["shape"] = {2, 4};
+  EXPECT_ERRC((void)build(spec, dir.path()), size_mismatch, "/points: ");
+  spec["points"].erase("shape");
+  EXPECT_ERRC((void)build(spec, dir.path()), missing_field, "/points/shape: missing field");
+  spec["points"]["shape"] = {2, 3};
+  spec["points"]["npy"] = "x.npy";
+  EXPECT_ERRC((void)build(spec, dir.path()), wrong_type, "/points: give either \"npy\" or \"csv\"");
+  spec["points"] = json::object();
+  EXPECT_ERRC((void)build(spec, dir.path()), missing_field, "/points: a point array given as an object needs");
+  write_text(dir / "bad.csv", "0,0,0\n1,0,abc\n2,0,0\n0,1,0\n1,1,1\n2,1,0\n");
+  spec["points"] = {{"csv", "bad.csv"}, {"shape", {2, 3}}};
+  EXPECT_ERRC((void)build(spec, dir.path()), malformed_file, "/points: ");
+}
+
+TEST(SpecErrors, BSplineSurfaceFieldsAreChecked) {
+  const json good = {{"type", "bspline_surface"},
+                     {"degree", {1, 1}},
+                     {"knots", {{"u", {0, 0, 1, 1}}, {"v", {0, 0, 1, 1}}}},
+                     {"control_points", {{{0, 0, 0}, {0, 1, 0}}, {{1, 0, 0}, {1, 1, 1}}}}};
+  EXPECT_NEAR(std::get<BSplineSurface>(build(good).exact).point(0.5, 0.5).z, 0.25, 1e-15);
+  json s = good;
+  s.erase("degree");
+  EXPECT_ERRC((void)build(s), missing_field, "/degree: missing field");
+  s = good;
+  s["knots"]["u"] = {0, 0, 0.5, 1, 1};
+  EXPECT_ERRC((void)build(s), size_mismatch, "/control_points: 2 control points along u");
+  s = good;
+  s["knots"]["v"] = {0, 1, 0, 1};
+  EXPECT_ERRC((void)build(s), non_increasing, "/knots/v: ");
+  s = good;
+  s["knots"]["v"] = "0011";
+  EXPECT_ERRC((void)build(s), wrong_type, "/knots/v: expected an array of numbers");
+  s = good;
+  s["knots"].erase("u");
+  EXPECT_ERRC((void)build(s), missing_field, "/knots/u: missing field");
+  s = good;
+  s["weights"] = {{1, 0}, {1, 1}};
+  EXPECT_ERRC((void)build(s), invalid_weight, "/weights/0/1: weight 0 is not positive");
+  s["weights"] = {{1, 1, 1}, {1, 1, 1}};
+  EXPECT_ERRC((void)build(s), size_mismatch, "/weights: shape 2x3 differs from /control_points, 2x2");
+  s["weights"] = {{1, 1}, {1}};
+  EXPECT_ERRC((void)build(s), ragged_grid, "/weights/1: has 1 numbers, but /weights/0 has 2");
+}
+
+TEST(SpecErrors, UnreadableSpecFile) {
+  TempDir dir;
+  EXPECT_ERRC((void)build_file(dir / "nope.json"), file_unreadable, "nope.json");
+  EXPECT_ERRC((void)build_file(dir.path()), file_unreadable, "directory");
+  write_text(dir / "bad.json", "{\"type\": \"interpolate\",\n \"points\": [}");
+  EXPECT_ERRC((void)build_file(dir / "bad.json"), invalid_json, "bad.json:2:");
+}
+
+}  // namespace
+}  // namespace interpatch::io
