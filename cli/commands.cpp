@@ -47,7 +47,7 @@ std::optional<std::size_t> parse_count(std::string_view s) {
 }
 
 // Only surfaces exist so far; a volume alternative will get its own branch.
-const BSplineSurface& surface_of(const io::Construction& c) { return std::get<BSplineSurface>(c.exact); }
+const Surface& surface_of(const io::Construction& c) { return io::evaluator(c); }
 
 std::string what_size(std::size_t a, std::size_t b) { return std::to_string(a) + "x" + std::to_string(b); }
 
@@ -114,12 +114,14 @@ void require_mesh_memory(const Resolution& res) {
   require_memory(res.nu * res.nv, 2 * sizeof(Vec3) + 2 * 50, what);
 }
 
-void write_build(const io::Construction& c, const fs::path& out) { io::write_exact_json(out, c.exact); }
+void write_build(const io::Construction& c, const fs::path& out) {
+  if (!c.exact) throw error(errc::no_exact_form, c.type + ": " + c.no_exact_form);
+  io::write_exact_json(out, *c.exact);
+}
 
 void write_mesh(const io::Construction& c, const fs::path& out, const Resolution& res) {
-  const BSplineSurface& s = surface_of(c);
-  const auto [u0, u1] = s.domain_u();
-  const auto [v0, v1] = s.domain_v();
+  const Surface& s = surface_of(c);
+  constexpr double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  // every construction is over the unit square
   const std::vector<double> us = linspace(u0, u1, res.nu), vs = linspace(v0, v1, res.nv);
   io::SurfaceMesh mesh{PointGrid({res.nu, res.nv}), PointGrid({res.nu, res.nv})};
   ProgressLine progress("meshing");
@@ -141,9 +143,8 @@ void write_mesh(const io::Construction& c, const fs::path& out, const Resolution
 }
 
 void write_eval(const io::Construction& c, const fs::path& out, std::size_t k) {
-  const BSplineSurface& s = surface_of(c);
-  const auto [u0, u1] = s.domain_u();
-  const auto [v0, v1] = s.domain_v();
+  const Surface& s = surface_of(c);
+  constexpr double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  // every construction is over the unit square
   std::vector<std::vector<double>> params{linspace(u0, u1, k), linspace(v0, v1, k)};
   ProgressLine progress("evaluating");
   const PointGrid g = s.evaluate(params[0], params[1], progress.callback());

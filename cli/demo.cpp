@@ -174,6 +174,70 @@ std::string read_text(const fs::path& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+ojson point_json(const Vec3& p) { return {p.x, p.y, p.z}; }
+
+// A curve spec interpolating `f` at `n` uniformly spaced parameters: with uniform
+// parameters an interpolating spline of degree 3 reproduces any cubic f exactly.
+ojson sampled_curve(const std::function<Vec3(double)>& f, std::size_t n, int degree = 3) {
+  ojson pts = ojson::array();
+  for (std::size_t k = 0; k < n; ++k) pts.push_back(point_json(f(static_cast<double>(k) / static_cast<double>(n - 1))));
+  return {{"interpolate", pts}, {"degree", degree}, {"param", "uniform"}};
+}
+
+// A bicubic polynomial surface with a twist, and its partial derivatives: data
+// whose boundary curves, cross derivatives and corners all agree.
+Vec3 dome(double u, double v) { return {u, v, 0.3 * u * v + 0.8 * u * (1 - u) * v * (1 - v) + 0.2 * u * u * v}; }
+Vec3 dome_u(double u, double v) { return {1, 0, 0.3 * v + 0.8 * (1 - 2 * u) * v * (1 - v) + 0.4 * u * v}; }
+Vec3 dome_v(double u, double v) { return {0, 1, 0.3 * u + 0.8 * u * (1 - u) * (1 - 2 * v) + 0.2 * u * u}; }
+Vec3 dome_uv(double u, double v) { return {0, 0, 0.3 + 0.8 * (1 - 2 * u) * (1 - 2 * v) + 0.4 * u}; }
+
+// A smooth hill over [0, 4] x [0, 3]: the surface the network's curves are cut from.
+Vec3 hill(double u, double v) {
+  const double x = 4 * u, y = 3 * v;
+  return {x, y, std::sin(0.8 * x) * std::cos(0.7 * y) + 0.1 * x * y};
+}
+
+ojson coons_boundary(const std::function<Vec3(double, double)>& f) {
+  return {{"v0", sampled_curve([&](double t) { return f(t, 0); }, 7)},
+          {"v1", sampled_curve([&](double t) { return f(t, 1); }, 7)},
+          {"u0", sampled_curve([&](double t) { return f(0, t); }, 7)},
+          {"u1", sampled_curve([&](double t) { return f(1, t); }, 7)}};
+}
+
+ojson dome_cross(double bend) {
+  // S_v along v = 0 and 1, S_u along u = 0 and 1; `bend` adds a term to S_u(0, v)
+  // that vanishes at both ends but changes its slope at v = 0 (a twist that the
+  // other cross-derivative curve does not share).
+  return {{"v0", sampled_curve([](double t) { return dome_v(t, 0); }, 5)},
+          {"v1", sampled_curve([](double t) { return dome_v(t, 1); }, 5)},
+          {"u0", sampled_curve([bend](double t) { return dome_u(0, t) + Vec3{0, 0, bend * t * (1 - t) * (1 - t)}; }, 5)},
+          {"u1", sampled_curve([](double t) { return dome_u(1, t); }, 5)}};
+}
+
+ojson network_spec(const char* method) {
+  ojson u_curves = ojson::array(), v_curves = ojson::array();
+  const double vs[4] = {0, 1.0 / 3, 2.0 / 3, 1}, us[5] = {0, 0.25, 0.5, 0.75, 1};
+  // 13 samples along u include every u_i, 10 along v every v_j: the curves cross at the nodes.
+  for (double v : vs) u_curves.push_back(sampled_curve([v](double t) { return hill(t, v); }, 13));
+  for (double u : us) v_curves.push_back(sampled_curve([u](double t) { return hill(u, t); }, 10));
+  return {{"type", "network"},
+          {"comment", "Curves cut from a hill at u = 0, 1/4, 1/2, 3/4, 1 and v = 0, 1/3, 2/3, 1; crossings found from the curves."},
+          {"method", method},
+          {"u_curves", u_curves},
+          {"v_curves", v_curves}};
+}
+
+ojson hermite_corners() {
+  ojson c = ojson::object();
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j)
+      c["p" + std::to_string(i) + std::to_string(j)] = {{"p", point_json(dome(i, j))},
+                                                        {"du", point_json(dome_u(i, j))},
+                                                        {"dv", point_json(dome_v(i, j))},
+                                                        {"duv", point_json(dome_uv(i, j))}};
+  return c;
+}
+
 struct Example {
   std::string name;
   std::string about;
@@ -210,6 +274,51 @@ std::vector<Example> examples() {
                  {"comment", "A saddle through an 8x8 grid, degree 5 in both directions (C4)."},
                  {"degree", {5, 5}},
                  {"points", grid_json(saddle())}},
+                nullptr, "", false});
+  ex.push_back({"bilinear", "seed 000 Example 6-9: Q(0.5, 0.5) = (0.5, 0.5, 0.5)",
+                {{"type", "bilinear"},
+                 {"comment", "The hyperbolic paraboloid of seed 000, Example 6-9."},
+                 {"p00", {0, 0, 1}},
+                 {"p01", {1, 1, 1}},
+                 {"p10", {1, 0, 0}},
+                 {"p11", {0, 1, 0}}},
+                nullptr, "", false});
+  ex.push_back({"ruled", "between a line and a Hermite arc",
+                {{"type", "ruled"},
+                 {"comment", "r(u,v) = (1-v) c0(u) + v c1(u): a straight edge and a Catmull-Rom arc above it."},
+                 {"curves",
+                  {{{"line", {{0, 0, 0}, {3, 0, 0}}}},
+                   {{"hermite", {{"points", {{0, 1, 1}, {1, 1.4, 1.5}, {2, 1.4, 1.5}, {3, 1, 1}}}}}}}}},
+                nullptr, "", false});
+  ex.push_back({"coons", "linear Coons patch from four boundary curves",
+                {{"type", "coons"},
+                 {"comment", "The boundary of a bicubic dome; the linear Coons patch fills it in."},
+                 {"blending", "linear"},
+                 {"boundary", coons_boundary(dome)}},
+                nullptr, "", false});
+  ex.push_back({"coons_hermite", "Coons patch with cubic Hermite blending (zero cross slopes of the blends)",
+                {{"type", "coons"}, {"blending", "hermite"}, {"boundary", coons_boundary(dome)}}, nullptr, "", false});
+  ex.push_back({"coons_cross", "bicubically blended Coons patch with cross-boundary derivatives",
+                {{"type", "coons"},
+                 {"comment", "Boundary and cross-boundary derivatives of a bicubic dome: the patch is the dome itself."},
+                 {"boundary", coons_boundary(dome)},
+                 {"cross_derivatives", dome_cross(0.0)}},
+                nullptr, "", false});
+  ex.push_back({"coons_gregory", "incompatible twist at p00 blended by Gregory's correction (no exact form)",
+                {{"type", "coons"},
+                 {"comment", "S_u(0, v) bent near v = 0: the twists at p00 disagree by 1; Gregory's rational blend meets both."},
+                 {"boundary", coons_boundary(dome)},
+                 {"cross_derivatives", dome_cross(1.0)},
+                 {"twist_correction", "gregory"}},
+                nullptr, "", false});
+  ex.push_back({"network_gordon", "Gordon surface through a 4 x 5 network of curves", network_spec("gordon"), nullptr, "",
+                false});
+  ex.push_back({"network_coons", "C1 network of Coons patches with Hermite blending", network_spec("coons_hermite"),
+                nullptr, "", false});
+  ex.push_back({"hermite_patch", "bicubic Hermite (Ferguson) patch from corner data",
+                {{"type", "hermite_patch"},
+                 {"comment", "Positions, tangents and twists at the corners of a bicubic dome."},
+                 {"corners", hermite_corners()}},
                 nullptr, "", false});
   ex.push_back({"half_cylinder", "11x5 grid read from half_cylinder.npy",
                 {{"type", "interpolate"},
@@ -282,7 +391,7 @@ int demo_command(const fs::path& requested) {
       written.push_back(ex.name + suffix);
       return dir / (ex.name + suffix);
     };
-    write_build(c, out(".bspline.json"));
+    if (c.exact) write_build(c, out(".bspline.json"));
     write_eval(c, out(".eval.npy"), eval_grid);
     write_eval(c, out(".eval.csv"), eval_grid);
     write_mesh(c, out(".obj"), res);
@@ -295,12 +404,15 @@ int demo_command(const fs::path& requested) {
 
     const auto& err = description["max_data_error"];
     std::string line = "  " + ex.name + std::string(ex.name.size() < 15 ? 15 - ex.name.size() : 1, ' ') + c.type + ": " +
-                       ex.about + "\n      " + std::to_string(description["control_points"][0].get<std::size_t>()) + "x" +
-                       std::to_string(description["control_points"][1].get<std::size_t>()) + " control points, degree " +
-                       std::to_string(description["degree"][0].get<int>()) + "x" +
-                       std::to_string(description["degree"][1].get<int>()) + ", continuity " +
-                       description["continuity"]["u"].get<std::string>() + "/" +
-                       description["continuity"]["v"].get<std::string>();
+                       ex.about + "\n      ";
+    if (c.exact)
+      line += std::to_string(description["control_points"][0].get<std::size_t>()) + "x" +
+              std::to_string(description["control_points"][1].get<std::size_t>()) + " control points, degree " +
+              std::to_string(description["degree"][0].get<int>()) + "x" +
+              std::to_string(description["degree"][1].get<int>()) + ", continuity " +
+              description["continuity"]["u"].get<std::string>() + "/" + description["continuity"]["v"].get<std::string>();
+    else
+      line += "no exact B-spline form (evaluated by its formula)";
     if (err.is_object())
       line += ", max error at the data " + short_number(err["absolute"].get<double>()) + " (relative " +
               short_number(err["relative"].get<double>()) + ")";

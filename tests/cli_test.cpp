@@ -479,6 +479,77 @@ TEST_F(CliTest, UnknownFieldIsAWarningNotAFailure) {
   EXPECT_NE(r.err.find("warning: /degre"), std::string::npos) << r.err;
 }
 
+
+// --- constructions from corners and curves ---------------------------------------------
+
+json line_curve(const json& a, const json& b) { return {{"line", {a, b}}}; }
+
+json square_coons() {
+  return {{"type", "coons"},
+          {"boundary",
+           {{"v0", line_curve({0, 0, 0}, {1, 0, 0})},
+            {"v1", line_curve({0, 1, 0}, {1, 1, 1})},
+            {"u0", line_curve({0, 0, 0}, {0, 1, 0})},
+            {"u1", line_curve({1, 0, 0}, {1, 1, 1})}}}};
+}
+
+TEST_F(CliTest, EveryConstructionTypeEvaluatesFromTheCommandLine) {
+  // The seed's bilinear example through the whole pipeline: eval at the centre.
+  write_file(at("b.json"), R"({"type": "bilinear", "p00": [0,0,1], "p01": [1,1,1], "p10": [1,0,0], "p11": [0,1,0]})");
+  ASSERT_EQ(run({"eval", "b.json", "--grid", "3", "-o", "b.csv"}).status, 0);
+  EXPECT_NE(read_file(at("b.csv")).find("\n0.5,0.5,0.5,0.5,0.5\n"), std::string::npos);
+  // A Coons patch of four lines is the bilinear patch of its corners: z = u v.
+  write_file(at("c.json"), square_coons().dump());
+  ASSERT_EQ(run({"eval", "c.json", "--grid", "5", "-o", "c.csv"}).status, 0);
+  EXPECT_NE(read_file(at("c.csv")).find("\n0.25,0.75,0.25,0.75,0.1875\n"), std::string::npos);
+  const Result info = run({"info", "c.json"});
+  ASSERT_EQ(info.status, 0) << info.err;
+  const json j = json::parse(info.out);
+  EXPECT_EQ(j["degree"], json({1, 1}));
+  EXPECT_LT(j["max_data_error"]["absolute"].get<double>(), 1e-15);
+  ASSERT_EQ(run({"build", "c.json", "-o", "c.bspline.json"}).status, 0);
+  ASSERT_EQ(run({"mesh", "c.json", "-o", "c.obj", "--res", "4x4"}).status, 0);
+}
+
+TEST_F(CliTest, BoundaryCurvesThatDoNotMeetExit3NamingTheCorner) {
+  json spec = square_coons();
+  spec["boundary"]["u1"] = line_curve({1, 0, 0}, {1, 1, 1.5});
+  expect_one_line_error(run({"info", "s.json"}), 4, {"s.json"});  // not written yet: unreadable
+  write_file(at("s.json"), spec.dump());
+  expect_one_line_error(run({"build", "s.json", "-o", "o.json"}), 3, {"corner p11", "gap 0.5"});
+  EXPECT_FALSE(fs::exists(at("o.json")));
+}
+
+TEST_F(CliTest, IncompatibleTwistsExit3UnlessGregory) {
+  const fs::path ex = fs::path(INTERPATCH_EXAMPLES) / "coons_gregory.json";
+  json spec = json::parse(read_file(ex));
+  spec.erase("twist_correction");
+  write_file(at("s.json"), spec.dump());
+  expect_one_line_error(run({"info", "s.json"}), 3, {"incompatible twists at corner p00", "differ by"});
+  spec["twist_correction"] = "gregory";
+  write_file(at("s.json"), spec.dump());
+  ASSERT_EQ(run({"eval", "s.json", "--grid", "4", "-o", "g.npy"}).status, 0);
+  // Gregory's patch is rational with singular blends: build refuses, nothing is written.
+  expect_one_line_error(run({"build", "s.json", "-o", "g.json"}), 3, {"no exact B-spline form"});
+  EXPECT_FALSE(fs::exists(at("g.json")));
+}
+
+TEST_F(CliTest, NetworkCurvesThatMissExit3NamingBothCurves) {
+  json spec = json::parse(read_file(fs::path(INTERPATCH_EXAMPLES) / "network_gordon.json"));
+  spec["u_params"] = {0, 0.25, 0.5, 0.75, 1};
+  spec["v_params"] = {0, 1.0 / 3, 2.0 / 3, 1};
+  for (auto& p : spec["u_curves"][2]["interpolate"]) p[2] = p[2].get<double>() + 0.125;
+  write_file(at("s.json"), spec.dump());
+  expect_one_line_error(run({"info", "s.json"}), 3, {"u_curves[2] and v_curves[0] miss each other", "gap 0.125"});
+}
+
+TEST_F(CliTest, UnknownChoiceExits3ListingTheChoices) {
+  json spec = square_coons();
+  spec["blending"] = "cubic";
+  write_file(at("s.json"), spec.dump());
+  expect_one_line_error(run({"info", "s.json"}), 3, {"/blending", "\"cubic\"", "\"hermite\""});
+}
+
 #else
 
 TEST(Cli, NotBuilt) { GTEST_SKIP() << "the interpatch command is not part of this build"; }

@@ -103,7 +103,7 @@ struct Box {
 };
 
 // The surface at the data parameters, a block of rows at a time.
-void surface_data_error(const BSplineSurface& s, const DataSet& d, DataError& e, std::size_t& done, std::size_t total,
+void surface_data_error(const Surface& s, const DataSet& d, DataError& e, std::size_t& done, std::size_t total,
                         const progress_callback& progress) {
   if (d.params.size() != 2)
     fail(errc::internal, d.pointer, ": data for a surface needs 2 parameter lists, got ", d.params.size());
@@ -213,14 +213,7 @@ std::optional<DataError> max_data_error(const Construction& c, const progress_ca
     for (const Vec3& p : d.points) box.add(p);
   }
   if (total == 0) return std::nullopt;
-  for (const DataSet& d : c.data)
-    std::visit(
-        [&](const auto& form) {
-          using T = std::decay_t<decltype(form)>;
-          if constexpr (std::is_same_v<T, BSplineSurface>) surface_data_error(form, d, e, done, total, progress);
-          else static_assert(unhandled_exact_form<T>, "max_data_error: an exact form without an evaluator");
-        },
-        c.exact);
+  for (const DataSet& d : c.data) surface_data_error(evaluator(c), d, e, done, total, progress);
   e.count = total;
   e.diagonal = box.diagonal();
   e.relative = e.diagonal > 0 ? e.absolute / e.diagonal
@@ -235,13 +228,19 @@ nlohmann::ordered_json info_json(const Construction& c, const progress_callback&
 
   ojson j;
   j["type"] = c.type;
-  std::visit(
-      [&](const auto& form) {
-        using T = std::decay_t<decltype(form)>;
-        if constexpr (std::is_same_v<T, BSplineSurface>) j.update(surface_info(form));
-        else static_assert(unhandled_exact_form<T>, "info_json: an exact form without a description");
-      },
-      c.exact);
+  if (c.exact) {
+    std::visit(
+        [&](const auto& form) {
+          using T = std::decay_t<decltype(form)>;
+          if constexpr (std::is_same_v<T, BSplineSurface>) j.update(surface_info(form));
+          else static_assert(unhandled_exact_form<T>, "info_json: an exact form without a description");
+        },
+        *c.exact);
+  } else {
+    j["kind"] = "surface";
+    j["exact_form"] = nullptr;
+    j["no_exact_form"] = c.no_exact_form;
+  }
   if (err) {
     j["max_data_error"] = {{"absolute", err->absolute}, {"relative", err->relative}, {"diagonal", err->diagonal},
                            {"points", err->count},      {"at", err->pointer},       {"params", err->params}};

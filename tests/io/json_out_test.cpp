@@ -35,10 +35,10 @@ TEST(JsonOut, ExactFormIsTheBsplineSurfaceSpecAndReadsBackBitForBit) {
   for (unsigned seed = 0; seed < 10; ++seed) {
     const Construction c = interpolated(seed, 3 + seed % 5, 4 + seed % 3);
     std::ostringstream os;
-    write_exact_json(os, c.exact);
+    write_exact_json(os, *c.exact);
     const json j = json::parse(os.str());
     EXPECT_EQ(j["type"], "bspline_surface");
-    const auto& s = std::get<BSplineSurface>(c.exact);
+    const auto& s = std::get<BSplineSurface>(*c.exact);
     EXPECT_EQ(j["degree"], json({s.degree_u(), s.degree_v()}));
     EXPECT_EQ(j["knots"]["u"].get<std::vector<double>>(), s.knots_u().values());
     EXPECT_EQ(j["control_points"].size(), s.control_points().extent(0));
@@ -58,11 +58,11 @@ TEST(JsonOut, RationalSurfacesCarryTheirWeights) {
                      {"weights", {{1, 2}, {0.5, 1}}}};
   const Construction c = build(spec);
   std::ostringstream os;
-  write_exact_json(os, c.exact);
+  write_exact_json(os, *c.exact);
   const json j = json::parse(os.str());
   EXPECT_EQ(j["weights"], json({{1, 2}, {0.5, 1}}));
   const Construction back = build(j);
-  EXPECT_EQ(std::get<BSplineSurface>(back.exact).weights().values(), std::get<BSplineSurface>(c.exact).weights().values());
+  EXPECT_EQ(std::get<BSplineSurface>(*back.exact).weights().values(), std::get<BSplineSurface>(*c.exact).weights().values());
 }
 
 TEST(JsonOut, MaxDataErrorIsAtRoundingLevelAndNamesThePoint) {
@@ -87,7 +87,7 @@ TEST(JsonOut, MaxDataErrorSeesAWrongSurface) {
 
 TEST(JsonOut, ExactSpecsHaveNoDataError) {
   std::ostringstream os;
-  write_exact_json(os, interpolated(5, 4, 4).exact);
+  write_exact_json(os, *interpolated(5, 4, 4).exact);
   const Construction c = build(json::parse(os.str()));
   EXPECT_FALSE(max_data_error(c).has_value());
   EXPECT_TRUE(info_json(c)["max_data_error"].is_null());

@@ -65,7 +65,7 @@ json small_spec() {
 }
 
 double max_error_at_data(const Construction& c) {
-  const auto& s = std::get<BSplineSurface>(c.exact);
+  const auto& s = std::get<BSplineSurface>(*c.exact);
   double e = 0;
   for (const DataSet& d : c.data) {
     const std::size_t nv = d.params[1].size();
@@ -87,7 +87,7 @@ TEST(Spec, InterpolateReproducesTheDataOverRandomGrids) {
     spec["param"] = trial % 3 == 0 ? "uniform" : (trial % 3 == 1 ? "chord" : "centripetal");
     const Construction c = build(spec);
     EXPECT_EQ(c.type, "interpolate");
-    const auto& s = std::get<BSplineSurface>(c.exact);
+    const auto& s = std::get<BSplineSurface>(*c.exact);
     EXPECT_EQ(s.control_points().extent(0), nu);
     EXPECT_EQ(s.control_points().extent(1), nv);
     EXPECT_EQ(s.degree_u(), std::min<int>(3, static_cast<int>(nu) - 1));  // the default degree
@@ -107,15 +107,15 @@ TEST(Spec, DegreeAsOneNumberOrOnePerDirection) {
   auto g = test::rng(2);
   json spec = interpolate_spec(test::random_grid(g, 6, 7));
   spec["degree"] = 2;
-  auto s = std::get<BSplineSurface>(build(spec).exact);
+  auto s = std::get<BSplineSurface>(*build(spec).exact);
   EXPECT_EQ(s.degree_u(), 2);
   EXPECT_EQ(s.degree_v(), 2);
   spec["degree"] = {1, 5};
-  s = std::get<BSplineSurface>(build(spec).exact);
+  s = std::get<BSplineSurface>(*build(spec).exact);
   EXPECT_EQ(s.degree_u(), 1);
   EXPECT_EQ(s.degree_v(), 5);
   spec["degree"] = 3.0;  // an integral float is an integer
-  EXPECT_EQ(std::get<BSplineSurface>(build(spec).exact).degree_u(), 3);
+  EXPECT_EQ(std::get<BSplineSurface>(*build(spec).exact).degree_u(), 3);
 }
 
 TEST(Spec, UniformParametersAreEquallySpaced) {
@@ -159,11 +159,11 @@ TEST(Spec, BuildOutputRoundTripsExactly) {
     json spec = interpolate_spec(test::random_grid(g, 3 + static_cast<std::size_t>(trial), 9 - static_cast<std::size_t>(trial)));
     const Construction a = build(spec);
     std::ostringstream text;
-    write_exact_json(text, a.exact);
+    write_exact_json(text, *a.exact);
     const Construction b = build(parse_json(text.str()));
     EXPECT_EQ(b.type, "bspline_surface");
-    const auto& sa = std::get<BSplineSurface>(a.exact);
-    const auto& sb = std::get<BSplineSurface>(b.exact);
+    const auto& sa = std::get<BSplineSurface>(*a.exact);
+    const auto& sb = std::get<BSplineSurface>(*b.exact);
     EXPECT_EQ(sa.knots_u(), sb.knots_u());
     EXPECT_EQ(sa.knots_v(), sb.knots_v());
     EXPECT_EQ(sa.control_points().values(), sb.control_points().values());  // bit for bit
@@ -180,7 +180,7 @@ TEST(Spec, BSplineSurfaceWithWeightsAndItsOwnDomain) {
                {"control_points", {{{1, 0, 0}, {1, 0, 1}}, {{1, 1, 0}, {1, 1, 1}}, {{0, 1, 0}, {0, 1, 1}}}},
                {"weights", {{1, 1}, {w, w}, {1, 1}}}};
   const Construction c = build(spec);
-  const auto& s = std::get<BSplineSurface>(c.exact);
+  const auto& s = std::get<BSplineSurface>(*c.exact);
   EXPECT_TRUE(s.rational());
   EXPECT_EQ(s.domain_u(), std::make_pair(0.0, 1.0));  // mapped onto [0,1]
   EXPECT_EQ(c.parameters["domain"]["u"], nlohmann::ordered_json({0.0, 2.0}));
@@ -209,8 +209,8 @@ TEST(Spec, PointsFromNpyAndCsvBesideTheSpec) {
   const Construction inline_ = build(interpolate_spec(q));
   for (const char* name : {"npy.json", "csv.json", "csv3.json"}) {
     const Construction c = build_file(dir / name);  // relative to the spec's directory
-    EXPECT_EQ(std::get<BSplineSurface>(c.exact).control_points().values(),
-              std::get<BSplineSurface>(inline_.exact).control_points().values())
+    EXPECT_EQ(std::get<BSplineSurface>(*c.exact).control_points().values(),
+              std::get<BSplineSurface>(*inline_.exact).control_points().values())
         << name;
     EXPECT_GE(c.timings.parse_ms, 0.0);
     EXPECT_GE(c.timings.build_ms, 0.0);
@@ -300,8 +300,9 @@ TEST(SpecErrors, MissingType) { EXPECT_ERRC((void)build(json::parse(R"({"points"
 TEST(SpecErrors, TypeNotAString) { EXPECT_ERRC((void)build(json::parse(R"({"type": 3})")), wrong_type, "/type:"); }
 
 TEST(SpecErrors, UnknownTypeListsTheKnownOnes) {
-  EXPECT_ERRC((void)build(json::parse(R"({"type": "coonz"})")), unknown_type, "\"coonz\"; known types: interpolate, bspline_surface");
-  EXPECT_EQ(known_types().front(), "interpolate");
+  EXPECT_ERRC((void)build(json::parse(R"({"type": "coonz"})")), unknown_type,
+              "\"coonz\"; known types: bilinear, ruled, coons, network, interpolate, hermite_patch, bspline_surface");
+  EXPECT_EQ(known_types().front(), "bilinear");
 }
 
 TEST(SpecErrors, MissingPoints) {
@@ -427,7 +428,7 @@ TEST(SpecErrors, BSplineSurfaceFieldsAreChecked) {
                      {"degree", {1, 1}},
                      {"knots", {{"u", {0, 0, 1, 1}}, {"v", {0, 0, 1, 1}}}},
                      {"control_points", {{{0, 0, 0}, {0, 1, 0}}, {{1, 0, 0}, {1, 1, 1}}}}};
-  EXPECT_NEAR(std::get<BSplineSurface>(build(good).exact).point(0.5, 0.5).z, 0.25, 1e-15);
+  EXPECT_NEAR(std::get<BSplineSurface>(*build(good).exact).point(0.5, 0.5).z, 0.25, 1e-15);
   json s = good;
   s.erase("degree");
   EXPECT_ERRC((void)build(s), missing_field, "/degree: missing field");

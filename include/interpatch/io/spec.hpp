@@ -10,6 +10,8 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -21,6 +23,7 @@
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/progress.hpp"
+#include "interpatch/surface.hpp"
 #include "interpatch/vec3.hpp"
 
 namespace interpatch::io {
@@ -53,14 +56,24 @@ struct Timings {
 /// A spec, built.
 struct Construction {
   std::string type;        ///< the spec's "type"
-  ExactForm exact;         ///< exact B-spline form over the unit domain
+  /// Exact B-spline form over the unit domain; empty when the construction has none
+  /// (Gregory's twist correction), and then `no_exact_form` says why.
+  std::optional<ExactForm> exact;
   std::vector<DataSet> data;  ///< what it interpolates (empty when given exactly)
   /// The options in effect, defaults filled in (degree, param, grid shape, ...).
   nlohmann::ordered_json parameters = nlohmann::ordered_json::object();
   /// Fields that were ignored (unknown names), each "pointer: reason".
   std::vector<std::string> warnings;
   Timings timings;
+  /// The construction's own formula, when it is not a B-spline itself (Coons
+  /// patches, networks, ...): what evaluates a construction without an exact form.
+  std::shared_ptr<const Surface> formula;
+  std::string no_exact_form;
 };
+
+/// What evaluates a construction: its exact form when it has one (the fast path),
+/// otherwise its formula.
+[[nodiscard]] const Surface& evaluator(const Construction& c);
 
 /// The construction types a spec's "type" may name, in the order they are documented.
 [[nodiscard]] std::vector<std::string_view> known_types();
