@@ -30,12 +30,32 @@ Blend::Blend(KnotVector knots, std::vector<double> coefficients) : knots_(std::m
            " is below coefficient ", i - 1, " = ", c_[i - 1]);
 }
 
+Blend::Blend(std::function<double(double, int)> f) : fn_(std::move(f)) {
+  if (!fn_) fail(errc::invalid_blend, "a blending function must be callable");
+  const double f0 = fn_(0.0, 0), f1 = fn_(1.0, 0);
+  if (!std::isfinite(f0) || !std::isfinite(f1)) fail(errc::not_finite, "blending function gives f(0) = ", f0, ", f(1) = ", f1);
+  // 1e-12: a closed-form blend evaluated in double is exact at the ends to a few ulps.
+  if (std::abs(f0) > 1e-12) fail(errc::invalid_blend, "a blending function must be 0 at 0; f(0) = ", f0);
+  if (std::abs(f1 - 1) > 1e-12) fail(errc::invalid_blend, "a blending function must be 1 at 1; f(1) = ", f1);
+  constexpr int samples = 1024;
+  double prev = f0;
+  for (int k = 1; k <= samples; ++k) {
+    const double t = static_cast<double>(k) / samples, y = fn_(t, 0);
+    if (!std::isfinite(y)) fail(errc::not_finite, "blending function gives f(", t, ") = ", y);
+    if (y < prev - 1e-12)
+      fail(errc::invalid_blend, "a blending function must not decrease: f(", t, ") = ", y, " is below f(",
+           static_cast<double>(k - 1) / samples, ") = ", prev);
+    prev = y;
+  }
+}
+
 Blend Blend::linear() { return Blend(KnotVector(1, {0, 0, 1, 1}), {0, 1}); }
 Blend Blend::hermite() { return Blend(KnotVector(3, {0, 0, 0, 0, 1, 1, 1, 1}), {0, 0, 1, 1}); }
 
 double Blend::derivative(double t, int order) const {
   if (!(t >= -1e-12 && t <= 1 + 1e-12)) fail(errc::out_of_domain, "blending parameter ", t, " is outside [0, 1]");
   t = std::clamp(t, 0.0, 1.0);
+  if (fn_) return fn_(t, order);
   const int p = knots_.degree();
   if (order > p) return 0.0;
   const int s = knots_.find_span(t);
@@ -56,13 +76,32 @@ BSplineCurve scalar(KnotVector knots, const std::vector<double>& coefficients) {
   return BSplineCurve(std::move(knots), std::move(cp));
 }
 
-BSplineCurve one_minus(const BSplineCurve& f) {
-  std::vector<Vec3> cp = f.control_points();
-  for (auto& x : cp) x = {1.0 - x.x, 0, 0};
-  return BSplineCurve(f.knots(), std::move(cp));
+void Scalar::eval(double t, double out[3]) const {
+  if (spline) {
+    Vec3 d[3];
+    spline->derivatives(t, 2, d);
+    for (int k = 0; k < 3; ++k) out[k] = d[k].x;
+  } else {
+    for (int k = 0; k < 3; ++k) out[k] = fn(t, k);
+  }
 }
 
-std::vector<BSplineCurve> hermite_scalars() {
+Scalar one_minus(const Scalar& f) {
+  if (!f.spline) {
+    auto fn = f.fn;
+    return Scalar(std::function<double(double, int)>([fn](double t, int k) { return (k == 0 ? 1.0 : 0.0) - fn(t, k); }));
+  }
+  std::vector<Vec3> cp = f.spline->control_points();
+  for (auto& x : cp) x = {1.0 - x.x, 0, 0};
+  return BSplineCurve(f.spline->knots(), std::move(cp));
+}
+
+Scalar scalar(const Blend& f) {
+  if (f.is_spline()) return scalar(f.knots(), f.coefficients());
+  return Scalar(f.function());
+}
+
+std::vector<Scalar> hermite_scalars() {
   const KnotVector k(3, {0, 0, 0, 0, 1, 1, 1, 1});
   return {scalar(k, {1, 1, 0, 0}), scalar(k, {0, 0, 1, 1}), scalar(k, {0, 1.0 / 3, 0, 0}), scalar(k, {0, 0, -1.0 / 3, 0})};
 }
@@ -83,6 +122,10 @@ namespace {
 
 struct D3 {  // value and first two derivatives of a function of one parameter
   Vec3 v[3];
+};
+
+struct S3 {  // the same for a scalar
+  double v[3];
 };
 
 D3 eval(const BSplineCurve& c, double t) {
@@ -114,16 +157,16 @@ SurfaceDerivatives BlendedSurface::derivatives(double u, double v) const {
   v = std::clamp(v, 0.0, 1.0);
   const auto& T = *t_;
   // Per-thread scratch: sized once, so repeated evaluation does not allocate.
-  thread_local std::vector<D3> F, G;
+  thread_local std::vector<S3> F, G;
   F.resize(T.f.size());
   G.resize(T.g.size());
-  for (std::size_t k = 0; k < T.f.size(); ++k) F[k] = eval(T.f[k], u);
-  for (std::size_t l = 0; l < T.g.size(); ++l) G[l] = eval(T.g[l], v);
+  for (std::size_t k = 0; k < T.f.size(); ++k) T.f[k].eval(u, F[k].v);
+  for (std::size_t l = 0; l < T.g.size(); ++l) T.g[l].eval(v, G[l].v);
   SurfaceDerivatives d{};
   // Σ f_k(u) a_k(v)
   for (std::size_t k = 0; k < T.a.size(); ++k) {
     const D3 A = eval(T.a[k], v);
-    const double f0 = F[k].v[0].x, f1 = F[k].v[1].x, f2 = F[k].v[2].x;
+    const double f0 = F[k].v[0], f1 = F[k].v[1], f2 = F[k].v[2];
     d.s += f0 * A.v[0];
     d.su += f1 * A.v[0];
     d.sv += f0 * A.v[1];
@@ -134,7 +177,7 @@ SurfaceDerivatives BlendedSurface::derivatives(double u, double v) const {
   // Σ b_l(u) g_l(v)
   for (std::size_t l = 0; l < T.b.size(); ++l) {
     const D3 B = eval(T.b[l], u);
-    const double g0 = G[l].v[0].x, g1 = G[l].v[1].x, g2 = G[l].v[2].x;
+    const double g0 = G[l].v[0], g1 = G[l].v[1], g2 = G[l].v[2];
     d.s += g0 * B.v[0];
     d.su += g0 * B.v[1];
     d.sv += g1 * B.v[0];
@@ -147,8 +190,8 @@ SurfaceDerivatives BlendedSurface::derivatives(double u, double v) const {
     for (std::size_t k = 0; k < T.f.size(); ++k)
       for (std::size_t l = 0; l < T.g.size(); ++l) {
         const Vec3& c = T.c(k, l);
-        const double f0 = F[k].v[0].x, f1 = F[k].v[1].x, f2 = F[k].v[2].x;
-        const double g0 = G[l].v[0].x, g1 = G[l].v[1].x, g2 = G[l].v[2].x;
+        const double f0 = F[k].v[0], f1 = F[k].v[1], f2 = F[k].v[2];
+        const double g0 = G[l].v[0], g1 = G[l].v[1], g2 = G[l].v[2];
         d.s += (f0 * g0) * c;
         d.su += (f1 * g0) * c;
         d.sv += (f0 * g1) * c;
@@ -183,6 +226,9 @@ SurfaceDerivatives BlendedSurface::derivatives(double u, double v) const {
 
 bool BlendedSurface::has_exact_form() const noexcept {
   if (!t_->gregory.empty()) return false;
+  for (const auto* list : {&t_->f, &t_->g})
+    for (const auto& s : *list)
+      if (!s.spline) return false;
   for (const auto* list : {&t_->a, &t_->b})
     for (const auto& c : *list)
       if (c.rational()) return false;
@@ -200,8 +246,15 @@ BSplineSurface BlendedSurface::to_bspline() const {
         fail(errc::no_exact_form, "curve ", k, " of the ", list == &T.a ? "v" : "u",
              "-direction terms is rational; blends of rational curves with different weights have no B-spline "
              "form of the same kind");
+  for (const auto* list : {&T.f, &T.g})
+    for (const auto& s : *list)
+      if (!s.spline)
+        fail(errc::no_exact_form, "a blending function given as a callable has no B-spline form; give it as a "
+                                  "B-spline (knots and coefficients) for an exact conversion");
   // Every function of u on one knot vector and degree, every function of v likewise.
-  std::vector<BSplineCurve> us(T.f), vs(T.g);
+  std::vector<BSplineCurve> us, vs;
+  for (const auto& s : T.f) us.push_back(*s.spline);
+  for (const auto& s : T.g) vs.push_back(*s.spline);
   us.insert(us.end(), T.b.begin(), T.b.end());
   vs.insert(vs.end(), T.a.begin(), T.a.end());
   const auto cu = make_compatible(us), cv = make_compatible(vs);

@@ -62,8 +62,7 @@ BlendedSurface coons(const CoonsBoundary& boundary, const CoonsOptions& options)
   const double tol = options.tolerance ? *options.tolerance : 1e-7 * control_diagonal({&b.v0, &b.v1, &b.u0, &b.u1});
   const auto p = corners(b, tol);
   auto t = std::make_shared<detail::BlendedTerms>();
-  const auto f = detail::scalar(options.blend_u.knots(), options.blend_u.coefficients());
-  const auto g = detail::scalar(options.blend_v.knots(), options.blend_v.coefficients());
+  const detail::Scalar f = detail::scalar(options.blend_u), g = detail::scalar(options.blend_v);
   t->f = {detail::one_minus(f), f};
   t->a = {b.u0, b.u1};
   t->g = {detail::one_minus(g), g};

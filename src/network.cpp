@@ -88,9 +88,9 @@ double control_diagonal(const CurveNetwork& n) {
 }
 
 // Cardinal functions φ_i(t_k) = δ_ik over the node parameters t.
-std::vector<BSplineCurve> cardinals(const std::vector<double>& t, NetworkMethod method) {
+std::vector<detail::Scalar> cardinals(const std::vector<double>& t, NetworkMethod method) {
   const std::size_t n = t.size();
-  std::vector<BSplineCurve> out;
+  std::vector<detail::Scalar> out;
   out.reserve(n);
   if (method == NetworkMethod::coons_linear) {
     std::vector<double> k{t.front()};

@@ -94,6 +94,28 @@ TEST(Coons, GeneralBlendMatchesFormula) {
   EXPECT_LT(test::max_distance(c, c.to_bspline()), 1e-12 * 16);
 }
 
+TEST(Coons, CallableBlendEvaluatesExactlyButHasNoExactForm) {
+  auto g = test::rng(77);
+  const auto s = test::random_bspline_surface(g, 3, 2, 5, 5);
+  const Blend square([](double t, int k) { return k == 0 ? t * t : (k == 1 ? 2 * t : 2.0); });
+  const Blend square_spline(KnotVector(2, {0, 0, 0, 1, 1, 1}), {0, 0, 1});  // t² in Bernstein form
+  CoonsOptions a, b;
+  a.blend_u = square;
+  b.blend_u = square_spline;
+  const auto ca = coons(boundary_of(s), a), cb = coons(boundary_of(s), b);
+  EXPECT_FALSE(ca.has_exact_form());
+  EXPECT_ERRC((void)ca.to_bspline(), no_exact_form, "callable");
+  for (double u : linspace(0, 1, 9))
+    for (double v : linspace(0, 1, 9)) {
+      const auto da = ca.derivatives(u, v), db = cb.derivatives(u, v);
+      EXPECT_LT(distance(da.s, db.s), 1e-14 * 16);  // the same function, two evaluations
+      EXPECT_LT(distance(da.suu, db.suu), 1e-12 * 16);
+    }
+  EXPECT_ERRC(Blend([](double t, int) { return std::sin(3.0 * t); }), invalid_blend, "1 at 1");
+  EXPECT_ERRC(Blend([](double t, int) { return t + 0.2 * std::sin(12.0 * t) * t * (1 - t) * 4; }), invalid_blend,
+              "must not decrease");
+}
+
 TEST(Coons, BicubicReproducesBoundaryCrossDerivativesAndBicubics) {
   auto g = test::rng(74);
   for (int trial = 0; trial < 10; ++trial) {

@@ -4,9 +4,12 @@
 // Scalar functions f, g are B-spline curves whose x coordinate is the value; every
 // function and curve is over [0, 1].
 
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "interpatch/blended_surface.hpp"
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/grid.hpp"
 
@@ -20,9 +23,24 @@ struct GregoryCorner {
   Vec3 tu, tv;
 };
 
+/// A scalar function of one parameter on [0, 1]: a B-spline (exact form: its value
+/// is the x coordinate), or a callable f(t, order) returning the value (order 0)
+/// or a derivative (1, 2), which has no exact form.
+struct Scalar {
+  std::optional<BSplineCurve> spline;
+  std::function<double(double, int)> fn;
+
+  Scalar(BSplineCurve s) : spline(std::move(s)) {}  // NOLINT: a B-spline is a scalar function
+  explicit Scalar(std::function<double(double, int)> f) : fn(std::move(f)) {}
+  /// Value and first two derivatives at t.
+  void eval(double t, double out[3]) const;
+};
+
 struct BlendedTerms {
-  std::vector<BSplineCurve> f, a;  // a empty, or one curve of v per f
-  std::vector<BSplineCurve> g, b;  // b empty, or one curve of u per g
+  std::vector<Scalar> f;
+  std::vector<BSplineCurve> a;  // a empty, or one curve of v per f
+  std::vector<Scalar> g;
+  std::vector<BSplineCurve> b;  // b empty, or one curve of u per g
   Grid<Vec3, 2> c;                 // |f| × |g| or empty
   std::vector<GregoryCorner> gregory;
   std::vector<std::string> notes;
@@ -31,10 +49,12 @@ struct BlendedTerms {
 /// A scalar B-spline function as a curve whose x coordinate is the value.
 BSplineCurve scalar(KnotVector knots, const std::vector<double>& coefficients);
 /// 1 − f for a scalar function f.
-BSplineCurve one_minus(const BSplineCurve& f);
+Scalar one_minus(const Scalar& f);
+/// A blending function as a scalar: its B-spline, or its callable.
+Scalar scalar(const Blend& f);
 /// The cubic Hermite functions α0, α1, β0, β1 on [0, 1] as scalar Bézier functions
 /// (α0 = B0 + B1, α1 = B2 + B3, β0 = B1/3, β1 = −B2/3).
-std::vector<BSplineCurve> hermite_scalars();
+std::vector<Scalar> hermite_scalars();
 /// The curve over [0, 1].
 BSplineCurve unit(const BSplineCurve& c);
 
