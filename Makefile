@@ -7,7 +7,7 @@ DEBS := cmake ninja-build g++ python3 libeigen3-dev liblapack-dev libcli11-dev n
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
-.PHONY: all deps build demo test test-release test-asan clean
+.PHONY: all deps build demo test test-release test-asan bench clean
 
 all: build
 
@@ -37,6 +37,21 @@ test-asan: deps
 	ctest --preset asan -j $(JOBS)
 
 test: test-release test-asan
+
+# Benchmarks (never part of `make test`): the console table, then the JSON record
+# and its Markdown tables (docs/BENCHMARKS.md). Repetitions tame a shared machine;
+# pinned OpenMP threads keep a spinning thread off the core doing the work.
+# A single-thread record: make bench BENCH_ENV=OMP_NUM_THREADS=1 BENCH_OUT=build/bench/results_1thread.json
+BENCH_FLAGS ?= --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+BENCH_ENV ?= OMP_PROC_BIND=true
+BENCH_OUT ?= build/bench/results.json
+
+bench: deps
+	cmake --preset bench
+	cmake --build --preset bench -j $(JOBS)
+	env $(BENCH_ENV) ./build/bench/bench/interpatch_bench $(BENCH_FLAGS) \
+	  --benchmark_out=$(BENCH_OUT) --benchmark_out_format=json
+	python3 tools/bench_report.py $(BENCH_OUT)
 
 clean:
 	rm -rf build demo-output
