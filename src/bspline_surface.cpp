@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 
 #include "detail/parallel.hpp"
@@ -180,50 +181,52 @@ PointGrid BSplineSurface::evaluate(std::span<const double> us, std::span<const d
   const std::size_t nv = vs.size();
   PointGrid out({us.size(), nv});
   const bool rat = rational();
-  // Rows in chunks so progress comes from the calling thread between them.
-  constexpr std::size_t chunk = 64;
-  // Starting the second thread costs milliseconds here: small grids stay on one.
+  // One parallel region: opening one costs microseconds with pinned threads but up
+  // to milliseconds on a loaded machine, where the idle thread spins. Progress is
+  // reported by the calling thread (thread 0) from a shared row count.
   const bool threads = us.size() * (nv + ncv) >= detail::parallel_min_work;
-  for (std::size_t r0 = 0; r0 < us.size(); r0 += chunk) {
-    const auto r1 = static_cast<long long>(std::min(us.size(), r0 + chunk));
+  std::atomic<std::size_t> done{0};
+  const auto nu = static_cast<long long>(us.size());
 #pragma omp parallel if (threads)
-    {
-      // One contracted row of homogeneous points per thread, reused for every u.
-      std::vector<std::array<double, 4>> row(ncv);
-#pragma omp for schedule(static)
-      for (long long ri = static_cast<long long>(r0); ri < r1; ++ri) {
-        const auto i = static_cast<std::size_t>(ri);
-        const Basis& b = bu[i];
-        for (std::size_t l = 0; l < ncv; ++l) {
-          double x = 0, y = 0, z = 0, w = 0;
-          for (int a = 0; a <= p; ++a) {
-            const auto ii = static_cast<std::size_t>(b.span - p + a);
-            const double c = b.d[a] * (rat ? w_(ii, l) : 1.0);
-            const Vec3& P = cp_(ii, l);
-            x += c * P.x;
-            y += c * P.y;
-            z += c * P.z;
-            w += c;
-          }
-          row[l] = {x, y, z, w};
+  {
+    // One contracted row of homogeneous points per thread, reused for every u.
+    std::vector<std::array<double, 4>> row(ncv);
+    const bool reporter = detail::thread_index() == 0;
+#pragma omp for schedule(static, 16)
+    for (long long ri = 0; ri < nu; ++ri) {
+      const auto i = static_cast<std::size_t>(ri);
+      const Basis& b = bu[i];
+      for (std::size_t l = 0; l < ncv; ++l) {
+        double x = 0, y = 0, z = 0, w = 0;
+        for (int a = 0; a <= p; ++a) {
+          const auto ii = static_cast<std::size_t>(b.span - p + a);
+          const double c = b.d[a] * (rat ? w_(ii, l) : 1.0);
+          const Vec3& P = cp_(ii, l);
+          x += c * P.x;
+          y += c * P.y;
+          z += c * P.z;
+          w += c;
         }
-        Vec3* o = &out(i, 0);
-        for (std::size_t j = 0; j < nv; ++j) {
-          const Basis& c = bv[j];
-          double x = 0, y = 0, z = 0, w = 0;
-          for (int k = 0; k <= q; ++k) {
-            const auto& h = row[static_cast<std::size_t>(c.span - q + k)];
-            x += c.d[k] * h[0];
-            y += c.d[k] * h[1];
-            z += c.d[k] * h[2];
-            w += c.d[k] * h[3];
-          }
-          o[j] = rat ? Vec3{x / w, y / w, z / w} : Vec3{x, y, z};
-        }
+        row[l] = {x, y, z, w};
       }
+      Vec3* o = &out(i, 0);
+      for (std::size_t j = 0; j < nv; ++j) {
+        const Basis& c = bv[j];
+        double x = 0, y = 0, z = 0, w = 0;
+        for (int k = 0; k <= q; ++k) {
+          const auto& h = row[static_cast<std::size_t>(c.span - q + k)];
+          x += c.d[k] * h[0];
+          y += c.d[k] * h[1];
+          z += c.d[k] * h[2];
+          w += c.d[k] * h[3];
+        }
+        o[j] = rat ? Vec3{x / w, y / w, z / w} : Vec3{x, y, z};
+      }
+      const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
+      if (progress && reporter && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(us.size()));
     }
-    if (progress) progress(static_cast<double>(r1) / static_cast<double>(us.size()));
   }
+  if (progress) progress(1.0);
   return out;
 }
 

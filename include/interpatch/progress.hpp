@@ -7,7 +7,8 @@
 
 namespace interpatch {
 
-/// Called with the fraction of the work done, 0..1, from the calling thread.
+/// Called with the fraction of the work done, 0..1, from the calling thread; it
+/// must not throw (it may run inside a parallel region).
 using progress_callback = std::function<void(double)>;
 
 }  // namespace interpatch

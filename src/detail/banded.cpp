@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <utility>
+#include <vector>
 
 namespace interpatch::detail {
 
@@ -76,12 +77,38 @@ void solve_along_axis(const BandedLU& lu, double* data, const std::size_t* shape
   for (std::size_t a = axis + 1; a < rank; ++a) inner *= shape[a];
   const std::size_t n = shape[axis];
   const std::size_t block = n * inner;
-  // Column slices of a few KiB keep the band's rows in cache; many lines are split
-  // across threads line by line instead.
+  const bool threads = block * outer >= parallel_min_work;
+  if (inner < 64 && outer > 1) {
+    // Narrow lines (the last axis: 3 doubles a row) solved one at a time make the
+    // substitutions one dependent chain of scalar operations. Eight lines side by
+    // side in a buffer give each row operation 24 independent columns; every number
+    // still goes through the same operations, so the result is the same bits.
+    constexpr std::size_t group = 8;
+    const auto groups = static_cast<long long>((outer + group - 1) / group);
+#pragma omp parallel if (threads)
+    {
+      std::vector<double> buf(n * group * inner);
+#pragma omp for schedule(static)
+      for (long long g = 0; g < groups; ++g) {
+        const std::size_t o0 = static_cast<std::size_t>(g) * group;
+        const std::size_t m = std::min(group, outer - o0);
+        const std::size_t width = m * inner;
+        for (std::size_t k = 0; k < n; ++k)
+          for (std::size_t l = 0; l < m; ++l)
+            std::copy_n(data + (o0 + l) * block + k * inner, inner, buf.data() + k * width + l * inner);
+        lu.solve(buf.data(), width, width);
+        for (std::size_t k = 0; k < n; ++k)
+          for (std::size_t l = 0; l < m; ++l)
+            std::copy_n(buf.data() + k * width + l * inner, inner, data + (o0 + l) * block + k * inner);
+      }
+    }
+    return;
+  }
+  // Wide lines: column slices of a few KiB keep the band's rows in cache.
   constexpr std::size_t slice = 512;
   const std::size_t slices = (inner + slice - 1) / slice;
   const auto tasks = static_cast<long long>(outer * slices);
-#pragma omp parallel for schedule(static) if (tasks > 1 && block * outer >= parallel_min_work)
+#pragma omp parallel for schedule(static) if (tasks > 1 && threads)
   for (long long t = 0; t < tasks; ++t) {
     const std::size_t o = static_cast<std::size_t>(t) / slices;
     const std::size_t s = static_cast<std::size_t>(t) % slices;

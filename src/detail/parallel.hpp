@@ -6,8 +6,21 @@
 
 #include <cstddef>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 namespace interpatch::detail {
 
 inline constexpr std::size_t parallel_min_work = std::size_t{1} << 18;
+
+/// The calling thread is 0, inside or outside a parallel region.
+inline int thread_index() noexcept {
+#ifdef _OPENMP
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
 
 }  // namespace interpatch::detail
