@@ -1,0 +1,88 @@
+#include "interpatch/blended_surface.hpp"
+
+#include "interpatch/interpolate.hpp"
+#include "interpatch/network.hpp"
+#include "interpatch/patches.hpp"
+#include "surface_util.hpp"
+
+namespace interpatch {
+namespace {
+
+// Seed 002 eq. 1: r(u,v) = Σ c_k(u,v) r_k with c_k(u_l, v_l) = δ_kl and Σ c_k ≡ 1. For
+// constructions from curves the "data" r_k are whole curves; both properties are
+// checked through linearity in the data.
+
+BSplineCurve scaled(const BSplineCurve& c, double s, const Vec3& shift = {}) {
+  auto cp = c.control_points();
+  for (auto& x : cp) x = s * x + shift;
+  return BSplineCurve(c.knots(), cp);
+}
+
+TEST(BlendedSurface, BlendValues) {
+  EXPECT_EQ(Blend::linear()(0.25), 0.25);
+  EXPECT_NEAR(Blend::hermite()(0.25), 3 * 0.0625 - 2 * 0.015625, 1e-16);
+  EXPECT_NEAR(Blend::hermite().derivative(0.0, 1), 0.0, 1e-16);  // zero slopes: C1 networks
+  EXPECT_NEAR(Blend::hermite().derivative(1.0, 1), 0.0, 1e-16);
+  EXPECT_TRUE(Blend::hermite().is_spline());
+}
+
+TEST(BlendedSurface, NetworkCardinalFunctionsAreDeltas) {
+  // Every curve zero except v_curves[k], a bump that vanishes at the node parameters:
+  // the surface is that bump along u = u_k and zero along every other network line.
+  const std::vector<double> tu{0, 0.3, 0.65, 1}, tv{0, 0.4, 1};
+  const BSplineCurve zero(KnotVector(1, {0, 0, 1, 1}), {{0, 0, 0}, {0, 0, 0}});
+  // Cubic through (0,0), (0.4, 0) and (1, 0) with a non-zero middle: t (t − 0.4)(t − 1) · (1,2,3).
+  auto bump_at = [](double t) { return (t * (t - 0.4) * (t - 1)) * Vec3{1, 2, 3}; };
+  std::vector<Vec3> samples;
+  for (int k = 0; k < 4; ++k) samples.push_back(bump_at(k / 3.0));
+  CurveInterpolationOptions o;
+  o.params = {0, 1.0 / 3, 2.0 / 3, 1};
+  const BSplineCurve bump = interpolate_curve(samples, o).curve;  // the cubic itself
+  for (auto method : {NetworkMethod::coons_linear, NetworkMethod::coons_hermite, NetworkMethod::gordon})
+    for (std::size_t k = 0; k < tu.size(); ++k) {
+      CurveNetwork n{std::vector<BSplineCurve>(tv.size(), zero), std::vector<BSplineCurve>(tu.size(), zero), tu, tv};
+      n.v_curves[k] = bump;
+      const auto s = curve_network(n, {method, {}});
+      for (double t : linspace(0, 1, 11)) {
+        for (std::size_t i = 0; i < tu.size(); ++i)
+          EXPECT_LT(distance(s.point(tu[i], t), i == k ? bump_at(t) : Vec3{}), 1e-15 * 16);
+        for (double v : tv) EXPECT_LT(norm(s.point(t, v)), 1e-15 * 16);
+      }
+    }
+}
+
+TEST(BlendedSurface, TranslatingTheDataTranslatesTheSurface) {
+  auto g = test::rng(90);
+  const auto src = test::random_bspline_surface(g, 3, 3, 6, 6);
+  const std::vector<double> tu{0, 0.5, 1}, tv{0, 0.3, 0.7, 1};
+  CurveNetwork n, m;
+  const Vec3 d{5, -1, 0.5};
+  for (double v : tv) n.u_curves.push_back(test::iso_curve(src, 1, v));
+  for (double u : tu) n.v_curves.push_back(test::iso_curve(src, 0, u));
+  for (const auto& c : n.u_curves) m.u_curves.push_back(scaled(c, 1, d));
+  for (const auto& c : n.v_curves) m.v_curves.push_back(scaled(c, 1, d));
+  n.u_params = m.u_params = tu;
+  n.v_params = m.v_params = tv;
+  for (auto method : {NetworkMethod::coons_linear, NetworkMethod::coons_hermite, NetworkMethod::gordon}) {
+    const auto a = curve_network(n, {method, {}}), b = curve_network(m, {method, {}});
+    for (double u : linspace(0, 1, 9))
+      for (double v : linspace(0, 1, 9)) EXPECT_LT(distance(b.point(u, v) - d, a.point(u, v)), 1e-13);
+  }
+  const Vec3 p[4] = {test::random_point(g), test::random_point(g), test::random_point(g), test::random_point(g)};
+  const auto bl = bilinear(p[0], p[1], p[2], p[3]), bt = bilinear(p[0] + d, p[1] + d, p[2] + d, p[3] + d);
+  std::array<HermiteCorner, 4> hc, ht;
+  for (std::size_t k = 0; k < 4; ++k) {
+    hc[k] = {p[k], test::random_point(g), test::random_point(g), test::random_point(g)};
+    ht[k] = hc[k];
+    ht[k].p += d;  // only positions move; derivatives of a translated surface are the same
+  }
+  const auto h0 = hermite_patch(hc), h1 = hermite_patch(ht);
+  for (double u : linspace(0, 1, 9))
+    for (double v : linspace(0, 1, 9)) {
+      EXPECT_LT(distance(bt.point(u, v) - d, bl.point(u, v)), 1e-14 * 8);
+      EXPECT_LT(distance(h1.point(u, v) - d, h0.point(u, v)), 1e-14 * 8);
+    }
+}
+
+}  // namespace
+}  // namespace interpatch
