@@ -137,10 +137,14 @@ CurveInterpolation interpolate_curve(std::span<const Vec3> points, const CurveIn
   return {BSplineCurve(std::move(knots), std::move(rhs)), std::move(t)};
 }
 
-std::vector<double> grid_parameters(const PointGrid& q, int axis, Parametrization param) {
-  const std::size_t nu = q.extent(0), nv = q.extent(1);
-  const std::size_t n = axis == 0 ? nu : nv;      // points along the axis
-  const std::size_t lines = axis == 0 ? nv : nu;  // lines along it
+namespace {
+
+// Parameters along the middle axis of a grid seen as outer × n × inner points in C
+// order (any rank and axis): each line along the axis gets its chord parameters;
+// lines of zero length (a pole) are left out; the rest are averaged in line order
+// (seed 003). Every loop runs along memory.
+std::vector<double> line_parameters(const Vec3* q, std::size_t outer, std::size_t n, std::size_t inner, int axis,
+                                    Parametrization param) {
   if (n < 2) fail(errc::too_few_points, "a grid needs at least 2 points along ", axis_name(axis), ", got ", n);
   std::vector<double> t(n, 0.0);
   if (param == Parametrization::uniform) {
@@ -148,20 +152,17 @@ std::vector<double> grid_parameters(const PointGrid& q, int axis, Parametrizatio
     t.back() = 1.0;
     return t;
   }
+  const std::size_t lines = outer * inner;
+  require_memory(lines, 2 * sizeof(double) + 1, detail::cat("chord lengths of the ", lines, " grid lines along ", axis_name(axis)));
   // Pass 1: each line's length. Pass 2: each line's normalized running length,
-  // summed over the lines that have a length (a pole line has none) in line order.
-  // Loops run along memory (the second index) in both passes.
+  // summed over the lines that have a length in line order.
   std::vector<double> total(lines, 0.0), cum(lines, 0.0);
-  auto d = [&](std::size_t k, std::size_t line) {  // step from point k-1 to k on a line
-    return axis == 0 ? step(q(k - 1, line), q(k, line), param) : step(q(line, k - 1), q(line, k), param);
+  auto d = [&](std::size_t o, std::size_t k, std::size_t i) {  // step from point k-1 to k on line (o, i)
+    return step(q[(o * n + k - 1) * inner + i], q[(o * n + k) * inner + i], param);
   };
-  if (axis == 0) {
+  for (std::size_t o = 0; o < outer; ++o)
     for (std::size_t k = 1; k < n; ++k)
-      for (std::size_t l = 0; l < lines; ++l) total[l] += d(k, l);
-  } else {
-    for (std::size_t l = 0; l < lines; ++l)
-      for (std::size_t k = 1; k < n; ++k) total[l] += d(k, l);
-  }
+      for (std::size_t i = 0; i < inner; ++i) total[o * inner + i] += d(o, k, i);
   double maxlen = 0;
   for (double L : total) maxlen = std::max(maxlen, L);
   // A line shorter than 1e-14 of the longest is a collapsed row (pole) within rounding.
@@ -174,25 +175,13 @@ std::vector<double> grid_parameters(const PointGrid& q, int axis, Parametrizatio
   if (nused == 0)
     fail(errc::zero_chord, "every line of the grid along ", axis_name(axis),
          " has zero length: all points coincide along ", axis_name(axis));
-  if (axis == 0) {
-    for (std::size_t k = 1; k < n; ++k) {
-      double s = 0;
-      for (std::size_t l = 0; l < lines; ++l) {
-        cum[l] += d(k, l);
-        if (used[l]) s += cum[l] / total[l];
+  for (std::size_t o = 0; o < outer; ++o)
+    for (std::size_t k = 1; k < n; ++k)
+      for (std::size_t i = 0; i < inner; ++i) {
+        const std::size_t l = o * inner + i;
+        cum[l] += d(o, k, i);
+        if (used[l]) t[k] += cum[l] / total[l];
       }
-      t[k] = s;
-    }
-  } else {
-    for (std::size_t l = 0; l < lines; ++l) {
-      if (!used[l]) continue;
-      double c = 0;
-      for (std::size_t k = 1; k < n; ++k) {
-        c += d(k, l);
-        t[k] += c / total[l];
-      }
-    }
-  }
   for (std::size_t k = 1; k < n; ++k) t[k] /= static_cast<double>(nused);
   t.back() = 1.0;
   for (std::size_t k = 1; k < n; ++k)
@@ -200,6 +189,26 @@ std::vector<double> grid_parameters(const PointGrid& q, int axis, Parametrizatio
       fail(errc::zero_chord, "grid points ", k - 1, " and ", k, " along ", axis_name(axis),
            " coincide on every line (averaged parameters ", t[k - 1], " and ", t[k], ")");
   return t;
+}
+
+template <class G>
+std::vector<double> grid_parameters_of(const G& q, int axis, Parametrization param) {
+  const auto& shape = q.shape();
+  const auto a = static_cast<std::size_t>(axis);
+  std::size_t outer = 1, inner = 1;
+  for (std::size_t x = 0; x < a; ++x) outer *= shape[x];
+  for (std::size_t x = a + 1; x < shape.size(); ++x) inner *= shape[x];
+  return line_parameters(q.data(), outer, shape[a], inner, axis, param);
+}
+
+}  // namespace
+
+std::vector<double> grid_parameters(const PointGrid& q, int axis, Parametrization param) {
+  return grid_parameters_of(q, axis, param);
+}
+
+std::vector<double> grid_parameters(const PointGrid3& q, int axis, Parametrization param) {
+  return grid_parameters_of(q, axis, param);
 }
 
 SurfaceInterpolation interpolate_surface(PointGrid points, const SurfaceInterpolationOptions& options) {
@@ -233,6 +242,45 @@ SurfaceInterpolation interpolate_surface(PointGrid points, const SurfaceInterpol
   detail::solve_along_axis(lu_v, &points.data()->x, shape, 2, 1, 3);
   if (options.progress) options.progress(1.0);
   return {BSplineSurface(std::move(ku), std::move(kv), std::move(points)), std::move(tu), std::move(tv)};
+}
+
+VolumeInterpolation interpolate_volume(PointGrid3 points, const VolumeInterpolationOptions& options) {
+  const std::size_t nu = points.extent(0), nv = points.extent(1), nw = points.extent(2);
+  if (nu < 2 || nv < 2 || nw < 2)
+    fail(errc::too_few_points, "volume interpolation needs at least 2 x 2 x 2 points, got ", nu, " x ", nv, " x ", nw);
+  const Vec3* data = points.data();
+  for (std::size_t k = 0; k < points.size(); ++k)
+    if (!is_finite(data[k]))
+      fail(errc::not_finite, "point [", k / (nv * nw), "][", k / nw % nv, "][", k % nw, "] is ", data[k]);
+  const int p = resolve_degree(options.degree_u, nu, 0, " in u");
+  const int q = resolve_degree(options.degree_v, nv, 0, " in v");
+  const int r = resolve_degree(options.degree_w, nw, 0, " in w");
+  if (options.progress) options.progress(0.0);
+  auto tu = grid_parameters(points, 0, options.param);
+  auto tv = grid_parameters(points, 1, options.param);
+  auto tw = grid_parameters(points, 2, options.param);
+  KnotVector ku = averaged_knots(tu, p), kv = averaged_knots(tv, q), kw = averaged_knots(tw, r);
+  auto factor = [](const KnotVector& k, const std::vector<double>& t, const char* dir) {
+    try {
+      return detail::factor_collocation(k, t);
+    } catch (const error& e) {
+      fail(e.code(), "along ", dir, ": ", e.what());
+    }
+  };
+  const auto lu_u = factor(ku, tu, "u");
+  const auto lu_v = factor(kv, tv, "v");
+  const auto lu_w = factor(kw, tw, "w");
+  if (options.progress) options.progress(0.1);
+  // Lines along u, then along v, then along w, in place: the data become the control points.
+  const std::size_t shape[3] = {nu, nv, nw};
+  detail::solve_along_axis(lu_u, &points.data()->x, shape, 3, 0, 3);
+  if (options.progress) options.progress(0.4);
+  detail::solve_along_axis(lu_v, &points.data()->x, shape, 3, 1, 3);
+  if (options.progress) options.progress(0.7);
+  detail::solve_along_axis(lu_w, &points.data()->x, shape, 3, 2, 3);
+  if (options.progress) options.progress(1.0);
+  return {BSplineVolume(std::move(ku), std::move(kv), std::move(kw), std::move(points)), std::move(tu), std::move(tv),
+          std::move(tw)};
 }
 
 }  // namespace interpatch

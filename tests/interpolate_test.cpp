@@ -222,5 +222,152 @@ TEST(InterpolateSurface, InvalidInput) {
   EXPECT_ERRC((void)interpolate_surface(flat), zero_chord, "every line of the grid along u has zero length");
 }
 
+// --- Volumes -----------------------------------------------------------------------
+
+double max_error_at_data(const VolumeInterpolation& r, const PointGrid3& q) {
+  double e = 0;
+  for (std::size_t i = 0; i < q.extent(0); ++i)
+    for (std::size_t j = 0; j < q.extent(1); ++j)
+      for (std::size_t k = 0; k < q.extent(2); ++k)
+        e = std::max(e, distance(r.volume.point(r.params_u[i], r.params_v[j], r.params_w[k]), q(i, j, k)));
+  return e;
+}
+
+PointGrid3 random_grid3(std::mt19937_64& g, std::size_t nu, std::size_t nv, std::size_t nw, double noise) {
+  PointGrid3 q({nu, nv, nw});
+  for (std::size_t i = 0; i < nu; ++i)
+    for (std::size_t j = 0; j < nv; ++j)
+      for (std::size_t k = 0; k < nw; ++k)
+        q(i, j, k) = Vec3{static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)} + test::random_point(g, noise);
+  return q;
+}
+
+TEST(InterpolateVolume, PassesThroughRandomGridsOfManyShapesAndDegrees) {
+  auto g = test::rng(250);
+  for (int trial = 0; trial < 60; ++trial) {
+    const std::size_t nu = 2 + static_cast<std::size_t>(trial % 7), nv = 2 + static_cast<std::size_t>((trial * 5) % 6),
+                      nw = 2 + static_cast<std::size_t>((trial * 3) % 9);
+    const auto q = random_grid3(g, nu, nv, nw, 0.35);
+    VolumeInterpolationOptions o;
+    o.degree_u = 1 + trial % std::min<int>(5, static_cast<int>(nu) - 1);
+    o.degree_v = 1 + (trial / 2) % std::min<int>(5, static_cast<int>(nv) - 1);
+    o.degree_w = 1 + (trial / 3) % std::min<int>(5, static_cast<int>(nw) - 1);
+    o.param = static_cast<Parametrization>(trial % 3);
+    const auto r = interpolate_volume(q, o);
+    EXPECT_EQ(r.volume.control_points().shape(), q.shape());  // exactly (n+1) x (m+1) x (l+1) control points
+    EXPECT_EQ(r.volume.degree_w(), *o.degree_w);
+    // Three banded solves: rounding grows with the (small) condition numbers of the collocation matrices.
+    EXPECT_LT(max_error_at_data(r, q), 1e-12 * test::bbox_diagonal(q.values())) << nu << "x" << nv << "x" << nw;
+  }
+}
+
+TEST(InterpolateVolume, HeaderExample) {
+  PointGrid3 q({5, 6, 4});
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 6; ++j)
+      for (int k = 0; k < 4; ++k) q(i, j, k) = {double(i), double(j) + 0.1 * i * i, double(k) + std::sin(i + j)};
+  auto r = interpolate_volume(q);
+  EXPECT_EQ(r.volume.degree_w(), 3);
+  EXPECT_LT(distance(r.volume.point(r.params_u[2], r.params_v[3], r.params_w[1]), q(2, 3, 1)), 1e-12 * 10);  // rounding
+}
+
+TEST(InterpolateVolume, DefaultDegreesAndProgress) {
+  auto g = test::rng(251);
+  const auto q = random_grid3(g, 6, 3, 2, 0.3);
+  std::vector<double> seen;
+  VolumeInterpolationOptions o;
+  o.progress = [&](double f) { seen.push_back(f); };
+  const auto r = interpolate_volume(q, o);
+  EXPECT_EQ(r.volume.degree_u(), 3);  // min(3, points - 1)
+  EXPECT_EQ(r.volume.degree_v(), 2);
+  EXPECT_EQ(r.volume.degree_w(), 1);
+  EXPECT_EQ(seen.front(), 0.0);
+  EXPECT_EQ(seen.back(), 1.0);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_LT(max_error_at_data(r, q), 1e-12 * test::bbox_diagonal(q.values()));
+}
+
+TEST(InterpolateVolume, ReproducesTrivariatePolynomialsEverywhere) {
+  // A polynomial of degree (3, 2, 3) in uniform parameters lies in the spline space.
+  auto f = [](double u, double v, double w) {
+    return Vec3{u + 0.1 * v * w, v - u * u * w, u * u * u * v - 2 * w * w * w + u * v * w};
+  };
+  const std::size_t n[3] = {7, 5, 6};
+  PointGrid3 q({n[0], n[1], n[2]});
+  for (std::size_t i = 0; i < n[0]; ++i)
+    for (std::size_t j = 0; j < n[1]; ++j)
+      for (std::size_t k = 0; k < n[2]; ++k)
+        q(i, j, k) = f(static_cast<double>(i) / static_cast<double>(n[0] - 1), static_cast<double>(j) / static_cast<double>(n[1] - 1),
+                       static_cast<double>(k) / static_cast<double>(n[2] - 1));
+  VolumeInterpolationOptions o;
+  o.param = Parametrization::uniform;
+  o.degree_v = 2;
+  const auto r = interpolate_volume(q, o);
+  for (double u : linspace(0, 1, 9))
+    for (double v : linspace(0, 1, 9))
+      for (double w : linspace(0, 1, 9)) EXPECT_LT(distance(r.volume.point(u, v, w), f(u, v, w)), 1e-14 * 4);
+}
+
+TEST(InterpolateVolume, ParametersAverageAllLinesAndSkipACollapsedLine) {
+  // Lines along u: (j, k) in a 2 x 2 set; three have spacings 1, 3 (and one 3, 1), the
+  // line (0, 0) collapses to one point and is left out of the average.
+  PointGrid3 q({3, 2, 2});
+  const double x[3][3] = {{0, 1, 4}, {0, 3, 4}, {0, 1, 4}};
+  for (std::size_t j = 0; j < 2; ++j)
+    for (std::size_t k = 0; k < 2; ++k) {
+      const std::size_t line = 2 * j + k;
+      for (std::size_t i = 0; i < 3; ++i)
+        q(i, j, k) = line == 0 ? Vec3{0, 0, 0} : Vec3{x[line - 1][i], 2.0 * static_cast<double>(j), 2.0 * static_cast<double>(k)};
+    }
+  const auto tu = grid_parameters(q, 0, Parametrization::chord);
+  EXPECT_DOUBLE_EQ(tu[1], (0.25 + 0.75 + 0.25) / 3);
+  EXPECT_EQ(tu.front(), 0.0);
+  EXPECT_EQ(tu.back(), 1.0);
+  // Still interpolated, the collapsed line included.
+  const auto r = interpolate_volume(q);
+  EXPECT_LT(max_error_at_data(r, q), 1e-12 * test::bbox_diagonal(q.values()));
+  EXPECT_EQ(r.params_u, tu);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_LT(norm(r.volume.control_points()(i, 0, 0)), 1e-14);  // the line stays a point
+}
+
+TEST(InterpolateVolume, SurfaceParametersUnchangedByTheGeneralCode) {
+  // grid_parameters of a surface is the volume code with one axis of extent 1 less:
+  // both must give the same numbers for the same lines.
+  auto g = test::rng(252);
+  const auto q2 = test::random_grid(g, 5, 7, 0.3);
+  PointGrid3 q3({5, 7, 1});
+  for (std::size_t i = 0; i < 5; ++i)
+    for (std::size_t j = 0; j < 7; ++j) q3(i, j, 0) = q2(i, j);
+  for (auto param : {Parametrization::chord, Parametrization::centripetal}) {
+    EXPECT_EQ(grid_parameters(q2, 0, param), grid_parameters(q3, 0, param));
+    EXPECT_EQ(grid_parameters(q2, 1, param), grid_parameters(q3, 1, param));
+  }
+}
+
+TEST(InterpolateVolume, InvalidInput) {
+  auto g = test::rng(253);
+  const auto q = random_grid3(g, 4, 3, 5, 0.3);
+  EXPECT_ERRC((void)interpolate_volume(PointGrid3({2, 1, 3})), too_few_points,
+              "at least 2 x 2 x 2 points, got 2 x 1 x 3");
+  VolumeInterpolationOptions o;
+  o.degree_v = 3;
+  EXPECT_ERRC((void)interpolate_volume(q, o), too_few_points, "degree 3 in v needs at least 4 points, got 3");
+  o.degree_v.reset();
+  o.degree_u = 0;
+  EXPECT_ERRC((void)interpolate_volume(q, o), invalid_degree, "degree 0 in u");
+  PointGrid3 bad = q;
+  bad(1, 2, 0).x = NAN;
+  EXPECT_ERRC((void)interpolate_volume(bad), not_finite, "point [1][2][0] is");
+  PointGrid3 dup = q;
+  for (std::size_t i = 0; i < 4; ++i)
+    for (std::size_t j = 0; j < 3; ++j) dup(i, j, 2) = dup(i, j, 1);  // layer w = 2 repeats layer 1 on every line
+  EXPECT_ERRC((void)interpolate_volume(dup), zero_chord, "grid points 1 and 2 along w coincide on every line");
+  PointGrid3 flat = q;
+  for (std::size_t i = 0; i < 4; ++i)
+    for (std::size_t k = 0; k < 5; ++k)
+      for (std::size_t j = 0; j < 3; ++j) flat(i, j, k) = flat(i, 0, k);  // nothing varies along v
+  EXPECT_ERRC((void)interpolate_volume(flat), zero_chord, "every line of the grid along v has zero length");
+}
+
 }  // namespace
 }  // namespace interpatch

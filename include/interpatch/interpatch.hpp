@@ -3,8 +3,11 @@
 /// Everything of interpatch in one include.
 
 #include "interpatch/allocator.hpp"
+#include "interpatch/blended_volume.hpp"
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/bspline_surface.hpp"
+#include "interpatch/bspline_volume.hpp"
+#include "interpatch/coons_volume.hpp"
 #include "interpatch/error.hpp"
 #include "interpatch/evaluate.hpp"
 #include "interpatch/grid.hpp"
@@ -14,3 +17,5 @@
 #include "interpatch/memory.hpp"
 #include "interpatch/progress.hpp"
 #include "interpatch/vec3.hpp"
+#include "interpatch/volume.hpp"
+#include "interpatch/volume_patches.hpp"

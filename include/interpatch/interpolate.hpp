@@ -1,7 +1,7 @@
 #pragma once
 /// @file interpolate.hpp
-/// Global B-spline interpolation of curves and of grids of points (seed 003;
-/// The NURBS Book §9.2), solved as banded systems factored once.
+/// Global B-spline interpolation of curves and of grids of points, surfaces and
+/// volumes (seed 003; The NURBS Book §9.2), solved as banded systems factored once.
 
 #include <optional>
 #include <span>
@@ -9,6 +9,7 @@
 
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/bspline_surface.hpp"
+#include "interpatch/bspline_volume.hpp"
 #include "interpatch/grid.hpp"
 #include "interpatch/progress.hpp"
 
@@ -96,5 +97,44 @@ struct SurfaceInterpolation {
 /// @endcode
 /// @throws error too_few_points, invalid_degree, not_finite, zero_chord, singular, too_large.
 [[nodiscard]] SurfaceInterpolation interpolate_surface(PointGrid points, const SurfaceInterpolationOptions& options = {});
+
+struct VolumeInterpolationOptions {
+  /// Degrees in u, v and w; unset means min(3, points − 1) in that direction.
+  std::optional<int> degree_u, degree_v, degree_w;
+  Parametrization param = Parametrization::chord;
+  progress_callback progress;
+};
+
+struct VolumeInterpolation {
+  BSplineVolume volume;
+  std::vector<double> params_u, params_v, params_w;  ///< S(params_u[i], params_v[j], params_w[k]) = Q[i][j][k]
+};
+
+/// Parameters of a volume grid along `axis` (0: u, 1: v, 2: w): as for surfaces, each
+/// of the lines of points along the axis gets chord parameters, lines of zero length
+/// (a collapsed edge or face) are left out, the rest are averaged.
+/// @throws error too_few_points, not_finite, zero_chord (every line has a zero chord at
+///   the same place, or all lines have zero length), too_large.
+[[nodiscard]] std::vector<double> grid_parameters(const PointGrid3& points, int axis, Parametrization param);
+
+/// The B-spline volume with exactly (n+1) × (m+1) × (l+1) control points through every
+/// point Q[i][j][k] of the grid (indices along u, v, w): the three-pass tensor extension
+/// of interpolate_surface (SPEC 3.5). Every line along u is interpolated, then every
+/// line of the result along v, then along w; each pass is one banded solve factored
+/// once, computed in place of the data.
+///
+/// Example:
+/// @code
+///   using namespace interpatch;
+///   PointGrid3 q({5, 6, 4});
+///   for (int i = 0; i < 5; ++i)
+///     for (int j = 0; j < 6; ++j)
+///       for (int k = 0; k < 4; ++k) q(i, j, k) = {double(i), double(j) + 0.1 * i * i, double(k) + std::sin(i + j)};
+///   auto r = interpolate_volume(q);  // degrees (3, 3, 3)
+///   Vec3 p = r.volume.point(r.params_u[2], r.params_v[3], r.params_w[1]);  // == q(2, 3, 1) up to rounding
+/// @endcode
+/// @throws error too_few_points (fewer than 2 points along an axis, or fewer than the
+///   degree needs), invalid_degree, not_finite (naming [i][j][k]), zero_chord, singular, too_large.
+[[nodiscard]] VolumeInterpolation interpolate_volume(PointGrid3 points, const VolumeInterpolationOptions& options = {});
 
 }  // namespace interpatch

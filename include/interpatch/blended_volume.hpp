@@ -1,0 +1,50 @@
+#pragma once
+/// @file blended_volume.hpp
+/// Volumes made by blending faces, edges and corner data (seed 004): the trilinear,
+/// tricubic Hermite and transfinite (Coons) volumes are all
+///
+///   S(u,v,w) = Σ f_a(t_a) F(other two) + Σ c f_a(t_a) g_b(t_b) E(t_c) + Σ f(u) g(v) h(w) P
+///
+/// with blending functions of one parameter (linear, cubic Hermite or any Blend),
+/// boundary surfaces F, lines E on them (positions and cross derivatives along the 12
+/// edges) and corner data P. Every ingredient is a B-spline, so the sum converts
+/// exactly to one B-spline volume.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "interpatch/bspline_volume.hpp"
+#include "interpatch/volume.hpp"
+
+namespace interpatch {
+
+namespace detail {
+struct VolumeTerms;
+}
+
+/// One of the blended volume constructions. Built by the functions of
+/// volume_patches.hpp and coons_volume.hpp; evaluates its own formula exactly over
+/// [0, 1]³ and converts exactly to a B-spline volume.
+class BlendedVolume final : public Volume {
+ public:
+  explicit BlendedVolume(std::shared_ptr<const detail::VolumeTerms> terms);
+
+  /// S and its first partials from the terms; no allocation. @throws error out_of_domain.
+  [[nodiscard]] VolumeDerivatives derivatives(double u, double v, double w) const override;
+  /// Every function of u made compatible (common degree and knots, by degree
+  /// elevation and knot insertion), likewise v and w, then the control points of
+  /// the tensor-product terms summed.
+  /// @throws error no_exact_form (a rational face or cross-derivative surface, or a
+  ///   blending function given as a callable).
+  [[nodiscard]] BSplineVolume to_bspline() const override;
+  /// Whether to_bspline() succeeds.
+  [[nodiscard]] bool has_exact_form() const noexcept;
+  /// Notes on how the data were used (e.g. the largest gap found between faces along an edge).
+  [[nodiscard]] const std::vector<std::string>& notes() const noexcept;
+
+ private:
+  std::shared_ptr<const detail::VolumeTerms> t_;
+};
+
+}  // namespace interpatch
