@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <iostream>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <system_error>
@@ -46,10 +47,45 @@ std::optional<std::size_t> parse_count(std::string_view s) {
   return v;
 }
 
-// Only surfaces exist so far; a volume alternative will get its own branch.
-const Surface& surface_of(const io::Construction& c) { return io::evaluator(c); }
-
 std::string what_size(std::size_t a, std::size_t b) { return std::to_string(a) + "x" + std::to_string(b); }
+std::string what_size(std::size_t a, std::size_t b, std::size_t c) { return what_size(a, b) + "x" + std::to_string(c); }
+
+std::string resolution_text(const Resolution& r) { return r.nw ? what_size(r.nu, r.nv, r.nw) : what_size(r.nu, r.nv); }
+
+// Points as float64 triples in C order, for .npy.
+std::vector<double> flat_points(const Vec3* p, std::size_t n) {
+  std::vector<double> flat(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    flat[3 * i] = p[i].x;
+    flat[3 * i + 1] = p[i].y;
+    flat[3 * i + 2] = p[i].z;
+  }
+  return flat;
+}
+
+void mesh_volume(const io::Construction& c, const fs::path& out, const Resolution& res) {
+  const Volume& v = io::volume_evaluator(c);
+  // Every construction is over the unit cube.
+  const std::vector<double> us = linspace(0, 1, res.nu), vs = linspace(0, 1, res.nv), ws = linspace(0, 1, res.nw);
+  ProgressLine progress("meshing");
+  const VolumeJacobians j = v.evaluate_jacobians(us, vs, ws, progress.callback());
+  progress.clear();
+  io::write_volume_mesh(out, j.points, j.determinants);
+}
+
+void eval_volume(const io::Construction& c, const fs::path& out, std::size_t k) {
+  const Volume& v = io::volume_evaluator(c);
+  const std::vector<std::vector<double>> params{linspace(0, 1, k), linspace(0, 1, k), linspace(0, 1, k)};
+  ProgressLine progress("evaluating");
+  const PointGrid3 g = v.evaluate(params[0], params[1], params[2], progress.callback());
+  progress.clear();
+  if (lower_extension(out) == ".npy") {
+    const std::size_t shape[4] = {k, k, k, 3};
+    io::write_npy(out, shape, flat_points(g.data(), g.size()));
+  } else {
+    io::write_csv_grid(out, params, std::span<const Vec3>(g.data(), g.size()));
+  }
+}
 
 }  // namespace
 
@@ -58,13 +94,22 @@ Resolution parse_resolution(std::string_view text) {
   const auto bad = [&](std::string_view why) {
     return usage_error("--res '" + std::string(text) + "': " + std::string(why));
   };
-  if (x == std::string_view::npos) throw bad("expected NUxNV, e.g. 64x64 (vertices along u and v)");
-  if (text.find_first_of("xX", x + 1) != std::string_view::npos)
-    throw bad("a surface mesh takes two counts, NUxNV (NUxNVxNW is for volumes)");
+  if (x == std::string_view::npos)
+    throw bad("expected NUxNV, e.g. 64x64 (vertices along u and v), or NUxNVxNW for a volume");
+  const auto x2 = text.find_first_of("xX", x + 1);
+  if (x2 != std::string_view::npos) {
+    if (text.find_first_of("xX", x2 + 1) != std::string_view::npos)
+      throw bad("expected NUxNV (a surface) or NUxNVxNW (a volume), not more counts");
+    const auto nu = parse_count(text.substr(0, x)), nv = parse_count(text.substr(x + 1, x2 - x - 1)),
+               nw = parse_count(text.substr(x2 + 1));
+    if (!nu || !nv || !nw) throw bad("expected NUxNVxNW with whole numbers, e.g. 33x33x33");
+    if (*nu < 2 || *nv < 2 || *nw < 2) throw bad("a mesh needs at least 2 vertices along each direction");
+    return {*nu, *nv, *nw};
+  }
   const auto nu = parse_count(text.substr(0, x)), nv = parse_count(text.substr(x + 1));
   if (!nu || !nv) throw bad("expected NUxNV with whole numbers, e.g. 64x64");
   if (*nu < 2 || *nv < 2) throw bad("a mesh needs at least 2 vertices along each direction");
-  return {*nu, *nv};
+  return {*nu, *nv, 0};
 }
 
 std::size_t parse_grid(std::string_view text) {
@@ -98,20 +143,42 @@ void check_info_output(const fs::path& out) {
   throw usage_error("cannot tell the output format of '" + out.string() + "': info writes .json");
 }
 
-void require_eval_memory(std::size_t k, const fs::path& out) {
-  const std::string what = "evaluation grid " + (k == std::numeric_limits<std::size_t>::max() ? std::string("beyond 2^64") : what_size(k, k));
-  if (k >= (std::size_t{1} << 32)) throw error(errc::too_large, what + ": more points than can be addressed");
+void require_eval_memory(std::size_t k, const fs::path& out, int dims) {
+  const std::string size = dims == 3 ? what_size(k, k, k) : what_size(k, k);
+  const std::string what = "evaluation grid " + (k == std::numeric_limits<std::size_t>::max() ? std::string("beyond 2^64") : size);
+  if (k >= (std::size_t{1} << (dims == 3 ? 21 : 32))) throw error(errc::too_large, what + ": more points than can be addressed");
   // The points, plus a float64 copy for .npy or the text of a row for .csv.
   const std::size_t per_point = lower_extension(out) == ".npy" ? 2 * sizeof(Vec3) : sizeof(Vec3) + 8;
-  require_memory(k * k, per_point, what);
+  require_memory(dims == 3 ? k * k * k : k * k, per_point, what);
 }
 
 void require_mesh_memory(const Resolution& res) {
-  const std::string what = "mesh of " + what_size(res.nu, res.nv) + " vertices";
+  const std::string what = "mesh of " + resolution_text(res) + " vertices";
+  if (res.nw) {
+    constexpr std::size_t limit = std::size_t{1} << 21;
+    if (res.nu >= limit || res.nv >= limit || res.nw >= limit)
+      throw error(errc::too_large, what + ": more vertices than can be addressed");
+    // Points and Jacobian determinants, plus the text of a vertex in the ASCII formats.
+    require_memory(res.nu * res.nv * res.nw, sizeof(Vec3) + sizeof(double) + 80, what);
+    return;
+  }
   if (res.nu >= (std::size_t{1} << 32) || res.nv >= (std::size_t{1} << 32))
     throw error(errc::too_large, what + ": more vertices than can be addressed");
   // Points and normals, plus room for the writers' faces (two triangles per vertex in STL).
   require_memory(res.nu * res.nv, 2 * sizeof(Vec3) + 2 * 50, what);
+}
+
+void check_mesh_kind(const io::Construction& c, const fs::path& out, const Resolution& res) {
+  const std::string r = resolution_text(res);
+  if (!io::is_volume(c)) {
+    if (res.nw) throw usage_error("--res '" + r + "': a surface mesh takes two counts, NUxNV (NUxNVxNW is for volumes)");
+    return;
+  }
+  const std::string ext = lower_extension(out);
+  if (ext != ".vts" && ext != ".vtk" && ext != ".xyz")
+    throw usage_error("'" + out.string() + "': " + c.type + " is a volume; " + ext +
+                      " holds surfaces only, a volume mesh is written to .vts, .vtk or .xyz (Plot3D)");
+  if (!res.nw) throw usage_error("--res '" + r + "': " + c.type + " is a volume; its mesh takes three counts, NUxNVxNW (e.g. 33x33x33)");
 }
 
 void write_build(const io::Construction& c, const fs::path& out) {
@@ -120,7 +187,9 @@ void write_build(const io::Construction& c, const fs::path& out) {
 }
 
 void write_mesh(const io::Construction& c, const fs::path& out, const Resolution& res) {
-  const Surface& s = surface_of(c);
+  check_mesh_kind(c, out, res);
+  if (io::is_volume(c)) return mesh_volume(c, out, res);
+  const Surface& s = io::evaluator(c);
   constexpr double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  // every construction is over the unit square
   const std::vector<double> us = linspace(u0, u1, res.nu), vs = linspace(v0, v1, res.nv);
   io::SurfaceMesh mesh{PointGrid({res.nu, res.nv}), PointGrid({res.nu, res.nv})};
@@ -143,22 +212,16 @@ void write_mesh(const io::Construction& c, const fs::path& out, const Resolution
 }
 
 void write_eval(const io::Construction& c, const fs::path& out, std::size_t k) {
-  const Surface& s = surface_of(c);
+  if (io::is_volume(c)) return eval_volume(c, out, k);
+  const Surface& s = io::evaluator(c);
   constexpr double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  // every construction is over the unit square
   std::vector<std::vector<double>> params{linspace(u0, u1, k), linspace(v0, v1, k)};
   ProgressLine progress("evaluating");
   const PointGrid g = s.evaluate(params[0], params[1], progress.callback());
   progress.clear();
   if (lower_extension(out) == ".npy") {
-    std::vector<double> flat(3 * g.size());
-    for (std::size_t i = 0; i < g.size(); ++i) {
-      const Vec3& p = g.data()[i];
-      flat[3 * i] = p.x;
-      flat[3 * i + 1] = p.y;
-      flat[3 * i + 2] = p.z;
-    }
     const std::size_t shape[3] = {k, k, 3};
-    io::write_npy(out, shape, flat);
+    io::write_npy(out, shape, flat_points(g.data(), g.size()));
   } else {
     io::write_csv_grid(out, params, std::span<const Vec3>(g.data(), g.size()));
   }
@@ -188,11 +251,14 @@ int build_command(const fs::path& spec, const fs::path& out) {
 }
 
 int mesh_command(const fs::path& spec, const fs::path& out, std::string_view res_text) {
-  const Resolution res = parse_resolution(res_text);
+  const std::optional<Resolution> given = res_text.empty() ? std::nullopt : std::optional(parse_resolution(res_text));
   check_mesh_output(out);
   io::check_writable(out);
-  require_mesh_memory(res);
+  if (given) require_mesh_memory(*given);
   const io::Construction c = build_spec(spec);
+  const Resolution res = given ? *given : (io::is_volume(c) ? default_volume_resolution : default_surface_resolution);
+  check_mesh_kind(c, out, res);
+  if (!given) require_mesh_memory(res);
   write_mesh(c, out, res);
   report_warnings(c);
   return 0;
@@ -204,6 +270,7 @@ int eval_command(const fs::path& spec, const fs::path& out, std::string_view gri
   io::check_writable(out);
   require_eval_memory(k, out);
   const io::Construction c = build_spec(spec);
+  if (io::is_volume(c)) require_eval_memory(k, out, 3);
   write_eval(c, out, k);
   report_warnings(c);
   return 0;

@@ -23,12 +23,17 @@ class usage_error : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Vertices per direction of a mesh.
+/// Vertices per direction of a mesh; nw is 0 for a surface mesh.
 struct Resolution {
-  std::size_t nu = 64, nv = 64;
+  std::size_t nu = 64, nv = 64, nw = 0;
 };
 
-/// "NUxNV" (also "NUXNV"), both counts at least 2. @throws usage_error.
+/// The default resolutions: 64x64 for a surface, 33x33x33 for a volume.
+inline constexpr Resolution default_surface_resolution{64, 64, 0};
+inline constexpr Resolution default_volume_resolution{33, 33, 33};
+
+/// "NUxNV" or, for volumes, "NUxNVxNW" (also with "X"), every count at least 2.
+/// @throws usage_error.
 Resolution parse_resolution(std::string_view text);
 
 /// "K", at least 2. A K too large to count is returned as the largest size_t, so
@@ -44,8 +49,13 @@ void check_eval_output(const std::filesystem::path& out);
 void check_info_output(const std::filesystem::path& out);
 
 /// Refuse (error too_large) an evaluation grid or a mesh that cannot fit in memory.
-void require_eval_memory(std::size_t k, const std::filesystem::path& out);
+/// `dims` is 2 for a K×K grid, 3 for K×K×K.
+void require_eval_memory(std::size_t k, const std::filesystem::path& out, int dims = 2);
 void require_mesh_memory(const Resolution& res);
+
+/// Refuse (usage_error) a resolution or a mesh format that does not fit the kind of
+/// the construction: NUxNVxNW for a surface, NUxNV or .obj/.stl/.ply for a volume.
+void check_mesh_kind(const io::Construction& c, const std::filesystem::path& out, const Resolution& res);
 
 /// The outputs, from a built construction.
 void write_build(const io::Construction& c, const std::filesystem::path& out);
@@ -58,6 +68,7 @@ io::Construction build_spec(const std::filesystem::path& spec);
 
 /// The subcommands; each returns the exit status of success (0).
 int build_command(const std::filesystem::path& spec, const std::filesystem::path& out);
+/// `res` empty: the default resolution of the construction's kind.
 int mesh_command(const std::filesystem::path& spec, const std::filesystem::path& out, std::string_view res);
 int eval_command(const std::filesystem::path& spec, const std::filesystem::path& out, std::string_view grid);
 int info_command(const std::filesystem::path& spec, const std::optional<std::filesystem::path>& out);

@@ -3,6 +3,7 @@
 // read back from there, so the demo goes through exactly the path a user's spec
 // takes; then every output the command line offers is written beside it.
 
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -238,6 +239,110 @@ ojson hermite_corners() {
   return c;
 }
 
+// --- volumes ---------------------------------------------------------------------
+
+ojson corner_name_points(const std::array<Vec3, 8>& c) {
+  ojson j = ojson::object();
+  for (std::size_t n = 0; n < 8; ++n)
+    j["p" + std::to_string(n >> 2) + std::to_string((n >> 1) & 1) + std::to_string(n & 1)] = point_json(c[n]);
+  return j;
+}
+
+// A hexahedral block, leaning and tapered: eight corners, (i, j, k) at index 4i + 2j + k.
+ojson trilinear_spec() {
+  const std::array<Vec3, 8> c{Vec3{0, 0, 0}, Vec3{0.2, 0, 1}, Vec3{0, 1, 0}, Vec3{0.3, 0.9, 1.1},
+                              Vec3{2, 0, 0}, Vec3{1.8, 0.1, 0.8}, Vec3{2, 1.2, 0}, Vec3{1.9, 1.1, 0.9}};
+  ojson spec = {{"type", "trilinear"},
+                {"comment", "A leaning, tapered block from its 8 corners p_ijk (corner (i,j,k) of the parameter cube)."}};
+  spec.update(corner_name_points(c));
+  return spec;
+}
+
+// A box [0,2] x [0,1] x [0,1] whose wall y = 1 bulges out and whose lid z = 1 bulges
+// up, from its six faces given as three kinds of surface spec. Every face meets its
+// neighbours exactly along the shared edges (the bulges vanish there).
+ojson coons_volume_spec() {
+  auto bilinear_face = [](const Vec3& p00, const Vec3& p01, const Vec3& p10, const Vec3& p11) {
+    return ojson{{"type", "bilinear"}, {"p00", point_json(p00)}, {"p01", point_json(p01)}, {"p10", point_json(p10)},
+                 {"p11", point_json(p11)}};
+  };
+  // Wall v = 1, by (u, w): a biquadratic Bezier patch with its middle control point pushed out.
+  ojson wall = ojson::array();
+  for (int a = 0; a < 3; ++a) {
+    ojson row = ojson::array();
+    for (int b = 0; b < 3; ++b) row.push_back({a, a == 1 && b == 1 ? 1.5 : 1.0, 0.5 * b});
+    wall.push_back(row);
+  }
+  // Lid w = 1, by (u, v): interpolated through a 7 x 7 grid of z = 1 + 4.8 u(1-u) v(1-v);
+  // uniform parameters keep its straight edges parametrized like the neighbours'.
+  ojson lid = ojson::array();
+  for (int i = 0; i < 7; ++i) {
+    ojson row = ojson::array();
+    for (int j = 0; j < 7; ++j) {
+      const double u = i / 6.0, v = j / 6.0;
+      row.push_back({2 * u, v, 1 + 4.8 * u * (1 - u) * v * (1 - v)});
+    }
+    lid.push_back(row);
+  }
+  return {{"type", "coons_volume"},
+          {"comment", "A box with a bulging wall (v1, a bspline_surface) and a domed lid (w1, interpolated); the other "
+                      "faces are bilinear. Face u0 is S(0,v,w) by (v,w), v0 is S(u,0,w) by (u,w), w0 is S(u,v,0) by (u,v)."},
+          {"blending", "linear"},
+          {"faces",
+           {{"u0", bilinear_face({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, {0, 1, 1})},
+            {"u1", bilinear_face({2, 0, 0}, {2, 0, 1}, {2, 1, 0}, {2, 1, 1})},
+            {"v0", bilinear_face({0, 0, 0}, {0, 0, 1}, {2, 0, 0}, {2, 0, 1})},
+            {"v1",
+             {{"type", "bspline_surface"},
+              {"degree", {2, 2}},
+              {"knots", {{"u", {0, 0, 0, 1, 1, 1}}, {"v", {0, 0, 0, 1, 1, 1}}}},
+              {"control_points", wall}}},
+            {"w0", bilinear_face({0, 0, 0}, {0, 1, 0}, {2, 0, 0}, {2, 1, 0})},
+            {"w1", {{"type", "interpolate"}, {"degree", 3}, {"param", "uniform"}, {"points", lid}}}}}};
+}
+
+// The point frame of the tricubic polynomial volume
+// (u + 0.2 v w, v + 0.1 u^2, w + 0.3 u v w): the Hermite volume reproduces it.
+ojson hermite_volume_spec() {
+  ojson corners = ojson::array();
+  for (int n = 0; n < 8; ++n) {
+    const double u = n >> 2, v = (n >> 1) & 1, w = n & 1;
+    corners.push_back({{"p", {u + 0.2 * v * w, v + 0.1 * u * u, w + 0.3 * u * v * w}},
+                       {"du", {1, 0.2 * u, 0.3 * v * w}},
+                       {"dv", {0.2 * w, 1, 0.3 * u * w}},
+                       {"dw", {0.2 * v, 0, 1 + 0.3 * u * v}},
+                       {"duv", {0, 0, 0.3 * w}},
+                       {"duw", {0, 0, 0.3 * v}},
+                       {"dvw", {0.2, 0, 0.3 * u}},
+                       {"duvw", {0, 0, 0.3}}});
+  }
+  return {{"type", "hermite_volume"},
+          {"comment", "Positions and derivatives at the 8 corners (index 4i+2j+k) of (u + 0.2vw, v + 0.1u^2, w + 0.3uvw)."},
+          {"corners", corners}};
+}
+
+// A thick quarter annulus: radius 1..2 (u, 5 points), angle 0..90 degrees (v, 7), height 0..0.5 (w, 3).
+ojson annular_sector_spec() {
+  ojson g = ojson::array();
+  for (int i = 0; i < 5; ++i) {
+    ojson slab = ojson::array();
+    for (int j = 0; j < 7; ++j) {
+      ojson row = ojson::array();
+      for (int k = 0; k < 3; ++k) {
+        const double r = 1 + i / 4.0, a = 0.5 * pi * j / 6.0, z = 0.25 * k;
+        row.push_back({r * std::cos(a), r * std::sin(a), z});
+      }
+      slab.push_back(row);
+    }
+    g.push_back(slab);
+  }
+  return {{"type", "interpolate_volume"},
+          {"comment", "A thick quarter annulus through a 5x7x3 grid: radius (u), angle (v), height (w); degree 2 along w."},
+          {"degree", {3, 3, 2}},
+          {"param", "chord"},
+          {"points", g}};
+}
+
 struct Example {
   std::string name;
   std::string about;
@@ -333,6 +438,12 @@ std::vector<Example> examples() {
                  {"param", "centripetal"},
                  {"points", {{"csv", "twisted_strip.csv"}, {"shape", {5, 9, 3}}}}},
                 [](const fs::path& dir) { write_points_csv(dir / "twisted_strip.csv", twisted_strip()); }, "", false});
+  ex.push_back({"trilinear", "a leaning, tapered block from 8 corners", trilinear_spec(), nullptr, "", false});
+  ex.push_back({"coons_volume", "transfinite volume from 6 faces (bilinear, bspline_surface, interpolate)",
+                coons_volume_spec(), nullptr, "", false});
+  ex.push_back({"hermite_volume", "tricubic Hermite volume from a point frame", hermite_volume_spec(), nullptr, "", false});
+  ex.push_back({"annular_sector", "tricubic/quadratic volume through a 5x7x3 grid", annular_sector_spec(), nullptr, "",
+                false});
   ex.push_back({"terrain_exact", "terrain.bspline.json (the build output) read back as a bspline_surface spec", nullptr,
                 nullptr, "terrain.bspline.json", false});
   return ex;
@@ -366,7 +477,8 @@ std::string short_number(double v) {
 int demo_command(const fs::path& requested) {
   const fs::path dir = prepare(requested);
   constexpr std::size_t eval_grid = 33;
-  const Resolution res{64, 64};
+  const Resolution res = default_surface_resolution, volume_res = default_volume_resolution;
+  constexpr std::size_t volume_eval_grid = 17;
 
   std::size_t files = 0;
   std::string summary;
@@ -391,13 +503,21 @@ int demo_command(const fs::path& requested) {
       written.push_back(ex.name + suffix);
       return dir / (ex.name + suffix);
     };
+    const bool volume = io::is_volume(c);
     if (c.exact) write_build(c, out(".bspline.json"));
-    write_eval(c, out(".eval.npy"), eval_grid);
-    write_eval(c, out(".eval.csv"), eval_grid);
-    write_mesh(c, out(".obj"), res);
-    write_mesh(c, out(".vtk"), res);
-    if (ex.every_mesh_format)
-      for (const char* ext : {".ply", ".stl", ".vts", ".xyz"}) write_mesh(c, out(ext), res);
+    write_eval(c, out(".eval.npy"), volume ? volume_eval_grid : eval_grid);
+    write_eval(c, out(".eval.csv"), volume ? volume_eval_grid : eval_grid);
+    if (volume) {
+      write_mesh(c, out(".vts"), volume_res);
+      write_mesh(c, out(".vtk"), volume_res);
+      write_mesh(c, out(".xyz"), volume_res);
+      written.push_back(ex.name + ".f");  // the Jacobian beside the Plot3D grid
+    } else {
+      write_mesh(c, out(".obj"), res);
+      write_mesh(c, out(".vtk"), res);
+      if (ex.every_mesh_format)
+        for (const char* ext : {".ply", ".stl", ".vts", ".xyz"}) write_mesh(c, out(ext), res);
+    }
     const ojson description = info(c);
     write_text(out(".info.json"), io::pretty_json(description));
     report_warnings(c);
@@ -405,12 +525,14 @@ int demo_command(const fs::path& requested) {
     const auto& err = description["max_data_error"];
     std::string line = "  " + ex.name + std::string(ex.name.size() < 15 ? 15 - ex.name.size() : 1, ' ') + c.type + ": " +
                        ex.about + "\n      ";
+    const auto joined = [](const ojson& a, const char* sep) {
+      std::string t;
+      for (const auto& e : a) t += (t.empty() ? "" : sep) + (e.is_string() ? e.get<std::string>() : e.dump());
+      return t;
+    };
     if (c.exact)
-      line += std::to_string(description["control_points"][0].get<std::size_t>()) + "x" +
-              std::to_string(description["control_points"][1].get<std::size_t>()) + " control points, degree " +
-              std::to_string(description["degree"][0].get<int>()) + "x" +
-              std::to_string(description["degree"][1].get<int>()) + ", continuity " +
-              description["continuity"]["u"].get<std::string>() + "/" + description["continuity"]["v"].get<std::string>();
+      line += joined(description["control_points"], "x") + " control points, degree " +
+              joined(description["degree"], "x") + ", continuity " + joined(description["continuity"], "/");
     else
       line += "no exact B-spline form (evaluated by its formula)";
     if (err.is_object())
@@ -419,6 +541,12 @@ int demo_command(const fs::path& requested) {
     if (!ex.spec_file.empty()) {
       const bool same = read_text(spec_path) == read_text(dir / (ex.name + ".bspline.json"));
       line += same ? ", rebuilt identically" : ", rebuilt with differences";
+    }
+    if (volume) {
+      const auto& jac = description["jacobian"];
+      line += ", " + jac["inverted_cells"].dump() + " of " + jac["cells"].dump() + " cells inverted (det J from " +
+              short_number(jac["min_determinant"].get<double>()) + " to " +
+              short_number(jac["max_determinant"].get<double>()) + ")";
     }
     line += "\n      ";
     for (std::size_t i = 0; i < written.size(); ++i) line += (i ? " " : "") + written[i];

@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.footer("Exit status: 0 ok, 2 bad usage, 3 invalid input, 4 unreadable/unwritable file, 5 too large, 1 other.");
 
-  std::string spec, out, res = "64x64", grid, demo_dir = "interpatch-demo";
+  std::string spec, out, res, grid, demo_dir = "interpatch-demo";
 
   CLI::App* build = app.add_subcommand("build", "Write the exact B-spline form of SPEC.json (.json)");
   build->add_option("SPEC", spec, "The spec file (SPEC.json)")->required();
@@ -44,13 +44,14 @@ int main(int argc, char** argv) {
 
   CLI::App* mesh = app.add_subcommand("mesh", "Tessellate the construction (.obj .stl .ply .vtk .vts .xyz)");
   mesh->add_option("SPEC", spec, "The spec file (SPEC.json)")->required();
-  mesh->add_option("-o,--output", out, "Output file: .obj, .stl, .ply, .vtk, .vts or .xyz (Plot3D)")->required();
-  mesh->add_option("--res", res, "Vertices along u and v, NUxNV")->capture_default_str();
+  mesh->add_option("-o,--output", out, "Output file: .obj, .stl, .ply, .vtk, .vts or .xyz (Plot3D); volumes: .vtk, .vts or .xyz")->required();
+  mesh->add_option("--res", res,
+                   "Vertices along u and v, NUxNV (default 64x64); for a volume NUxNVxNW (default 33x33x33)");
 
-  CLI::App* eval = app.add_subcommand("eval", "Evaluate on a uniform KxK grid over [0,1]^2 (.npy or .csv)");
+  CLI::App* eval = app.add_subcommand("eval", "Evaluate on a uniform KxK grid over [0,1]^2 (KxKxK over [0,1]^3 for volumes; .npy or .csv)");
   eval->add_option("SPEC", spec, "The spec file (SPEC.json)")->required();
   eval->add_option("--grid", grid, "K: points along each direction")->required();
-  eval->add_option("-o,--output", out, "Output file: .npy (K,K,3), u index first, or .csv (u,v,x,y,z)")->required();
+  eval->add_option("-o,--output", out, "Output file: .npy (K,K,3) or (K,K,K,3), u index first, or .csv (u,v[,w],x,y,z)")->required();
 
   CLI::App* info = app.add_subcommand("info", "Describe the construction as one JSON object on stdout");
   info->add_option("SPEC", spec, "The spec file (SPEC.json)")->required();

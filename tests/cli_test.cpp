@@ -295,6 +295,17 @@ TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
   EXPECT_TRUE(fs::exists(at("out") / "half_cylinder.npy"));
   EXPECT_TRUE(fs::exists(at("out") / "twisted_strip.csv"));
   EXPECT_TRUE(fs::exists(at("out") / "hemisphere.stl"));
+  for (const char* name : {"trilinear", "coons_volume", "hermite_volume", "annular_sector"}) {
+    for (const char* suffix : {".spec.json", ".bspline.json", ".eval.npy", ".eval.csv", ".vts", ".vtk", ".xyz", ".info.json"})
+      EXPECT_TRUE(fs::exists(at("out") / (std::string(name) + suffix))) << name << suffix;
+    const json info = json::parse(read_file(at("out") / (std::string(name) + ".info.json")));
+    EXPECT_EQ(info["kind"], "volume") << name;
+    EXPECT_LT(info["max_data_error"]["relative"].get<double>(), 1e-12) << name;
+    EXPECT_EQ(info["jacobian"]["inverted_cells"], 0) << name;
+    // The demo's spec is the checked-in example.
+    EXPECT_EQ(read_file(at("out") / (std::string(name) + ".spec.json")),
+              read_file(fs::path(INTERPATCH_EXAMPLES) / (std::string(name) + ".json"))) << name;
+  }
   EXPECT_NE(r.out.find("rebuilt identically"), std::string::npos) << r.out;
   const json exact = json::parse(read_file(at("out") / "wave.bspline.json"));
   EXPECT_EQ(exact["degree"], json({2, 3}));
@@ -548,6 +559,151 @@ TEST_F(CliTest, UnknownChoiceExits3ListingTheChoices) {
   spec["blending"] = "cubic";
   write_file(at("s.json"), spec.dump());
   expect_one_line_error(run({"info", "s.json"}), 3, {"/blending", "\"cubic\"", "\"hermite\""});
+}
+
+// --- volumes -----------------------------------------------------------------------------
+
+// The trilinear volume of the corners (i, 2j, 3k): the box [0,1] x [0,2] x [0,3].
+json box_trilinear() {
+  json spec = {{"type", "trilinear"}};
+  for (int n = 0; n < 8; ++n)
+    spec["p" + std::to_string(n >> 2) + std::to_string((n >> 1) & 1) + std::to_string(n & 1)] = {
+        n >> 2, 2 * ((n >> 1) & 1), 3 * (n & 1)};
+  return spec;
+}
+
+const char* const volume_examples[] = {"trilinear", "coons_volume", "hermite_volume", "annular_sector"};
+
+TEST_F(CliTest, EveryVolumeTypeEvaluatesMeshesDescribesAndBuilds) {
+  for (const char* name : volume_examples) {
+    SCOPED_TRACE(name);
+    const fs::path spec = fs::path(INTERPATCH_EXAMPLES) / (std::string(name) + ".json");
+    Result r = run({"eval", spec.string(), "--grid", "5", "-o", "g.npy"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const Npy n = parse_npy(read_file(at("g.npy")));
+    EXPECT_EQ(n.shape, std::vector<std::size_t>({5, 5, 5, 3}));
+    EXPECT_EQ(n.data.size(), 5u * 5u * 5u * 3u);
+
+    for (const char* ext : {".vts", ".vtk", ".xyz"}) {
+      r = run({"mesh", spec.string(), "-o", std::string("m") + ext, "--res", "4x5x6"});
+      ASSERT_EQ(r.status, 0) << ext << ": " << r.err;
+      EXPECT_GT(fs::file_size(at(std::string("m") + ext)), 100u) << ext;
+    }
+    EXPECT_NE(read_file(at("m.vtk")).find("DIMENSIONS 4 5 6"), std::string::npos);
+    EXPECT_NE(read_file(at("m.vtk")).find("POINTS 120 double"), std::string::npos);
+    EXPECT_NE(read_file(at("m.vts")).find("WholeExtent=\"0 3 0 4 0 5\""), std::string::npos);
+    EXPECT_NE(read_file(at("m.vts")).find("Name=\"jacobian\""), std::string::npos);
+    EXPECT_TRUE(fs::exists(at("m.f")));  // the Jacobian beside the Plot3D grid
+
+    r = run({"info", spec.string()});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const json a = json::parse(r.out);
+    EXPECT_EQ(a["type"], name == std::string("annular_sector") ? "interpolate_volume" : name);
+    EXPECT_EQ(a["kind"], "volume");
+    EXPECT_EQ(a["exact_form"], "bspline_volume");
+    EXPECT_EQ(a["degree"].size(), 3u);
+    EXPECT_EQ(a["control_points"].size(), 3u);
+    for (const char* axis : {"u", "v", "w"}) {
+      EXPECT_TRUE(a["knots"][axis].is_array()) << axis;
+      EXPECT_TRUE(a["continuity"][axis].is_string()) << axis;
+    }
+    EXPECT_LT(a["max_data_error"]["relative"].get<double>(), 1e-12);
+    EXPECT_EQ(a["jacobian"]["samples_per_direction"], 17);
+    EXPECT_EQ(a["jacobian"]["samples"], 17 * 17 * 17);
+    EXPECT_EQ(a["jacobian"]["cells"], 16 * 16 * 16);
+    EXPECT_EQ(a["jacobian"]["inverted_cells"], 0);
+    EXPECT_GT(a["jacobian"]["min_determinant"].get<double>(), 0.0);
+
+    // The exact form reads back as a bspline_volume spec with the same knots and control net.
+    ASSERT_EQ(run({"build", spec.string(), "-o", "exact.json"}).status, 0);
+    const json exact = json::parse(read_file(at("exact.json")));
+    EXPECT_EQ(exact["type"], "bspline_volume");
+    r = run({"info", "exact.json"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const json b = json::parse(r.out);
+    EXPECT_EQ(b["type"], "bspline_volume");
+    EXPECT_EQ(a["knots"], b["knots"]);
+    EXPECT_EQ(a["degree"], b["degree"]);
+    EXPECT_EQ(a["control_points"], b["control_points"]);
+    EXPECT_EQ(a["bounding_box"], b["bounding_box"]);
+    EXPECT_EQ(a["jacobian"], b["jacobian"]);
+    ASSERT_EQ(run({"build", "exact.json", "-o", "again.json"}).status, 0);
+    EXPECT_EQ(read_file(at("exact.json")), read_file(at("again.json")));
+  }
+}
+
+TEST_F(CliTest, TrilinearVolumeEvaluatesToItsCornersAndCentre) {
+  write_file(at("t.json"), box_trilinear().dump());
+  ASSERT_EQ(run({"eval", "t.json", "--grid", "3", "-o", "t.npy"}).status, 0);
+  const Npy n = parse_npy(read_file(at("t.npy")));
+  ASSERT_EQ(n.shape, std::vector<std::size_t>({3, 3, 3, 3}));
+  const auto value = [&](std::size_t i, std::size_t j, std::size_t k, std::size_t c) {
+    return n.data[((i * 3 + j) * 3 + k) * 3 + c];
+  };
+  EXPECT_DOUBLE_EQ(value(1, 1, 1, 0), 0.5);  // the centre
+  EXPECT_DOUBLE_EQ(value(1, 1, 1, 1), 1.0);
+  EXPECT_DOUBLE_EQ(value(1, 1, 1, 2), 1.5);
+  EXPECT_DOUBLE_EQ(value(2, 0, 2, 0), 1.0);  // corner p101, u index first
+  EXPECT_DOUBLE_EQ(value(2, 0, 2, 1), 0.0);
+  EXPECT_DOUBLE_EQ(value(2, 0, 2, 2), 3.0);
+  ASSERT_EQ(run({"eval", "t.json", "--grid", "3", "-o", "t.csv"}).status, 0);
+  const std::string csv = read_file(at("t.csv"));
+  EXPECT_EQ(csv.rfind("u,v,w,x,y,z\n", 0), 0u) << csv;
+  EXPECT_NE(csv.find("\n0.5,0.5,0.5,0.5,1,1.5\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\n0,0,0.5,0,0,1.5\n"), std::string::npos) << csv;  // w fastest
+  // The default volume mesh is 33x33x33.
+  ASSERT_EQ(run({"mesh", "t.json", "-o", "t.vtk"}).status, 0);
+  EXPECT_NE(read_file(at("t.vtk")).find("DIMENSIONS 33 33 33"), std::string::npos);
+}
+
+TEST_F(CliTest, FoldedTrilinearVolumeReportsInvertedCells) {
+  json spec = box_trilinear();
+  std::swap(spec["p000"], spec["p111"]);  // the box turned inside out
+  write_file(at("t.json"), spec.dump());
+  const Result r = run({"info", "t.json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_GT(j["jacobian"]["inverted_cells"].get<int>(), 0);
+  EXPECT_GT(j["jacobian"]["inverted_points"].get<int>(), 0);
+  EXPECT_LE(j["jacobian"]["min_determinant"].get<double>(), 0.0);
+  EXPECT_FALSE(j["jacobian"]["inverted_at"].empty());
+}
+
+TEST_F(CliTest, CoonsVolumeFacesThatDoNotMeetExit3NamingBothFacesAndTheGap) {
+  json spec = json::parse(read_file(fs::path(INTERPATCH_EXAMPLES) / "coons_volume.json"));
+  spec["faces"]["u1"]["p11"] = {2, 1, 1.5};  // face u1's corner (v, w) = (1, 1) lifted by 0.5
+  write_file(at("s.json"), spec.dump());
+  const Result r = run({"info", "s.json"});
+  expect_one_line_error(r, 3, {"/faces", "u1", "0.5"});
+  EXPECT_TRUE(r.err.find("faces u1 and") != std::string::npos || r.err.find("and u1") != std::string::npos) << r.err;
+}
+
+TEST_F(CliTest, VolumeUsageErrorsExit2) {
+  write_file(at("t.json"), box_trilinear().dump());
+  expect_one_line_error(run({"mesh", "t.json", "-o", "t.vts", "--res", "8x8"}), 2, {"--res", "8x8", "NUxNVxNW"});
+  expect_one_line_error(run({"mesh", "t.json", "-o", "t.vts", "--res", "8x8x1"}), 2, {"--res", "8x8x1"});
+  expect_one_line_error(run({"mesh", "t.json", "-o", "t.vts", "--res", "8x8x8x8"}), 2, {"--res"});
+  for (const char* out : {"t.obj", "t.stl", "t.ply"})
+    expect_one_line_error(run({"mesh", "t.json", "-o", out}), 2, {out, "volume", ".vts"});
+  EXPECT_EQ(listing(), std::set<std::string>({"t.json"}));
+}
+
+TEST_F(CliTest, RaggedVolumeGridExits3NamingThePointer) {
+  json spec = json::parse(read_file(fs::path(INTERPATCH_EXAMPLES) / "annular_sector.json"));
+  spec["points"][1][2].erase(2);
+  write_file(at("s.json"), spec.dump());
+  expect_one_line_error(run({"eval", "s.json", "--grid", "4", "-o", "g.npy"}), 3, {"/points/1/2", "2 points", "3"});
+  EXPECT_FALSE(fs::exists(at("g.npy")));
+}
+
+TEST_F(CliTest, HugeVolumeGridExits5BeforeAllocating) {
+  write_file(at("t.json"), box_trilinear().dump());
+  Result r = run({"eval", "t.json", "--grid", "5000", "-o", "g.npy"});
+  expect_one_line_error(r, 5, {"5000x5000x5000"});
+  EXPECT_LT(r.seconds, 5.0);
+  r = run({"mesh", "t.json", "--res", "5000x5000x5000", "-o", "m.vts"});
+  expect_one_line_error(r, 5, {"5000x5000x5000"});
+  EXPECT_EQ(listing(), std::set<std::string>({"t.json"}));
 }
 
 #else

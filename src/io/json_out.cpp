@@ -11,6 +11,7 @@
 
 #include "detail/text.hpp"
 #include "interpatch/bspline_surface.hpp"
+#include "interpatch/bspline_volume.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/memory.hpp"
 
@@ -85,6 +86,45 @@ void write_surface(std::ostream& os, const BSplineSurface& s) {
   os << "\n}\n";
 }
 
+// A volume grid: one list per u index, one line per innermost row along w.
+template <class T>
+void put_grid(std::ostream& os, const Grid<T, 3>& g) {
+  os << "[\n";
+  std::string row;
+  for (std::size_t i = 0; i < g.extent(0); ++i) {
+    os << "    [\n";
+    for (std::size_t j = 0; j < g.extent(1); ++j) {
+      row = "      [";
+      for (std::size_t k = 0; k < g.extent(2); ++k) {
+        if (k) row += ", ";
+        put(row, g(i, j, k));
+      }
+      row += j + 1 < g.extent(1) ? "],\n" : "]\n";
+      os << row;
+    }
+    os << (i + 1 < g.extent(0) ? "    ],\n" : "    ]\n");
+  }
+  os << "  ]";
+}
+
+void write_volume(std::ostream& os, const BSplineVolume& v) {
+  std::string head = cat("{\n  \"type\": \"bspline_volume\",\n  \"degree\": [", v.degree_u(), ", ", v.degree_v(), ", ",
+                         v.degree_w(), "],\n  \"knots\": {\n    \"u\": ");
+  put(head, v.knots_u().values());
+  head += ",\n    \"v\": ";
+  put(head, v.knots_v().values());
+  head += ",\n    \"w\": ";
+  put(head, v.knots_w().values());
+  head += "\n  },\n  \"control_points\": ";
+  os << head;
+  put_grid(os, v.control_points());
+  if (v.rational()) {
+    os << ",\n  \"weights\": ";
+    put_grid(os, v.weights());
+  }
+  os << "\n}\n";
+}
+
 ojson vec(const Vec3& p) { return ojson::array({p.x, p.y, p.z}); }
 
 double round_ms(double ms) { return std::round(ms * 1000.0) / 1000.0; }
@@ -129,6 +169,75 @@ void surface_data_error(const Surface& s, const DataSet& d, DataError& e, std::s
     done += nb * nv;
     if (progress) progress(static_cast<double>(done) / static_cast<double>(total));
   }
+}
+
+// The volume at the data parameters, a block of u slices at a time.
+void volume_data_error(const Volume& s, const DataSet& d, DataError& e, std::size_t& done, std::size_t total,
+                       const progress_callback& progress) {
+  if (d.params.size() != 3)
+    fail(errc::internal, d.pointer, ": data for a volume needs 3 parameter lists, got ", d.params.size());
+  const auto& us = d.params[0];
+  const auto& vs = d.params[1];
+  const auto& ws = d.params[2];
+  const std::size_t nu = us.size(), nv = vs.size(), nw = ws.size();
+  if (d.points.size() != nu * nv * nw)
+    fail(errc::internal, d.pointer, ": ", d.points.size(), " data points for ", nu, " x ", nv, " x ", nw, " parameters");
+  if (nv == 0 || nw == 0) return;
+  const std::size_t block = std::max<std::size_t>(1, (std::size_t{1} << 16) / (nv * nw));
+  for (std::size_t i0 = 0; i0 < nu; i0 += block) {
+    const std::size_t nb = std::min(block, nu - i0);
+    const PointGrid3 p = s.evaluate(std::span<const double>(us).subspan(i0, nb), vs, ws);
+    for (std::size_t i = 0; i < nb; ++i)
+      for (std::size_t j = 0; j < nv; ++j)
+        for (std::size_t k = 0; k < nw; ++k) {
+          const double dist = distance(p(i, j, k), d.points[((i0 + i) * nv + j) * nw + k]);
+          if (dist > e.absolute || e.pointer.empty()) {
+            e.absolute = dist;
+            e.pointer = cat(d.pointer, "/", i0 + i, "/", j, "/", k);
+            e.params = {us[i0 + i], vs[j], ws[k]};
+          }
+        }
+    done += nb * nv * nw;
+    if (progress) progress(static_cast<double>(done) / static_cast<double>(total));
+  }
+}
+
+ojson volume_info(const BSplineVolume& v) {
+  ojson j;
+  j["kind"] = "volume";
+  j["exact_form"] = "bspline_volume";
+  j["degree"] = {v.degree_u(), v.degree_v(), v.degree_w()};
+  const auto& cp = v.control_points();
+  j["control_points"] = {cp.extent(0), cp.extent(1), cp.extent(2)};
+  j["rational"] = v.rational();
+  j["knots"] = {{"u", v.knots_u().values()}, {"v", v.knots_v().values()}, {"w", v.knots_w().values()}};
+  j["continuity"] = {{"u", continuity_name(v.knots_u())},
+                     {"v", continuity_name(v.knots_v())},
+                     {"w", continuity_name(v.knots_w())}};
+  const auto d = v.domain();
+  j["domain"] = {{"u", {d[0].first, d[0].second}}, {"v", {d[1].first, d[1].second}}, {"w", {d[2].first, d[2].second}}};
+  Box box;
+  for (const Vec3& p : cp.values()) box.add(p);
+  j["bounding_box"] = {{"min", vec(box.lo)}, {"max", vec(box.hi)}, {"diagonal", box.diagonal()}};
+  return j;
+}
+
+// Where the volume folds, det J sampled on a jacobian_samples³ grid.
+constexpr std::size_t jacobian_samples = 17;
+
+ojson jacobian_info(const Volume& v) {
+  const InvertedCells r = inverted_cells(v, jacobian_samples);
+  ojson at = ojson::array();
+  for (const auto& l : r.locations) at.push_back({l[0], l[1], l[2]});
+  return {{"samples_per_direction", jacobian_samples},
+          {"samples", r.samples},
+          {"inverted_points", r.inverted_points},
+          {"cells", r.cells},
+          {"inverted_cells", r.inverted_cells},
+          {"min_determinant", r.min_determinant},
+          {"max_determinant", r.max_determinant},
+          {"min_at", {r.min_at[0], r.min_at[1], r.min_at[2]}},
+          {"inverted_at", std::move(at)}};
 }
 
 ojson surface_info(const BSplineSurface& s) {
@@ -189,6 +298,7 @@ void write_exact_json(std::ostream& os, const ExactForm& exact) {
       [&](const auto& form) {
         using T = std::decay_t<decltype(form)>;
         if constexpr (std::is_same_v<T, BSplineSurface>) write_surface(os, form);
+        else if constexpr (std::is_same_v<T, BSplineVolume>) write_volume(os, form);
         else static_assert(unhandled_exact_form<T>, "write_exact_json: an exact form without a writer");
       },
       exact);
@@ -213,7 +323,13 @@ std::optional<DataError> max_data_error(const Construction& c, const progress_ca
     for (const Vec3& p : d.points) box.add(p);
   }
   if (total == 0) return std::nullopt;
-  for (const DataSet& d : c.data) surface_data_error(evaluator(c), d, e, done, total, progress);
+  if (is_volume(c)) {
+    const Volume& v = volume_evaluator(c);
+    for (const DataSet& d : c.data) volume_data_error(v, d, e, done, total, progress);
+  } else {
+    const Surface& s = evaluator(c);
+    for (const DataSet& d : c.data) surface_data_error(s, d, e, done, total, progress);
+  }
   e.count = total;
   e.diagonal = box.diagonal();
   e.relative = e.diagonal > 0 ? e.absolute / e.diagonal
@@ -224,6 +340,8 @@ std::optional<DataError> max_data_error(const Construction& c, const progress_ca
 nlohmann::ordered_json info_json(const Construction& c, const progress_callback& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::optional<DataError> err = max_data_error(c, progress);
+  const bool volume = is_volume(c);
+  const ojson jac = volume ? jacobian_info(volume_evaluator(c)) : ojson();
   const double check_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
   ojson j;
@@ -233,11 +351,12 @@ nlohmann::ordered_json info_json(const Construction& c, const progress_callback&
         [&](const auto& form) {
           using T = std::decay_t<decltype(form)>;
           if constexpr (std::is_same_v<T, BSplineSurface>) j.update(surface_info(form));
+          else if constexpr (std::is_same_v<T, BSplineVolume>) j.update(volume_info(form));
           else static_assert(unhandled_exact_form<T>, "info_json: an exact form without a description");
         },
         *c.exact);
   } else {
-    j["kind"] = "surface";
+    j["kind"] = volume ? "volume" : "surface";
     j["exact_form"] = nullptr;
     j["no_exact_form"] = c.no_exact_form;
   }
@@ -247,6 +366,7 @@ nlohmann::ordered_json info_json(const Construction& c, const progress_callback&
   } else {
     j["max_data_error"] = nullptr;
   }
+  if (volume) j["jacobian"] = jac;
   ojson data = ojson::array();
   for (const DataSet& d : c.data) {
     ojson shape = ojson::array(), params = ojson::object();

@@ -18,10 +18,12 @@
 #include "interpatch/error.hpp"
 #include "interpatch/hermite.hpp"
 #include "interpatch/coons.hpp"
+#include "interpatch/coons_volume.hpp"
 #include "interpatch/evaluate.hpp"
 #include "interpatch/interpolate.hpp"
 #include "interpatch/network.hpp"
 #include "interpatch/patches.hpp"
+#include "interpatch/volume_patches.hpp"
 #include "interpatch/io/csv.hpp"
 #include "interpatch/io/npy.hpp"
 #include "interpatch/knot_vector.hpp"
@@ -352,16 +354,19 @@ PointArray inline_points(const json& j, std::size_t rank, std::string_view ptr) 
   return out;
 }
 
-Grid<double, 2> inline_number_grid(const json& j, std::string_view ptr) {
+template <std::size_t Rank = 2>
+Grid<double, Rank> inline_number_grid(const json& j, std::string_view ptr) {
   std::vector<double> values;
   std::vector<std::size_t> idx;
-  const auto shape = walk_grid(j, 2, 0, false, ptr, idx, [&](const json& node) {
-    if (!node.is_number()) fail(errc::wrong_type, index_pointer(ptr, idx, 2), ": expected a number, got ", kind(node));
+  const auto shape = walk_grid(j, Rank, 0, false, ptr, idx, [&](const json& node) {
+    if (!node.is_number()) fail(errc::wrong_type, index_pointer(ptr, idx, Rank), ": expected a number, got ", kind(node));
     const double v = node.get<double>();
-    if (!std::isfinite(v)) fail(errc::not_finite, index_pointer(ptr, idx, 2), ": value is ", v);
+    if (!std::isfinite(v)) fail(errc::not_finite, index_pointer(ptr, idx, Rank), ": value is ", v);
     values.push_back(v);
   });
-  return Grid<double, 2>({shape[0], shape[1]}, std::move(values));
+  typename Grid<double, Rank>::shape_type sh{};
+  for (std::size_t a = 0; a < Rank; ++a) sh[a] = shape[a];
+  return Grid<double, Rank>(sh, std::move(values));
 }
 
 std::string expected_shape(std::size_t rank) {
@@ -618,7 +623,7 @@ Construction build_interpolate(const json& spec, Context& ctx) {
   data.params = {to_unit(std::move(r.params_u), r.surface.domain_u()), to_unit(std::move(r.params_v), r.surface.domain_v())};
   BSplineSurface s = on_unit_domain(std::move(r.surface));
   nlohmann::ordered_json parameters = {{"grid", {nu, nv}}, {"degree", {s.degree_u(), s.degree_v()}}, {"param", param_name(param)}};
-  Construction c{"interpolate", std::move(s), {}, std::move(parameters), {}, {}, {}, {}};
+  Construction c{"interpolate", std::move(s), {}, std::move(parameters), {}, {}, {}, {}, {}};
   c.data.push_back(std::move(data));
   return c;
 }
@@ -661,7 +666,7 @@ Construction build_bspline_surface(const json& spec, Context& ctx) {
   const auto [u0, u1] = s.domain_u();
   const auto [v0, v1] = s.domain_v();
   nlohmann::ordered_json parameters = {{"domain", {{"u", {u0, u1}}, {"v", {v0, v1}}}}};
-  return Construction{"bspline_surface", on_unit_domain(std::move(s)), {}, std::move(parameters), {}, {}, {}, {}};
+  return Construction{"bspline_surface", on_unit_domain(std::move(s)), {}, std::move(parameters), {}, {}, {}, {}, {}};
 }
 
 // ---------------------------------------------------------------------------
@@ -863,21 +868,300 @@ Construction build_hermite_patch(const json& spec, Context& ctx) {
   return blended("hermite_patch", hermite_patch(c), {corner_data(p, "/corners")}, nlohmann::ordered_json::object());
 }
 
+// ---------------------------------------------------------------------------
+// Volumes (SPEC section 3): from corners, from six boundary surfaces, through a
+// grid of points, and the exact form build writes.
+
+BSplineVolume on_unit_domain(BSplineVolume v) {
+  const auto d = v.domain();
+  if (d[0] == std::pair{0.0, 1.0} && d[1] == std::pair{0.0, 1.0} && d[2] == std::pair{0.0, 1.0}) return v;
+  return v.mapped(0.0, 1.0, 0.0, 1.0, 0.0, 1.0);
+}
+
+// A blended volume construction: the formula, its exact form if it has one.
+Construction blended_volume(std::string_view type, BlendedVolume v, std::vector<DataSet> data,
+                            nlohmann::ordered_json parameters) {
+  Construction c;
+  c.type = type;
+  auto formula = std::make_shared<const BlendedVolume>(std::move(v));
+  try {
+    c.exact = formula->to_bspline();
+  } catch (const error& e) {
+    if (e.code() != errc::no_exact_form) throw;
+    c.no_exact_form = e.what();
+  }
+  if (!formula->notes().empty()) parameters["notes"] = formula->notes();
+  c.volume_formula = std::move(formula);
+  c.data = std::move(data);
+  c.parameters = std::move(parameters);
+  return c;
+}
+
+// The 8 corners of a volume as data: (i, j, k) at index 4i + 2j + k, the C order of (u, v, w).
+DataSet volume_corner_data(const std::array<Vec3, 8>& p, std::string pointer) {
+  DataSet d;
+  d.params = {{0.0, 1.0}, {0.0, 1.0}, {0.0, 1.0}};
+  d.points.assign(p.begin(), p.end());
+  d.pointer = std::move(pointer);
+  return d;
+}
+
+// Samples per direction of a boundary surface checked against a Coons volume.
+constexpr std::size_t face_samples = 17;
+
+// A face of a volume sampled for the data check: face u_i at (i, v, w), v_j at
+// (u, j, w), w_k at (u, v, k), the face's own parameters running over [0, 1]².
+DataSet face_data(const BSplineSurface& f, std::size_t axis, double fixed, std::string pointer) {
+  DataSet d;
+  const std::vector<double> t = linspace(0, 1, face_samples);
+  const PointGrid g = f.evaluate(t, t);
+  d.params.assign(3, t);
+  d.params[axis] = {fixed};
+  d.points.assign(g.values().begin(), g.values().end());
+  d.pointer = std::move(pointer);
+  return d;
+}
+
+BSplineSurface face_surface(const json& j, const std::string& ptr, Context& ctx);
+
+Construction build_trilinear(const json& spec, Context& ctx) {
+  check_fields(spec, "", {"type", "p000", "p001", "p010", "p011", "p100", "p101", "p110", "p111"}, ctx);
+  std::array<Vec3, 8> p;
+  for (std::size_t n = 0; n < 8; ++n) {
+    const std::string name = cat("p", n >> 2, (n >> 1) & 1, n & 1);
+    p[n] = point_value(member(spec, name, "", "a point [x, y, z]"), child("", name));
+  }
+  ctx.parsed();
+  return blended_volume("trilinear", at("", [&] { return trilinear(p); }), {volume_corner_data(p, "/p000")},
+                        nlohmann::ordered_json::object());
+}
+
+Construction build_hermite_volume(const json& spec, Context& ctx) {
+  check_fields(spec, "", {"type", "corners"}, ctx);
+  constexpr std::string_view expected = "an array of 8 corners {\"p\", \"du\", \"dv\", \"dw\"}, corner (i,j,k) at index 4i+2j+k";
+  const json& cs = member(spec, "corners", "", expected);
+  if (!cs.is_array()) wrong_type("/corners", expected, cs);
+  if (cs.size() != 8) fail(errc::size_mismatch, "/corners: expected 8 corners (corner (i,j,k) at index 4i+2j+k), got ", cs.size());
+  std::array<HermiteVolumeCorner, 8> c{};
+  std::array<Vec3, 8> p;
+  for (std::size_t n = 0; n < 8; ++n) {
+    const std::string ptr = child("/corners", n);
+    const json& o = cs[n];
+    expect_object(o, ptr, "a corner {\"p\", \"du\", \"dv\", \"dw\", \"duv\", \"duw\", \"dvw\", \"duvw\"}");
+    check_fields(o, ptr, {"p", "du", "dv", "dw", "duv", "duw", "dvw", "duvw"}, ctx);
+    c[n].p = point_value(member(o, "p", ptr, "a point [x, y, z]"), child(ptr, "p"));
+    c[n].du = point_value(member(o, "du", ptr, "a vector [x, y, z]"), child(ptr, "du"));
+    c[n].dv = point_value(member(o, "dv", ptr, "a vector [x, y, z]"), child(ptr, "dv"));
+    c[n].dw = point_value(member(o, "dw", ptr, "a vector [x, y, z]"), child(ptr, "dw"));
+    if (const json* t = find_member(o, "duv")) c[n].duv = point_value(*t, child(ptr, "duv"));
+    if (const json* t = find_member(o, "duw")) c[n].duw = point_value(*t, child(ptr, "duw"));
+    if (const json* t = find_member(o, "dvw")) c[n].dvw = point_value(*t, child(ptr, "dvw"));
+    if (const json* t = find_member(o, "duvw")) c[n].duvw = point_value(*t, child(ptr, "duvw"));
+    p[n] = c[n].p;
+  }
+  ctx.parsed();
+  return blended_volume("hermite_volume", at("/corners", [&] { return hermite_volume(c); }),
+                        {volume_corner_data(p, "/corners")}, nlohmann::ordered_json::object());
+}
+
+Construction build_coons_volume(const json& spec, Context& ctx) {
+  check_fields(spec, "", {"type", "faces", "blending", "cross_derivatives", "tolerance"}, ctx);
+  static constexpr const char* names[6] = {"u0", "u1", "v0", "v1", "w0", "w1"};
+  constexpr std::string_view expected = "an object {\"u0\", \"u1\", \"v0\", \"v1\", \"w0\", \"w1\"} of surface specs";
+  const json& fj = member(spec, "faces", "", expected);
+  expect_object(fj, "/faces", expected);
+  check_fields(fj, "/faces", {"u0", "u1", "v0", "v1", "w0", "w1"}, ctx);
+  std::vector<BSplineSurface> f;
+  for (const char* n : names) f.push_back(face_surface(member(fj, n, "/faces", "a surface spec"), child("/faces", n), ctx));
+  const VolumeFaces faces{f[0], f[1], f[2], f[3], f[4], f[5]};
+  std::string blending = choice(spec, "blending", "", {"linear", "hermite"}, "linear");
+  const std::optional<double> tol = tolerance_of(spec);
+  std::vector<DataSet> data;
+  for (std::size_t n = 0; n < 6; ++n) data.push_back(face_data(f[n], n / 2, static_cast<double>(n % 2), child("/faces", names[n])));
+  if (const json* x = find_member(spec, "cross_derivatives")) {
+    constexpr std::string_view cexpected = "an object with any of \"u0\", \"u1\", \"v0\", \"v1\", \"w0\", \"w1\": surface specs";
+    expect_object(*x, "/cross_derivatives", cexpected);
+    check_fields(*x, "/cross_derivatives", {"u0", "u1", "v0", "v1", "w0", "w1"}, ctx);
+    VolumeCrossDerivatives cross;
+    std::optional<BSplineSurface>* slots[6] = {&cross.u0, &cross.u1, &cross.v0, &cross.v1, &cross.w0, &cross.w1};
+    nlohmann::ordered_json given = nlohmann::ordered_json::array();
+    for (std::size_t n = 0; n < 6; ++n)
+      if (const json* s = find_member(*x, names[n])) {
+        *slots[n] = face_surface(*s, child("/cross_derivatives", names[n]), ctx);
+        given.push_back(names[n]);
+      }
+    if (blending == "linear" && find_member(spec, "blending"))
+      ctx.warn("/blending: \"linear\" ignored with \"cross_derivatives\" (the volume is Hermite-blended)");
+    HermiteCoonsVolumeOptions o;
+    o.tolerance = tol;
+    ctx.parsed();
+    nlohmann::ordered_json parameters = {{"blending", "hermite"}, {"cross_derivatives", given}};
+    return blended_volume("coons_volume", at("", [&] { return coons_volume(faces, cross, o); }), std::move(data),
+                          std::move(parameters));
+  }
+  CoonsVolumeOptions o;
+  o.tolerance = tol;
+  if (blending == "hermite") o.blend_u = o.blend_v = o.blend_w = Blend::hermite();
+  ctx.parsed();
+  nlohmann::ordered_json parameters = {{"blending", blending}};
+  return blended_volume("coons_volume", at("/faces", [&] { return coons_volume(faces, o); }), std::move(data),
+                        std::move(parameters));
+}
+
+Construction build_interpolate_volume(const json& spec, Context& ctx) {
+  check_fields(spec, "", {"type", "points", "degree", "param"}, ctx);
+  PointArray pts =
+      points_impl(member(spec, "points", "", "a volume grid of points, (n+1) x (m+1) x (l+1) x 3"), 3, "/points", ctx);
+  const auto degree = degrees(spec, "", 3);
+  const Parametrization param = parametrization(spec, "");
+  const std::size_t nu = pts.shape[0], nv = pts.shape[1], nw = pts.shape[2];
+  const std::string shape = cat(nu, "x", nv, "x", nw);
+  for (std::size_t a = 0; a < 3; ++a) {
+    const std::size_t count = pts.shape[a];
+    if (count < 2)
+      fail(errc::too_few_points, "/points: the grid has ", count, " point", count == 1 ? "" : "s", " along ", axis_name(a),
+           " (shape ", shape, "); interpolation needs at least 2");
+    if (degree[a] && static_cast<std::size_t>(*degree[a]) >= count)
+      fail(errc::too_few_points, degree_pointer(spec, "", a), ": degree ", *degree[a], " along ", axis_name(a),
+           " needs at least ", *degree[a] + 1, " points, /points has ", count, " (shape ", shape, ")");
+  }
+  PointGrid3 grid({nu, nv, nw}, std::move(pts.points));
+  DataSet data;
+  data.pointer = "/points";
+  require_memory(grid.size(), sizeof(Vec3), cat("/points: a copy of the ", shape, " data points for the error check"));
+  data.points.assign(grid.values().begin(), grid.values().end());
+
+  VolumeInterpolationOptions options;
+  options.degree_u = degree[0];
+  options.degree_v = degree[1];
+  options.degree_w = degree[2];
+  options.param = param;
+  options.progress = ctx.progress;
+  ctx.parsed();
+  VolumeInterpolation r = at("/points", [&] { return interpolate_volume(std::move(grid), options); });
+  const auto dom = r.volume.domain();
+  data.params = {to_unit(std::move(r.params_u), dom[0]), to_unit(std::move(r.params_v), dom[1]),
+                 to_unit(std::move(r.params_w), dom[2])};
+  BSplineVolume v = on_unit_domain(std::move(r.volume));
+  nlohmann::ordered_json parameters = {{"grid", {nu, nv, nw}},
+                                       {"degree", {v.degree_u(), v.degree_v(), v.degree_w()}},
+                                       {"param", param_name(param)}};
+  Construction c;
+  c.type = "interpolate_volume";
+  c.exact = std::move(v);
+  c.parameters = std::move(parameters);
+  c.data.push_back(std::move(data));
+  return c;
+}
+
+Construction build_bspline_volume(const json& spec, Context& ctx) {
+  check_fields(spec, "", {"type", "degree", "knots", "control_points", "weights"}, ctx);
+  member(spec, "degree", "", "an integer degree or [p, q, r]");
+  const auto degree = degrees(spec, "", 3);
+  constexpr std::string_view kexpected = "an object {\"u\": [...], \"v\": [...], \"w\": [...]}";
+  const json& knots = member(spec, "knots", "", kexpected);
+  expect_object(knots, "/knots", kexpected);
+  check_fields(knots, "/knots", {"u", "v", "w"}, ctx);
+  std::vector<double> kv[3];
+  for (std::size_t a = 0; a < 3; ++a)
+    kv[a] = numbers(member(knots, axis_name(a), "/knots", "an array of knots"), child("/knots", axis_name(a)));
+  PointArray cp = points_impl(member(spec, "control_points", "", "a grid of control points, (n+1) x (m+1) x (l+1) x 3"),
+                              3, "/control_points", ctx);
+  const std::string shape = cat(cp.shape[0], "x", cp.shape[1], "x", cp.shape[2]);
+  Grid<double, 3> weights;
+  if (const json* w = find_member(spec, "weights")) {
+    weights = inline_number_grid<3>(*w, "/weights");
+    if (weights.extent(0) != cp.shape[0] || weights.extent(1) != cp.shape[1] || weights.extent(2) != cp.shape[2])
+      fail(errc::size_mismatch, "/weights: shape ", weights.extent(0), "x", weights.extent(1), "x", weights.extent(2),
+           " differs from /control_points, ", shape);
+    for (std::size_t i = 0; i < weights.extent(0); ++i)
+      for (std::size_t j = 0; j < weights.extent(1); ++j)
+        for (std::size_t k = 0; k < weights.extent(2); ++k)
+          if (!(weights(i, j, k) > 0))
+            fail(errc::invalid_weight, "/weights/", i, "/", j, "/", k, ": weight ", weights(i, j, k), " is not positive");
+  }
+  std::vector<KnotVector> k;
+  for (std::size_t a = 0; a < 3; ++a)
+    k.push_back(at(child("/knots", axis_name(a)), [&] { return KnotVector(*degree[a], std::move(kv[a])); }));
+  for (std::size_t a = 0; a < 3; ++a)
+    if (static_cast<std::size_t>(k[a].count()) != cp.shape[a])
+      fail(errc::size_mismatch, "/control_points: ", cp.shape[a], " control points along ", axis_name(a), " (shape ",
+           shape, "), but the ", k[a].size(), " knots of degree ", k[a].degree(), " in /knots/", axis_name(a), " need ",
+           k[a].count());
+  ctx.parsed();
+  BSplineVolume v = at("/control_points", [&] {
+    return BSplineVolume(std::move(k[0]), std::move(k[1]), std::move(k[2]),
+                         PointGrid3({cp.shape[0], cp.shape[1], cp.shape[2]}, std::move(cp.points)), std::move(weights));
+  });
+  const auto d = v.domain();
+  nlohmann::ordered_json parameters = {
+      {"domain", {{"u", {d[0].first, d[0].second}}, {"v", {d[1].first, d[1].second}}, {"w", {d[2].first, d[2].second}}}}};
+  Construction c;
+  c.type = "bspline_volume";
+  c.exact = on_unit_domain(std::move(v));
+  c.parameters = std::move(parameters);
+  return c;
+}
+
 struct ConstructionType {
   std::string_view name;
   Construction (*build)(const json& spec, Context& ctx);
+  int dims;  // 2: a surface, 3: a volume
 };
 
 // Adding a construction: one function above, one line here.
 constexpr ConstructionType construction_types[] = {
-    {"bilinear", build_bilinear},
-    {"ruled", build_ruled},
-    {"coons", build_coons},
-    {"network", build_network},
-    {"interpolate", build_interpolate},
-    {"hermite_patch", build_hermite_patch},
-    {"bspline_surface", build_bspline_surface},
+    {"bilinear", build_bilinear, 2},
+    {"ruled", build_ruled, 2},
+    {"coons", build_coons, 2},
+    {"network", build_network, 2},
+    {"interpolate", build_interpolate, 2},
+    {"hermite_patch", build_hermite_patch, 2},
+    {"bspline_surface", build_bspline_surface, 2},
+    {"trilinear", build_trilinear, 3},
+    {"coons_volume", build_coons_volume, 3},
+    {"hermite_volume", build_hermite_volume, 3},
+    {"interpolate_volume", build_interpolate_volume, 3},
+    {"bspline_volume", build_bspline_volume, 3},
 };
+
+// A message of a nested spec, whose places are pointers from the nested object,
+// placed under `ptr`: "/points/3: ..." becomes "/faces/u1/points/3: ...".
+std::string rebased(std::string_view message, std::string_view ptr) {
+  constexpr std::string_view top = "(top level)";
+  if (message.substr(0, top.size()) == top) return cat(ptr, message.substr(top.size()));
+  if (!message.empty() && message[0] == '/') return cat(ptr, message);
+  return cat(ptr, ": ", message);
+}
+
+// A surface spec inside a volume spec (a face, a cross-derivative field): built by
+// the surface constructions, used by its exact form over [0, 1]².
+BSplineSurface face_surface(const json& j, const std::string& ptr, Context& ctx) {
+  std::string surfaces;
+  for (const auto& t : construction_types)
+    if (t.dims == 2) surfaces += cat(surfaces.empty() ? "" : ", ", t.name);
+  if (!j.is_object()) wrong_type(ptr, cat("a surface spec: an object with a \"type\", one of ", surfaces), j);
+  const json& t = member(j, "type", ptr, cat("a string, one of ", surfaces));
+  if (!t.is_string()) wrong_type(child(ptr, "type"), cat("a string, one of ", surfaces), t);
+  const auto& name = t.get_ref<const std::string&>();
+  const auto it = std::find_if(std::begin(construction_types), std::end(construction_types),
+                               [&](const ConstructionType& c) { return c.name == name; });
+  if (it == std::end(construction_types) || it->dims != 2)
+    fail(errc::unknown_type, child(ptr, "type"), ": \"", name, "\" is not a surface type; a face takes one of ", surfaces);
+  Context sub;
+  sub.base_dir = ctx.base_dir;
+  Construction c;
+  try {
+    c = it->build(j, sub);
+  } catch (const error& e) {
+    throw error(e.code(), rebased(e.what(), ptr));
+  }
+  for (const std::string& w : sub.warnings) ctx.warn(rebased(w, ptr));
+  if (!c.exact)
+    fail(errc::no_exact_form, place(ptr), ": the ", name, " surface has no exact B-spline form (", c.no_exact_form,
+         "); a face needs one");
+  return std::get<BSplineSurface>(*c.exact);
+}
 
 std::string type_list() {
   std::string s;
@@ -976,10 +1260,21 @@ json read_json_file(const std::filesystem::path& path) {
   return parse_json(text, name);
 }
 
+bool is_volume(const Construction& c) noexcept {
+  return c.exact ? std::holds_alternative<BSplineVolume>(*c.exact) : c.volume_formula != nullptr;
+}
+
 const Surface& evaluator(const Construction& c) {
+  if (is_volume(c)) fail(errc::wrong_type, c.type, ": the construction is a volume, not a surface");
   if (c.exact) return std::get<BSplineSurface>(*c.exact);
   if (!c.formula) fail(errc::internal, c.type, ": the construction has neither an exact form nor a formula");
   return *c.formula;
+}
+
+const Volume& volume_evaluator(const Construction& c) {
+  if (!is_volume(c)) fail(errc::wrong_type, c.type, ": the construction is a surface, not a volume");
+  if (c.exact) return std::get<BSplineVolume>(*c.exact);
+  return *c.volume_formula;
 }
 
 Construction build(const json& spec, const std::filesystem::path& base_dir, const progress_callback& progress) {

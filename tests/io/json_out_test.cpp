@@ -2,12 +2,15 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "test_util.hpp"
 
@@ -126,6 +129,73 @@ TEST(JsonOut, PrettyJsonKeepsPlainArraysOnOneLineAndParsesBack) {
   EXPECT_EQ(nlohmann::ordered_json::parse(text), j);
   EXPECT_NE(text.find("\"degree\": [3, 3]"), std::string::npos) << text;
   EXPECT_EQ(text.back(), '\n');
+}
+
+}  // namespace
+}  // namespace interpatch::io
+
+namespace interpatch::io {
+namespace {
+
+json corners_spec(bool folded) {
+  json spec = {{"type", "trilinear"}};
+  std::array<Vec3, 8> c;
+  for (int n = 0; n < 8; ++n) c[static_cast<std::size_t>(n)] = {double(n >> 2), double((n >> 1) & 1), double(n & 1)};
+  if (folded) std::swap(c[0], c[7]);
+  for (std::size_t n = 0; n < 8; ++n)
+    spec["p" + std::to_string(n >> 2) + std::to_string((n >> 1) & 1) + std::to_string(n & 1)] = {c[n].x, c[n].y, c[n].z};
+  return spec;
+}
+
+TEST(JsonOutVolume, InfoDescribesAVolumeAndItsJacobian) {
+  const auto j = info_json(build(corners_spec(false)));
+  EXPECT_EQ(j["kind"], "volume");
+  EXPECT_EQ(j["exact_form"], "bspline_volume");
+  EXPECT_EQ(j["degree"], nlohmann::ordered_json({1, 1, 1}));
+  EXPECT_EQ(j["control_points"], nlohmann::ordered_json({2, 2, 2}));
+  EXPECT_EQ(j["knots"]["w"].size(), 4u);
+  EXPECT_EQ(j["continuity"]["w"], "Cinf");
+  EXPECT_EQ(j["domain"]["w"], nlohmann::ordered_json({0.0, 1.0}));
+  EXPECT_EQ(j["max_data_error"]["points"], 8);
+  EXPECT_EQ(j["max_data_error"]["params"].size(), 3u);
+  const auto& jac = j["jacobian"];
+  EXPECT_EQ(jac["samples_per_direction"], 17);
+  EXPECT_EQ(jac["samples"], 4913);
+  EXPECT_EQ(jac["cells"], 4096);
+  EXPECT_EQ(jac["inverted_cells"], 0);
+  EXPECT_DOUBLE_EQ(jac["min_determinant"].get<double>(), 1.0);  // the identity map
+  EXPECT_TRUE(jac["inverted_at"].empty());
+  EXPECT_EQ(j["data"][0]["shape"], nlohmann::ordered_json({2, 2, 2}));
+
+  const auto f = info_json(build(corners_spec(true)));
+  EXPECT_GT(f["jacobian"]["inverted_cells"].get<std::size_t>(), 0u);
+  EXPECT_LE(f["jacobian"]["min_determinant"].get<double>(), 0.0);
+  EXPECT_EQ(f["jacobian"]["inverted_at"][0].size(), 3u);
+  EXPECT_EQ(f["jacobian"]["min_at"].size(), 3u);
+}
+
+TEST(JsonOutVolume, MaxDataErrorNamesTheVolumePoint) {
+  Construction c = build(corners_spec(false));
+  c.data[0].points[6] += Vec3{0, 0.25, 0};  // corner p110 moved
+  const auto e = max_data_error(c);
+  ASSERT_TRUE(e.has_value());
+  EXPECT_NEAR(e->absolute, 0.25, 1e-15);
+  EXPECT_EQ(e->pointer, "/p000/1/1/0");
+  EXPECT_EQ(e->params, std::vector<double>({1.0, 1.0, 0.0}));
+}
+
+TEST(JsonOutVolume, ExactVolumeJsonReadsBackBitForBit) {
+  const Construction c = build(corners_spec(false));
+  std::ostringstream os;
+  write_exact_json(os, *c.exact);
+  const json j = json::parse(os.str());
+  EXPECT_EQ(j["type"], "bspline_volume");
+  EXPECT_EQ(j["degree"], json({1, 1, 1}));
+  EXPECT_EQ(j["control_points"][1][0][1], json({1, 0, 1}));
+  EXPECT_FALSE(j.contains("weights"));
+  const Construction back = build(j);
+  EXPECT_EQ(std::get<BSplineVolume>(*back.exact).control_points().values(),
+            std::get<BSplineVolume>(*c.exact).control_points().values());
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
@@ -441,6 +442,243 @@ TEST(SpecErrors, UnreadableSpecFile) {
   EXPECT_ERRC((void)build_file(dir.path()), file_unreadable, "directory");
   write_text(dir / "bad.json", "{\"type\": \"interpolate\",\n \"points\": [}");
   EXPECT_ERRC((void)build_file(dir / "bad.json"), invalid_json, "bad.json:2:");
+}
+
+}  // namespace
+}  // namespace interpatch::io
+
+namespace interpatch::io {
+namespace {
+
+// --- volumes --------------------------------------------------------------------
+
+json trilinear_box() {
+  json spec = {{"type", "trilinear"}};
+  for (int n = 0; n < 8; ++n)
+    spec["p" + std::to_string(n >> 2) + std::to_string((n >> 1) & 1) + std::to_string(n & 1)] = {
+        n >> 2, 2 * ((n >> 1) & 1), 3 * (n & 1)};
+  return spec;
+}
+
+json bilinear_face(const Vec3& p00, const Vec3& p01, const Vec3& p10, const Vec3& p11) {
+  return {{"type", "bilinear"},
+          {"p00", {p00.x, p00.y, p00.z}},
+          {"p01", {p01.x, p01.y, p01.z}},
+          {"p10", {p10.x, p10.y, p10.z}},
+          {"p11", {p11.x, p11.y, p11.z}}};
+}
+
+// The unit cube from its six faces; face w1 interpolated through a 4x4 grid of its points.
+json cube_coons() {
+  json lid = json::array();
+  for (int i = 0; i < 4; ++i) {
+    json row = json::array();
+    for (int j = 0; j < 4; ++j) row.push_back({i / 3.0, j / 3.0, 1.0});
+    lid.push_back(row);
+  }
+  return {{"type", "coons_volume"},
+          {"faces",
+           {{"u0", bilinear_face({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, {0, 1, 1})},
+            {"u1", bilinear_face({1, 0, 0}, {1, 0, 1}, {1, 1, 0}, {1, 1, 1})},
+            {"v0", bilinear_face({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {1, 0, 1})},
+            {"v1", bilinear_face({0, 1, 0}, {0, 1, 1}, {1, 1, 0}, {1, 1, 1})},
+            {"w0", bilinear_face({0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0})},
+            {"w1", {{"type", "interpolate"}, {"param", "uniform"}, {"points", lid}}}}}};
+}
+
+json volume_grid_json(const PointGrid3& g) {
+  json a = json::array();
+  for (std::size_t i = 0; i < g.extent(0); ++i) {
+    json slab = json::array();
+    for (std::size_t j = 0; j < g.extent(1); ++j) {
+      json row = json::array();
+      for (std::size_t k = 0; k < g.extent(2); ++k) row.push_back({g(i, j, k).x, g(i, j, k).y, g(i, j, k).z});
+      slab.push_back(row);
+    }
+    a.push_back(slab);
+  }
+  return a;
+}
+
+PointGrid3 curved_grid(std::size_t nu, std::size_t nv, std::size_t nw) {
+  PointGrid3 q({nu, nv, nw});
+  for (std::size_t i = 0; i < nu; ++i)
+    for (std::size_t j = 0; j < nv; ++j)
+      for (std::size_t k = 0; k < nw; ++k) {
+        const double x = static_cast<double>(i), y = static_cast<double>(j), z = static_cast<double>(k);
+        q(i, j, k) = {x + 0.1 * y * y, y + 0.2 * std::sin(x + z), z + 0.05 * x * y};
+      }
+  return q;
+}
+
+TEST(SpecVolume, TrilinearIsAVolumeWithItsCornersAsData) {
+  const Construction c = build(trilinear_box());
+  EXPECT_EQ(c.type, "trilinear");
+  EXPECT_TRUE(is_volume(c));
+  const auto& v = std::get<BSplineVolume>(*c.exact);
+  EXPECT_EQ(v.degree_u(), 1);
+  const Vec3 p = volume_evaluator(c).point(0.5, 0.5, 0.5);
+  EXPECT_NEAR(distance(p, Vec3{0.5, 1, 1.5}), 0.0, 1e-15);
+  ASSERT_EQ(c.data.size(), 1u);
+  EXPECT_EQ(c.data[0].params.size(), 3u);
+  EXPECT_EQ(c.data[0].points[5], (Vec3{1, 0, 3}));  // p101 at 4i + 2j + k
+  EXPECT_ERRC((void)evaluator(c), wrong_type, "volume");
+}
+
+TEST(SpecVolume, HermiteVolumeReproducesATricubicPolynomial) {
+  // (u + 0.2 v w, v + 0.1 u^2, w + 0.3 u v w) from its point frame.
+  json corners = json::array();
+  for (int n = 0; n < 8; ++n) {
+    const double u = n >> 2, v = (n >> 1) & 1, w = n & 1;
+    corners.push_back({{"p", {u + 0.2 * v * w, v + 0.1 * u * u, w + 0.3 * u * v * w}},
+                       {"du", {1, 0.2 * u, 0.3 * v * w}},
+                       {"dv", {0.2 * w, 1, 0.3 * u * w}},
+                       {"dw", {0.2 * v, 0, 1 + 0.3 * u * v}},
+                       {"duv", {0, 0, 0.3 * w}},
+                       {"duw", {0, 0, 0.3 * v}},
+                       {"dvw", {0.2, 0, 0.3 * u}},
+                       {"duvw", {0, 0, 0.3}}});
+  }
+  const Construction c = build(json{{"type", "hermite_volume"}, {"corners", corners}});
+  const auto& v = std::get<BSplineVolume>(*c.exact);
+  const double u = 0.3, vv = 0.6, w = 0.8;
+  EXPECT_NEAR(distance(v.point(u, vv, w), Vec3{u + 0.2 * vv * w, vv + 0.1 * u * u, w + 0.3 * u * vv * w}), 0.0, 1e-14);
+  corners.erase(7);
+  EXPECT_ERRC((void)build(json{{"type", "hermite_volume"}, {"corners", corners}}), size_mismatch, "/corners");
+  corners.push_back({{"p", {1, 1, 1}}, {"du", {1, 0, 0}}, {"dv", {0, 1, 0}}});
+  EXPECT_ERRC((void)build(json{{"type", "hermite_volume"}, {"corners", corners}}), missing_field, "/corners/7/dw");
+}
+
+TEST(SpecVolume, CoonsVolumeFromSurfaceSpecsTakesItsFaces) {
+  const Construction c = build(cube_coons());
+  EXPECT_EQ(c.type, "coons_volume");
+  EXPECT_TRUE(c.exact.has_value());
+  const Vec3 p = volume_evaluator(c).point(0.2, 0.3, 0.4);
+  EXPECT_NEAR(distance(p, Vec3{0.2, 0.3, 0.4}), 0.0, 1e-14);
+  ASSERT_EQ(c.data.size(), 6u);
+  EXPECT_EQ(c.data[3].pointer, "/faces/v1");
+  EXPECT_EQ(c.data[3].params[1], std::vector<double>({1.0}));
+  const auto e = max_data_error(c);
+  ASSERT_TRUE(e.has_value());
+  EXPECT_LT(e->absolute, 1e-14);
+
+  json spec = cube_coons();
+  spec["blending"] = "hermite";
+  spec["cross_derivatives"] = {{"w0", bilinear_face({0, 0, 1}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1})}};
+  const Construction h = build(spec);
+  EXPECT_EQ(h.parameters["cross_derivatives"], nlohmann::ordered_json({"w0"}));
+  EXPECT_NEAR(norm(volume_evaluator(h).derivatives(0.5, 0.5, 0).sw - Vec3{0, 0, 1}), 0.0, 1e-12);
+}
+
+TEST(SpecVolume, CoonsVolumeErrorsKeepTheirPointerUnderTheFace) {
+  json spec = cube_coons();
+  spec["faces"]["w1"]["points"][3][2] = {1, 2};
+  EXPECT_ERRC((void)build(spec), ragged_grid, "/faces/w1/points/3/2: a point must be 3 numbers");
+  spec = cube_coons();
+  spec["faces"]["w1"]["points"][1][2][0] = nullptr;
+  EXPECT_ERRC((void)build(spec), wrong_type, "/faces/w1/points/1/2/0");
+  spec = cube_coons();
+  spec["faces"]["u0"] = trilinear_box();
+  EXPECT_ERRC((void)build(spec), unknown_type, "/faces/u0/type: \"trilinear\" is not a surface type");
+  spec = cube_coons();
+  spec["faces"].erase("v1");
+  EXPECT_ERRC((void)build(spec), missing_field, "/faces/v1");
+  spec = cube_coons();
+  spec["faces"]["u1"]["p11"] = {1, 1, 1.25};
+  EXPECT_ERRC((void)build(spec), corner_gap, "/faces: faces u1 and");
+  spec = cube_coons();
+  spec["faces"]["u0"]["bogus"] = 1;
+  const Construction c = build(spec);
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_EQ(c.warnings[0], "/faces/u0/bogus: unknown field, ignored");
+}
+
+TEST(SpecVolume, InterpolateVolumeReproducesTheDataAndRoundTrips) {
+  const PointGrid3 q = curved_grid(5, 4, 6);
+  json spec = {{"type", "interpolate_volume"}, {"points", volume_grid_json(q)}, {"degree", {3, 2, 3}}};
+  const Construction c = build(spec);
+  const auto& v = std::get<BSplineVolume>(*c.exact);
+  EXPECT_EQ(v.degree_v(), 2);
+  ASSERT_EQ(c.data.size(), 1u);
+  const DataSet& d = c.data[0];
+  ASSERT_EQ(d.params.size(), 3u);
+  for (std::size_t i = 0; i < 5; ++i)
+    for (std::size_t j = 0; j < 4; ++j)
+      for (std::size_t k = 0; k < 6; ++k)
+        EXPECT_LT(distance(v.point(d.params[0][i], d.params[1][j], d.params[2][k]), q(i, j, k)), 1e-12);
+
+  std::ostringstream text;
+  write_exact_json(text, *c.exact);
+  const Construction b = build(parse_json(text.str()));
+  EXPECT_EQ(b.type, "bspline_volume");
+  const auto& vb = std::get<BSplineVolume>(*b.exact);
+  EXPECT_EQ(v.knots_u(), vb.knots_u());
+  EXPECT_EQ(v.knots_w(), vb.knots_w());
+  EXPECT_EQ(v.control_points().values(), vb.control_points().values());  // bit for bit
+}
+
+TEST(SpecVolume, InterpolateVolumeErrorsNameThePlace) {
+  json spec = {{"type", "interpolate_volume"}, {"points", volume_grid_json(curved_grid(4, 3, 3))}};
+  json bad = spec;
+  bad["points"][2][1].erase(0);
+  EXPECT_ERRC((void)build(bad), ragged_grid, "/points/2/1: has 2 points, but /points/0/0 has 3");
+  bad = spec;
+  bad["degree"] = {3, 3, 3};
+  EXPECT_ERRC((void)build(bad), too_few_points, "/degree/1");
+  bad = spec;
+  bad["degree"] = {3, 3};
+  EXPECT_ERRC((void)build(bad), size_mismatch, "3 degrees");
+  bad = spec;
+  bad["points"] = grid_json(PointGrid({3, 3}));
+  EXPECT_ERRC((void)build(bad), wrong_type, "/points");
+}
+
+TEST(SpecVolume, BSplineVolumeWithWeightsAndItsOwnDomain) {
+  json cp = json::array(), w = json::array();
+  for (int i = 0; i < 2; ++i) {
+    json slab = json::array(), ws = json::array();
+    for (int j = 0; j < 2; ++j) {
+      json row = json::array(), wr = json::array();
+      for (int k = 0; k < 3; ++k) {
+        row.push_back({i, j, k});
+        wr.push_back(k == 1 ? 2.0 : 1.0);
+      }
+      slab.push_back(row);
+      ws.push_back(wr);
+    }
+    cp.push_back(slab);
+    w.push_back(ws);
+  }
+  json spec = {{"type", "bspline_volume"},
+               {"degree", {1, 1, 2}},
+               {"knots", {{"u", {0, 0, 2, 2}}, {"v", {0, 0, 1, 1}}, {"w", {0, 0, 0, 1, 1, 1}}}},
+               {"control_points", cp},
+               {"weights", w}};
+  const Construction c = build(spec);
+  const auto& v = std::get<BSplineVolume>(*c.exact);
+  EXPECT_TRUE(v.rational());
+  EXPECT_EQ(v.domain()[0], std::make_pair(0.0, 1.0));  // mapped onto [0,1]
+  EXPECT_EQ(c.parameters["domain"]["u"], nlohmann::ordered_json({0.0, 2.0}));
+  std::ostringstream text;
+  write_exact_json(text, *c.exact);
+  const Construction b = build(parse_json(text.str()));
+  EXPECT_EQ(std::get<BSplineVolume>(*b.exact).weights().values(), v.weights().values());
+
+  json bad = spec;
+  bad["weights"][1][0][2] = -1;
+  EXPECT_ERRC((void)build(bad), invalid_weight, "/weights/1/0/2");
+  bad = spec;
+  bad["knots"].erase("w");
+  EXPECT_ERRC((void)build(bad), missing_field, "/knots/w");
+  bad = spec;
+  bad["knots"]["v"] = {0, 0, 0.5, 1, 1};
+  EXPECT_ERRC((void)build(bad), size_mismatch, "/control_points: 2 control points along v");
+}
+
+TEST(SpecVolume, KnownTypesListTheVolumes) {
+  const auto t = known_types();
+  for (const char* name : {"trilinear", "coons_volume", "hermite_volume", "interpolate_volume", "bspline_volume"})
+    EXPECT_NE(std::find(t.begin(), t.end(), name), t.end()) << name;
 }
 
 }  // namespace

@@ -24,8 +24,10 @@ namespace interpatch::io {
 /// `{"type": "bspline_surface", "degree": [p, q], "knots": {"u": [...], "v": [...]},
 /// "control_points": [[[x, y, z], ...], ...], "weights": [[...], ...]}` with
 /// control_points (n+1) × (m+1) × 3 (first index along u) and weights only when
-/// rational. Numbers are written in the shortest form that reads back to the same
-/// double.
+/// rational. A volume is the same with three directions:
+/// `{"type": "bspline_volume", "degree": [p, q, r], "knots": {"u", "v", "w"},
+/// "control_points": (n+1) × (m+1) × (l+1) × 3, "weights"}`. Numbers are written in
+/// the shortest form that reads back to the same double.
 ///
 /// Example:
 /// @code
@@ -65,6 +67,11 @@ struct DataError {
 /// "max_data_error": {"absolute", "relative", "diagonal", "points", "at", "params"} or
 /// null, "data": [{"pointer", "shape", "params": {"u", "v"}}], "parameters",
 /// "warnings", "timings": {"parse_ms", "build_ms", "check_ms", "total_ms"}}`.
+/// A volume has "kind": "volume", "exact_form": "bspline_volume", three entries in
+/// degree, control_points, knots, continuity and domain (u, v, w), and
+/// "jacobian": {"samples_per_direction": 17, "samples", "inverted_points", "cells",
+/// "inverted_cells", "min_determinant", "max_determinant", "min_at", "inverted_at"}
+/// from inverted_cells() on a 17 × 17 × 17 grid (its time counts into check_ms).
 /// @throws error too_large.
 [[nodiscard]] nlohmann::ordered_json info_json(const Construction& c, const progress_callback& progress = {});
 

@@ -22,9 +22,11 @@
 #include "interpatch/allocator.hpp"
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/bspline_surface.hpp"
+#include "interpatch/bspline_volume.hpp"
 #include "interpatch/progress.hpp"
 #include "interpatch/surface.hpp"
 #include "interpatch/vec3.hpp"
+#include "interpatch/volume.hpp"
 
 namespace interpatch::io {
 
@@ -34,7 +36,8 @@ using PointStorage = std::vector<Vec3, large_allocator<Vec3>>;
 /// Points a construction interpolates, as a tensor grid: `points` holds the data
 /// point for every combination of the parameters in `params` (one list per
 /// parameter axis: u, v[, w]), in C order, first axis slowest. The exact form
-/// evaluated at (params[0][i], params[1][j]) should reproduce points[i * nv + j].
+/// evaluated at (params[0][i], params[1][j]) should reproduce points[i * nv + j]
+/// (for a volume, at (params[0][i], params[1][j], params[2][k]) points[(i * nv + j) * nw + k]).
 struct DataSet {
   std::vector<std::vector<double>> params;
   PointStorage points;
@@ -43,9 +46,9 @@ struct DataSet {
   std::string pointer;
 };
 
-/// The exact B-spline form of a construction, over [0,1]² (a BSplineVolume over
-/// [0,1]³ joins when volumes do).
-using ExactForm = std::variant<BSplineSurface>;
+/// The exact B-spline form of a construction: a surface over [0,1]² or a volume
+/// over [0,1]³.
+using ExactForm = std::variant<BSplineSurface, BSplineVolume>;
 
 /// Wall-clock milliseconds spent on each stage.
 struct Timings {
@@ -69,11 +72,20 @@ struct Construction {
   /// patches, networks, ...): what evaluates a construction without an exact form.
   std::shared_ptr<const Surface> formula;
   std::string no_exact_form;
+  /// The same for a volume construction (trilinear, Coons and Hermite volumes).
+  std::shared_ptr<const Volume> volume_formula;
 };
 
-/// What evaluates a construction: its exact form when it has one (the fast path),
-/// otherwise its formula.
+/// Whether the construction is a volume (its exact form a BSplineVolume, or its
+/// formula a Volume) rather than a surface.
+[[nodiscard]] bool is_volume(const Construction& c) noexcept;
+
+/// What evaluates a surface construction: its exact form when it has one (the fast
+/// path), otherwise its formula. @throws error wrong_type (a volume construction).
 [[nodiscard]] const Surface& evaluator(const Construction& c);
+
+/// The same for a volume construction. @throws error wrong_type (a surface construction).
+[[nodiscard]] const Volume& volume_evaluator(const Construction& c);
 
 /// The construction types a spec's "type" may name, in the order they are documented.
 [[nodiscard]] std::vector<std::string_view> known_types();
