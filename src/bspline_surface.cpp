@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cmath>
 
+#include "detail/basis_table.hpp"
 #include "detail/parallel.hpp"
 #include "detail/text.hpp"
 #include "interpatch/bspline_curve.hpp"
@@ -18,35 +19,11 @@ namespace {
 
 constexpr int W = max_degree + 1;
 
-void check_param(const KnotVector& k, double t, const char* dir) {
-  const double a = k.front(), b = k.back();
-  const double slack = 1e-12 * (b - a);  // rounding of the caller's parameter mapping
-  if (!(t >= a - slack && t <= b + slack))
-    fail(errc::out_of_domain, "parameter ", dir, " = ", t, " is outside the domain [", a, ", ", b, "]");
-}
-
-// Basis functions (and derivatives up to `nd`) of one parameter, computed once.
-struct Basis {
-  int span;
-  double d[3 * W];  // d[k*(p+1)+j], k <= 2
-};
-
+using detail::check_parameter;
+// Rows of basis functions with derivatives up to second order.
+using Basis = detail::BasisRow<3>;
 std::vector<Basis> bases(const KnotVector& k, std::span<const double> ts, int nd, const char* dir) {
-  std::vector<Basis> b(ts.size());
-  const int p = k.degree();
-  for (std::size_t i = 0; i < ts.size(); ++i) {
-    check_param(k, ts[i], dir);
-    const double t = std::clamp(ts[i], k.front(), k.back());
-    b[i].span = k.find_span(t);
-    if (nd == 0) {
-      k.basis(b[i].span, t, b[i].d);
-    } else {
-      double tmp[W * W];
-      k.basis_derivatives(b[i].span, t, nd, tmp);
-      std::copy(tmp, tmp + (nd + 1) * (p + 1), b[i].d);
-    }
-  }
-  return b;
+  return detail::basis_table<3>(k, ts, nd, dir);
 }
 
 // A line of homogeneous control points along u at column j (or along v at row i).
@@ -112,8 +89,8 @@ BSplineSurface::BSplineSurface(KnotVector knots_u, KnotVector knots_v, PointGrid
 Vec3 BSplineSurface::point(double u, double v) const { return derivative(u, v, 0, 0); }
 
 Vec3 BSplineSurface::derivative(double u, double v, int du, int dv) const {
-  check_param(ku_, u, "u");
-  check_param(kv_, v, "v");
+  check_parameter(ku_, u, "u");
+  check_parameter(kv_, v, "v");
   if (du < 0 || dv < 0 || du > max_degree || dv > max_degree)
     fail(errc::invalid_degree, "derivative order (", du, ", ", dv, ") is outside 0..", max_degree);
   u = std::clamp(u, ku_.front(), ku_.back());

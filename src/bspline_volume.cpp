@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "detail/parallel.hpp"
+#include "detail/basis_table.hpp"
 #include "detail/text.hpp"
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/memory.hpp"
@@ -20,29 +21,11 @@ constexpr int W = max_degree + 1;
 constexpr int D = max_volume_derivative + 1;
 using H = std::array<double, 4>;  // homogeneous point (w x, w y, w z, w)
 
-void check_param(const KnotVector& k, double t, const char* dir) {
-  const double a = k.front(), b = k.back();
-  const double slack = 1e-12 * (b - a);  // rounding of the caller's parameter mapping
-  if (!(t >= a - slack && t <= b + slack))
-    fail(errc::out_of_domain, "parameter ", dir, " = ", t, " is outside the domain [", a, ", ", b, "]");
-}
-
-// Basis functions and first derivatives of one parameter, computed once per batch.
-struct Basis {
-  int span;
-  double d[2 * W];  // d[k*(p+1)+j], k <= 1
-};
-
-// Checked here, before any parallel region: an exception must not leave one.
+using detail::check_parameter;
+// Rows of basis functions with first derivatives, computed once per batch.
+using Basis = detail::BasisRow<2>;
 std::vector<Basis> bases(const KnotVector& k, std::span<const double> ts, int nd, const char* dir) {
-  std::vector<Basis> b(ts.size());
-  for (std::size_t i = 0; i < ts.size(); ++i) {
-    check_param(k, ts[i], dir);
-    const double t = std::clamp(ts[i], k.front(), k.back());
-    b[i].span = k.find_span(t);
-    k.basis_derivatives(b[i].span, t, nd, b[i].d);
-  }
-  return b;
+  return detail::basis_table<2>(k, ts, nd, dir);
 }
 
 // nu × nv × nw items, refused (too_large) when the product overflows or does not fit.
@@ -265,9 +248,9 @@ std::array<std::pair<double, double>, 3> BSplineVolume::domain() const {
 Vec3 BSplineVolume::point(double u, double v, double w) const { return derivative(u, v, w, 0, 0, 0); }
 
 Vec3 BSplineVolume::derivative(double u, double v, double w, int du, int dv, int dw) const {
-  check_param(ku_, u, "u");
-  check_param(kv_, v, "v");
-  check_param(kw_, w, "w");
+  check_parameter(ku_, u, "u");
+  check_parameter(kv_, v, "v");
+  check_parameter(kw_, w, "w");
   for (int k : {du, dv, dw})
     if (k < 0 || k > max_volume_derivative)
       fail(errc::invalid_degree, "derivative order (", du, ", ", dv, ", ", dw, ") is outside 0..",
@@ -335,9 +318,9 @@ Vec3 BSplineVolume::derivative(double u, double v, double w, int du, int dv, int
 }
 
 VolumeDerivatives BSplineVolume::derivatives(double u, double v, double w) const {
-  check_param(ku_, u, "u");
-  check_param(kv_, v, "v");
-  check_param(kw_, w, "w");
+  check_parameter(ku_, u, "u");
+  check_parameter(kv_, v, "v");
+  check_parameter(kw_, w, "w");
   u = std::clamp(u, ku_.front(), ku_.back());
   v = std::clamp(v, kv_.front(), kv_.back());
   w = std::clamp(w, kw_.front(), kw_.back());

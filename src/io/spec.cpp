@@ -721,11 +721,14 @@ DataSet corner_data(const std::array<Vec3, 4>& p, std::string pointer) {
   return d;
 }
 
-// A blended construction: the formula, its exact form if it has one.
-Construction blended(std::string_view type, BlendedSurface s, std::vector<DataSet> data, nlohmann::ordered_json parameters) {
+// A blended construction (surface or volume): the formula, stored in `slot`, and
+// its exact form if it has one.
+template <class Formula, class Slot>
+Construction blended_with(std::string_view type, Formula f, std::vector<DataSet> data, nlohmann::ordered_json parameters,
+                          Slot Construction::*slot) {
   Construction c;
   c.type = type;
-  auto formula = std::make_shared<const BlendedSurface>(std::move(s));
+  auto formula = std::make_shared<const Formula>(std::move(f));
   try {
     c.exact = formula->to_bspline();
   } catch (const error& e) {
@@ -733,10 +736,14 @@ Construction blended(std::string_view type, BlendedSurface s, std::vector<DataSe
     c.no_exact_form = e.what();
   }
   if (!formula->notes().empty()) parameters["notes"] = formula->notes();
-  c.formula = std::move(formula);
+  c.*slot = std::move(formula);
   c.data = std::move(data);
   c.parameters = std::move(parameters);
   return c;
+}
+
+Construction blended(std::string_view type, BlendedSurface s, std::vector<DataSet> data, nlohmann::ordered_json parameters) {
+  return blended_with(type, std::move(s), std::move(data), std::move(parameters), &Construction::formula);
 }
 
 Construction build_bilinear(const json& spec, Context& ctx) {
@@ -878,23 +885,9 @@ BSplineVolume on_unit_domain(BSplineVolume v) {
   return v.mapped(0.0, 1.0, 0.0, 1.0, 0.0, 1.0);
 }
 
-// A blended volume construction: the formula, its exact form if it has one.
 Construction blended_volume(std::string_view type, BlendedVolume v, std::vector<DataSet> data,
                             nlohmann::ordered_json parameters) {
-  Construction c;
-  c.type = type;
-  auto formula = std::make_shared<const BlendedVolume>(std::move(v));
-  try {
-    c.exact = formula->to_bspline();
-  } catch (const error& e) {
-    if (e.code() != errc::no_exact_form) throw;
-    c.no_exact_form = e.what();
-  }
-  if (!formula->notes().empty()) parameters["notes"] = formula->notes();
-  c.volume_formula = std::move(formula);
-  c.data = std::move(data);
-  c.parameters = std::move(parameters);
-  return c;
+  return blended_with(type, std::move(v), std::move(data), std::move(parameters), &Construction::volume_formula);
 }
 
 // The 8 corners of a volume as data: (i, j, k) at index 4i + 2j + k, the C order of (u, v, w).
