@@ -3,7 +3,7 @@
 
 SHELL := /bin/bash
 DEBS := cmake ninja-build g++ python3 libeigen3-dev liblapack-dev libcli11-dev nlohmann-json3-dev \
-        libgtest-dev libgmock-dev libbenchmark-dev
+        libgtest-dev libgmock-dev libbenchmark-dev python3-numpy python3-vtk9
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
