@@ -1,6 +1,7 @@
 #include "interpatch/interpolate.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "detail/banded.hpp"
@@ -211,76 +212,70 @@ std::vector<double> grid_parameters(const PointGrid3& q, int axis, Parametrizati
   return grid_parameters_of(q, axis, param);
 }
 
-SurfaceInterpolation interpolate_surface(PointGrid points, const SurfaceInterpolationOptions& options) {
-  const std::size_t nu = points.extent(0), nv = points.extent(1);
-  if (nu < 2 || nv < 2)
-    fail(errc::too_few_points, "surface interpolation needs at least 2 x 2 points, got ", nu, " x ", nv);
+namespace {
+
+struct GridSolution {
+  std::vector<KnotVector> knots;           // one per axis
+  std::vector<std::vector<double>> params;  // one per axis
+};
+
+// The tensor-product interpolation behind surfaces and volumes (seed 003): parameters
+// averaged over the lines along each axis, knots by averaging, then one in-place
+// banded pass along each axis, each factored once. The data become the control points.
+template <std::size_t Rank>
+GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional<int>, Rank>& degree,
+                        Parametrization param, const progress_callback& progress, const char* what) {
+  const auto& shape = points.shape();
+  auto dims = [&](bool wanted) {  // "2 x 2 x 2" or the actual "nu x nv x nw"
+    std::string s;
+    for (std::size_t a = 0; a < Rank; ++a) s += detail::cat(a ? " x " : "", wanted ? std::size_t{2} : shape[a]);
+    return s;
+  };
+  if (std::any_of(shape.begin(), shape.end(), [](std::size_t n) { return n < 2; }))
+    fail(errc::too_few_points, what, " interpolation needs at least ", dims(true), " points, got ", dims(false));
   const Vec3* data = points.data();
   for (std::size_t k = 0; k < points.size(); ++k)
-    if (!is_finite(data[k])) fail(errc::not_finite, "point [", k / nv, "][", k % nv, "] is ", data[k]);
-  const int p = resolve_degree(options.degree_u, nu, 0, " in u");
-  const int q = resolve_degree(options.degree_v, nv, 0, " in v");
-  if (options.progress) options.progress(0.0);
-  auto tu = grid_parameters(points, 0, options.param);
-  auto tv = grid_parameters(points, 1, options.param);
-  KnotVector ku = averaged_knots(tu, p), kv = averaged_knots(tv, q);
-  auto factor = [](const KnotVector& k, const std::vector<double>& t, const char* dir) {
-    try {
-      return detail::factor_collocation(k, t);
-    } catch (const error& e) {
-      fail(e.code(), "along ", dir, ": ", e.what());
+    if (!is_finite(data[k])) {
+      std::string at;
+      for (std::size_t a = Rank, rest = k; a-- > 0; rest /= shape[a]) at = detail::cat("[", rest % shape[a], "]", at);
+      fail(errc::not_finite, "point ", at, " is ", data[k]);
     }
-  };
-  const auto lu_u = factor(ku, tu, "u");
-  const auto lu_v = factor(kv, tv, "v");
-  if (options.progress) options.progress(0.1);
-  // Rows first (every line along u), then across (every line along v), in place:
-  // the data become the control points.
-  const std::size_t shape[2] = {nu, nv};
-  detail::solve_along_axis(lu_u, &points.data()->x, shape, 2, 0, 3);
-  if (options.progress) options.progress(0.55);
-  detail::solve_along_axis(lu_v, &points.data()->x, shape, 2, 1, 3);
-  if (options.progress) options.progress(1.0);
-  return {BSplineSurface(std::move(ku), std::move(kv), std::move(points)), std::move(tu), std::move(tv)};
+  static constexpr const char* in_axis[3] = {" in u", " in v", " in w"};
+  std::array<int, Rank> p{};
+  for (std::size_t a = 0; a < Rank; ++a) p[a] = resolve_degree(degree[a], shape[a], 0, in_axis[a]);
+  if (progress) progress(0.0);
+  GridSolution r;
+  std::vector<detail::BandedLU> lu;
+  for (std::size_t a = 0; a < Rank; ++a) {
+    r.params.push_back(grid_parameters(points, static_cast<int>(a), param));
+    r.knots.push_back(averaged_knots(r.params[a], p[a]));
+    try {
+      lu.push_back(detail::factor_collocation(r.knots[a], r.params[a]));
+    } catch (const error& e) {
+      fail(e.code(), "along ", axis_name(static_cast<int>(a)), ": ", e.what());
+    }
+  }
+  if (progress) progress(0.1);
+  for (std::size_t a = 0; a < Rank; ++a) {
+    detail::solve_along_axis(lu[a], &points.data()->x, shape.data(), Rank, a, 3);
+    if (progress) progress(0.1 + 0.9 * static_cast<double>(a + 1) / Rank);
+  }
+  return r;
+}
+
+}  // namespace
+
+SurfaceInterpolation interpolate_surface(PointGrid points, const SurfaceInterpolationOptions& options) {
+  GridSolution s = solve_grid<2>(points, {options.degree_u, options.degree_v}, options.param, options.progress, "surface");
+  return {BSplineSurface(std::move(s.knots[0]), std::move(s.knots[1]), std::move(points)), std::move(s.params[0]),
+          std::move(s.params[1])};
 }
 
 VolumeInterpolation interpolate_volume(PointGrid3 points, const VolumeInterpolationOptions& options) {
-  const std::size_t nu = points.extent(0), nv = points.extent(1), nw = points.extent(2);
-  if (nu < 2 || nv < 2 || nw < 2)
-    fail(errc::too_few_points, "volume interpolation needs at least 2 x 2 x 2 points, got ", nu, " x ", nv, " x ", nw);
-  const Vec3* data = points.data();
-  for (std::size_t k = 0; k < points.size(); ++k)
-    if (!is_finite(data[k]))
-      fail(errc::not_finite, "point [", k / (nv * nw), "][", k / nw % nv, "][", k % nw, "] is ", data[k]);
-  const int p = resolve_degree(options.degree_u, nu, 0, " in u");
-  const int q = resolve_degree(options.degree_v, nv, 0, " in v");
-  const int r = resolve_degree(options.degree_w, nw, 0, " in w");
-  if (options.progress) options.progress(0.0);
-  auto tu = grid_parameters(points, 0, options.param);
-  auto tv = grid_parameters(points, 1, options.param);
-  auto tw = grid_parameters(points, 2, options.param);
-  KnotVector ku = averaged_knots(tu, p), kv = averaged_knots(tv, q), kw = averaged_knots(tw, r);
-  auto factor = [](const KnotVector& k, const std::vector<double>& t, const char* dir) {
-    try {
-      return detail::factor_collocation(k, t);
-    } catch (const error& e) {
-      fail(e.code(), "along ", dir, ": ", e.what());
-    }
-  };
-  const auto lu_u = factor(ku, tu, "u");
-  const auto lu_v = factor(kv, tv, "v");
-  const auto lu_w = factor(kw, tw, "w");
-  if (options.progress) options.progress(0.1);
-  // Lines along u, then along v, then along w, in place: the data become the control points.
-  const std::size_t shape[3] = {nu, nv, nw};
-  detail::solve_along_axis(lu_u, &points.data()->x, shape, 3, 0, 3);
-  if (options.progress) options.progress(0.4);
-  detail::solve_along_axis(lu_v, &points.data()->x, shape, 3, 1, 3);
-  if (options.progress) options.progress(0.7);
-  detail::solve_along_axis(lu_w, &points.data()->x, shape, 3, 2, 3);
-  if (options.progress) options.progress(1.0);
-  return {BSplineVolume(std::move(ku), std::move(kv), std::move(kw), std::move(points)), std::move(tu), std::move(tv),
-          std::move(tw)};
+  GridSolution s = solve_grid<3>(points, {options.degree_u, options.degree_v, options.degree_w}, options.param,
+                                 options.progress, "volume");
+  return {BSplineVolume(std::move(s.knots[0]), std::move(s.knots[1]), std::move(s.knots[2]), std::move(points)),
+          std::move(s.params[0]), std::move(s.params[1]), std::move(s.params[2])};
 }
 
 }  // namespace interpatch
