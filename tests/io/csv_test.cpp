@@ -21,12 +21,7 @@ namespace fs = std::filesystem;
 
 using test::TempDir;
 
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::read_text;
 
 fs::path write_text(const fs::path& p, const std::string& text) {
   std::ofstream out(p, std::ios::binary);
