@@ -2,8 +2,12 @@
 # Each installs what is missing from Debian's packages first.
 
 SHELL := /bin/bash
+# OpenCASCADE reads back the STEP and IGES files (tests) and, with SISL, runs the
+# side-by-side benchmarks; clang's libFuzzer runs the fuzz targets; matplotlib plots.
 DEBS := cmake ninja-build g++ python3 libeigen3-dev liblapack-dev libcli11-dev nlohmann-json3-dev \
-        libgtest-dev libgmock-dev libbenchmark-dev python3-numpy python3-vtk9
+        libgtest-dev libgmock-dev libbenchmark-dev python3-numpy python3-vtk9 python3-matplotlib \
+        libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
+        libocct-foundation-dev libsisl-dev clang libclang-rt-14-dev
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
