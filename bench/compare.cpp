@@ -1,0 +1,1170 @@
+// bench/compare: interpatch, OpenCASCADE and SISL side by side on the same data in
+// one run, each next to a memcpy of the same bytes (SPEC §7).
+//
+// Jobs (each selectable with --jobs):
+//   interpolate  bicubic interpolation of N x N terrain grids (bench/terrain.hpp)
+//   evaluate     1000 x 1000 points on the bicubic surface through an M x M grid
+//   coons        a Coons patch from four interpolated boundary curves, built and evaluated
+//   process      `interpatch eval SPEC --grid K` against bench/sisl_eval, as whole processes
+//   memory       peak resident memory of each library's interpolation, in a child process
+//
+// Every timing is the wall clock of one call (median of --reps repetitions), with the
+// data built beforehand; every timed result is checked (points at the data, or against
+// an independent evaluation) so that no figure belongs to a wrong answer. The console
+// gets tables; --json gets everything, read by tools/plot_bench.py.
+
+#include <GeomAPI_Interpolate.hxx>
+#include <GeomAPI_PointsToBSplineSurface.hxx>
+#include <GeomAPI_ProjectPointOnSurf.hxx>
+#include <GeomAdaptor_Surface.hxx>
+#include <GeomFill_BSplineCurves.hxx>
+#include <Geom_BSplineCurve.hxx>
+#include <Geom_BSplineSurface.hxx>
+#include <Standard_Failure.hxx>
+#include <Standard_Version.hxx>
+#include <TColStd_Array1OfInteger.hxx>
+#include <TColStd_Array1OfReal.hxx>
+#include <TColStd_HArray1OfReal.hxx>
+#include <TColgp_Array2OfPnt.hxx>
+#include <TColgp_HArray1OfPnt.hxx>
+#include <gp_Pnt.hxx>
+#include <sisl.h>
+#include <spawn.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#if defined(_OPENMP)
+#include <omp.h>
+#endif
+
+#include "grid_params.hpp"
+#include "interpatch/bspline_surface.hpp"
+#include "interpatch/coons.hpp"
+#include "interpatch/evaluate.hpp"
+#include "interpatch/interpolate.hpp"
+#include "interpatch/io/npy.hpp"
+#include "terrain.hpp"
+
+extern char** environ;
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace ib = interpatch::bench;
+using interpatch::BSplineSurface;
+using interpatch::PointGrid;
+using interpatch::Vec3;
+using json = nlohmann::json;
+using clock_type = std::chrono::steady_clock;
+
+double seconds_since(clock_type::time_point t0) {
+  return std::chrono::duration<double>(clock_type::now() - t0).count();
+}
+
+double dist(const Vec3& a, const Vec3& b) { return std::sqrt(dot(a - b, a - b)); }
+double dist(const Vec3& a, const double* b) { return dist(a, Vec3{b[0], b[1], b[2]}); }
+
+// Relative errors are distances over the diagonal of the data's bounding box.
+double diagonal(const Vec3* p, std::size_t n) {
+  Vec3 lo = p[0], hi = p[0];
+  for (std::size_t k = 1; k < n; ++k) {
+    lo = {std::min(lo.x, p[k].x), std::min(lo.y, p[k].y), std::min(lo.z, p[k].z)};
+    hi = {std::max(hi.x, p[k].x), std::max(hi.y, p[k].y), std::max(hi.z, p[k].z)};
+  }
+  return dist(lo, hi);
+}
+
+// A few indices spread over 0..n-1, ends included: where results are checked.
+std::vector<std::size_t> sample_indices(std::size_t n) {
+  std::vector<std::size_t> s{0, n / 7, n / 3, n / 2, (2 * n) / 3, n - 1};
+  std::sort(s.begin(), s.end());
+  s.erase(std::unique(s.begin(), s.end()), s.end());
+  return s;
+}
+
+void set_threads(int threads) {
+#if defined(_OPENMP)
+  omp_set_num_threads(threads);
+#else
+  static_cast<void>(threads);
+#endif
+}
+
+int max_threads() {
+#if defined(_OPENMP)
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+
+// ---------------------------------------------------------------- options
+
+struct Options {
+  std::vector<std::size_t> sizes{256, 1024, 2048, 4096};
+  std::set<std::string> libs{"interpatch", "occt", "sisl", "memcpy"};
+  std::set<std::string> jobs{"interpolate", "evaluate", "coons", "process", "memory"};
+  std::vector<int> threads;
+  std::vector<std::size_t> memory_sizes{2048, 4096};
+  int reps = 3;
+  std::size_t eval_grid = 1024, eval_points = 1000, coons_points = 1024, process_grid = 1024;
+  double occt_budget = 60;  // seconds one OpenCASCADE interpolation may be predicted to take
+  std::string json_out = "build/bench/compare.json";
+  std::string workdir = "build/bench/compare-work";
+  std::string commit;
+  std::string cli = INTERPATCH_CLI_PATH, sisl_eval = SISL_EVAL_PATH;
+  bool has(const std::string& lib) const { return libs.count(lib) != 0; }
+  bool job(const std::string& j) const { return jobs.count(j) != 0; }
+};
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+template <class T>
+std::vector<T> split_numbers(const std::string& s) {
+  std::vector<T> out;
+  for (const auto& item : split(s)) out.push_back(static_cast<T>(std::stoll(item)));
+  return out;
+}
+
+const char* usage =
+    "usage: compare [--sizes 256,1024,2048,4096] [--libs interpatch,occt,sisl,memcpy]\n"
+    "               [--jobs interpolate,evaluate,coons,process,memory] [--reps 3] [--threads 1,2]\n"
+    "               [--memory-sizes 2048,4096] [--eval-grid 1024] [--coons-points 1024]\n"
+    "               [--process-grid 1024] [--occt-budget 60] [--json FILE] [--workdir DIR]\n"
+    "               [--commit TEXT] [--cli PATH] [--sisl-eval PATH]\n";
+
+Options parse(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "-h" || a == "--help") {
+      std::cout << usage;
+      std::exit(0);
+    }
+    if (i + 1 >= argc) throw std::runtime_error(a + ": expected a value\n" + usage);
+    const std::string v = argv[++i];
+    if (a == "--sizes") o.sizes = split_numbers<std::size_t>(v);
+    else if (a == "--libs") { auto l = split(v); o.libs = {l.begin(), l.end()}; }
+    else if (a == "--jobs") { auto l = split(v); o.jobs = {l.begin(), l.end()}; }
+    else if (a == "--reps") o.reps = std::max(1, std::stoi(v));
+    else if (a == "--threads") o.threads = split_numbers<int>(v);
+    else if (a == "--memory-sizes") o.memory_sizes = split_numbers<std::size_t>(v);
+    else if (a == "--eval-grid") o.eval_grid = std::stoul(v);
+    else if (a == "--coons-points") o.coons_points = std::stoul(v);
+    else if (a == "--process-grid") o.process_grid = std::stoul(v);
+    else if (a == "--occt-budget") o.occt_budget = std::stod(v);
+    else if (a == "--json") o.json_out = v;
+    else if (a == "--workdir") o.workdir = v;
+    else if (a == "--commit") o.commit = v;
+    else if (a == "--cli") o.cli = v;
+    else if (a == "--sisl-eval") o.sisl_eval = v;
+    else throw std::runtime_error("unknown option " + a + "\n" + usage);
+  }
+  std::sort(o.sizes.begin(), o.sizes.end());
+  if (o.threads.empty()) {
+    o.threads = {1};
+    if (max_threads() > 1) o.threads.push_back(max_threads());
+  }
+  return o;
+}
+
+// ---------------------------------------------------------------- measuring
+
+// One timed configuration: repetitions, the named parts of each, and its check.
+struct Row {
+  std::string job, library, variant;
+  std::size_t n = 0;
+  int threads = 1;
+  std::vector<double> times;
+  std::map<std::string, std::vector<double>> parts;
+  double error = 0, tolerance = 0;
+  std::string note;
+  std::optional<double> maxrss_bytes;
+
+  [[nodiscard]] bool ok() const { return error <= tolerance; }
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+// Lap times of the parts of one repetition.
+class Laps {
+ public:
+  void start() { t_ = clock_type::now(); }
+  void lap(const std::string& name) {
+    const auto now = clock_type::now();
+    laps_.emplace_back(name, std::chrono::duration<double>(now - t_).count());
+    t_ = now;
+  }
+  [[nodiscard]] const std::vector<std::pair<std::string, double>>& laps() const { return laps_; }
+
+ private:
+  clock_type::time_point t_ = clock_type::now();
+  std::vector<std::pair<std::string, double>> laps_;
+};
+
+std::vector<Row> g_rows;
+
+std::string format_time(double s) {
+  std::ostringstream os;
+  os << std::setprecision(3);
+  if (!(s == s)) os << "–";
+  else if (s >= 1) os << s << " s";
+  else if (s >= 1e-3) os << s * 1e3 << " ms";
+  else os << s * 1e6 << " µs";
+  return os.str();
+}
+
+// Times `run` (which returns the result, recording lap times) `reps` times, checking
+// every result with `check` (a relative error) after the clock stops and freeing it
+// before the next repetition. Stops repeating once `budget` seconds have been spent.
+template <class Run, class Check>
+Row& measure(Row row, int reps, Run&& run, Check&& check, double budget = 1e30) {
+  double spent = 0;
+  for (int r = 0; r < reps; ++r) {
+    Laps laps;
+    const auto t0 = clock_type::now();
+    laps.start();
+    auto result = run(laps);
+    const double t = seconds_since(t0);
+    row.times.push_back(t);
+    for (const auto& [name, s] : laps.laps()) row.parts[name].push_back(s);
+    row.error = std::max(row.error, check(result));
+    spent += t;
+    if (spent > budget && r + 1 < reps) {
+      row.note += (row.note.empty() ? "" : "; ") + std::to_string(r + 1) + " of " + std::to_string(reps) +
+                  " repetitions (time budget)";
+      break;
+    }
+  }
+  std::cout << "  " << std::left << std::setw(12) << row.job << std::setw(6) << row.n << std::setw(12) << row.library
+            << std::setw(34) << row.variant << " thr " << row.threads << "  " << std::right << std::setw(10)
+            << format_time(median(row.times)) << "  check " << std::setprecision(2) << row.error
+            << (row.ok() ? " ok" : " FAILED") << (row.note.empty() ? "" : "  (" + row.note + ")") << std::endl;
+  g_rows.push_back(std::move(row));
+  return g_rows.back();
+}
+
+Row row_of(std::string job, std::size_t n, std::string library, std::string variant, int threads, double tolerance) {
+  Row r;
+  r.job = std::move(job);
+  r.n = n;
+  r.library = std::move(library);
+  r.variant = std::move(variant);
+  r.threads = threads;
+  r.tolerance = tolerance;
+  return r;
+}
+
+json g_agreement = json::array(), g_skipped = json::array(), g_memory = json::array();
+
+void agreement(const std::string& job, std::size_t n, const std::string& what, double deviation, double tolerance,
+               const std::string& note) {
+  const bool ok = !(tolerance > 0) || deviation <= tolerance;
+  std::cout << "  agreement " << job << " " << n << ": " << what << ": max deviation " << std::setprecision(3)
+            << deviation << " of the diagonal" << (tolerance > 0 ? (ok ? " (ok)" : " (OVER TOLERANCE)") : "")
+            << (note.empty() ? "" : " — " + note) << std::endl;
+  g_agreement.push_back({{"job", job}, {"n", n}, {"what", what}, {"max_rel_deviation", deviation},
+                         {"tolerance", tolerance > 0 ? json(tolerance) : json(nullptr)}, {"ok", ok}, {"note", note}});
+}
+
+void skipped(const std::string& job, std::size_t n, const std::string& library, const std::string& reason) {
+  std::cout << "  skipped " << job << " " << n << " " << library << ": " << reason << std::endl;
+  g_skipped.push_back({{"job", job}, {"n", n}, {"library", library}, {"reason", reason}});
+}
+
+// ---------------------------------------------------------------- memcpy baseline
+
+// Copies with one thread, or with `threads` threads each copying its share.
+void copy_bytes(std::byte* dst, const std::byte* src, std::size_t bytes, int threads) {
+#if defined(_OPENMP)
+  if (threads > 1) {
+#pragma omp parallel num_threads(threads)
+    {
+      const auto t = static_cast<std::size_t>(omp_get_thread_num());
+      const auto nt = static_cast<std::size_t>(omp_get_num_threads());
+      const std::size_t a = bytes / nt * t, b = t + 1 == nt ? bytes : bytes / nt * (t + 1);
+      std::memcpy(dst + a, src + a, b - a);
+    }
+    return;
+  }
+#endif
+  std::memcpy(dst, src, bytes);
+}
+
+// A memcpy of `bytes` (reading them and writing as many: the traffic of a job that
+// reads its input once and writes its output once), between buffers allocated and
+// touched beforehand, on one thread and on every thread of the run.
+void measure_memcpy(const Options& o, const std::string& job, std::size_t n, std::size_t bytes) {
+  if (!o.has("memcpy")) return;
+  std::vector<std::byte> src(bytes), dst(bytes);
+  for (std::size_t k = 0; k < bytes; ++k) src[k] = static_cast<std::byte>(k * 131);
+  std::set<int> thread_counts{1, o.threads.back()};
+  for (int threads : thread_counts) {
+    auto row = row_of(job, n, "memcpy", std::to_string(bytes) + " bytes", threads, 0);
+    measure(std::move(row), std::max(o.reps, 5),
+            [&](Laps&) {
+              copy_bytes(dst.data(), src.data(), bytes, threads);
+              return dst.data();
+            },
+            [&](const std::byte* d) {
+              // Every byte is compared: the copy happened, and cannot be dropped.
+              return std::memcmp(d, src.data(), bytes) == 0 ? 0.0 : 1.0;
+            });
+  }
+}
+
+// ---------------------------------------------------------------- SISL and OpenCASCADE helpers
+
+struct SurfDeleter {
+  void operator()(SISLSurf* s) const { freeSurf(s); }
+};
+struct CurveDeleter {
+  void operator()(SISLCurve* c) const { freeCurve(c); }
+};
+using SislSurface = std::unique_ptr<SISLSurf, SurfDeleter>;
+using SislCurve = std::unique_ptr<SISLCurve, CurveDeleter>;
+
+void sisl_status(int stat, const char* what) {
+  if (stat < 0) throw std::runtime_error(std::string(what) + " failed with status " + std::to_string(stat));
+}
+
+// SISL's first parameter direction runs fastest in memory, so an interpatch grid
+// (first index along u, slowest) is SISL's (v, u): points pass unchanged and the
+// parameter directions swap.
+SislSurface sisl_interpolate(const PointGrid& grid, const std::vector<double>& pu, const std::vector<double>& pv) {
+  SISLSurf* s = nullptr;
+  int stat = 0;
+  auto u = pu, v = pv;  // s1537 takes non-const arrays
+  s1537(const_cast<double*>(&grid.data()->x), static_cast<int>(grid.extent(1)), static_cast<int>(grid.extent(0)), 3,
+        v.data(), u.data(), 0, 0, 0, 0, 4, 4, 1, 1, &s, &stat);
+  sisl_status(stat, "s1537");
+  return SislSurface(s);
+}
+
+Vec3 sisl_point(SISLSurf* s, double first, double second) {
+  double par[2] = {first, second}, out[3];
+  int left1 = 0, left2 = 0, stat = 0;
+  s1424(s, 0, 0, par, &left1, &left2, out, &stat);
+  sisl_status(stat, "s1424");
+  return {out[0], out[1], out[2]};
+}
+
+// An m1 x m2 grid with s1506, the first direction fastest; the output is allocated
+// here, as a caller of s1506 must.
+std::unique_ptr<double[]> sisl_grid(SISLSurf* s, std::vector<double>& first, std::vector<double>& second) {
+  auto out = std::make_unique_for_overwrite<double[]>(3 * first.size() * second.size());
+  int stat = 0;
+  s1506(s, 0, static_cast<int>(first.size()), first.data(), static_cast<int>(second.size()), second.data(), out.get(),
+        nullptr, &stat);
+  sisl_status(stat, "s1506");
+  return out;
+}
+
+// The same B-spline surface as an interpatch one, in SISL (coefficients copied).
+SislSurface sisl_copy(const BSplineSurface& s) {
+  auto ku = s.knots_u().values(), kv = s.knots_v().values();
+  const PointGrid& cp = s.control_points();
+  SISLSurf* out = newSurf(static_cast<int>(cp.extent(1)), static_cast<int>(cp.extent(0)), s.degree_v() + 1,
+                          s.degree_u() + 1, kv.data(), ku.data(), const_cast<double*>(&cp.data()->x), 1, 3, 1);
+  if (!out) throw std::runtime_error("newSurf failed");
+  return SislSurface(out);
+}
+
+// Distinct knots and multiplicities, as OpenCASCADE takes them.
+std::pair<TColStd_Array1OfReal, TColStd_Array1OfInteger> occt_knots(const std::vector<double>& flat) {
+  std::vector<double> k;
+  std::vector<int> m;
+  for (double t : flat) {
+    if (!k.empty() && t == k.back()) ++m.back();
+    else {
+      k.push_back(t);
+      m.push_back(1);
+    }
+  }
+  TColStd_Array1OfReal knots(1, static_cast<int>(k.size()));
+  TColStd_Array1OfInteger mults(1, static_cast<int>(m.size()));
+  for (std::size_t i = 0; i < k.size(); ++i) {
+    knots(static_cast<int>(i) + 1) = k[i];
+    mults(static_cast<int>(i) + 1) = m[i];
+  }
+  return {knots, mults};
+}
+
+// The same B-spline surface as an interpatch one, in OpenCASCADE.
+Handle(Geom_BSplineSurface) occt_copy(const BSplineSurface& s) {
+  const PointGrid& cp = s.control_points();
+  TColgp_Array2OfPnt poles(1, static_cast<int>(cp.extent(0)), 1, static_cast<int>(cp.extent(1)));
+  for (std::size_t i = 0; i < cp.extent(0); ++i)
+    for (std::size_t j = 0; j < cp.extent(1); ++j)
+      poles(static_cast<int>(i) + 1, static_cast<int>(j) + 1) = gp_Pnt(cp(i, j).x, cp(i, j).y, cp(i, j).z);
+  auto [ku, mu] = occt_knots(s.knots_u().values());
+  auto [kv, mv] = occt_knots(s.knots_v().values());
+  return new Geom_BSplineSurface(poles, ku, kv, mu, mv, s.degree_u(), s.degree_v());
+}
+
+TColgp_Array2OfPnt occt_points(const PointGrid& g) {
+  TColgp_Array2OfPnt a(1, static_cast<int>(g.extent(0)), 1, static_cast<int>(g.extent(1)));
+  for (std::size_t i = 0; i < g.extent(0); ++i)
+    for (std::size_t j = 0; j < g.extent(1); ++j) a(static_cast<int>(i) + 1, static_cast<int>(j) + 1) = gp_Pnt(g(i, j).x, g(i, j).y, g(i, j).z);
+  return a;
+}
+
+Handle(Geom_BSplineSurface) occt_interpolate(const TColgp_Array2OfPnt& points) {
+  GeomAPI_PointsToBSplineSurface api;
+  api.Interpolate(points);  // degree 3, Approx_ChordLength
+  if (!api.IsDone()) throw std::runtime_error("GeomAPI_PointsToBSplineSurface::Interpolate failed");
+  return api.Surface();
+}
+
+// Points of a surface on a grid of its parameters, one D0 call each, u slowest.
+template <class S>
+std::unique_ptr<double[]> occt_grid(const S& s, const std::vector<double>& us, const std::vector<double>& vs) {
+  auto out = std::make_unique_for_overwrite<double[]>(3 * us.size() * vs.size());
+  gp_Pnt p;
+  double* o = out.get();
+  for (double u : us)
+    for (double v : vs) {
+      s.D0(u, v, p);
+      o[0] = p.X();
+      o[1] = p.Y();
+      o[2] = p.Z();
+      o += 3;
+    }
+  return out;
+}
+
+std::vector<double> linspace(std::pair<double, double> d, std::size_t n) { return interpatch::linspace(d.first, d.second, n); }
+
+// Largest distance between a grid of points in u-slowest order and an interpatch grid.
+double max_deviation(const PointGrid& ref, const double* p) {
+  double e = 0;
+  for (std::size_t k = 0; k < ref.size(); ++k) e = std::max(e, dist(ref.data()[k], p + 3 * k));
+  return e;
+}
+
+// The same when `p` holds the grid in u-fastest order (SISL's surfaces whose first
+// direction is u).
+double max_deviation_transposed(const PointGrid& ref, const double* p) {
+  double e = 0;
+  const std::size_t nu = ref.extent(0), nv = ref.extent(1);
+  for (std::size_t i = 0; i < nu; ++i)
+    for (std::size_t j = 0; j < nv; ++j) e = std::max(e, dist(ref(i, j), p + 3 * (j * nu + i)));
+  return e;
+}
+
+// ---------------------------------------------------------------- job: interpolation
+
+struct OcctGrowth {
+  std::size_t n = 0;
+  double seconds = 0, exponent = 2;
+};
+
+void job_interpolate(const Options& o) {
+  std::cout << "\nBicubic interpolation of N x N grids (chord parameters)\n";
+  OcctGrowth occt;
+  for (std::size_t n : o.sizes) {
+    const PointGrid grid = ib::make_terrain(n);
+    const double diag = diagonal(grid.data(), grid.size());
+    const auto idx = sample_indices(n);
+    const double tol = 1e-9;
+    // Checks at the data: S(t_i, t_j) = Q(i, j) for the sampled indices.
+    auto check_at_data = [&](auto&& point_at) {
+      double e = 0;
+      for (std::size_t i : idx)
+        for (std::size_t j : idx) e = std::max(e, dist(grid(i, j), point_at(i, j)));
+      return e / diag;
+    };
+
+    if (o.has("interpatch")) {
+      for (int threads : o.threads) {
+        set_threads(threads);
+        auto check = [&](const interpatch::SurfaceInterpolation& r) {
+          return check_at_data([&](std::size_t i, std::size_t j) { return r.surface.point(r.params_u[i], r.params_v[j]); });
+        };
+        measure(row_of("interpolate", n, "interpatch", "interpolate_surface, copied in", threads, tol), o.reps,
+                [&](Laps&) { return interpatch::interpolate_surface(grid); }, check);
+        // The caller hands its grid over; the copy is made before the clock starts.
+        auto row = row_of("interpolate", n, "interpatch", "interpolate_surface, moved in", threads, tol);
+        std::optional<PointGrid> fresh;
+        for (int r = 0; r < o.reps; ++r) {
+          fresh = grid;
+          const auto t0 = clock_type::now();
+          auto res = interpatch::interpolate_surface(std::move(*fresh));
+          row.times.push_back(seconds_since(t0));
+          row.error = std::max(row.error, check(res));
+        }
+        measure(std::move(row), 0, [](Laps&) { return 0; }, [](int) { return 0.0; });
+      }
+      set_threads(o.threads.back());
+    }
+
+    if (o.has("sisl")) {
+      const auto pu_ref = interpatch::grid_parameters(grid, 0, interpatch::Parametrization::chord);
+      const auto pv_ref = interpatch::grid_parameters(grid, 1, interpatch::Parametrization::chord);
+      std::vector<double> pu, pv;
+      measure(row_of("interpolate", n, "sisl", "averaged chord parameters + s1537", 1, tol), o.reps,
+              [&](Laps& laps) {
+                pu = ib::averaged_chord_parameters(&grid.data()->x, n, n, 0);
+                pv = ib::averaged_chord_parameters(&grid.data()->x, n, n, 1);
+                laps.lap("parameters");
+                auto s = sisl_interpolate(grid, pu, pv);
+                laps.lap("s1537");
+                return s;
+              },
+              [&](const SislSurface& s) {
+                double dp = 0;  // the parameters are interpatch's, to rounding
+                for (std::size_t k = 0; k < n; ++k) dp = std::max({dp, std::abs(pu[k] - pu_ref[k]), std::abs(pv[k] - pv_ref[k])});
+                if (dp > 1e-12) return 1.0;
+                return check_at_data([&](std::size_t i, std::size_t j) { return sisl_point(s.get(), pv[j], pu[i]); });
+              });
+    }
+
+    if (o.has("occt")) {
+      const double predicted = occt.n ? occt.seconds * std::pow(static_cast<double>(n) / static_cast<double>(occt.n), occt.exponent) : 0;
+      if (predicted > o.occt_budget) {
+        std::ostringstream why;
+        why << "predicted " << std::setprecision(3) << predicted << " s for one call (t ~ N^" << occt.exponent
+            << " from N = " << occt.n << "), over the --occt-budget of " << o.occt_budget << " s";
+        skipped("interpolate", n, "occt", why.str());
+      } else {
+        const TColgp_Array2OfPnt points = occt_points(grid);
+        auto& row = measure(
+            row_of("interpolate", n, "occt", "GeomAPI_PointsToBSplineSurface::Interpolate", 1, tol), o.reps,
+            [&](Laps&) { return occt_interpolate(points); },
+            [&](const Handle(Geom_BSplineSurface)& s) {
+              // OpenCASCADE chooses its own parameters: the data points are found on
+              // the surface by projection.
+              return check_at_data([&](std::size_t i, std::size_t j) {
+                const gp_Pnt q(grid(i, j).x, grid(i, j).y, grid(i, j).z);
+                GeomAPI_ProjectPointOnSurf proj(q, s);
+                if (!proj.IsDone() || proj.NbPoints() == 0) return Vec3{NAN, NAN, NAN};
+                const gp_Pnt p = proj.NearestPoint();
+                return Vec3{p.X(), p.Y(), p.Z()};
+              });
+            },
+            o.occt_budget);
+        const double t = median(row.times);
+        if (occt.n) occt.exponent = std::max(2.0, std::log(t / occt.seconds) / std::log(static_cast<double>(n) / static_cast<double>(occt.n)));
+        occt = {n, t, occt.exponent};
+      }
+    }
+    measure_memcpy(o, "interpolate", n, n * n * sizeof(Vec3));
+  }
+}
+
+// ---------------------------------------------------------------- job: evaluation
+
+void job_evaluate(const Options& o) {
+  const std::size_t m = o.eval_grid, k = o.eval_points;
+  std::cout << "\nEvaluation of " << k << " x " << k << " points on the bicubic surface through the " << m << " x " << m
+            << " terrain\n";
+  const PointGrid grid = ib::make_terrain(m);
+  const double diag = diagonal(grid.data(), grid.size());
+  const auto ip = interpatch::interpolate_surface(grid);
+  const BSplineSurface& s = ip.surface;
+  auto us = linspace(s.domain_u(), k), vs = linspace(s.domain_v(), k);
+  const double tol = 1e-9;
+  // interpatch's grid is checked against its own single-point evaluation; the others
+  // against interpatch's grid (the same surface, so ≤ 1e-9 of the diagonal).
+  const PointGrid ref = s.evaluate(us, vs);
+  const auto idx = sample_indices(k);
+  double self = 0;
+  for (std::size_t i : idx)
+    for (std::size_t j : idx) self = std::max(self, dist(ref(i, j), s.point(us[i], vs[j])));
+  if (self / diag > tol) throw std::runtime_error("evaluate disagrees with point");
+
+  if (o.has("interpatch"))
+    for (int threads : o.threads) {
+      set_threads(threads);
+      measure(row_of("evaluate", m, "interpatch", "BSplineSurface::evaluate", threads, tol), o.reps,
+              [&](Laps&) { return s.evaluate(us, vs); },
+              [&](const PointGrid& g) {
+                double e = 0;
+                for (std::size_t i : idx)
+                  for (std::size_t j : idx) e = std::max(e, dist(g(i, j), s.point(us[i], vs[j])));
+                return e / diag;
+              });
+    }
+  set_threads(o.threads.back());
+
+  if (o.has("sisl")) {
+    const auto copy = sisl_copy(s);
+    measure(row_of("evaluate", m, "sisl", "s1506 (interpatch's knots and control points)", 1, tol), o.reps,
+            [&](Laps&) { return sisl_grid(copy.get(), vs, us); },
+            [&](const std::unique_ptr<double[]>& g) { return max_deviation(ref, g.get()) / diag; });
+    // s1537 through the same data with the same parameters: SISL puts the knots of a
+    // cubic at the parameters, interpatch averages them, so the two surfaces differ
+    // between the data points.
+    const auto own = sisl_interpolate(grid, ip.params_u, ip.params_v);
+    const auto g = sisl_grid(own.get(), vs, us);
+    agreement("evaluate", m, "sisl s1537 surface vs interpatch interpolate_surface", max_deviation(ref, g.get()) / diag, 0,
+              "same data and parameters; SISL places a cubic's knots at the parameters, interpatch averages them (NURBS Book eq. 9.8)");
+  }
+
+  if (o.has("occt")) {
+    const auto copy = occt_copy(s);
+    measure(row_of("evaluate", m, "occt", "Geom_BSplineSurface::D0 loop (interpatch's surface)", 1, tol), o.reps,
+            [&](Laps&) { return occt_grid(*copy, us, vs); },
+            [&](const std::unique_ptr<double[]>& g) { return max_deviation(ref, g.get()) / diag; });
+    const GeomAdaptor_Surface adaptor(copy);
+    measure(row_of("evaluate", m, "occt", "GeomAdaptor_Surface::D0 loop (cached spans)", 1, tol), o.reps,
+            [&](Laps&) { return occt_grid(adaptor, us, vs); },
+            [&](const std::unique_ptr<double[]>& g) { return max_deviation(ref, g.get()) / diag; });
+  }
+  measure_memcpy(o, "evaluate", m, k * k * sizeof(Vec3));
+}
+
+// ---------------------------------------------------------------- job: Coons patch
+
+void job_coons(const Options& o) {
+  const std::size_t m = o.coons_points, k = o.eval_points;
+  std::cout << "\nCoons patch from four " << m << "-point boundary curves, built and evaluated on " << k << " x " << k
+            << " points\n";
+  const PointGrid grid = ib::make_terrain(m);
+  std::vector<Vec3> bottom(m), top(m), left(m), right(m);  // v = 0, v = 1, u = 0, u = 1
+  for (std::size_t t = 0; t < m; ++t) {
+    bottom[t] = grid(t, 0);
+    top[t] = grid(t, m - 1);
+    left[t] = grid(0, t);
+    right[t] = grid(m - 1, t);
+  }
+  std::vector<Vec3> boundary;
+  for (const auto* c : {&bottom, &top, &left, &right}) boundary.insert(boundary.end(), c->begin(), c->end());
+  const double diag = diagonal(boundary.data(), boundary.size());
+  const std::array<Vec3, 4> corners{grid(0, 0), grid(m - 1, 0), grid(0, m - 1), grid(m - 1, m - 1)};
+  auto us = interpatch::linspace(0, 1, k), vs = interpatch::linspace(0, 1, k);
+  const double tol = 1e-9;
+  const auto idx = sample_indices(k);
+
+  auto interpatch_patch = [&](Laps& laps) {
+    auto c = [](const std::vector<Vec3>& p) { return interpatch::interpolate_curve(p).curve; };
+    interpatch::CoonsBoundary b{c(bottom), c(top), c(left), c(right)};
+    laps.lap("curves");
+    auto patch = interpatch::coons(b);
+    laps.lap("patch");
+    return patch;
+  };
+  // Corners at the data; sampled points equal the patch's own formula.
+  Laps scratch;
+  const auto formula = interpatch_patch(scratch);
+  auto check_interpatch = [&](const PointGrid& g) {
+    double e = std::max({dist(g(0, 0), corners[0]), dist(g(k - 1, 0), corners[1]), dist(g(0, k - 1), corners[2]),
+                         dist(g(k - 1, k - 1), corners[3])});
+    for (std::size_t i : idx)
+      for (std::size_t j : idx) e = std::max(e, dist(g(i, j), formula.point(us[i], vs[j])));
+    return e / diag;
+  };
+  std::optional<PointGrid> ref;
+  if (o.has("interpatch"))
+    for (int threads : o.threads) {
+      set_threads(threads);
+      measure(row_of("coons", m, "interpatch", "coons + BlendedSurface::evaluate", threads, tol), o.reps,
+              [&](Laps& laps) {
+                auto patch = interpatch_patch(laps);
+                auto g = patch.evaluate(us, vs);
+                laps.lap("evaluate");
+                return g;
+              },
+              check_interpatch);
+      measure(row_of("coons", m, "interpatch", "coons + to_bspline().evaluate", threads, tol), o.reps,
+              [&](Laps& laps) {
+                auto patch = interpatch_patch(laps);
+                auto b = patch.to_bspline();
+                laps.lap("to_bspline");
+                auto g = b.evaluate(us, vs);
+                laps.lap("evaluate");
+                return g;
+              },
+              check_interpatch);
+    }
+  set_threads(o.threads.back());
+  ref = formula.evaluate(us, vs);
+
+  if (o.has("sisl")) {
+    // s1390's edges run around the patch: 1 v = 0 and 3 v = 1 along u, 2 u = 1 and
+    // 4 u = 0 along v; its first parameter is u, so s1506's grid is u-fastest.
+    std::array<std::vector<double>, 4> params;
+    measure(row_of("coons", m, "sisl", "s1357 curves + s1390 + s1506", 1, tol), o.reps,
+            [&](Laps& laps) {
+              std::array<SislCurve, 4> curves;
+              const std::array<const std::vector<Vec3>*, 4> edges{&bottom, &right, &top, &left};
+              std::vector<int> types(m, 1);
+              for (std::size_t e = 0; e < 4; ++e) {
+                auto pts = *edges[e];
+                params[e] = ib::chord_parameters(&pts.data()->x, m);
+                SISLCurve* c = nullptr;
+                double* gpar = nullptr;
+                double end = 0;
+                int npar = 0, stat = 0;
+                s1357(&pts.data()->x, static_cast<int>(m), 3, types.data(), params[e].data(), 0, 0, 1, 4, 0.0, &end, &c,
+                      &gpar, &npar, &stat);
+                std::free(gpar);
+                sisl_status(stat, "s1357");
+                curves[e].reset(c);
+              }
+              laps.lap("curves");
+              SISLCurve* pc[4] = {curves[0].get(), curves[1].get(), curves[2].get(), curves[3].get()};
+              int nder[4] = {1, 1, 1, 1}, stat = 0;
+              SISLSurf* s = nullptr;
+              s1390(pc, &s, nder, &stat);
+              sisl_status(stat, "s1390");
+              SislSurface surf(s);
+              laps.lap("patch");
+              auto g = sisl_grid(surf.get(), us, vs);
+              laps.lap("evaluate");
+              return std::make_pair(std::move(surf), std::move(g));
+            },
+            [&](const std::pair<SislSurface, std::unique_ptr<double[]>>& r) {
+              const double* g = r.second.get();
+              auto at = [&](std::size_t i, std::size_t j) { return g + 3 * (j * k + i); };
+              double e = std::max({dist(corners[0], at(0, 0)), dist(corners[1], at(k - 1, 0)), dist(corners[2], at(0, k - 1)),
+                                   dist(corners[3], at(k - 1, k - 1))});
+              // The boundary passes through the data at the curves' parameters.
+              for (std::size_t t : sample_indices(m)) {
+                e = std::max(e, dist(bottom[t], sisl_point(r.first.get(), params[0][t], 0.0)));
+                e = std::max(e, dist(right[t], sisl_point(r.first.get(), 1.0, params[1][t])));
+              }
+              return e / diag;
+            });
+    // Deviation from interpatch's patch: the boundary curves differ between the data
+    // points (knot placement) and s1390 blends its two lofts with its own weights.
+    std::array<SislCurve, 4> curves;
+    const std::array<const std::vector<Vec3>*, 4> edges{&bottom, &right, &top, &left};
+    std::vector<int> types(m, 1);
+    for (std::size_t e = 0; e < 4; ++e) {
+      auto pts = *edges[e];
+      auto t = ib::chord_parameters(&pts.data()->x, m);
+      SISLCurve* c = nullptr;
+      double* gpar = nullptr;
+      double end = 0;
+      int npar = 0, stat = 0;
+      s1357(&pts.data()->x, static_cast<int>(m), 3, types.data(), t.data(), 0, 0, 1, 4, 0.0, &end, &c, &gpar, &npar, &stat);
+      std::free(gpar);
+      curves[e].reset(c);
+    }
+    SISLCurve* pc[4] = {curves[0].get(), curves[1].get(), curves[2].get(), curves[3].get()};
+    int nder[4] = {1, 1, 1, 1}, stat = 0;
+    SISLSurf* sp = nullptr;
+    s1390(pc, &sp, nder, &stat);
+    SislSurface surf(sp);
+    auto g = sisl_grid(surf.get(), us, vs);
+    agreement("coons", m, "sisl s1390 vs interpatch coons (linear blending)", max_deviation_transposed(*ref, g.get()) / diag, 0,
+              "same boundary data and parameters; the curves' knots differ and s1390 is SISL's own blend of two lofts");
+  }
+
+  if (o.has("occt")) {
+    std::array<Handle(TColgp_HArray1OfPnt), 4> pts;
+    const std::array<const std::vector<Vec3>*, 4> edges{&bottom, &right, &top, &left};
+    for (std::size_t e = 0; e < 4; ++e) {
+      pts[e] = new TColgp_HArray1OfPnt(1, static_cast<int>(m));
+      for (std::size_t t = 0; t < m; ++t) pts[e]->SetValue(static_cast<int>(t) + 1, gp_Pnt((*edges[e])[t].x, (*edges[e])[t].y, (*edges[e])[t].z));
+    }
+    auto occt_patch = [&](Laps& laps) {
+      std::array<Handle(Geom_BSplineCurve), 4> c;
+      for (std::size_t e = 0; e < 4; ++e) {
+        const auto t = ib::chord_parameters(&(*edges[e]).data()->x, m);
+        Handle(TColStd_HArray1OfReal) par = new TColStd_HArray1OfReal(1, static_cast<int>(m));
+        for (std::size_t q = 0; q < m; ++q) par->SetValue(static_cast<int>(q) + 1, t[q]);
+        GeomAPI_Interpolate interp(pts[e], par, Standard_False, 1e-9);
+        interp.Perform();
+        if (!interp.IsDone()) throw std::runtime_error("GeomAPI_Interpolate failed");
+        c[e] = interp.Curve();
+      }
+      laps.lap("curves");
+      GeomFill_BSplineCurves fill(c[0], c[1], c[2], c[3], GeomFill_CoonsStyle);
+      Handle(Geom_BSplineSurface) s = fill.Surface();
+      laps.lap("patch");
+      return s;
+    };
+    std::vector<double> ou, ov;
+    measure(row_of("coons", m, "occt", "GeomAPI_Interpolate + GeomFill_BSplineCurves (CoonsStyle) + D0 loop", 1, tol),
+            o.reps,
+            [&](Laps& laps) {
+              Handle(Geom_BSplineSurface) s = occt_patch(laps);
+              double u0, u1, v0, v1;
+              s->Bounds(u0, u1, v0, v1);
+              ou = interpatch::linspace(u0, u1, k);
+              ov = interpatch::linspace(v0, v1, k);
+              auto g = occt_grid(*s, ou, ov);
+              laps.lap("evaluate");
+              return g;
+            },
+            [&](const std::unique_ptr<double[]>& g) {
+              // OpenCASCADE arranges the curves its own way: each corner of the grid
+              // must be one of the data's corners.
+              double e = 0;
+              for (std::size_t c : {std::size_t{0}, k - 1, k * (k - 1), k * k - 1}) {
+                double best = INFINITY;
+                for (const Vec3& q : corners) best = std::min(best, dist(q, g.get() + 3 * c));
+                e = std::max(e, best);
+              }
+              return e / diag;
+            });
+    // Deviation from interpatch's patch, in whichever of the eight orientations fits.
+    Laps none;
+    Handle(Geom_BSplineSurface) s = occt_patch(none);
+    double u0, u1, v0, v1;
+    s->Bounds(u0, u1, v0, v1);
+    auto g = occt_grid(*s, interpatch::linspace(u0, u1, k), interpatch::linspace(v0, v1, k));
+    double best = INFINITY;
+    for (int flip = 0; flip < 8; ++flip) {
+      double e = 0;
+      for (std::size_t i = 0; i < k; i += 7)
+        for (std::size_t j = 0; j < k; j += 7) {
+          std::size_t a = flip & 1 ? k - 1 - i : i, b = flip & 2 ? k - 1 - j : j;
+          if (flip & 4) std::swap(a, b);
+          e = std::max(e, dist((*ref)(a, b), g.get() + 3 * (i * k + j)));
+        }
+      best = std::min(best, e);
+    }
+    agreement("coons", m, "occt GeomFill_BSplineCurves (CoonsStyle) vs interpatch coons", best / diag, 0,
+              "every 7th point; OpenCASCADE's Coons style blends with its own functions over its own parametrization");
+  }
+  measure_memcpy(o, "coons", m, k * k * sizeof(Vec3));
+}
+
+// ---------------------------------------------------------------- job: whole process
+
+struct ProcessResult {
+  int status = -1;
+  double seconds = 0;
+  long maxrss_kb = 0;
+  std::string out;
+};
+
+// Runs argv with OMP_NUM_THREADS set, timing it as a whole (wall clock from spawn to
+// exit) and reading its peak resident memory from wait4; stdout captured if asked.
+ProcessResult run_process(const std::vector<std::string>& args, int threads, bool capture) {
+  std::vector<std::string> env_strings;
+  for (char** e = environ; *e; ++e)
+    if (std::strncmp(*e, "OMP_NUM_THREADS=", 16) != 0) env_strings.emplace_back(*e);
+  env_strings.push_back("OMP_NUM_THREADS=" + std::to_string(threads));
+  std::vector<char*> envp, argvp;
+  for (auto& s : env_strings) envp.push_back(s.data());
+  envp.push_back(nullptr);
+  std::vector<std::string> args_copy = args;
+  for (auto& s : args_copy) argvp.push_back(s.data());
+  argvp.push_back(nullptr);
+
+  int fds[2] = {-1, -1};
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  if (capture) {
+    if (pipe(fds) != 0) throw std::runtime_error("pipe failed");
+    posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
+    posix_spawn_file_actions_addclose(&actions, fds[0]);
+    posix_spawn_file_actions_addclose(&actions, fds[1]);
+  }
+  ProcessResult r;
+  pid_t pid = 0;
+  const auto t0 = clock_type::now();
+  if (posix_spawn(&pid, argvp[0], &actions, nullptr, argvp.data(), envp.data()) != 0)
+    throw std::runtime_error("cannot run " + args[0]);
+  posix_spawn_file_actions_destroy(&actions);
+  if (capture) {
+    close(fds[1]);
+    char buf[4096];
+    for (ssize_t got; (got = read(fds[0], buf, sizeof buf)) > 0;) r.out.append(buf, static_cast<std::size_t>(got));
+    close(fds[0]);
+  }
+  int status = 0;
+  rusage ru{};
+  if (wait4(pid, &status, 0, &ru) != pid) throw std::runtime_error("wait4 failed");
+  r.seconds = seconds_since(t0);
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.maxrss_kb = ru.ru_maxrss;
+  return r;
+}
+
+void job_process(const Options& o) {
+  const std::size_t n = o.process_grid;
+  std::cout << "\nWhole process: read a " << n << " x " << n << " .npy grid, interpolate, evaluate " << n << " x " << n
+            << ", write .npy\n";
+  fs::create_directories(o.workdir);
+  const fs::path dir = fs::absolute(o.workdir);
+  const PointGrid grid = ib::make_terrain(n);
+  const double diag = diagonal(grid.data(), grid.size());
+  const std::array<std::size_t, 3> shape{n, n, 3};
+  interpatch::io::write_npy(dir / "grid.npy", shape, std::span<const double>(&grid.data()->x, 3 * grid.size()));
+  std::ofstream(dir / "spec.json") << R"({"type": "interpolate", "points": {"npy": "grid.npy"}})" << '\n';
+  const std::string grid_arg = std::to_string(n);
+
+  // The output's corners are the data's corners (the grid spans the whole domain).
+  auto check_output = [&](const fs::path& out) {
+    const auto a = interpatch::io::read_npy(out);
+    if (a.shape != std::vector<std::size_t>{n, n, 3}) return 1.0;
+    const double* p = a.data.data();
+    const double e = std::max({dist(grid(0, 0), p), dist(grid(0, n - 1), p + 3 * (n - 1)),
+                               dist(grid(n - 1, 0), p + 3 * n * (n - 1)), dist(grid(n - 1, n - 1), p + 3 * (n * n - 1))});
+    return e / diag;
+  };
+  auto run = [&](const std::string& library, const std::string& variant, const std::vector<std::string>& args,
+                 const fs::path& out, int threads) {
+    auto row = row_of("process", n, library, variant, threads, 1e-9);
+    double rss = 0;
+    measure(std::move(row), o.reps,
+            [&](Laps&) {
+              fs::remove(out);
+              auto r = run_process(args, threads, false);
+              if (r.status != 0) throw std::runtime_error(args[0] + " exited with status " + std::to_string(r.status));
+              rss = std::max(rss, 1024.0 * static_cast<double>(r.maxrss_kb));
+              return r;
+            },
+            [&](const ProcessResult&) { return check_output(out); });
+    g_rows.back().maxrss_bytes = rss;
+  };
+  if (o.has("interpatch"))
+    for (int threads : o.threads)
+      run("interpatch", "interpatch eval spec.json --grid " + grid_arg + " -o out.npy",
+          {o.cli, "eval", (dir / "spec.json").string(), "--grid", grid_arg, "-o", (dir / "interpatch_out.npy").string()},
+          dir / "interpatch_out.npy", threads);
+  if (o.has("sisl"))
+    run("sisl", "sisl_eval grid.npy out.npy " + grid_arg,
+        {o.sisl_eval, (dir / "grid.npy").string(), (dir / "sisl_out.npy").string(), grid_arg}, dir / "sisl_out.npy", 1);
+  if (o.has("interpatch") && o.has("sisl")) {
+    const auto a = interpatch::io::read_npy(dir / "interpatch_out.npy"), b = interpatch::io::read_npy(dir / "sisl_out.npy");
+    double e = 0;
+    for (std::size_t q = 0; q < a.data.size(); q += 3)
+      e = std::max(e, dist(Vec3{a.data[q], a.data[q + 1], a.data[q + 2]}, b.data.data() + q));
+    agreement("process", n, "sisl_eval output vs interpatch eval output", e / diag, 0,
+              "same parameters; knots at the parameters (SISL) against averaged knots (interpatch)");
+  }
+  if (o.has("memcpy")) {
+    // The bytes a whole process cannot avoid moving: the grid read and the grid written.
+    measure_memcpy(o, "process", n, n * n * sizeof(Vec3));
+  }
+}
+
+// ---------------------------------------------------------------- job: peak memory
+
+long status_kb(const char* field) {
+  std::ifstream in("/proc/self/status");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind(field, 0) == 0) return std::stol(line.substr(std::strlen(field)));
+  return -1;
+}
+
+// In a child process (`compare --memory-child LIBRARY N`): build the data and the
+// library's own input, reset the peak-RSS mark, interpolate, report "baseline peak" in
+// kB: the peak minus the baseline is the memory the call itself needed.
+int memory_child(const std::string& library, std::size_t n) {
+  PointGrid grid = ib::make_terrain(n);
+  std::optional<TColgp_Array2OfPnt> points;
+  if (library == "occt") points.emplace(occt_points(grid));
+  std::ofstream("/proc/self/clear_refs") << "5" << std::flush;  // resets VmHWM to the current RSS
+  const long baseline = status_kb("VmHWM:");
+  std::size_t keep = 0;
+  if (library == "interpatch-copy") {
+    auto r = interpatch::interpolate_surface(grid);
+    keep = r.surface.control_points().size();
+  } else if (library == "interpatch-move") {
+    auto r = interpatch::interpolate_surface(std::move(grid));
+    keep = r.surface.control_points().size();
+  } else if (library == "sisl") {
+    auto pu = ib::averaged_chord_parameters(&grid.data()->x, n, n, 0);
+    auto pv = ib::averaged_chord_parameters(&grid.data()->x, n, n, 1);
+    auto s = sisl_interpolate(grid, pu, pv);
+    keep = static_cast<std::size_t>(s->in1) * static_cast<std::size_t>(s->in2);
+  } else if (library == "occt") {
+    auto s = occt_interpolate(*points);
+    keep = static_cast<std::size_t>(s->NbUPoles()) * static_cast<std::size_t>(s->NbVPoles());
+  } else {
+    std::cerr << "unknown library " << library << '\n';
+    return 2;
+  }
+  std::cout << baseline << ' ' << status_kb("VmHWM:") << ' ' << keep << std::endl;
+  return 0;
+}
+
+void job_memory(const Options& o, const std::string& self) {
+  std::cout << "\nPeak memory of one interpolation (child process; extra = peak RSS − RSS with the data built)\n";
+  const int threads = o.threads.back();
+  for (std::size_t n : o.memory_sizes) {
+    std::vector<std::string> libs;
+    if (o.has("interpatch")) libs.insert(libs.end(), {"interpatch-copy", "interpatch-move"});
+    if (o.has("sisl")) libs.push_back("sisl");
+    if (o.has("occt")) {
+      bool timed = false;
+      for (const auto& r : g_rows) timed = timed || (r.job == "interpolate" && r.library == "occt" && r.n == n);
+      if (timed || !o.job("interpolate")) libs.push_back("occt");
+      else skipped("memory", n, "occt", "not measured: its interpolation at this size was skipped for time");
+    }
+    for (const auto& lib : libs) {
+      const auto r = run_process({self, "--memory-child", lib, std::to_string(n)}, threads, true);
+      long baseline = 0, peak = 0;
+      std::size_t poles = 0;
+      std::istringstream(r.out) >> baseline >> peak >> poles;
+      if (r.status != 0 || peak <= 0) {
+        skipped("memory", n, lib, "child failed with status " + std::to_string(r.status));
+        continue;
+      }
+      const double io_bytes = 2.0 * static_cast<double>(n * n * sizeof(Vec3));
+      const double extra = 1024.0 * static_cast<double>(peak - baseline);
+      std::cout << "  memory " << n << " " << std::left << std::setw(16) << lib << std::right << " extra "
+                << std::setprecision(4) << extra / 1048576 << " MiB = " << std::setprecision(3) << extra / io_bytes
+                << " x (input + output " << io_bytes / 1048576 << " MiB); peak RSS " << peak / 1024 << " MiB, "
+                << r.seconds << " s" << std::endl;
+      g_memory.push_back({{"n", n}, {"library", lib}, {"threads", lib.rfind("interpatch", 0) == 0 ? threads : 1},
+                          {"baseline_bytes", 1024.0 * static_cast<double>(baseline)},
+                          {"peak_bytes", 1024.0 * static_cast<double>(peak)}, {"extra_bytes", extra},
+                          {"io_bytes", io_bytes}, {"extra_over_io", extra / io_bytes}, {"poles", poles},
+                          {"seconds", r.seconds}});
+    }
+  }
+}
+
+// ---------------------------------------------------------------- report
+
+std::string shell_output(const std::string& cmd) {
+  std::string out;
+  if (FILE* p = popen(cmd.c_str(), "r")) {
+    char buf[256];
+    while (std::fgets(buf, sizeof buf, p)) out += buf;
+    pclose(p);
+  }
+  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+  return out;
+}
+
+json machine(const Options& o) {
+  std::string cpu, mhz;
+  std::ifstream in("/proc/cpuinfo");
+  for (std::string line; std::getline(in, line);) {
+    if (cpu.empty() && line.rfind("model name", 0) == 0) cpu = line.substr(line.find(':') + 2);
+    if (mhz.empty() && line.rfind("cpu MHz", 0) == 0) mhz = line.substr(line.find(':') + 2);
+  }
+  std::string load;
+  std::getline(std::ifstream("/proc/loadavg"), load);
+  const std::time_t now = std::time(nullptr);
+  char date[64];
+  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  return {{"date", date}, {"cpu", cpu}, {"mhz", mhz}, {"nproc", sysconf(_SC_NPROCESSORS_ONLN)},
+          {"memory_kb", shell_output("awk '/MemTotal/ {print $2}' /proc/meminfo")}, {"load_average", load},
+          {"openmp_max_threads", max_threads()}, {"threads", o.threads},
+          {"omp_proc_bind", std::getenv("OMP_PROC_BIND") ? std::getenv("OMP_PROC_BIND") : ""},
+          {"interpatch_commit", o.commit.empty() ? shell_output("git describe --always --dirty 2>/dev/null") : o.commit},
+          {"occt_version", OCC_VERSION_COMPLETE},
+          {"sisl_version", shell_output("dpkg-query -W -f='${Version}' libsisl-dev 2>/dev/null")},
+          {"compiler", __VERSION__}, {"reps", o.reps}, {"eval_points", o.eval_points}};
+}
+
+json row_json(const Row& r) {
+  json parts = json::object();
+  for (const auto& [name, v] : r.parts) parts[name] = median(v);
+  json j = {{"job", r.job}, {"n", r.n}, {"library", r.library}, {"variant", r.variant}, {"threads", r.threads},
+            {"times_s", r.times}, {"median_s", median(r.times)},
+            {"min_s", r.times.empty() ? NAN : *std::min_element(r.times.begin(), r.times.end())},
+            {"parts_median_s", parts}, {"check_max_rel_error", r.error}, {"check_tolerance", r.tolerance},
+            {"check_ok", r.ok()}, {"note", r.note}};
+  if (r.maxrss_bytes) j["maxrss_bytes"] = *r.maxrss_bytes;
+  return j;
+}
+
+// The console summary: each row against the fastest memcpy of its job and size, and
+// against interpatch's fastest row there.
+void print_summary() {
+  std::cout << "\nSummary (median wall clock; ratios to the faster memcpy of the same bytes and to interpatch's fastest)\n";
+  std::map<std::pair<std::string, std::size_t>, double> best_memcpy, best_interpatch;
+  for (const auto& r : g_rows) {
+    auto& m = r.library == "memcpy" ? best_memcpy : best_interpatch;
+    if (r.library != "memcpy" && r.library != "interpatch") continue;
+    const auto key = std::make_pair(r.job, r.n);
+    m[key] = m.count(key) ? std::min(m[key], median(r.times)) : median(r.times);
+  }
+  std::cout << std::left << std::setw(12) << "job" << std::setw(6) << "N" << std::setw(12) << "library" << std::setw(64)
+            << "variant" << std::setw(5) << "thr" << std::right << std::setw(11) << "median" << std::setw(11) << "/memcpy"
+            << std::setw(13) << "/interpatch" << "  check\n";
+  for (const auto& r : g_rows) {
+    const auto key = std::make_pair(r.job, r.n);
+    const double t = median(r.times);
+    std::cout << std::left << std::setw(12) << r.job << std::setw(6) << r.n << std::setw(12) << r.library << std::setw(64)
+              << r.variant.substr(0, 63) << std::setw(5) << r.threads << std::right << std::setw(11) << format_time(t)
+              << std::setw(11) << std::setprecision(3) << (best_memcpy.count(key) ? t / best_memcpy[key] : NAN) << std::setw(13)
+              << (best_interpatch.count(key) ? t / best_interpatch[key] : NAN) << "  " << (r.ok() ? "ok" : "FAILED") << '\n';
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    if (argc == 4 && std::string(argv[1]) == "--memory-child") return memory_child(argv[2], std::stoul(argv[3]));
+    const Options o = parse(argc, argv);
+    const json meta = machine(o);
+    std::cout << "bench/compare: " << meta["cpu"].get<std::string>() << ", " << meta["nproc"] << " CPUs, OpenMP threads "
+              << max_threads() << " (interpatch measured with " << json(o.threads).dump() << "), load "
+              << meta["load_average"].get<std::string>() << "\ninterpatch " << meta["interpatch_commit"].get<std::string>()
+              << ", OpenCASCADE " << OCC_VERSION_COMPLETE << ", SISL " << meta["sisl_version"].get<std::string>()
+              << "; median of " << o.reps << " repetitions" << std::endl;
+    const std::string self = fs::canonical("/proc/self/exe").string();
+    if (o.job("interpolate")) job_interpolate(o);
+    if (o.job("evaluate")) job_evaluate(o);
+    if (o.job("coons")) job_coons(o);
+    if (o.job("process")) job_process(o);
+    if (o.job("memory")) job_memory(o, self);
+    print_summary();
+
+    json rows = json::array();
+    bool all_ok = true;
+    for (const auto& r : g_rows) {
+      rows.push_back(row_json(r));
+      all_ok = all_ok && r.ok();
+    }
+    json out = {{"meta", meta}, {"rows", rows}, {"agreement", g_agreement}, {"memory", g_memory}, {"skipped", g_skipped}};
+    out["meta"]["load_average_end"] = shell_output("cat /proc/loadavg");
+    if (!o.json_out.empty()) {
+      fs::path p(o.json_out);
+      if (p.has_parent_path()) fs::create_directories(p.parent_path());
+      std::ofstream(p) << out.dump(2) << '\n';
+      std::cout << "\nwrote " << o.json_out << '\n';
+    }
+    if (!all_ok) {
+      std::cerr << "compare: some results failed their checks (see FAILED above)\n";
+      return 1;
+    }
+  } catch (const Standard_Failure& e) {
+    std::cerr << "compare: OpenCASCADE: " << e.GetMessageString() << '\n';
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "compare: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}
