@@ -50,12 +50,20 @@ BENCH_FLAGS ?= --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 BENCH_ENV ?= OMP_PROC_BIND=true
 BENCH_OUT ?= build/bench/results.json
 
+# bench/compare then runs interpatch, OpenCASCADE and SISL on the same data (interpatch
+# on 1 and on all threads), writes $(COMPARE_OUT), and tools/plot_bench.py draws
+# docs/bench_interpolation.png and prints the Markdown tables of docs/BENCHMARKS.md.
+COMPARE_FLAGS ?= --reps 3
+COMPARE_OUT ?= build/bench/compare.json
 bench: deps
 	cmake --preset bench
 	cmake --build --preset bench -j $(JOBS)
 	env $(BENCH_ENV) ./build/bench/bench/interpatch_bench $(BENCH_FLAGS) \
 	  --benchmark_out=$(BENCH_OUT) --benchmark_out_format=json
 	python3 tools/bench_report.py $(BENCH_OUT)
+	env $(BENCH_ENV) ./build/bench/bench/compare $(COMPARE_FLAGS) --json $(COMPARE_OUT) \
+	  --workdir build/bench/compare-work --commit "$$(git describe --always --dirty 2>/dev/null || echo unknown)"
+	python3 tools/plot_bench.py $(COMPARE_OUT) -o docs/bench_interpolation.png
 
 clean:
 	rm -rf build demo-output
