@@ -17,9 +17,11 @@
 #include "interpatch/evaluate.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/io/csv.hpp"
+#include "interpatch/io/iges.hpp"
 #include "interpatch/io/json_out.hpp"
 #include "interpatch/io/mesh.hpp"
 #include "interpatch/io/npy.hpp"
+#include "interpatch/io/step.hpp"
 #include "interpatch/memory.hpp"
 #include "progress.hpp"
 
@@ -121,10 +123,9 @@ std::size_t parse_grid(std::string_view text) {
 
 void check_build_output(const fs::path& out) {
   const std::string ext = lower_extension(out);
-  if (ext == ".json") return;
-  if (ext == ".step" || ext == ".stp" || ext == ".igs" || ext == ".iges")
-    throw usage_error("output format " + ext + " is not available in this build; use .json");
-  throw usage_error("cannot tell the output format of '" + out.string() + "': build writes .json");
+  if (ext == ".json" || ext == ".step" || ext == ".stp" || ext == ".igs" || ext == ".iges") return;
+  throw usage_error("cannot tell the output format of '" + out.string() +
+                    "': build writes .json, .step/.stp (STEP AP214) or .igs/.iges (IGES 5.3)");
 }
 
 void check_mesh_output(const fs::path& out) {
@@ -183,6 +184,11 @@ void check_mesh_kind(const io::Construction& c, const fs::path& out, const Resol
 
 void write_build(const io::Construction& c, const fs::path& out) {
   if (!c.exact) throw error(errc::no_exact_form, c.type + ": " + c.no_exact_form);
+  const std::string ext = lower_extension(out);
+  // The product (STEP) or file (IGES) is named after the output file.
+  const std::string name = out.stem().string();
+  if (ext == ".step" || ext == ".stp") return io::write_step(out, *c.exact, {.name = name, .time_stamp = {}});
+  if (ext == ".igs" || ext == ".iges") return io::write_iges(out, *c.exact, {.name = out.filename().string(), .time_stamp = {}});
   io::write_exact_json(out, *c.exact);
 }
 

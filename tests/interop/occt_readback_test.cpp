@@ -1,0 +1,350 @@
+// STEP and IGES files written by `interpatch build` read back by OpenCASCADE's own
+// readers — independent of interpatch's writers — and compared with interpatch's
+// exact form point by point, face by face; OCCT's shape checker must call every
+// face (and a volume's solid) valid.
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <BRepCheck_Analyzer.hxx>
+#include <BRepClass3d_SolidClassifier.hxx>
+#include <BRepGProp.hxx>
+#include <BRep_Tool.hxx>
+#include <GProp_GProps.hxx>
+#include <Geom_BSplineSurface.hxx>
+#include <Geom_Surface.hxx>
+#include <IFSelect_ReturnStatus.hxx>
+#include <IGESControl_Reader.hxx>
+#include <IGESData_IGESEntity.hxx>
+#include <IGESData_IGESModel.hxx>
+#include <Interface_Static.hxx>
+#include <STEPControl_Reader.hxx>
+#include <TopAbs_State.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Face.hxx>
+#include <TopoDS_Shape.hxx>
+#include <gp_Pnt.hxx>
+
+#include "interpatch/bspline_surface.hpp"
+#include "interpatch/bspline_volume.hpp"
+#include "interpatch/evaluate.hpp"
+#include "interpatch/io/iges.hpp"
+#include "interpatch/io/spec.hpp"
+#include "interpatch/io/step.hpp"
+#include "temp_dir.hpp"
+
+namespace interpatch {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Points per direction on every face. 21 puts samples on knots of uniform
+// 2-, 4-, 5-, 10- and 20-span vectors and inside every span of the examples.
+constexpr std::size_t samples = 21;
+
+// The files hold the control points, weights and knots digit for digit (shortest
+// round-trip text), so OCCT's surface is the same surface; what is left is the two
+// evaluators' rounding (de Boor in OCCT, basis functions here), ~1e-15 of the
+// size. 1e-9 of the bounding-box diagonal leaves room for that and nothing else:
+// one knot or control point read wrong moves points by far more.
+constexpr double relative_tolerance = 1e-9;
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (const char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// Runs `interpatch build spec -o out`; returns the exit status, stderr into `err`.
+int build(const fs::path& spec, const fs::path& out, std::string* err = nullptr) {
+  const fs::path err_file = out.parent_path() / (out.filename().string() + ".stderr");
+  const std::string cmd = quote(INTERPATCH_CLI) + " build " + quote(spec.string()) + " -o " + quote(out.string()) +
+                          " 2>" + quote(err_file.string()) + " </dev/null";
+  const int rc = std::system(cmd.c_str());
+  if (err) *err = test::read_text(err_file);
+  fs::remove(err_file);
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+TopoDS_Shape read_step(const fs::path& path) {
+  STEPControl_Reader reader;
+  EXPECT_EQ(reader.ReadFile(path.c_str()), IFSelect_RetDone) << path;
+  EXPECT_GT(reader.TransferRoots(), 0) << path;
+  return reader.OneShape();
+}
+
+struct IgesRead {
+  TopoDS_Shape shape;
+  std::multiset<int> entity_types;  // the type number of every entity in the file
+};
+
+IgesRead read_iges(const fs::path& path) {
+  IGESControl_Reader reader;
+  IgesRead r;
+  EXPECT_EQ(reader.ReadFile(path.c_str()), IFSelect_RetDone) << path;
+  const Handle(IGESData_IGESModel) model = reader.IGESModel();
+  for (Standard_Integer i = 1; i <= model->NbEntities(); ++i) r.entity_types.insert(model->Entity(i)->TypeNumber());
+  EXPECT_GT(reader.TransferRoots(), 0) << path;
+  r.shape = reader.OneShape();
+  return r;
+}
+
+std::vector<TopoDS_Face> faces_of(const TopoDS_Shape& shape) {
+  std::vector<TopoDS_Face> faces;
+  for (TopExp_Explorer e(shape, TopAbs_FACE); e.More(); e.Next()) faces.push_back(TopoDS::Face(e.Current()));
+  return faces;
+}
+
+std::size_t count(const TopoDS_Shape& shape, TopAbs_ShapeEnum type) {
+  std::size_t n = 0;
+  for (TopExp_Explorer e(shape, type); e.More(); e.Next()) ++n;
+  return n;
+}
+
+using FaceGrid = std::vector<Vec3>;  // samples × samples points, first index along the face's u
+
+// The face's underlying surface on a uniform grid over its parameter bounds (the
+// bounds mapped linearly onto interpatch's [0,1]).
+FaceGrid occt_grid(const TopoDS_Face& face) {
+  const Handle(Geom_Surface) s = BRep_Tool::Surface(face);
+  Standard_Real u0, u1, v0, v1;
+  s->Bounds(u0, u1, v0, v1);
+  FaceGrid g;
+  for (std::size_t i = 0; i < samples; ++i)
+    for (std::size_t j = 0; j < samples; ++j) {
+      const double a = static_cast<double>(i) / (samples - 1), b = static_cast<double>(j) / (samples - 1);
+      const gp_Pnt p = s->Value(u0 + a * (u1 - u0), v0 + b * (v1 - v0));
+      g.push_back({p.X(), p.Y(), p.Z()});
+    }
+  return g;
+}
+
+// interpatch's exact form on the same grids: the surface, or a volume's six faces
+// evaluated through the volume itself (u0: S(0, v, w), v0: S(u, 0, w), w0: S(u, v, 0), ...).
+std::vector<FaceGrid> reference_grids(const io::ExactForm& exact) {
+  const std::vector<double> t = linspace(0, 1, samples);
+  if (const auto* s = std::get_if<BSplineSurface>(&exact)) {
+    const PointGrid g = s->evaluate(t, t);
+    return {FaceGrid(g.values().begin(), g.values().end())};
+  }
+  const auto& vol = std::get<BSplineVolume>(exact);
+  std::vector<FaceGrid> faces;
+  for (int axis = 0; axis < 3; ++axis)
+    for (const double at : {0.0, 1.0}) {
+      FaceGrid g;
+      for (const double a : t)
+        for (const double b : t)
+          g.push_back(axis == 0 ? vol.point(at, a, b) : axis == 1 ? vol.point(a, at, b) : vol.point(a, b, at));
+      faces.push_back(std::move(g));
+    }
+  return faces;
+}
+
+double diagonal(const std::vector<FaceGrid>& grids) {
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (const auto& g : grids)
+    for (const Vec3& p : g)
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], p[k]);
+        hi[k] = std::max(hi[k], p[k]);
+      }
+  return norm(hi - lo);
+}
+
+double max_distance(const FaceGrid& a, const FaceGrid& b) {
+  double d = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, norm(a[i] - b[i]));
+  return d;
+}
+
+// Every face read back matches a different face of the exact form (a volume's
+// faces are matched by geometry: the reader need not keep their order). Returns
+// the largest distance relative to the diagonal.
+double compare(const std::vector<TopoDS_Face>& faces, const std::vector<FaceGrid>& reference, const std::string& what) {
+  EXPECT_EQ(faces.size(), reference.size()) << what;
+  const double diag = diagonal(reference);
+  double worst = 0;
+  std::set<std::size_t> matched;
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    const FaceGrid g = occt_grid(faces[f]);
+    std::size_t best = reference.size();
+    double best_d = HUGE_VAL;
+    for (std::size_t r = 0; r < reference.size(); ++r) {
+      const double d = max_distance(g, reference[r]);
+      if (d < best_d) {
+        best_d = d;
+        best = r;
+      }
+    }
+    EXPECT_TRUE(matched.insert(best).second) << what << ": two faces read back match reference face " << best;
+    EXPECT_LE(best_d, relative_tolerance * diag) << what << ": face " << f;
+    worst = std::max(worst, best_d / diag);
+  }
+  return worst;
+}
+
+// The figures docs/interop.md quotes: printed, one line per file.
+void report(const std::string& what, double rel) {
+  std::printf("[ readback ] %-34s max |OCCT - interpatch| / diagonal = %.2e\n", what.c_str(), rel);
+}
+
+struct Case {
+  std::string name;
+  fs::path spec;
+};
+
+std::vector<Case> example_cases() {
+  std::vector<Case> cases;
+  for (const auto& e : fs::directory_iterator(INTERPATCH_EXAMPLES))
+    if (e.path().extension() == ".json" && e.path().stem() != "coons_gregory")
+      cases.push_back({e.path().stem().string(), e.path()});
+  std::sort(cases.begin(), cases.end(), [](const Case& a, const Case& b) { return a.name < b.name; });
+  return cases;
+}
+
+void write_text(const fs::path& p, const std::string& text) {
+  std::ofstream(p, std::ios::binary) << text;
+}
+
+// Rational specs no example has: a quarter cylinder (radius 2, height 3; degree 2
+// in u with weights 1, √2/2, 1) and a quarter of a thick cylindrical shell as a
+// rational volume (radii 1 and 2, height 1).
+void write_rational_specs(const fs::path& dir) {
+  write_text(dir / "quarter_cylinder.json", R"({"type": "bspline_surface", "degree": [2, 1],
+    "knots": {"u": [0, 0, 0, 1, 1, 1], "v": [0, 0, 1, 1]},
+    "control_points": [[[2, 0, 0], [2, 0, 3]], [[2, 2, 0], [2, 2, 3]], [[0, 2, 0], [0, 2, 3]]],
+    "weights": [[1, 1], [0.70710678118654757, 0.70710678118654757], [1, 1]]})");
+  write_text(dir / "quarter_shell.json", R"({"type": "bspline_volume", "degree": [2, 1, 1],
+    "knots": {"u": [0, 0, 0, 1, 1, 1], "v": [0, 0, 1, 1], "w": [0, 0, 1, 1]},
+    "control_points": [
+      [[[1, 0, 0], [1, 0, 1]], [[2, 0, 0], [2, 0, 1]]],
+      [[[1, 1, 0], [1, 1, 1]], [[2, 2, 0], [2, 2, 1]]],
+      [[[0, 1, 0], [0, 1, 1]], [[0, 2, 0], [0, 2, 1]]]],
+    "weights": [[[1, 1], [1, 1]], [[0.70710678118654757, 0.70710678118654757], [0.70710678118654757, 0.70710678118654757]], [[1, 1], [1, 1]]]})");
+}
+
+class OcctReadback : public ::testing::TestWithParam<Case> {
+ protected:
+  void SetUp() override {
+    // OCCT's readers keep the file's millimetres as they are.
+    Interface_Static::SetCVal("xstep.cascade.unit", "MM");
+  }
+  test::TempDir dir_;
+};
+
+TEST_P(OcctReadback, StepFacesMatchTheExactFormAndAreValid) {
+  const Case& c = GetParam();
+  const io::Construction built = io::build_file(c.spec);
+  ASSERT_TRUE(built.exact) << c.name;
+  const fs::path out = dir_ / (c.name + ".step");
+  std::string err;
+  ASSERT_EQ(build(c.spec, out, &err), 0) << err;
+  const TopoDS_Shape shape = read_step(out);
+  ASSERT_FALSE(shape.IsNull());
+  const auto faces = faces_of(shape);
+  report(c.name + ".step", compare(faces, reference_grids(*built.exact), c.name + ".step"));
+
+  BRepCheck_Analyzer check(shape);
+  EXPECT_TRUE(check.IsValid()) << c.name << ".step: OCCT's checker finds the shape invalid";
+  for (const auto& f : faces) EXPECT_TRUE(BRepCheck_Analyzer(f).IsValid()) << c.name << ".step: a face is invalid";
+
+  if (io::is_volume(built)) {
+    // The six faces close into one solid, oriented outward: positive volume, and
+    // the volume's own centre classified inside it.
+    ASSERT_EQ(count(shape, TopAbs_SOLID), 1u) << c.name;
+    GProp_GProps props;
+    BRepGProp::VolumeProperties(shape, props);
+    EXPECT_GT(props.Mass(), 0) << c.name << ": faces oriented inward";
+    const Volume& v = io::volume_evaluator(built);
+    const Vec3 centre = v.point(0.5, 0.5, 0.5);
+    BRepClass3d_SolidClassifier inside(shape, gp_Pnt(centre.x, centre.y, centre.z), 1e-7);
+    EXPECT_EQ(inside.State(), TopAbs_IN) << c.name;
+  }
+}
+
+TEST_P(OcctReadback, IgesEntities128MatchTheExactForm) {
+  const Case& c = GetParam();
+  const io::Construction built = io::build_file(c.spec);
+  ASSERT_TRUE(built.exact) << c.name;
+  const fs::path out = dir_ / (c.name + ".igs");
+  std::string err;
+  ASSERT_EQ(build(c.spec, out, &err), 0) << err;
+  const IgesRead r = read_iges(out);
+  const std::size_t expected = io::is_volume(built) ? 6 : 1;
+  EXPECT_EQ(r.entity_types.count(128), expected) << c.name;
+  EXPECT_EQ(r.entity_types.size(), expected) << c.name << ": entities other than 128";
+  ASSERT_FALSE(r.shape.IsNull());
+  const auto faces = faces_of(r.shape);
+  report(c.name + ".igs", compare(faces, reference_grids(*built.exact), c.name + ".igs"));
+  for (const auto& f : faces) {
+    EXPECT_TRUE(BRepCheck_Analyzer(f).IsValid()) << c.name << ".igs: a face is invalid";
+    EXPECT_FALSE(Handle(Geom_BSplineSurface)::DownCast(BRep_Tool::Surface(f)).IsNull())
+        << c.name << ".igs: not read as a B-spline surface";
+  }
+}
+
+std::vector<Case> all_cases() {
+  static const test::TempDir specs;  // lives for the whole run
+  write_rational_specs(specs.path());
+  std::vector<Case> cases = example_cases();
+  cases.push_back({"quarter_cylinder", specs / "quarter_cylinder.json"});
+  cases.push_back({"quarter_shell", specs / "quarter_shell.json"});
+  return cases;
+}
+
+INSTANTIATE_TEST_SUITE_P(Every, OcctReadback, ::testing::ValuesIn(all_cases()),
+                         [](const ::testing::TestParamInfo<Case>& i) { return i.param.name; });
+
+TEST(OcctReadbackCli, NoExactFormIsRefusedWithExit3AndNoFile) {
+  test::TempDir dir;
+  for (const char* ext : {".step", ".igs"}) {
+    const fs::path out = dir / (std::string("gregory") + ext);
+    std::string err;
+    EXPECT_EQ(build(fs::path(INTERPATCH_EXAMPLES) / "coons_gregory.json", out, &err), 3) << ext;
+    EXPECT_NE(err.find("coons"), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(out)) << ext;
+  }
+}
+
+// The hemisphere has a pole (its u = 0 row is one point) and a seam (its v = 0
+// and v = 1 boundaries are the same meridian). The file leaves the pole out of the
+// loop and writes the meridian once, as a SEAM_CURVE used in both directions; OCCT
+// must read a degenerated edge at the pole and the seam as one edge closed on the face.
+TEST(OcctReadbackTopology, HemispherePoleAndSeam) {
+  test::TempDir dir;
+  Interface_Static::SetCVal("xstep.cascade.unit", "MM");
+  const fs::path out = dir / "dome.step";
+  ASSERT_EQ(build(fs::path(INTERPATCH_EXAMPLES) / "hemisphere.json", out), 0);
+  const TopoDS_Shape shape = read_step(out);
+  const auto faces = faces_of(shape);
+  ASSERT_EQ(faces.size(), 1u);
+  std::size_t degenerated = 0, seams = 0;
+  for (TopExp_Explorer e(faces[0], TopAbs_EDGE); e.More(); e.Next()) {
+    const TopoDS_Edge& edge = TopoDS::Edge(e.Current());
+    if (BRep_Tool::Degenerated(edge)) ++degenerated;
+    if (BRep_Tool::IsClosed(edge, faces[0])) ++seams;
+  }
+  EXPECT_EQ(degenerated, 1u);
+  EXPECT_EQ(seams, 2u);  // the seam edge, met once in each direction
+  EXPECT_TRUE(BRepCheck_Analyzer(shape).IsValid());
+}
+
+}  // namespace
+}  // namespace interpatch
