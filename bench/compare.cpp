@@ -869,13 +869,12 @@ struct ProcessResult {
   std::string out;
 };
 
-// Runs argv with OMP_NUM_THREADS set, timing it as a whole (wall clock from spawn to
-// exit) and reading its peak resident memory from wait4; stdout captured if asked.
-ProcessResult run_process(const std::vector<std::string>& args, int threads, bool capture) {
+// Spawns argv with OMP_NUM_THREADS set and waits for it; stdout captured if asked.
+ProcessResult spawn_and_wait(const std::vector<std::string>& args, int threads, bool capture) {
   std::vector<std::string> env_strings;
   for (char** e = environ; *e; ++e)
     if (std::strncmp(*e, "OMP_NUM_THREADS=", 16) != 0) env_strings.emplace_back(*e);
-  env_strings.push_back("OMP_NUM_THREADS=" + std::to_string(threads));
+  if (threads > 0) env_strings.push_back("OMP_NUM_THREADS=" + std::to_string(threads));
   std::vector<char*> envp, argvp;
   for (auto& s : env_strings) envp.push_back(s.data());
   envp.push_back(nullptr);
@@ -895,9 +894,9 @@ ProcessResult run_process(const std::vector<std::string>& args, int threads, boo
   ProcessResult r;
   pid_t pid = 0;
   const auto t0 = clock_type::now();
-  if (posix_spawn(&pid, argvp[0], &actions, nullptr, argvp.data(), envp.data()) != 0)
-    throw std::runtime_error("cannot run " + args[0]);
+  const int spawned = posix_spawn(&pid, argvp[0], &actions, nullptr, argvp.data(), envp.data());
   posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) throw std::runtime_error("cannot run " + args[0]);
   if (capture) {
     close(fds[1]);
     char buf[4096];
@@ -913,7 +912,31 @@ ProcessResult run_process(const std::vector<std::string>& args, int threads, boo
   return r;
 }
 
-void job_process(const Options& o) {
+// `compare --time-child PROGRAM ARGS...`: runs the program and prints "seconds
+// maxrss_kb status" as the last line. A child's ru_maxrss starts from the peak of the
+// process it was spawned from, so the program is spawned from this small process
+// rather than from the benchmark holding its grids.
+int time_child(int argc, char** argv) {
+  const std::vector<std::string> args(argv, argv + argc);
+  const auto r = spawn_and_wait(args, 0, false);
+  std::cout << '\n' << r.seconds << ' ' << r.maxrss_kb << ' ' << r.status << std::endl;
+  return 0;
+}
+
+// Runs a whole process with OMP_NUM_THREADS = threads through --time-child: its wall
+// clock from spawn to exit, its own peak resident memory and its exit status.
+ProcessResult run_process(const std::string& self, const std::vector<std::string>& args, int threads) {
+  std::vector<std::string> full{self, "--time-child"};
+  full.insert(full.end(), args.begin(), args.end());
+  const auto helper = spawn_and_wait(full, threads, true);
+  ProcessResult r;
+  const std::size_t last = helper.out.find_last_of('\n', helper.out.size() - 2);
+  std::istringstream(helper.out.substr(last == std::string::npos ? 0 : last + 1)) >> r.seconds >> r.maxrss_kb >> r.status;
+  if (helper.status != 0) r.status = helper.status;
+  return r;
+}
+
+void job_process(const Options& o, const std::string& self) {
   const std::size_t n = o.process_grid;
   std::cout << "\nWhole process: read a " << n << " x " << n << " .npy grid, interpolate, evaluate " << n << " x " << n
             << ", write .npy\n";
@@ -937,18 +960,19 @@ void job_process(const Options& o) {
   };
   auto run = [&](const std::string& library, const std::string& variant, const std::vector<std::string>& args,
                  const fs::path& out, int threads) {
+    // The time is the one measured around the program inside the helper.
     auto row = row_of("process", n, library, variant, threads, 1e-9);
     double rss = 0;
-    measure(std::move(row), o.reps,
-            [&](Laps&) {
-              fs::remove(out);
-              auto r = run_process(args, threads, false);
-              if (r.status != 0) throw std::runtime_error(args[0] + " exited with status " + std::to_string(r.status));
-              rss = std::max(rss, 1024.0 * static_cast<double>(r.maxrss_kb));
-              return r;
-            },
-            [&](const ProcessResult&) { return check_output(out); });
-    g_rows.back().maxrss_bytes = rss;
+    for (int r = 0; r < o.reps; ++r) {
+      fs::remove(out);
+      const auto p = run_process(self, args, threads);
+      if (p.status != 0) throw std::runtime_error(args[0] + " exited with status " + std::to_string(p.status));
+      row.times.push_back(p.seconds);
+      rss = std::max(rss, 1024.0 * static_cast<double>(p.maxrss_kb));
+      row.error = std::max(row.error, check_output(out));
+    }
+    row.maxrss_bytes = rss;
+    measure(std::move(row), 0, [](Laps&) { return 0; }, [](int) { return 0.0; });
   };
   if (o.has("interpatch"))
     for (int threads : o.threads)
@@ -1027,7 +1051,7 @@ void job_memory(const Options& o, const std::string& self) {
       else skipped("memory", n, "occt", "not measured: its interpolation at this size was skipped for time");
     }
     for (const auto& lib : libs) {
-      const auto r = run_process({self, "--memory-child", lib, std::to_string(n)}, threads, true);
+      const auto r = spawn_and_wait({self, "--memory-child", lib, std::to_string(n)}, threads, true);
       long baseline = 0, peak = 0;
       std::size_t poles = 0;
       std::istringstream(r.out) >> baseline >> peak >> poles;
@@ -1126,6 +1150,7 @@ void print_summary() {
 int main(int argc, char** argv) {
   try {
     if (argc == 4 && std::string(argv[1]) == "--memory-child") return memory_child(argv[2], std::stoul(argv[3]));
+    if (argc >= 3 && std::string(argv[1]) == "--time-child") return time_child(argc - 2, argv + 2);
     const Options o = parse(argc, argv);
     const json meta = machine(o);
     std::cout << "bench/compare: " << meta["cpu"].get<std::string>() << ", " << meta["nproc"] << " CPUs, OpenMP threads "
@@ -1137,7 +1162,7 @@ int main(int argc, char** argv) {
     if (o.job("interpolate")) job_interpolate(o);
     if (o.job("evaluate")) job_evaluate(o);
     if (o.job("coons")) job_coons(o);
-    if (o.job("process")) job_process(o);
+    if (o.job("process")) job_process(o, self);
     if (o.job("memory")) job_memory(o, self);
     print_summary();
 
