@@ -63,7 +63,7 @@ bench: deps
 	python3 tools/bench_report.py $(BENCH_OUT)
 	env $(BENCH_ENV) ./build/bench/bench/compare $(COMPARE_FLAGS) --json $(COMPARE_OUT) \
 	  --workdir build/bench/compare-work --commit "$$(git describe --always --dirty 2>/dev/null || echo unknown)"
-	python3 tools/plot_bench.py $(COMPARE_OUT) -o docs/bench_interpolation.png
+	/usr/bin/python3 tools/plot_bench.py $(COMPARE_OUT) -o docs/bench_interpolation.png
 
 clean:
 	rm -rf build demo-output
