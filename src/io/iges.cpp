@@ -1,5 +1,6 @@
 #include "interpatch/io/iges.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <string>
 #include <string_view>
@@ -22,11 +23,21 @@ std::string hollerith(std::string_view s) {
   return a.empty() ? a : std::to_string(a.size()) + "H" + a;
 }
 
-// Right-justified in `width` columns.
-std::string right(std::string_view s, std::size_t width) {
-  return std::string(width > s.size() ? width - s.size() : 0, ' ') + std::string(s);
+// `s` right-justified in `width` columns, appended.
+void append_right(std::string& out, std::string_view s, std::size_t width) {
+  if (width > s.size()) out.append(width - s.size(), ' ');
+  out += s;
 }
-std::string right(std::size_t v, std::size_t width) { return right(std::to_string(v), width); }
+void append_right(std::string& out, std::size_t v, std::size_t width) {
+  char b[24];
+  const auto r = std::to_chars(b, b + sizeof b, v);
+  append_right(out, std::string_view(b, static_cast<std::size_t>(r.ptr - b)), width);
+}
+std::string right(std::size_t v, std::size_t width) {
+  std::string s;
+  append_right(s, v, width);
+  return s;
+}
 
 // Lines of one section: columns 73-80 get the letter and the sequence number.
 class Section {
@@ -40,7 +51,7 @@ class Section {
     buf_.assign(data);
     buf_.resize(line_data, ' ');
     buf_ += letter_;
-    buf_ += right(count_, 7);
+    append_right(buf_, count_, 7);
     buf_ += '\n';
     os_->write(buf_.data(), static_cast<std::streamsize>(buf_.size()));
   }
@@ -61,32 +72,36 @@ class Packer {
       : section_(section), width_(width), suffix_(std::move(suffix)) {}
 
   void put(std::string_view token, bool last = false) {
-    std::string t(token);
-    t += last ? ';' : ',';
-    if (!cur_.empty() && cur_.size() + t.size() > width_) emit();
+    if (!cur_.empty() && cur_.size() + token.size() + 1 > width_) emit();
     // A Hollerith string longer than a line is the one thing that may be split.
-    while (t.size() > width_) {
-      cur_ = t.substr(0, width_);
-      t.erase(0, width_);
+    while (token.size() + 1 > width_) {
+      cur_.assign(token.substr(0, width_));
+      token.remove_prefix(width_);
       emit();
     }
-    cur_ += t;
+    cur_ += token;
+    cur_ += last ? ';' : ',';
     if (last) emit();
   }
-  void put(double v, bool last = false) { put(detail::real_text(v), last); }
+  void put(double v, bool last = false) {
+    number_.clear();
+    detail::append_real(number_, v);
+    put(number_, last);
+  }
   void put_int(long long v, bool last = false) { put(std::to_string(v), last); }
 
  private:
   void emit() {
     cur_.resize(width_, ' ');
-    section_.line(cur_ + suffix_);
+    cur_ += suffix_;
+    section_.line(cur_);
     cur_.clear();
   }
 
   Section& section_;
   std::size_t width_;
   std::string suffix_;
-  std::string cur_;
+  std::string cur_, number_;
 };
 
 // Entity 128's parameters (IGES 5.3, section 4.24): counts, degrees, flags, both
