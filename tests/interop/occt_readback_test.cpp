@@ -360,6 +360,21 @@ TEST(OcctReadbackCli, NoExactFormIsRefusedWithExit3AndNoFile) {
   }
 }
 
+// .stp and .iges are the same formats as .step and .igs, in any case.
+TEST(OcctReadbackCli, ExtensionAliasesWriteTheSameFormats) {
+  test::TempDir dir;
+  Interface_Static::SetCVal("xstep.cascade.unit", "MM");
+  const fs::path spec = fs::path(INTERPATCH_EXAMPLES) / "ruled.json";
+  ASSERT_EQ(build(spec, dir / "a.stp"), 0);
+  ASSERT_EQ(build(spec, dir / "b.STEP"), 0);
+  ASSERT_EQ(build(spec, dir / "c.iges"), 0);
+  ASSERT_EQ(build(spec, dir / "d.IGS"), 0);
+  EXPECT_EQ(faces_of(read_step(dir / "a.stp")).size(), 1u);
+  EXPECT_EQ(faces_of(read_step(dir / "b.STEP")).size(), 1u);
+  EXPECT_EQ(read_iges(dir / "c.iges").entity_types, std::multiset<int>{128});
+  EXPECT_EQ(read_iges(dir / "d.IGS").entity_types, std::multiset<int>{128});
+}
+
 // The hemisphere has a pole (its u = 0 row is one point) and a seam (its v = 0
 // and v = 1 boundaries are the same meridian). The file leaves the pole out of the
 // loop and writes the meridian once, as a SEAM_CURVE used in both directions; OCCT
