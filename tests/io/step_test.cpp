@@ -51,6 +51,11 @@ std::size_t count_of(const std::map<int, std::string>& e, const std::string& pre
       std::count_if(e.begin(), e.end(), [&](const auto& kv) { return kv.second.rfind(prefix, 0) == 0; }));
 }
 
+// How many entities start with each prefix.
+void expect_counts(const std::map<int, std::string>& e, const std::map<std::string, std::size_t>& expected) {
+  for (const auto& [prefix, n] : expected) EXPECT_EQ(count_of(e, prefix), n) << prefix;
+}
+
 BSplineSurface bilinear_patch() {
   PointGrid cp({2, 2});
   cp(0, 0) = {0, 0, 0};
@@ -100,15 +105,9 @@ TEST(Step, EntitiesAreNumberedInOrderAndReferOnlyBackwards) {
 
 TEST(Step, SurfaceIsOneFaceBoundedByItsFourEdges) {
   const auto e = entities(step_text(bilinear_patch()));
-  EXPECT_EQ(count_of(e, "B_SPLINE_SURFACE_WITH_KNOTS('',1,1,"), 1u);
-  EXPECT_EQ(count_of(e, "ADVANCED_FACE("), 1u);
-  EXPECT_EQ(count_of(e, "VERTEX_POINT("), 4u);
-  EXPECT_EQ(count_of(e, "EDGE_CURVE("), 4u);
-  EXPECT_EQ(count_of(e, "PCURVE("), 4u);
-  EXPECT_EQ(count_of(e, "ORIENTED_EDGE("), 4u);
-  EXPECT_EQ(count_of(e, "OPEN_SHELL("), 1u);
-  EXPECT_EQ(count_of(e, "MANIFOLD_SURFACE_SHAPE_REPRESENTATION("), 1u);
-  EXPECT_EQ(count_of(e, "MANIFOLD_SOLID_BREP("), 0u);
+  expect_counts(e, {{"B_SPLINE_SURFACE_WITH_KNOTS('',1,1,", 1}, {"ADVANCED_FACE(", 1}, {"VERTEX_POINT(", 4},
+                    {"EDGE_CURVE(", 4}, {"PCURVE(", 4}, {"ORIENTED_EDGE(", 4}, {"OPEN_SHELL(", 1},
+                    {"MANIFOLD_SURFACE_SHAPE_REPRESENTATION(", 1}, {"MANIFOLD_SOLID_BREP(", 0}});
   // Corner control points are the surface's corners: only the net's four points
   // and the placement's origin are CARTESIAN_POINTs in 3D.
   std::size_t points3d = 0;
@@ -128,11 +127,8 @@ TEST(Step, PoleHasNoEdgeAndSeamIsOneEdgeUsedTwice) {
   }
   const BSplineSurface cone(KnotVector(1, {0, 0, 1, 1}), KnotVector(1, {0, 0, 0.25, 0.5, 0.75, 1, 1}), cp);
   const auto e = entities(step_text(cone));
-  EXPECT_EQ(count_of(e, "VERTEX_POINT("), 2u);
-  EXPECT_EQ(count_of(e, "EDGE_CURVE("), 2u);
-  EXPECT_EQ(count_of(e, "SEAM_CURVE("), 1u);
-  EXPECT_EQ(count_of(e, "ORIENTED_EDGE("), 3u);
-  EXPECT_EQ(count_of(e, "B_SPLINE_SURFACE_WITH_KNOTS('',1,1,"), 1u);
+  expect_counts(e, {{"VERTEX_POINT(", 2}, {"EDGE_CURVE(", 2}, {"SEAM_CURVE(", 1}, {"ORIENTED_EDGE(", 3},
+                    {"B_SPLINE_SURFACE_WITH_KNOTS('',1,1,", 1}});
   for (const auto& [n, body] : e) {
     // Closed in v (the seam), not in u.
     if (body.rfind("B_SPLINE_SURFACE_WITH_KNOTS", 0) == 0) {
@@ -143,12 +139,8 @@ TEST(Step, PoleHasNoEdgeAndSeamIsOneEdgeUsedTwice) {
 
 TEST(Step, VolumeIsAClosedShellWithEveryEdgeRunBothWays) {
   const auto e = entities(step_text(unit_cube()));
-  EXPECT_EQ(count_of(e, "ADVANCED_FACE("), 6u);
-  EXPECT_EQ(count_of(e, "EDGE_CURVE("), 12u);
-  EXPECT_EQ(count_of(e, "VERTEX_POINT("), 8u);
-  EXPECT_EQ(count_of(e, "CLOSED_SHELL("), 1u);
-  EXPECT_EQ(count_of(e, "MANIFOLD_SOLID_BREP("), 1u);
-  EXPECT_EQ(count_of(e, "ADVANCED_BREP_SHAPE_REPRESENTATION("), 1u);
+  expect_counts(e, {{"ADVANCED_FACE(", 6}, {"EDGE_CURVE(", 12}, {"VERTEX_POINT(", 8}, {"CLOSED_SHELL(", 1},
+                    {"MANIFOLD_SOLID_BREP(", 1}, {"ADVANCED_BREP_SHAPE_REPRESENTATION(", 1}});
   std::map<std::string, std::multiset<std::string>> uses;  // edge -> orientations
   const std::regex oriented(R"(ORIENTED_EDGE\('',\*,\*,(#[0-9]+),(\.[TF]\.)\))");
   for (const auto& [n, body] : e) {
