@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <optional>
@@ -14,6 +15,7 @@
 
 #include "detail/text.hpp"
 #include "interpatch/io/atomic_file.hpp"
+#include "io/memory_stream.hpp"
 
 namespace interpatch::io {
 namespace fs = std::filesystem;
@@ -61,16 +63,11 @@ std::size_t split(std::string_view line, std::string_view* fields, std::size_t m
   }
 }
 
-/// Reads a file line by line in large blocks (no per-line allocation).
+/// Reads a stream line by line in large blocks (no per-line allocation).
 class LineReader {
  public:
-  explicit LineReader(const fs::path& path) : path_(path), in_(path, std::ios::binary) {
-    if (!in_) {
-      const int e = errno;
-      detail::fail(errc::file_unreadable, "cannot open '", path.string(), "': ",
-                   e != 0 ? std::strerror(e) : "open failed");
-    }
-  }
+  /// `name` names the stream in messages.
+  LineReader(std::istream& in, const std::string& name) : name_(name), in_(in) {}
 
   /// The next line without its '\n'; nullopt at the end.
   std::optional<std::string_view> next() {
@@ -106,19 +103,19 @@ class LineReader {
     buf_.resize(old + got);
     if (in_.bad() || (!in_ && !in_.eof())) {
       const int e = errno;
-      detail::fail(errc::file_unreadable, "cannot read '", path_.string(), "': ", e != 0 ? std::strerror(e) : "read error");
+      detail::fail(errc::file_unreadable, "cannot read '", name_, "': ", e != 0 ? std::strerror(e) : "read error");
     }
     if (got < block) eof_ = true;
     if (buf_.size() > max_line && buf_.find('\n') == std::string::npos) {
-      detail::fail(errc::malformed_file, path_.string(), ":", line_, ": line longer than ", max_line,
+      detail::fail(errc::malformed_file, name_, ":", line_, ": line longer than ", max_line,
                    " bytes; not a text file of points?");
     }
   }
 
   static constexpr std::size_t max_line = std::size_t{1} << 24;
-  const fs::path& path_;
+  const std::string& name_;
   std::size_t line_ = 0;
-  std::ifstream in_;
+  std::istream& in_;
   std::string buf_;
   std::size_t pos_ = 0;
   bool eof_ = false;
@@ -136,20 +133,16 @@ void append_number(std::string& out, double v) {
   out.append(buf, r.ptr);
 }
 
-}  // namespace
-
-std::vector<Vec3> read_csv_points(const fs::path& path, std::size_t expected) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) detail::fail(errc::file_unreadable, "cannot read '", path.string(), "': it is a directory");
-  LineReader reader(path);
-  const std::string name = path.string();
+/// The points in `in`, of `size` bytes when known (0 otherwise); `name` names it in
+/// messages. What read_csv_points and parse_csv_points share.
+std::vector<Vec3> read_csv_stream(std::istream& in, std::uintmax_t size, const std::string& name, std::size_t expected) {
+  LineReader reader(in, name);
 
   std::vector<Vec3> points;
   if (expected > 0) {
     // Never trust `expected` for a reservation larger than the file could fill
     // ("0,0,0\n" is the shortest line).
-    const auto size = fs::file_size(path, ec);
-    points.reserve(ec ? std::size_t{0} : std::min<std::size_t>(expected, static_cast<std::size_t>(size / 6 + 1)));
+    points.reserve(std::min<std::size_t>(expected, static_cast<std::size_t>(size / 6 + 1)));
   }
 
   std::size_t count = 0;  // points seen, also past `expected`
@@ -202,6 +195,26 @@ std::vector<Vec3> read_csv_points(const fs::path& path, std::size_t expected) {
                  " expected");
   }
   return points;
+}
+
+}  // namespace
+
+std::vector<Vec3> read_csv_points(const fs::path& path, std::size_t expected) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) detail::fail(errc::file_unreadable, "cannot read '", path.string(), "': it is a directory");
+  errno = 0;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const int e = errno;
+    detail::fail(errc::file_unreadable, "cannot open '", path.string(), "': ", e != 0 ? std::strerror(e) : "open failed");
+  }
+  const auto size = fs::file_size(path, ec);
+  return read_csv_stream(in, ec ? 0 : size, path.string(), expected);
+}
+
+std::vector<Vec3> parse_csv_points(std::string_view text, std::size_t expected, std::string_view name) {
+  detail::MemoryStream in(text);
+  return read_csv_stream(in, text.size(), std::string(name), expected);
 }
 
 void write_csv_grid(const fs::path& path, std::span<const std::vector<double>> params,

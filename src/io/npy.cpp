@@ -15,6 +15,7 @@
 #include "detail/text.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/memory.hpp"
+#include "io/memory_stream.hpp"
 
 namespace interpatch::io {
 namespace fs = std::filesystem;
@@ -48,7 +49,7 @@ struct Header {
 
 class HeaderParser {
  public:
-  HeaderParser(std::string_view text, const fs::path& file) : s_(text), file_(file) {}
+  HeaderParser(std::string_view text, const std::string& name) : s_(text), file_(name) {}
 
   Header parse() {
     Header h;
@@ -73,7 +74,7 @@ class HeaderParser {
       if (key == "descr") {
         seen(have_descr);
         if (peek() == '[') {
-          detail::fail(errc::malformed_file, file_.string(),
+          detail::fail(errc::malformed_file, file_,
                        ": structured dtype is not supported; use float64 or float32");
         }
         h.descr = string_literal("a dtype string");
@@ -148,13 +149,13 @@ class HeaderParser {
       std::uint64_t v = 0;
       const auto r = std::from_chars(s_.data() + pos_, s_.data() + s_.size(), v);
       if (r.ec == std::errc::result_out_of_range) {
-        detail::fail(errc::too_large, file_.string(), ": dimension ", std::string(s_.substr(start, static_cast<std::size_t>(r.ptr - (s_.data() + start)))),
+        detail::fail(errc::too_large, file_, ": dimension ", std::string(s_.substr(start, static_cast<std::size_t>(r.ptr - (s_.data() + start)))),
                      " in the shape is too large");
       }
       if (r.ec != std::errc()) fail_at(start, "expected a non-negative integer in 'shape'");
       pos_ = static_cast<std::size_t>(r.ptr - s_.data());
       if (peek() == 'L' || peek() == 'l') ++pos_;  // Python 2 long literals, as old NumPy wrote them
-      if (v > std::numeric_limits<std::size_t>::max()) detail::fail(errc::too_large, file_.string(), ": dimension ", v, " is too large");
+      if (v > std::numeric_limits<std::size_t>::max()) detail::fail(errc::too_large, file_, ": dimension ", v, " is too large");
       dims.push_back(static_cast<std::size_t>(v));
       skip_space();
       if (peek() == ',') {
@@ -167,11 +168,11 @@ class HeaderParser {
   }
 
   [[noreturn]] void fail_at(std::size_t at, const std::string& what) const {
-    detail::fail(errc::malformed_file, file_.string(), ": malformed NPY header: ", what, " at character ", at,
+    detail::fail(errc::malformed_file, file_, ": malformed NPY header: ", what, " at character ", at,
                  " of \"", excerpt(), "\"");
   }
   [[noreturn]] void fail_missing(const char* key) const {
-    detail::fail(errc::malformed_file, file_.string(), ": malformed NPY header: key '", key, "' is missing in \"",
+    detail::fail(errc::malformed_file, file_, ": malformed NPY header: key '", key, "' is missing in \"",
                  excerpt(), "\"");
   }
   [[nodiscard]] std::string excerpt() const {
@@ -187,7 +188,7 @@ class HeaderParser {
   }
 
   std::string_view s_;
-  const fs::path& file_;
+  const std::string& file_;
   std::size_t pos_ = 0;
 };
 
@@ -199,9 +200,9 @@ struct Dtype {
   bool big_endian = false;
 };
 
-Dtype parse_dtype(const std::string& descr, const fs::path& file) {
+Dtype parse_dtype(const std::string& descr, const std::string& name) {
   auto unsupported = [&]() {
-    detail::fail(errc::malformed_file, file.string(), ": dtype '", descr,
+    detail::fail(errc::malformed_file, name, ": dtype '", descr,
                  "' is not supported; use float64 or float32");
   };
   if (descr.size() != 3) unsupported();
@@ -250,46 +251,30 @@ std::uint32_t read_le(const unsigned char* p, std::size_t n) {
   return v;
 }
 
-[[noreturn]] void fail_read(const fs::path& path, int err) {
-  detail::fail(errc::file_unreadable, "cannot read '", path.string(), "': ",
+[[noreturn]] void fail_read(const std::string& name, int err) {
+  detail::fail(errc::file_unreadable, "cannot read '", name, "': ",
                err != 0 ? std::strerror(err) : "read error");
 }
 
-void read_exact(std::ifstream& in, char* dst, std::size_t n, const fs::path& path) {
+void read_exact(std::istream& in, char* dst, std::size_t n, const std::string& name) {
   while (n > 0) {
     const std::size_t step = std::min<std::size_t>(n, std::size_t{1} << 30);
     errno = 0;
     in.read(dst, static_cast<std::streamsize>(step));
-    if (static_cast<std::size_t>(in.gcount()) != step) fail_read(path, errno);
+    if (static_cast<std::size_t>(in.gcount()) != step) fail_read(name, errno);
     dst += step;
     n -= step;
   }
 }
 
-}  // namespace
-
-NpyArray read_npy(const fs::path& path) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) detail::fail(errc::file_unreadable, "cannot read '", path.string(), "': it is a directory");
-  errno = 0;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    const int e = errno;
-    detail::fail(errc::file_unreadable, "cannot open '", path.string(), "': ",
-                 e != 0 ? std::strerror(e) : "open failed");
-  }
-  in.seekg(0, std::ios::end);
-  const auto end = in.tellg();
-  in.seekg(0, std::ios::beg);
-  if (end < 0 || !in) fail_read(path, errno);
-  const auto file_size = static_cast<std::uint64_t>(end);
-
-  const std::string name = path.string();
+/// The array in `in`, which holds `file_size` bytes; `name` names it in messages.
+/// What read_npy and parse_npy share: one reader for files and memory.
+NpyArray read_npy_stream(std::istream& in, std::uint64_t file_size, const std::string& name) {
   unsigned char pre[12] = {};
   if (file_size < 10) {
     detail::fail(errc::malformed_file, name, ": not an NPY file (", file_size, " bytes, shorter than the NPY preamble)");
   }
-  read_exact(in, reinterpret_cast<char*>(pre), 10, path);
+  read_exact(in, reinterpret_cast<char*>(pre), 10, name);
   if (std::memcmp(pre, magic, sizeof magic) != 0) {
     detail::fail(errc::malformed_file, name, ": not an NPY file (bad magic: the file does not start with \\x93NUMPY)");
   }
@@ -299,7 +284,7 @@ NpyArray read_npy(const fs::path& path) {
     prefix = 12;
     len_bytes = 4;
     if (file_size < 12) detail::fail(errc::malformed_file, name, ": truncated NPY preamble (", file_size, " bytes)");
-    read_exact(in, reinterpret_cast<char*>(pre) + 10, 2, path);
+    read_exact(in, reinterpret_cast<char*>(pre) + 10, 2, name);
   } else if (major != 1) {
     detail::fail(errc::malformed_file, name, ": NPY format version ", major, ".", minor,
                  " is not supported (1.0, 2.0 and 3.0 are)");
@@ -314,9 +299,9 @@ NpyArray read_npy(const fs::path& path) {
                  file_size - prefix, " after the preamble");
   }
   std::string text(header_len, '\0');
-  read_exact(in, text.data(), header_len, path);
-  const Header h = HeaderParser(text, path).parse();
-  const Dtype dt = parse_dtype(h.descr, path);
+  read_exact(in, text.data(), header_len, name);
+  const Header h = HeaderParser(text, name).parse();
+  const Dtype dt = parse_dtype(h.descr, name);
 
   // Sizes, before allocating anything for the data.
   std::size_t count = 1;
@@ -349,7 +334,7 @@ NpyArray read_npy(const fs::path& path) {
 
   if (!fortran && dt.size == 8) {
     // The common case: the file's bytes are the result, up to byte order.
-    read_exact(in, reinterpret_cast<char*>(out.data.data()), count * 8, path);
+    read_exact(in, reinterpret_cast<char*>(out.data.data()), count * 8, name);
     if (!native) {
       for (double& v : out.data) v = std::bit_cast<double>(byteswap(std::bit_cast<std::uint64_t>(v)));
     }
@@ -378,7 +363,7 @@ NpyArray read_npy(const fs::path& path) {
   std::vector<unsigned char> buf(std::min(count, chunk_elems) * dt.size);
   for (std::size_t done = 0; done < count;) {
     const std::size_t n = std::min(count - done, chunk_elems);
-    read_exact(in, reinterpret_cast<char*>(buf.data()), n * dt.size, path);
+    read_exact(in, reinterpret_cast<char*>(buf.data()), n * dt.size, name);
     for (std::size_t k = 0; k < n; ++k) {
       out.data[offset] = decode(buf.data() + k * dt.size, dt);
       advance();
@@ -386,6 +371,30 @@ NpyArray read_npy(const fs::path& path) {
     done += n;
   }
   return out;
+}
+
+}  // namespace
+
+NpyArray read_npy(const fs::path& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) detail::fail(errc::file_unreadable, "cannot read '", path.string(), "': it is a directory");
+  errno = 0;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const int e = errno;
+    detail::fail(errc::file_unreadable, "cannot open '", path.string(), "': ",
+                 e != 0 ? std::strerror(e) : "open failed");
+  }
+  in.seekg(0, std::ios::end);
+  const auto end = in.tellg();
+  in.seekg(0, std::ios::beg);
+  if (end < 0 || !in) fail_read(path.string(), errno);
+  return read_npy_stream(in, static_cast<std::uint64_t>(end), path.string());
+}
+
+NpyArray parse_npy(std::string_view bytes, std::string_view name) {
+  detail::MemoryStream in(bytes);
+  return read_npy_stream(in, bytes.size(), std::string(name));
 }
 
 void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::span<const double> data) {

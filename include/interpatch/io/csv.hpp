@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "interpatch/vec3.hpp"
@@ -28,6 +29,17 @@ namespace interpatch::io {
 ///   overflow, naming file:row:column), size_mismatch (point count differs from
 ///   `expected`, when expected > 0; both counts named).
 [[nodiscard]] std::vector<Vec3> read_csv_points(const std::filesystem::path& path, std::size_t expected = 0);
+
+/// The same as read_csv_points, from text already in memory (the file reader and
+/// this one are one code path). `name` stands for the file in messages.
+///
+/// Example:
+/// @code
+///   auto pts = interpatch::io::parse_csv_points("x,y,z\n0,0,0\n1,0,0.5\n", 2, "inline.csv");
+/// @endcode
+/// @throws error malformed_file, not_finite, size_mismatch, as read_csv_points.
+[[nodiscard]] std::vector<Vec3> parse_csv_points(std::string_view text, std::size_t expected = 0,
+                                                 std::string_view name = "csv");
 
 /// Writes an evaluation grid: a header `u,v,x,y,z` (one name per parameter axis,
 /// then x,y,z), then one row per point in C order (first axis outermost). `params`

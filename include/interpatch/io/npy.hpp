@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <span>
+#include <string_view>
 #include <vector>
 
 namespace interpatch::io {
@@ -29,6 +30,18 @@ struct NpyArray {
 ///   naming the file and the sizes), too_large (the shape needs more memory than
 ///   available; refused before allocating).
 [[nodiscard]] NpyArray read_npy(const std::filesystem::path& path);
+
+/// The same as read_npy, from the bytes of a .npy file already in memory (the
+/// file reader and this one are one code path). `name` stands for the file in
+/// messages.
+///
+/// Example:
+/// @code
+///   std::string bytes = load_from_somewhere();
+///   interpatch::io::NpyArray a = interpatch::io::parse_npy(bytes, "upload.npy");
+/// @endcode
+/// @throws error malformed_file, too_large, as read_npy; file_unreadable never.
+[[nodiscard]] NpyArray parse_npy(std::string_view bytes, std::string_view name = "npy");
 
 /// Writes little-endian float64 in C order, format version 1.0 (header padded to
 /// 64 bytes as NumPy does), atomically.
