@@ -1,11 +1,14 @@
 #include "interpatch/blended_surface.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "detail/blended_terms.hpp"
+#include "detail/parallel.hpp"
 #include "detail/text.hpp"
 #include "interpatch/hermite.hpp"
+#include "interpatch/memory.hpp"
 
 namespace interpatch {
 
@@ -222,6 +225,58 @@ SurfaceDerivatives BlendedSurface::derivatives(double u, double v) const {
     d.svv -= B[0] * C[2] * g + 2 * B[0] * C[1] * gv + B[0] * C[0] * gvv;
   }
   return d;
+}
+
+PointGrid BlendedSurface::evaluate(std::span<const double> us, std::span<const double> vs,
+                                  const progress_callback& progress) const {
+  const auto& T = *t_;
+  if (!T.gregory.empty()) return Surface::evaluate(us, vs, progress);
+  detail::check_unit_parameters(us, "u");
+  detail::check_unit_parameters(vs, "v");
+  require_memory(us.size() * vs.size(), sizeof(Vec3), "surface evaluation grid");
+  const std::size_t nu = us.size(), nv = vs.size(), K = T.f.size(), L = T.g.size();
+  auto value = [](const detail::Scalar& f, double t) { return f.spline ? f.spline->point(t).x : f.fn(t, 0); };
+  auto clamp = [](double t) { return std::clamp(t, 0.0, 1.0); };
+  // Per u: F[i][k] = f_k(u_i), and P[i][l] = b_l(u_i) + Σ_k c_kl f_k(u_i), the factor
+  // of g_l(v). Per v: G[j][l] = g_l(v_j), A[j][k] = a_k(v_j).
+  std::vector<double> F(nu * K), G(nv * L);
+  std::vector<Vec3> P(nu * L), A(nv * T.a.size());
+  for (std::size_t i = 0; i < nu; ++i) {
+    const double u = clamp(us[i]);
+    for (std::size_t k = 0; k < K; ++k) F[i * K + k] = value(T.f[k], u);
+    for (std::size_t l = 0; l < L; ++l) {
+      Vec3 p = l < T.b.size() ? T.b[l].point(u) : Vec3{};
+      if (!T.c.empty())
+        for (std::size_t k = 0; k < K; ++k) p += F[i * K + k] * T.c(k, l);
+      P[i * L + l] = p;
+    }
+  }
+  for (std::size_t j = 0; j < nv; ++j) {
+    const double v = clamp(vs[j]);
+    for (std::size_t l = 0; l < L; ++l) G[j * L + l] = value(T.g[l], v);
+    for (std::size_t k = 0; k < T.a.size(); ++k) A[j * T.a.size() + k] = T.a[k].point(v);
+  }
+  PointGrid out({nu, nv});
+  const std::size_t KA = T.a.size();
+  const auto rows = static_cast<long long>(nu);
+  std::atomic<std::size_t> done{0};
+#pragma omp parallel for schedule(static, 16) if (nu * nv * (KA + L) >= detail::parallel_min_work)
+  for (long long ri = 0; ri < rows; ++ri) {
+    const auto i = static_cast<std::size_t>(ri);
+    const double* f = F.data() + i * K;
+    const Vec3* p = P.data() + i * L;
+    Vec3* o = &out(i, 0);
+    for (std::size_t j = 0; j < nv; ++j) {
+      Vec3 s{};
+      for (std::size_t k = 0; k < KA; ++k) s += f[k] * A[j * KA + k];
+      for (std::size_t l = 0; l < L; ++l) s += G[j * L + l] * p[l];
+      o[j] = s;
+    }
+    const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
+    if (progress && detail::thread_index() == 0 && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(nu));
+  }
+  if (progress) progress(1.0);
+  return out;
 }
 
 bool BlendedSurface::has_exact_form() const noexcept {

@@ -6,6 +6,7 @@
 
 #include "detail/banded.hpp"
 #include "detail/collocation.hpp"
+#include "detail/parallel.hpp"
 #include "detail/text.hpp"
 #include "interpatch/memory.hpp"
 
@@ -140,66 +141,321 @@ CurveInterpolation interpolate_curve(std::span<const Vec3> points, const CurveIn
 
 namespace {
 
-// Parameters along the middle axis of a grid seen as outer × n × inner points in C
-// order (any rank and axis): each line along the axis gets its chord parameters;
-// lines of zero length (a pole) are left out; the rest are averaged in line order
-// (seed 003). Every loop runs along memory.
-std::vector<double> line_parameters(const Vec3* q, std::size_t outer, std::size_t n, std::size_t inner, int axis,
-                                    Parametrization param) {
-  if (n < 2) fail(errc::too_few_points, "a grid needs at least 2 points along ", axis_name(axis), ", got ", n);
-  std::vector<double> t(n, 0.0);
-  if (param == Parametrization::uniform) {
+// ------------------------------------------------------------ tensor grids
+//
+// Interpolation through a grid (seed 003) streams the grid three times and keeps no
+// grid-sized temporary (fresh pages cost more than the arithmetic on them):
+//  1. chord pass: finite check; along every axis inside a row (the slice of one
+//     index along u: a row of a surface, a plane of a volume) each line's chords
+//     and normalized running lengths, summed over the lines; along u each line's
+//     length;
+//  2. row pass, a few rows at a time while they are in cache: each row's averaged
+//     step along u (chords to the row before, weighted by 1 / line length), then
+//     the banded solves along the axes inside the rows;
+//  3. the banded solve along u, in column slices that stay in cache.
+// Partial sums are formed in chunks of a fixed number of rows and added in chunk
+// order, so the result does not depend on the number of threads.
+
+constexpr std::size_t rows_per_chunk = 16;
+constexpr std::size_t rows_per_group = 8;
+// A line shorter than 1e-14 of the longest along its axis is a collapsed row (a
+// pole) within rounding: it is left out of the averaging.
+constexpr double pole_ratio = 1e-14;
+
+// Chord lengths |b[i] − a[i]| (square roots of them, centripetal) for i < count.
+// Squares first, roots in a loop of their own, which the compiler vectorizes.
+void chord_lengths(const Vec3* a, const Vec3* b, std::size_t count, double* out, Parametrization param) {
+  for (std::size_t i = 0; i < count; ++i) {
+    const double dx = b[i].x - a[i].x, dy = b[i].y - a[i].y, dz = b[i].z - a[i].z;
+    out[i] = dx * dx + dy * dy + dz * dz;
+  }
+  for (std::size_t i = 0; i < count; ++i) out[i] = std::sqrt(out[i]);
+  if (param == Parametrization::centripetal)
+    for (std::size_t i = 0; i < count; ++i) out[i] = std::sqrt(out[i]);
+}
+
+// Σ a[i] and Σ a[i] b[i] in four interleaved partial sums: a fixed order (the same
+// bits on every run) without one long chain of dependent additions.
+double sum(const double* a, std::size_t n) {
+  double s[4] = {0, 0, 0, 0};
+  std::size_t i = 0;
+  for (; i + 4 <= n; i += 4)
+    for (std::size_t j = 0; j < 4; ++j) s[j] += a[i + j];
+  for (; i < n; ++i) s[0] += a[i];
+  return (s[0] + s[1]) + (s[2] + s[3]);
+}
+
+double dot(const double* a, const double* b, std::size_t n) {
+  double s[4] = {0, 0, 0, 0};
+  std::size_t i = 0;
+  for (; i + 4 <= n; i += 4)
+    for (std::size_t j = 0; j < 4; ++j) s[j] += a[i + j] * b[i + j];
+  for (; i < n; ++i) s[0] += a[i] * b[i];
+  return (s[0] + s[1]) + (s[2] + s[3]);
+}
+
+struct GridShape {
+  std::size_t rank = 0;
+  std::array<std::size_t, 3> n{};
+  std::size_t row = 1;  // points in one row (every index but the first)
+  // Lines along in-row axis a inside one row: outer(a) × inner(a) of them.
+  [[nodiscard]] std::size_t outer(std::size_t a) const {
+    std::size_t o = 1;
+    for (std::size_t x = 1; x < a; ++x) o *= n[x];
+    return o;
+  }
+  [[nodiscard]] std::size_t inner(std::size_t a) const {
+    std::size_t i = 1;
+    for (std::size_t x = a + 1; x < rank; ++x) i *= n[x];
+    return i;
+  }
+  [[nodiscard]] std::size_t lines(std::size_t a) const { return outer(a) * inner(a); }
+};
+
+template <std::size_t Rank>
+GridShape grid_shape(const std::array<std::size_t, Rank>& shape) {
+  GridShape g;
+  g.rank = Rank;
+  for (std::size_t a = 0; a < Rank; ++a) g.n[a] = shape[a];
+  for (std::size_t a = 1; a < Rank; ++a) g.row *= shape[a];
+  return g;
+}
+
+// Pass 1 and what the averaged parameters need from it.
+class GridChords {
+ public:
+  GridChords(const Vec3* q, const GridShape& g, Parametrization param) : g_(g), param_(param) {
+    const std::size_t n0 = g.n[0], M = g.row, R = g.rank;
+    if (param == Parametrization::uniform) {
+      check_finite(q);
+      return;
+    }
+    const std::size_t chunks = (n0 + rows_per_chunk - 1) / rows_per_chunk;
+    std::size_t sums = chunks * M;
+    for (std::size_t a = 1; a < R; ++a) sums += n0 * g.lines(a) + chunks * g.n[a];
+    require_memory(sums, sizeof(double), "chord sums of the grid");
+    // part[c][a]: chunk c's sums; a = 0: the lengths of the lines along u (one per
+    // point of a row); a ≥ 1: normalized running lengths along axis a.
+    std::vector<std::vector<double>> part(chunks * R);
+    line_length_.assign(R, {});
+    for (std::size_t a = 1; a < R; ++a) line_length_[a].assign(n0 * g.lines(a), 0.0);
+    std::vector<std::size_t> bad(chunks, no_point);
+    const auto nchunks = static_cast<long long>(chunks);
+#pragma omp parallel if (n0 * M >= detail::parallel_min_work / 4)
+    {
+      std::vector<double> scratch(scratch_size());
+#pragma omp for schedule(static)
+      for (long long ci = 0; ci < nchunks; ++ci) {
+        const auto c = static_cast<std::size_t>(ci);
+        part[c * R].assign(M, 0.0);
+        for (std::size_t a = 1; a < R; ++a) part[c * R + a].assign(g.n[a], 0.0);
+        const std::size_t r1 = std::min(n0, (c + 1) * rows_per_chunk);
+        for (std::size_t r = c * rows_per_chunk; r < r1; ++r) {
+          const Vec3* row = q + r * M;
+          if (const std::size_t m = first_non_finite(row, M); m != no_point) {
+            bad[c] = r * M + m;
+            break;
+          }
+          if (r > 0) {
+            chord_lengths(row - M, row, M, scratch.data(), param);
+            double* t0 = part[c * R].data();
+            for (std::size_t m = 0; m < M; ++m) t0[m] += scratch[m];
+          }
+          for (std::size_t a = 1; a < R; ++a)
+            add_running_lengths(row, a, part[c * R + a].data(), line_length_[a].data() + r * g.lines(a),
+                                scratch.data());
+        }
+      }
+    }
+    for (std::size_t c = 0; c < chunks; ++c)
+      if (bad[c] != no_point) fail_not_finite(q, bad[c]);
+    // Nearly collapsed lines were summed like the others: take them out again.
+    used_.assign(R, 0);
+    for (std::size_t a = 1; a < R; ++a) {
+      const auto& len = line_length_[a];
+      const double cut = pole_ratio * *std::max_element(len.begin(), len.end());
+      const std::size_t per_row = g.lines(a);
+      for (std::size_t l = 0; l < len.size(); ++l) {
+        if (len[l] > cut) ++used_[a];
+        else if (len[l] > 0) remove_line(q, a, l / per_row, l % per_row, part[(l / per_row / rows_per_chunk) * R + a]);
+      }
+    }
+    sums_.assign(R, {});
+    for (std::size_t a = 0; a < R; ++a) {
+      sums_[a].assign(a == 0 ? M : g.n[a], 0.0);
+      for (std::size_t c = 0; c < chunks; ++c)
+        for (std::size_t k = 0; k < sums_[a].size(); ++k) sums_[a][k] += part[c * R + a][k];
+    }
+    // Along u: the weight of each line is 1 / its length, 0 for a collapsed line.
+    const double cut0 = pole_ratio * *std::max_element(sums_[0].begin(), sums_[0].end());
+    inv_length_.assign(M, 0.0);
+    for (std::size_t m = 0; m < M; ++m)
+      if (sums_[0][m] > cut0) {
+        inv_length_[m] = 1.0 / sums_[0][m];
+        ++used_[0];
+      }
+  }
+
+  // Averaged parameters along in-row axis a ≥ 1.
+  [[nodiscard]] std::vector<double> in_row_parameters(std::size_t a) const {
+    if (param_ == Parametrization::uniform) return uniform(g_.n[a]);
+    if (used_[a] == 0) fail_all_collapsed(a);
+    std::vector<double> t(g_.n[a], 0.0);
+    double s = 0;
+    for (std::size_t k = 1; k < t.size(); ++k) {
+      s += sums_[a][k];
+      t[k] = s / static_cast<double>(used_[a]);
+    }
+    return finish(std::move(t), a);
+  }
+
+  // Row r's step along u: Σ over the lines along u of chord(r − 1, r) / line length.
+  double row_step(const Vec3* prev, const Vec3* row, double* scratch) const {
+    chord_lengths(prev, row, g_.row, scratch, param_);
+    return dot(scratch, inv_length_.data(), g_.row);
+  }
+
+  // Parameters along u from the rows' steps (steps[0] unused).
+  [[nodiscard]] std::vector<double> u_parameters(std::span<const double> steps) const {
+    if (param_ == Parametrization::uniform) return uniform(g_.n[0]);
+    if (used_[0] == 0) fail_all_collapsed(0);
+    std::vector<double> t(g_.n[0], 0.0);
+    double s = 0;
+    for (std::size_t k = 1; k < t.size(); ++k) {
+      s += steps[k];
+      t[k] = s / static_cast<double>(used_[0]);
+    }
+    return finish(std::move(t), 0);
+  }
+
+  // Refuses a grid whose lines along some axis all have zero length, axes in order.
+  void check_lines() const {
+    if (!uses_chords()) return;
+    for (std::size_t a = 0; a < g_.rank; ++a)
+      if (used_[a] == 0) fail_all_collapsed(a);
+  }
+
+  [[nodiscard]] bool uses_chords() const noexcept { return param_ != Parametrization::uniform; }
+  [[nodiscard]] std::size_t scratch_size() const {
+    std::size_t s = g_.row;
+    for (std::size_t a = 1; a < g_.rank; ++a) s = std::max(s, (g_.n[a] + 1) * g_.inner(a));
+    return s;
+  }
+
+ private:
+  static constexpr std::size_t no_point = static_cast<std::size_t>(-1);
+
+  static std::size_t first_non_finite(const Vec3* p, std::size_t count) {
+    for (std::size_t m = 0; m < count; ++m)
+      if (!is_finite(p[m])) return m;
+    return no_point;
+  }
+
+  void check_finite(const Vec3* q) const {
+    const std::size_t total = g_.n[0] * g_.row;
+    if (const std::size_t k = first_non_finite(q, total); k != no_point) fail_not_finite(q, k);
+  }
+
+  [[noreturn]] void fail_not_finite(const Vec3* q, std::size_t k) const {
+    std::string at;
+    for (std::size_t a = g_.rank, rest = k; a-- > 0; rest /= g_.n[a]) at = detail::cat("[", rest % g_.n[a], "]", at);
+    fail(errc::not_finite, "point ", at, " is ", q[k]);
+  }
+
+  [[noreturn]] static void fail_all_collapsed(std::size_t a) {
+    const char* ax = axis_name(static_cast<int>(a));
+    fail(errc::zero_chord, "every line of the grid along ", ax, " has zero length: all points coincide along ", ax);
+  }
+
+  static std::vector<double> uniform(std::size_t n) {
+    std::vector<double> t(n);
     for (std::size_t i = 0; i < n; ++i) t[i] = static_cast<double>(i) / static_cast<double>(n - 1);
     t.back() = 1.0;
     return t;
   }
-  const std::size_t lines = outer * inner;
-  require_memory(lines, 2 * sizeof(double) + 1, detail::cat("chord lengths of the ", lines, " grid lines along ", axis_name(axis)));
-  // Pass 1: each line's length. Pass 2: each line's normalized running length,
-  // summed over the lines that have a length in line order.
-  std::vector<double> total(lines, 0.0), cum(lines, 0.0);
-  auto d = [&](std::size_t o, std::size_t k, std::size_t i) {  // step from point k-1 to k on line (o, i)
-    return step(q[(o * n + k - 1) * inner + i], q[(o * n + k) * inner + i], param);
-  };
-  for (std::size_t o = 0; o < outer; ++o)
-    for (std::size_t k = 1; k < n; ++k)
-      for (std::size_t i = 0; i < inner; ++i) total[o * inner + i] += d(o, k, i);
-  double maxlen = 0;
-  for (double L : total) maxlen = std::max(maxlen, L);
-  // A line shorter than 1e-14 of the longest is a collapsed row (pole) within rounding.
-  std::vector<char> used(lines);
-  std::size_t nused = 0;
-  for (std::size_t l = 0; l < lines; ++l) {
-    used[l] = total[l] > 1e-14 * maxlen ? 1 : 0;
-    nused += used[l];
+
+  static std::vector<double> finish(std::vector<double> t, std::size_t a) {
+    t.back() = 1.0;
+    for (std::size_t k = 1; k < t.size(); ++k)
+      if (!(t[k] > t[k - 1]))
+        fail(errc::zero_chord, "grid points ", k - 1, " and ", k, " along ", axis_name(static_cast<int>(a)),
+             " coincide on every line (averaged parameters ", t[k - 1], " and ", t[k], ")");
+    return t;
   }
-  if (nused == 0)
-    fail(errc::zero_chord, "every line of the grid along ", axis_name(axis),
-         " has zero length: all points coincide along ", axis_name(axis));
-  for (std::size_t o = 0; o < outer; ++o)
-    for (std::size_t k = 1; k < n; ++k)
-      for (std::size_t i = 0; i < inner; ++i) {
-        const std::size_t l = o * inner + i;
-        cum[l] += d(o, k, i);
-        if (used[l]) t[k] += cum[l] / total[l];
+
+  // Adds, for every line along in-row axis a of one row, its chords divided by its
+  // length (the running sums of these are the line's normalized parameters, summed
+  // once at the end: in_row_parameters); records each line's length.
+  void add_running_lengths(const Vec3* row, std::size_t a, double* acc, double* lengths, double* scratch) const {
+    const std::size_t n = g_.n[a], inner = g_.inner(a), outer = g_.outer(a);
+    double* ch = scratch;  // (n − 1) × inner chords
+    double* inv = ch + n * inner;
+    for (std::size_t o = 0; o < outer; ++o) {
+      const Vec3* base = row + o * n * inner;
+      if (inner == 1) {
+        chord_lengths(base, base + 1, n - 1, ch, param_);
+        lengths[o] = sum(ch, n - 1);
+        const double w = lengths[o] > 0 ? 1.0 / lengths[o] : 0.0;  // a line of zero length is left out
+        for (std::size_t k = 1; k < n; ++k) acc[k] += ch[k - 1] * w;
+        continue;
       }
-  for (std::size_t k = 1; k < n; ++k) t[k] /= static_cast<double>(nused);
-  t.back() = 1.0;
-  for (std::size_t k = 1; k < n; ++k)
-    if (!(t[k] > t[k - 1]))
-      fail(errc::zero_chord, "grid points ", k - 1, " and ", k, " along ", axis_name(axis),
-           " coincide on every line (averaged parameters ", t[k - 1], " and ", t[k], ")");
-  return t;
+      for (std::size_t k = 1; k < n; ++k)
+        chord_lengths(base + (k - 1) * inner, base + k * inner, inner, ch + (k - 1) * inner, param_);
+      double* len = lengths + o * inner;
+      std::fill_n(len, inner, 0.0);
+      for (std::size_t k = 1; k < n; ++k)
+        for (std::size_t i = 0; i < inner; ++i) len[i] += ch[(k - 1) * inner + i];
+      for (std::size_t i = 0; i < inner; ++i) inv[i] = len[i] > 0 ? 1.0 / len[i] : 0.0;
+      for (std::size_t k = 1; k < n; ++k) acc[k] += dot(ch + (k - 1) * inner, inv, inner);
+    }
+  }
+
+  // Takes line l of row r along axis a back out of its chunk's sums.
+  void remove_line(const Vec3* q, std::size_t a, std::size_t r, std::size_t l, std::vector<double>& acc) const {
+    const std::size_t n = g_.n[a], inner = g_.inner(a);
+    const Vec3* base = q + r * g_.row + (l / inner) * n * inner + l % inner;
+    const double w = 1.0 / line_length_[a][r * g_.lines(a) + l];
+    double d = 0;
+    for (std::size_t k = 1; k < n; ++k) {
+      chord_lengths(base + (k - 1) * inner, base + k * inner, 1, &d, param_);
+      acc[k] -= d * w;
+    }
+  }
+
+  GridShape g_;
+  Parametrization param_;
+  std::vector<std::vector<double>> sums_;         // per axis: 0 → line lengths along u; a ≥ 1 → Σ over lines of chord k / line length
+  std::vector<std::vector<double>> line_length_;  // per in-row axis: every line's length, row by row
+  std::vector<std::size_t> used_;                  // lines averaged per axis
+  std::vector<double> inv_length_;                 // per line along u: 1 / length, 0 when collapsed
+};
+
+// Every row's step along u (pass 2 without the solves).
+std::vector<double> row_steps(const Vec3* q, const GridShape& g, const GridChords& chords) {
+  std::vector<double> steps(g.n[0], 0.0);
+  const auto n0 = static_cast<long long>(g.n[0]);
+#pragma omp parallel if (g.n[0] * g.row >= detail::parallel_min_work / 4)
+  {
+    std::vector<double> scratch(g.row);
+#pragma omp for schedule(static)
+    for (long long r = 1; r < n0; ++r) {
+      const auto k = static_cast<std::size_t>(r);
+      steps[k] = chords.row_step(q + (k - 1) * g.row, q + k * g.row, scratch.data());
+    }
+  }
+  return steps;
 }
 
-template <class G>
-std::vector<double> grid_parameters_of(const G& q, int axis, Parametrization param) {
-  const auto& shape = q.shape();
+template <std::size_t Rank>
+std::vector<double> grid_parameters_of(const Grid<Vec3, Rank>& q, int axis, Parametrization param) {
+  if (axis < 0 || axis >= static_cast<int>(Rank))
+    fail(errc::out_of_domain, "axis ", axis, " is outside 0..", Rank - 1, " for a grid of rank ", Rank);
   const auto a = static_cast<std::size_t>(axis);
-  std::size_t outer = 1, inner = 1;
-  for (std::size_t x = 0; x < a; ++x) outer *= shape[x];
-  for (std::size_t x = a + 1; x < shape.size(); ++x) inner *= shape[x];
-  return line_parameters(q.data(), outer, shape[a], inner, axis, param);
+  if (q.extent(a) < 2) fail(errc::too_few_points, "a grid needs at least 2 points along ", axis_name(axis), ", got ", q.extent(a));
+  const GridShape g = grid_shape(q.shape());
+  const GridChords chords(q.data(), g, param);
+  if (a > 0) return chords.in_row_parameters(a);
+  return chords.u_parameters(chords.uses_chords() ? row_steps(q.data(), g, chords) : std::vector<double>(g.n[0], 0.0));
 }
 
 }  // namespace
@@ -219,9 +475,16 @@ struct GridSolution {
   std::vector<std::vector<double>> params;  // one per axis
 };
 
-// The tensor-product interpolation behind surfaces and volumes (seed 003): parameters
-// averaged over the lines along each axis, knots by averaging, then one in-place
-// banded pass along each axis, each factored once. The data become the control points.
+detail::BandedLU factor_axis(const KnotVector& knots, std::span<const double> params, std::size_t a) {
+  try {
+    return detail::factor_collocation(knots, params);
+  } catch (const error& e) {
+    fail(e.code(), "along ", axis_name(static_cast<int>(a)), ": ", e.what());
+  }
+}
+
+// The tensor-product interpolation behind surfaces and volumes (seed 003), in the
+// three passes described above. The data become the control points.
 template <std::size_t Rank>
 GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional<int>, Rank>& degree,
                         Parametrization param, const progress_callback& progress, const char* what) {
@@ -233,33 +496,64 @@ GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional
   };
   if (std::any_of(shape.begin(), shape.end(), [](std::size_t n) { return n < 2; }))
     fail(errc::too_few_points, what, " interpolation needs at least ", dims(true), " points, got ", dims(false));
-  const Vec3* data = points.data();
-  for (std::size_t k = 0; k < points.size(); ++k)
-    if (!is_finite(data[k])) {
-      std::string at;
-      for (std::size_t a = Rank, rest = k; a-- > 0; rest /= shape[a]) at = detail::cat("[", rest % shape[a], "]", at);
-      fail(errc::not_finite, "point ", at, " is ", data[k]);
-    }
   static constexpr const char* in_axis[3] = {" in u", " in v", " in w"};
   std::array<int, Rank> p{};
   for (std::size_t a = 0; a < Rank; ++a) p[a] = resolve_degree(degree[a], shape[a], 0, in_axis[a]);
   if (progress) progress(0.0);
+
+  // Pass 1, then the knots and factorizations of the axes inside the rows.
+  const GridShape g = grid_shape(shape);
+  const GridChords chords(points.data(), g, param);
+  chords.check_lines();
   GridSolution r;
+  r.params.resize(Rank);
+  r.knots.reserve(Rank);
   std::vector<detail::BandedLU> lu;
-  for (std::size_t a = 0; a < Rank; ++a) {
-    r.params.push_back(grid_parameters(points, static_cast<int>(a), param));
-    r.knots.push_back(averaged_knots(r.params[a], p[a]));
-    try {
-      lu.push_back(detail::factor_collocation(r.knots[a], r.params[a]));
-    } catch (const error& e) {
-      fail(e.code(), "along ", axis_name(static_cast<int>(a)), ": ", e.what());
+  for (std::size_t a = 1; a < Rank; ++a) {
+    r.params[a] = chords.in_row_parameters(a);
+    lu.push_back(factor_axis(averaged_knots(r.params[a], p[a]), r.params[a], a));
+  }
+  if (progress) progress(0.2);
+
+  // Pass 2: groups of rows, each thread a contiguous run of them. A row's step along
+  // u needs the row before it as it was, so each thread keeps a copy of the last
+  // row it has read before solving it.
+  std::vector<double> steps(g.n[0], 0.0);
+  Vec3* data = points.data();
+  const std::size_t M = g.row, groups = (g.n[0] + rows_per_group - 1) / rows_per_group;
+  std::array<std::size_t, Rank + 1> group_shape{};
+  for (std::size_t a = 1; a < Rank; ++a) group_shape[a] = shape[a];
+  group_shape[Rank] = 3;
+#pragma omp parallel if (points.size() >= detail::parallel_min_work / 8)
+  {
+    const std::size_t nt = detail::thread_count(), t = static_cast<std::size_t>(detail::thread_index());
+    const std::size_t g0 = groups * t / nt, g1 = groups * (t + 1) / nt;
+    std::vector<Vec3> prev(chords.uses_chords() ? M : 0);
+    std::vector<double> scratch(chords.uses_chords() ? M : 0);
+    if (chords.uses_chords() && g0 < g1 && g0 > 0) std::copy_n(data + (g0 * rows_per_group - 1) * M, M, prev.data());
+#pragma omp barrier
+    auto gs = group_shape;
+    for (std::size_t gi = g0; gi < g1; ++gi) {
+      const std::size_t r0 = gi * rows_per_group, r1 = std::min(g.n[0], r0 + rows_per_group);
+      if (chords.uses_chords()) {
+        for (std::size_t k = std::max<std::size_t>(r0, 1); k < r1; ++k)
+          steps[k] = chords.row_step(k == r0 ? prev.data() : data + (k - 1) * M, data + k * M, scratch.data());
+        std::copy_n(data + (r1 - 1) * M, M, prev.data());
+      }
+      gs[0] = r1 - r0;
+      for (std::size_t a = 1; a < Rank; ++a)
+        detail::solve_along_axis(lu[a - 1], &data[r0 * M].x, gs.data(), Rank + 1, a, 1, false);
     }
   }
-  if (progress) progress(0.1);
-  for (std::size_t a = 0; a < Rank; ++a) {
-    detail::solve_along_axis(lu[a], &points.data()->x, shape.data(), Rank, a, 3);
-    if (progress) progress(0.1 + 0.9 * static_cast<double>(a + 1) / Rank);
-  }
+  if (progress) progress(0.6);
+
+  // Pass 3: along u.
+  r.params[0] = chords.u_parameters(steps);
+  r.knots.push_back(averaged_knots(r.params[0], p[0]));
+  for (std::size_t a = 1; a < Rank; ++a) r.knots.push_back(averaged_knots(r.params[a], p[a]));
+  const detail::BandedLU lu0 = factor_axis(r.knots[0], r.params[0], 0);
+  detail::solve_along_axis(lu0, &data->x, shape.data(), Rank, 0, 3);
+  if (progress) progress(1.0);
   return r;
 }
 

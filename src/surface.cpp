@@ -8,21 +8,10 @@
 
 namespace interpatch {
 
-namespace {
-
-// Checked before the parallel loops: an exception must not leave an OpenMP region.
-void check_unit(std::span<const double> ts, const char* dir) {
-  for (double t : ts)
-    if (!(t >= -1e-12 && t <= 1 + 1e-12))  // rounding of the caller's parameter mapping
-      detail::fail(errc::out_of_domain, "parameter ", dir, " = ", t, " is outside the domain [0, 1]");
-}
-
-}  // namespace
-
 PointGrid Surface::evaluate(std::span<const double> us, std::span<const double> vs,
                             const progress_callback& progress) const {
-  check_unit(us, "u");
-  check_unit(vs, "v");
+  detail::check_unit_parameters(us, "u");
+  detail::check_unit_parameters(vs, "v");
   require_memory(us.size() * vs.size(), sizeof(Vec3), "surface evaluation grid");
   PointGrid out({us.size(), vs.size()});
   const auto nu = static_cast<long long>(us.size());
@@ -39,8 +28,8 @@ PointGrid Surface::evaluate(std::span<const double> us, std::span<const double> 
 
 Grid<SurfaceDerivatives, 2> Surface::evaluate_derivatives(std::span<const double> us,
                                                           std::span<const double> vs) const {
-  check_unit(us, "u");
-  check_unit(vs, "v");
+  detail::check_unit_parameters(us, "u");
+  detail::check_unit_parameters(vs, "v");
   require_memory(us.size() * vs.size(), sizeof(SurfaceDerivatives), "surface derivative grid");
   Grid<SurfaceDerivatives, 2> out({us.size(), vs.size()});
   const auto nu = static_cast<long long>(us.size());

@@ -1,5 +1,6 @@
 #include "interpatch/blended_surface.hpp"
 
+#include "interpatch/coons.hpp"
 #include "interpatch/interpolate.hpp"
 #include "interpatch/network.hpp"
 #include "interpatch/patches.hpp"
@@ -82,6 +83,58 @@ TEST(BlendedSurface, TranslatingTheDataTranslatesTheSurface) {
       EXPECT_LT(distance(bt.point(u, v) - d, bl.point(u, v)), 1e-14 * 8);
       EXPECT_LT(distance(h1.point(u, v) - d, h0.point(u, v)), 1e-14 * 8);
     }
+}
+
+// The batch path evaluates each function once per parameter and sums products; the
+// pointwise path (derivatives) sums the same terms per point. Both must agree for
+// every kind of blended construction, at parameters that are not grid-aligned.
+TEST(BlendedSurface, BatchEvaluationMatchesPointwise) {
+  auto g = test::rng(91);
+  for (int trial = 0; trial < 6; ++trial) {
+    const auto src = test::random_bspline_surface(g, 3, 3, 7, 6);
+    const std::vector<double> tu{0, 0.35, 0.6, 1}, tv{0, 0.5, 1};
+    CurveNetwork n;
+    for (double v : tv) n.u_curves.push_back(test::iso_curve(src, 1, v));
+    for (double u : tu) n.v_curves.push_back(test::iso_curve(src, 0, u));
+    n.u_params = tu;
+    n.v_params = tv;
+    const CoonsBoundary b{test::iso_curve(src, 1, 0), test::iso_curve(src, 1, 1), test::iso_curve(src, 0, 0),
+                          test::iso_curve(src, 0, 1)};
+    const CoonsCrossDerivatives cross{test::iso_curve(src, 1, 0, 1), test::iso_curve(src, 1, 1, 1),
+                                      test::iso_curve(src, 0, 0, 1), test::iso_curve(src, 0, 1, 1)};
+    CoonsOptions hermite, callable;
+    hermite.blend_u = hermite.blend_v = Blend::hermite();
+    callable.blend_u = Blend([](double t, int k) { return k == 0 ? t * t : (k == 1 ? 2 * t : 2.0); });
+    HermiteCoonsOptions gregory;
+    gregory.twist_correction = TwistCorrection::gregory;
+    gregory.twists[0] = Vec3{1, 2, 3};  // disagrees with the curves: Gregory's terms are active
+    const std::vector<BlendedSurface> surfaces{
+        coons(b), coons(b, hermite), coons(b, callable), coons(b, cross), coons(b, cross, gregory),
+        ruled(b.v0, b.v1), curve_network(n, {NetworkMethod::coons_linear, {}}),
+        curve_network(n, {NetworkMethod::coons_hermite, {}}), curve_network(n, {NetworkMethod::gordon, {}})};
+    std::vector<double> us = linspace(0, 1, 23), vs = linspace(0, 1, 17);
+    for (auto& u : us) u = u * u;  // uneven spacing, ends kept
+    for (const auto& s : surfaces) {
+      const PointGrid grid = s.evaluate(us, vs);
+      ASSERT_EQ(grid.extent(0), us.size());
+      ASSERT_EQ(grid.extent(1), vs.size());
+      double worst = 0;
+      for (std::size_t i = 0; i < us.size(); ++i)
+        for (std::size_t j = 0; j < vs.size(); ++j)
+          worst = std::max(worst, distance(grid(i, j), s.derivatives(us[i], vs[j]).s));
+      // Both sum the same few products of values of size ~1 in another order: a few ulps.
+      EXPECT_LT(worst, 1e-13) << "trial " << trial;
+    }
+  }
+}
+
+TEST(BlendedSurface, BatchEvaluationRefusesParametersOutsideTheDomain) {
+  auto line = [](Vec3 a, Vec3 b) { return BSplineCurve(KnotVector(1, {0, 0, 1, 1}), {a, b}); };
+  const auto s = coons(CoonsBoundary{line({0, 0, 0}, {1, 0, 0}), line({0, 1, 0}, {1, 1, 1}), line({0, 0, 0}, {0, 1, 0}),
+                                     line({1, 0, 0}, {1, 1, 1})});
+  const std::vector<double> good{0, 0.5, 1}, bad{0, 1.5};
+  EXPECT_ERRC((void)s.evaluate(bad, good), out_of_domain, "parameter u = 1.5");
+  EXPECT_ERRC((void)s.evaluate(good, bad), out_of_domain, "parameter v = 1.5");
 }
 
 }  // namespace

@@ -70,42 +70,58 @@ void BandedLU::solve(double* b, std::size_t width, std::size_t stride) const noe
   }
 }
 
+namespace {
+
+// Columns of wide lines solved together. The forward and the back sweep each stream
+// through whole rows of the right-hand sides (the rows of the band stay in cache
+// between uses), which runs at memory speed; narrow column slices that try to keep
+// all n rows in cache between the sweeps jump between pages and run slower. Slices
+// of 4 KiB or more keep the streams long.
+std::size_t slice_width(std::size_t inner) {
+  constexpr std::size_t min_width = 512;
+  const std::size_t w = std::max(min_width, (inner + 3) / 4);
+  return w + (8 - w % 8) % 8;
+}
+
+// Eight narrow lines (the last axis: 3 doubles a row) side by side in `buf` give each
+// row operation 24 independent columns instead of one dependent chain of scalar
+// operations; every number still goes through the same operations.
+constexpr std::size_t narrow_group = 8;
+
+void solve_narrow_group(const BandedLU& lu, double* data, std::size_t n, std::size_t inner, std::size_t block,
+                        std::size_t m, double* buf) {
+  const std::size_t width = m * inner;
+  for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t l = 0; l < m; ++l) std::copy_n(data + l * block + k * inner, inner, buf + k * width + l * inner);
+  lu.solve(buf, width, width);
+  for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t l = 0; l < m; ++l) std::copy_n(buf + k * width + l * inner, inner, data + l * block + k * inner);
+}
+
+}  // namespace
+
 void solve_along_axis(const BandedLU& lu, double* data, const std::size_t* shape, std::size_t rank,
-                      std::size_t axis, std::size_t components) {
+                      std::size_t axis, std::size_t components, bool parallel) {
   std::size_t outer = 1, inner = components;
   for (std::size_t a = 0; a < axis; ++a) outer *= shape[a];
   for (std::size_t a = axis + 1; a < rank; ++a) inner *= shape[a];
   const std::size_t n = shape[axis];
   const std::size_t block = n * inner;
-  const bool threads = block * outer >= parallel_min_work;
+  const bool threads = parallel && block * outer >= parallel_min_work;
   if (inner < 64 && outer > 1) {
-    // Narrow lines (the last axis: 3 doubles a row) solved one at a time make the
-    // substitutions one dependent chain of scalar operations. Eight lines side by
-    // side in a buffer give each row operation 24 independent columns; every number
-    // still goes through the same operations, so the result is the same bits.
-    constexpr std::size_t group = 8;
-    const auto groups = static_cast<long long>((outer + group - 1) / group);
+    const auto groups = static_cast<long long>((outer + narrow_group - 1) / narrow_group);
 #pragma omp parallel if (threads)
     {
-      std::vector<double> buf(n * group * inner);
+      std::vector<double> buf(n * narrow_group * inner);
 #pragma omp for schedule(static)
       for (long long g = 0; g < groups; ++g) {
-        const std::size_t o0 = static_cast<std::size_t>(g) * group;
-        const std::size_t m = std::min(group, outer - o0);
-        const std::size_t width = m * inner;
-        for (std::size_t k = 0; k < n; ++k)
-          for (std::size_t l = 0; l < m; ++l)
-            std::copy_n(data + (o0 + l) * block + k * inner, inner, buf.data() + k * width + l * inner);
-        lu.solve(buf.data(), width, width);
-        for (std::size_t k = 0; k < n; ++k)
-          for (std::size_t l = 0; l < m; ++l)
-            std::copy_n(buf.data() + k * width + l * inner, inner, data + (o0 + l) * block + k * inner);
+        const std::size_t o0 = static_cast<std::size_t>(g) * narrow_group;
+        solve_narrow_group(lu, data + o0 * block, n, inner, block, std::min(narrow_group, outer - o0), buf.data());
       }
     }
     return;
   }
-  // Wide lines: column slices of a few KiB keep the band's rows in cache.
-  constexpr std::size_t slice = 512;
+  const std::size_t slice = slice_width(inner);
   const std::size_t slices = (inner + slice - 1) / slice;
   const auto tasks = static_cast<long long>(outer * slices);
 #pragma omp parallel for schedule(static) if (tasks > 1 && threads)

@@ -41,9 +41,11 @@ class BandedLU {
 
 /// Solves along one axis of a C-order array of `shape` (doubles, last axis the
 /// `components` of each value) in place: every line along `axis` is a right-hand
-/// side of `lu`. Threads split independent lines and column slices; every number
-/// is computed by the same operations whatever the thread count.
+/// side of `lu`. With `parallel`, threads split independent lines and column
+/// slices; without, the calling thread does all (for callers already inside a
+/// parallel region). Every number is computed by the same operations whatever the
+/// thread count.
 void solve_along_axis(const BandedLU& lu, double* data, const std::size_t* shape, std::size_t rank,
-                      std::size_t axis, std::size_t components);
+                      std::size_t axis, std::size_t components, bool parallel = true);
 
 }  // namespace interpatch::detail

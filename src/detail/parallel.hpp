@@ -23,4 +23,13 @@ inline int thread_index() noexcept {
 #endif
 }
 
+/// Threads of the innermost parallel region (1 outside one).
+inline std::size_t thread_count() noexcept {
+#ifdef _OPENMP
+  return static_cast<std::size_t>(omp_get_num_threads());
+#else
+  return 1;
+#endif
+}
+
 }  // namespace interpatch::detail

@@ -38,6 +38,16 @@ template <class... A>
   throw error(code, cat(parts...));
 }
 
+/// Refuses a parameter outside [0, 1], the domain of every construction; 1e-12 of
+/// slack absorbs rounding in the caller's parameter mapping. Batch evaluations
+/// check before their parallel loops: an exception must not leave an OpenMP region.
+template <class Range>
+void check_unit_parameters(const Range& ts, const char* dir) {
+  for (double t : ts)
+    if (!(t >= -1e-12 && t <= 1 + 1e-12))
+      fail(errc::out_of_domain, "parameter ", dir, " = ", t, " is outside the domain [0, 1]");
+}
+
 }  // namespace interpatch::detail
 
 // Internal invariants: checked in debug builds, compiled out in release.
