@@ -3,15 +3,15 @@
 
 SHELL := /bin/bash
 # OpenCASCADE reads back the STEP and IGES files (tests) and, with SISL, runs the
-# side-by-side benchmarks; clang's libFuzzer runs the fuzz targets; matplotlib plots.
+# side-by-side benchmarks; clang's libFuzzer (and its OpenMP) runs the fuzz targets; matplotlib plots.
 DEBS := cmake ninja-build g++ python3 libeigen3-dev liblapack-dev libcli11-dev nlohmann-json3-dev \
         libgtest-dev libgmock-dev libbenchmark-dev python3-numpy python3-vtk9 python3-matplotlib \
         libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
-        libocct-foundation-dev libsisl-dev clang libclang-rt-14-dev
+        libocct-foundation-dev libsisl-dev clang libclang-rt-14-dev libomp-14-dev
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
-.PHONY: all deps build demo test test-release test-asan bench clean
+.PHONY: all deps build demo test test-release test-asan test-fuzz fuzz fuzz-build bench clean
 
 all: build
 
@@ -40,7 +40,23 @@ test-asan: deps
 	cmake --build --preset asan -j $(JOBS)
 	ctest --preset asan -j $(JOBS)
 
-test: test-release test-asan
+# The parsers under libFuzzer (clang, ASan + UBSan): every checked-in seed and
+# regression input once, then FUZZ_TEST_SECONDS of fuzzing per target. `make fuzz`
+# fuzzes longer; new corpus entries and crashes stay in build/fuzz/fuzz-work/.
+FUZZ_TEST_SECONDS ?= 20
+FUZZ_SECONDS ?= 600
+
+fuzz-build: deps
+	cmake --preset fuzz
+	cmake --build --preset fuzz -j $(JOBS)
+
+test-fuzz: fuzz-build
+	tests/fuzz/run.sh build/fuzz $(FUZZ_TEST_SECONDS)
+
+fuzz: fuzz-build
+	tests/fuzz/run.sh build/fuzz $(FUZZ_SECONDS)
+
+test: test-release test-asan test-fuzz
 
 # Benchmarks (never part of `make test`): the console table, then the JSON record
 # and its Markdown tables (docs/BENCHMARKS.md). Repetitions tame a shared machine;

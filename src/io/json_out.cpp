@@ -23,8 +23,9 @@ using ojson = nlohmann::ordered_json;
 
 namespace {
 
+// Used only in discarded static_asserts, which clang counts as unused.
 template <class>
-inline constexpr bool unhandled_exact_form = false;
+[[maybe_unused]] inline constexpr bool unhandled_exact_form = false;
 
 // Shortest text that reads back to the same double (std::to_chars without a
 // precision), which is always a valid JSON number for finite values.
