@@ -145,32 +145,13 @@ void grid_copy(benchmark::State& state) {
 
 // ---------------------------------------------------------------- memcpy baselines
 
-// Copies with every thread the library uses (each its own contiguous share), or
-// with one: the bandwidth limit the library's two-core solves are held against.
-void copy_bytes(std::byte* dst, const std::byte* src, std::size_t bytes, bool threaded) {
-#if defined(_OPENMP)
-  if (threaded) {
-#pragma omp parallel
-    {
-      const auto t = static_cast<std::size_t>(omp_get_thread_num());
-      const auto nt = static_cast<std::size_t>(omp_get_num_threads());
-      const std::size_t a = bytes / nt * t, b = t + 1 == nt ? bytes : bytes / nt * (t + 1);
-      std::memcpy(dst + a, src + a, b - a);
-    }
-    return;
-  }
-#endif
-  static_cast<void>(threaded);
-  std::memcpy(dst, src, bytes);
-}
-
 // Both buffers allocated and touched before timing.
 void time_memcpy(benchmark::State& state, std::size_t bytes, std::size_t points, bool threaded) {
   std::vector<std::byte> src(bytes, std::byte{1}), dst(bytes);
   for (auto _ : state) {
     benchmark::DoNotOptimize(src.data());
     const auto t0 = clock_type::now();
-    copy_bytes(dst.data(), src.data(), bytes, threaded);
+    interpatch::bench::copy_bytes(dst.data(), src.data(), bytes, threaded);
     benchmark::ClobberMemory();
     const auto t1 = clock_type::now();
     state.SetIterationTime(seconds(t0, t1));

@@ -15,7 +15,6 @@
 
 #include <GeomAPI_Interpolate.hxx>
 #include <GeomAPI_PointsToBSplineSurface.hxx>
-#include <GeomAPI_ProjectPointOnSurf.hxx>
 #include <GeomAdaptor_Surface.hxx>
 #include <GeomFill_BSplineCurves.hxx>
 #include <Geom_BSplineCurve.hxx>
@@ -311,23 +310,6 @@ void skipped(const std::string& job, std::size_t n, const std::string& library, 
 
 // ---------------------------------------------------------------- memcpy baseline
 
-// Copies with one thread, or with `threads` threads each copying its share.
-void copy_bytes(std::byte* dst, const std::byte* src, std::size_t bytes, int threads) {
-#if defined(_OPENMP)
-  if (threads > 1) {
-#pragma omp parallel num_threads(threads)
-    {
-      const auto t = static_cast<std::size_t>(omp_get_thread_num());
-      const auto nt = static_cast<std::size_t>(omp_get_num_threads());
-      const std::size_t a = bytes / nt * t, b = t + 1 == nt ? bytes : bytes / nt * (t + 1);
-      std::memcpy(dst + a, src + a, b - a);
-    }
-    return;
-  }
-#endif
-  std::memcpy(dst, src, bytes);
-}
-
 // A memcpy of `bytes` (reading them and writing as many: the traffic of a job that
 // reads its input once and writes its output once), between buffers allocated and
 // touched beforehand, on one thread and on every thread of the run.
@@ -340,7 +322,7 @@ void measure_memcpy(const Options& o, const std::string& job, std::size_t n, std
     auto row = row_of(job, n, "memcpy", std::to_string(bytes) + " bytes", threads, 0);
     measure(std::move(row), std::max(o.reps, 5),
             [&](Laps&) {
-              copy_bytes(dst.data(), src.data(), bytes, threads);
+              ib::copy_bytes(dst.data(), src.data(), bytes, threads > 1);
               return dst.data();
             },
             [&](const std::byte* d) {
@@ -437,6 +419,27 @@ Handle(Geom_BSplineSurface) occt_copy(const BSplineSurface& s) {
   auto [ku, mu] = occt_knots(s.knots_u().values());
   auto [kv, mv] = occt_knots(s.knots_v().values());
   return new Geom_BSplineSurface(poles, ku, kv, mu, mv, s.degree_u(), s.degree_v());
+}
+
+// The point of an OpenCASCADE surface nearest to q, by Gauss-Newton from (u, v).
+Vec3 occt_closest(const Geom_BSplineSurface& s, const Vec3& q, double u, double v) {
+  double u0, u1, v0, v1;
+  s.Bounds(u0, u1, v0, v1);
+  gp_Pnt p;
+  gp_Vec su, sv;
+  for (int it = 0; it < 50; ++it) {
+    s.D1(u, v, p, su, sv);
+    const gp_Vec r(gp_Pnt(q.x, q.y, q.z), p);
+    const double a = su.Dot(su), b = su.Dot(sv), c = sv.Dot(sv), ru = r.Dot(su), rv = r.Dot(sv);
+    const double det = a * c - b * b;
+    if (!(det > 0)) break;
+    const double du = -(c * ru - b * rv) / det, dv = -(a * rv - b * ru) / det;
+    u = std::clamp(u + du, u0, u1);
+    v = std::clamp(v + dv, v0, v1);
+    if (std::abs(du) < 1e-15 && std::abs(dv) < 1e-15) break;
+  }
+  s.D0(u, v, p);
+  return {p.X(), p.Y(), p.Z()};
 }
 
 TColgp_Array2OfPnt occt_points(const PointGrid& g) {
@@ -557,6 +560,8 @@ void job_interpolate(const Options& o) {
     }
 
     if (o.has("occt")) {
+      const auto pu_ref = interpatch::grid_parameters(grid, 0, interpatch::Parametrization::chord);
+      const auto pv_ref = interpatch::grid_parameters(grid, 1, interpatch::Parametrization::chord);
       const double predicted = occt.n ? occt.seconds * std::pow(static_cast<double>(n) / static_cast<double>(occt.n), occt.exponent) : 0;
       if (predicted > o.occt_budget) {
         std::ostringstream why;
@@ -569,15 +574,9 @@ void job_interpolate(const Options& o) {
             row_of("interpolate", n, "occt", "GeomAPI_PointsToBSplineSurface::Interpolate", 1, tol), o.reps,
             [&](Laps&) { return occt_interpolate(points); },
             [&](const Handle(Geom_BSplineSurface)& s) {
-              // OpenCASCADE chooses its own parameters: the data points are found on
-              // the surface by projection.
-              return check_at_data([&](std::size_t i, std::size_t j) {
-                const gp_Pnt q(grid(i, j).x, grid(i, j).y, grid(i, j).z);
-                GeomAPI_ProjectPointOnSurf proj(q, s);
-                if (!proj.IsDone() || proj.NbPoints() == 0) return Vec3{NAN, NAN, NAN};
-                const gp_Pnt p = proj.NearestPoint();
-                return Vec3{p.X(), p.Y(), p.Z()};
-              });
+              // OpenCASCADE chooses its own parameters: each data point is found on
+              // the surface by Gauss-Newton from the averaged chord parameters.
+              return check_at_data([&](std::size_t i, std::size_t j) { return occt_closest(*s, grid(i, j), pu_ref[i], pv_ref[j]); });
             },
             o.occt_budget);
         const double t = median(row.times);

@@ -1,14 +1,19 @@
 #pragma once
-// The benchmark data: an n x n jittered terrain, the same points in every run on
-// every machine. Shared by the Google Benchmark program and bench/compare so that
-// both time the same grids.
+// What the Google Benchmark program and bench/compare share, so that both time the
+// same thing: the data, an n x n jittered terrain with the same points in every run
+// on every machine, and the memory-bandwidth baseline, a memcpy.
 
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <numbers>
 
 #include "interpatch/grid.hpp"
+
+#if defined(_OPENMP)
+#include <omp.h>
+#endif
 
 namespace interpatch::bench {
 
@@ -40,6 +45,25 @@ inline PointGrid make_terrain(std::size_t n) {
                  static_cast<double>(j) * h + 0.2 * h * noise(i, j, 1), z};
     }
   return g;
+}
+
+// Copies with every OpenMP thread (each its own contiguous share), or with one: the
+// bandwidth limit the library's two-core work is held against.
+inline void copy_bytes(std::byte* dst, const std::byte* src, std::size_t bytes, bool threaded) {
+#if defined(_OPENMP)
+  if (threaded) {
+#pragma omp parallel
+    {
+      const auto t = static_cast<std::size_t>(omp_get_thread_num());
+      const auto nt = static_cast<std::size_t>(omp_get_num_threads());
+      const std::size_t a = bytes / nt * t, b = t + 1 == nt ? bytes : bytes / nt * (t + 1);
+      std::memcpy(dst + a, src + a, b - a);
+    }
+    return;
+  }
+#endif
+  static_cast<void>(threaded);
+  std::memcpy(dst, src, bytes);
 }
 
 }  // namespace interpatch::bench

@@ -13,19 +13,11 @@ import json
 import math
 import sys
 
+from bench_report import fmt_time  # the same time format as the Google Benchmark tables
+
 LIBS = ("interpatch", "occt", "sisl", "memcpy")
 NAMES = {"interpatch": "interpatch", "occt": "OpenCASCADE", "sisl": "SISL", "memcpy": "memcpy"}
 COLORS = {"interpatch": "tab:blue", "occt": "tab:red", "sisl": "tab:green", "memcpy": "tab:gray"}
-
-
-def fmt_time(s):
-    if s is None or (isinstance(s, float) and math.isnan(s)):
-        return "–"
-    if s >= 1:
-        return f"{s:.3g} s"
-    if s >= 1e-3:
-        return f"{s * 1e3:.3g} ms"
-    return f"{s * 1e6:.3g} µs"
 
 
 def fmt_ratio(r):
