@@ -54,15 +54,11 @@ std::string what_size(std::size_t a, std::size_t b, std::size_t c) { return what
 
 std::string resolution_text(const Resolution& r) { return r.nw ? what_size(r.nu, r.nv, r.nw) : what_size(r.nu, r.nv); }
 
-// Points as float64 triples in C order, for .npy.
-std::vector<double> flat_points(const Vec3* p, std::size_t n) {
-  std::vector<double> flat(3 * n);
-  for (std::size_t i = 0; i < n; ++i) {
-    flat[3 * i] = p[i].x;
-    flat[3 * i + 1] = p[i].y;
-    flat[3 * i + 2] = p[i].z;
-  }
-  return flat;
+// Points as float64 triples in C order, for .npy: a grid's own memory (Vec3 is
+// three doubles), written without a copy.
+std::span<const double> flat_points(const Vec3* p, std::size_t n) {
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 grids are written as arrays of doubles");
+  return {&p->x, 3 * n};
 }
 
 void mesh_volume(const io::Construction& c, const fs::path& out, const Resolution& res) {
@@ -148,8 +144,8 @@ void require_eval_memory(std::size_t k, const fs::path& out, int dims) {
   const std::string size = dims == 3 ? what_size(k, k, k) : what_size(k, k);
   const std::string what = "evaluation grid " + (k == std::numeric_limits<std::size_t>::max() ? std::string("beyond 2^64") : size);
   if (k >= (std::size_t{1} << (dims == 3 ? 21 : 32))) throw error(errc::too_large, what + ": more points than can be addressed");
-  // The points, plus a float64 copy for .npy or the text of a row for .csv.
-  const std::size_t per_point = lower_extension(out) == ".npy" ? 2 * sizeof(Vec3) : sizeof(Vec3) + 8;
+  // The points (.npy writes them from the grid's memory), plus the text of a row for .csv.
+  const std::size_t per_point = lower_extension(out) == ".npy" ? sizeof(Vec3) : sizeof(Vec3) + 8;
   require_memory(dims == 3 ? k * k * k : k * k, per_point, what);
 }
 

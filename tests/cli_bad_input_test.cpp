@@ -289,13 +289,13 @@ std::vector<Row> rows() {
        R"(cannot write 'missing/out\.json')", errc::file_unwritable, false},
       // too large: refused before allocating
       {"EvalGridTooLarge", {{grid_file, grid}}, {"eval", grid_file, "--grid", "100000", "-o", "out.npy"}, 5,
-       R"(evaluation grid 100000x100000 needs 480 GB \(480000000000 bytes\), [0-9.]+ [kMGT]?B available)",
+       R"(evaluation grid 100000x100000 needs 240 GB \(240000000000 bytes\), [0-9.]+ [kMGT]?B available)",
        errc::too_large, false},
       {"EvalGridBeyondCounting", {{grid_file, grid}},
        {"eval", grid_file, "--grid", "123456789012345678901234567890", "-o", "out.csv"}, 5,
        R"(evaluation grid beyond 2\^64)", errc::too_large, false},
       {"VolumeEvalGridTooLarge", {{grid_file, vol}}, {"eval", grid_file, "--grid", "5000", "-o", "out.npy"}, 5,
-       R"(evaluation grid 5000x5000x5000 needs 6 TB)", errc::too_large, false},
+       R"(evaluation grid 5000x5000x5000 needs 3 TB)", errc::too_large, false},
       {"MeshTooLarge", {{grid_file, grid}}, {"mesh", grid_file, "--res", "200000x200000", "-o", "out.obj"}, 5,
        R"(mesh of 200000x200000 vertices needs [0-9.]+ TB)", errc::too_large, false},
       {"VolumeMeshTooLarge", {{grid_file, vol}}, {"mesh", grid_file, "--res", "5000x5000x5000", "-o", "out.vts"}, 5,
@@ -397,7 +397,7 @@ TEST_P(BadInput, OneLineNamingPlaceAndSizeAndNothingWritten) {
     EXPECT_EQ(snapshot(dir), before);
 
     if (row.status == 5) {
-      // Refused before allocating: a 480 GB grid would take minutes and gigabytes.
+      // Refused before allocating: a 240 GB grid would take minutes and gigabytes.
       // 5 s leaves room for a loaded machine and sanitizers; 300 MB is what the
       // command needs to start under AddressSanitizer, far below any such grid.
       EXPECT_LT(r.seconds, 5.0);
