@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
+#include "cli_specs.hpp"
 #include "temp_dir.hpp"
 #include "test_util.hpp"
 
@@ -292,16 +293,7 @@ TEST_F(CliTest, UnknownFieldIsAWarningNotAFailure) {
 
 // --- constructions from corners and curves ---------------------------------------------
 
-json line_curve(const json& a, const json& b) { return {{"line", {a, b}}}; }
-
-json square_coons() {
-  return {{"type", "coons"},
-          {"boundary",
-           {{"v0", line_curve({0, 0, 0}, {1, 0, 0})},
-            {"v1", line_curve({0, 1, 0}, {1, 1, 1})},
-            {"u0", line_curve({0, 0, 0}, {0, 1, 0})},
-            {"u1", line_curve({1, 0, 0}, {1, 1, 1})}}}};
-}
+using test::square_coons;
 
 TEST_F(CliTest, EveryConstructionTypeEvaluatesFromTheCommandLine) {
   // The seed's bilinear example through the whole pipeline: eval at the centre.

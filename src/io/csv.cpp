@@ -15,7 +15,7 @@
 
 #include "detail/text.hpp"
 #include "interpatch/io/atomic_file.hpp"
-#include "io/memory_stream.hpp"
+#include "io/input_stream.hpp"
 
 namespace interpatch::io {
 namespace fs = std::filesystem;
@@ -200,14 +200,8 @@ std::vector<Vec3> read_csv_stream(std::istream& in, std::uintmax_t size, const s
 }  // namespace
 
 std::vector<Vec3> read_csv_points(const fs::path& path, std::size_t expected) {
+  std::ifstream in = detail::open_input(path);
   std::error_code ec;
-  if (fs::is_directory(path, ec)) detail::fail(errc::file_unreadable, "cannot read '", path.string(), "': it is a directory");
-  errno = 0;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    const int e = errno;
-    detail::fail(errc::file_unreadable, "cannot open '", path.string(), "': ", e != 0 ? std::strerror(e) : "open failed");
-  }
   const auto size = fs::file_size(path, ec);
   return read_csv_stream(in, ec ? 0 : size, path.string(), expected);
 }

@@ -15,7 +15,7 @@
 #include "detail/text.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/memory.hpp"
-#include "io/memory_stream.hpp"
+#include "io/input_stream.hpp"
 
 namespace interpatch::io {
 namespace fs = std::filesystem;
@@ -176,14 +176,16 @@ class HeaderParser {
                  excerpt(), "\"");
   }
   [[nodiscard]] std::string excerpt() const {
+    // Without the padding NumPy puts at the end ("...}   \n"), which says nothing.
+    std::string_view t = s_;
+    while (!t.empty() && (t.back() == ' ' || t.back() == '\n')) t.remove_suffix(1);
     std::string e;
-    for (char c : s_.substr(0, 200)) {
+    for (char c : t.substr(0, 200)) {
       if (c == '\n') e += "\\n";
       else if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) e += '?';
       else e += c;
     }
-    while (!e.empty() && e.back() == ' ') e.pop_back();
-    if (s_.size() > 200) e += "...";
+    if (t.size() > 200) e += "...";
     return e;
   }
 
@@ -376,15 +378,7 @@ NpyArray read_npy_stream(std::istream& in, std::uint64_t file_size, const std::s
 }  // namespace
 
 NpyArray read_npy(const fs::path& path) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) detail::fail(errc::file_unreadable, "cannot read '", path.string(), "': it is a directory");
-  errno = 0;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    const int e = errno;
-    detail::fail(errc::file_unreadable, "cannot open '", path.string(), "': ",
-                 e != 0 ? std::strerror(e) : "open failed");
-  }
+  std::ifstream in = detail::open_input(path);
   in.seekg(0, std::ios::end);
   const auto end = in.tellg();
   in.seekg(0, std::ios::beg);
