@@ -3,12 +3,12 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <csignal>
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -51,6 +51,53 @@ std::size_t count_of(const std::map<int, std::string>& e, const std::string& pre
       std::count_if(e.begin(), e.end(), [&](const auto& kv) { return kv.second.rfind(prefix, 0) == 0; }));
 }
 
+// The entity numbers an entity refers to (#n).
+std::vector<int> references(const std::string& body) {
+  std::vector<int> out;
+  for (std::size_t at = body.find('#'); at != std::string::npos; at = body.find('#', at + 1)) {
+    int v = 0;
+    const auto r = std::from_chars(body.data() + at + 1, body.data() + body.size(), v);
+    EXPECT_NE(r.ptr, body.data() + at + 1) << body;
+    out.push_back(v);
+  }
+  return out;
+}
+
+// The names of a complex instance's partial entities, "(A(...) B(...) ...)", in order.
+std::vector<std::string> partial_entities(const std::string& body) {
+  std::vector<std::string> names;
+  int depth = 0;
+  std::string word;
+  for (const char c : body) {
+    if (c == '(') {
+      if (depth == 1) names.push_back(word);
+      ++depth;
+    } else if (c == ')') {
+      --depth;
+    }
+    if (depth == 1 && (std::isupper(static_cast<unsigned char>(c)) || c == '_')) word += c;
+    else if (depth == 1) word.clear();
+  }
+  return names;
+}
+
+// A real as Part 21 writes it: optional sign, digits, a decimal point, digits,
+// optional exponent E with optional sign and digits.
+bool is_step_real(const std::string& t) {
+  std::size_t i = t[0] == '-' ? 1 : 0;
+  const auto digits = [&] {
+    const std::size_t from = i;
+    while (i < t.size() && std::isdigit(static_cast<unsigned char>(t[i]))) ++i;
+    return i > from;
+  };
+  if (!digits() || i == t.size() || t[i++] != '.') return false;
+  digits();
+  if (i == t.size()) return true;
+  if (t[i++] != 'E') return false;
+  if (i < t.size() && (t[i] == '-' || t[i] == '+')) ++i;
+  return digits() && i == t.size();
+}
+
 // How many entities start with each prefix.
 void expect_counts(const std::map<int, std::string>& e, const std::map<std::string, std::size_t>& expected) {
   for (const auto& [prefix, n] : expected) EXPECT_EQ(count_of(e, prefix), n) << prefix;
@@ -91,11 +138,9 @@ TEST(Step, EntitiesAreNumberedInOrderAndReferOnlyBackwards) {
   for (const ExactForm& f : {ExactForm(bilinear_patch()), ExactForm(unit_cube())}) {
     const auto e = entities(step_text(f));
     int expected = 1;
-    const std::regex ref("#([0-9]+)");
     for (const auto& [n, body] : e) {
       EXPECT_EQ(n, expected++);
-      for (std::sregex_iterator it(body.begin(), body.end(), ref), end; it != end; ++it) {
-        const int target = std::stoi((*it)[1]);
+      for (const int target : references(body)) {
         EXPECT_LT(target, n) << "#" << n << "=" << body;
         EXPECT_GE(target, 1);
       }
@@ -142,10 +187,11 @@ TEST(Step, VolumeIsAClosedShellWithEveryEdgeRunBothWays) {
   expect_counts(e, {{"ADVANCED_FACE(", 6}, {"EDGE_CURVE(", 12}, {"VERTEX_POINT(", 8}, {"CLOSED_SHELL(", 1},
                     {"MANIFOLD_SOLID_BREP(", 1}, {"ADVANCED_BREP_SHAPE_REPRESENTATION(", 1}});
   std::map<std::string, std::multiset<std::string>> uses;  // edge -> orientations
-  const std::regex oriented(R"(ORIENTED_EDGE\('',\*,\*,(#[0-9]+),(\.[TF]\.)\))");
+  const std::string head = "ORIENTED_EDGE('',*,*,";
   for (const auto& [n, body] : e) {
-    std::smatch m;
-    if (std::regex_match(body, m, oriented)) uses[m[1]].insert(m[2]);
+    if (body.rfind(head, 0) != 0) continue;
+    const auto comma = body.find(',', head.size());
+    uses[body.substr(head.size(), comma - head.size())].insert(body.substr(comma + 1, 3));
   }
   ASSERT_EQ(uses.size(), 12u);
   for (const auto& [edge, o] : uses) EXPECT_EQ(o, (std::multiset<std::string>{".F.", ".T."})) << edge;
@@ -163,10 +209,7 @@ TEST(Step, RationalSurfaceIsTheComplexEntityInAlphabeticalOrder) {
   for (const auto& [n, body] : e)
     if (body.find("RATIONAL_B_SPLINE_SURFACE") != std::string::npos) surface = body;
   ASSERT_FALSE(surface.empty());
-  std::vector<std::string> parts;
-  const std::regex name(R"((?:^\(|\)\s*)([A-Z_]+)\()");
-  for (std::sregex_iterator it(surface.begin(), surface.end(), name), end; it != end; ++it) parts.push_back((*it)[1]);
-  EXPECT_EQ(parts, (std::vector<std::string>{"BOUNDED_SURFACE", "B_SPLINE_SURFACE", "B_SPLINE_SURFACE_WITH_KNOTS",
+  EXPECT_EQ(partial_entities(surface), (std::vector<std::string>{"BOUNDED_SURFACE", "B_SPLINE_SURFACE", "B_SPLINE_SURFACE_WITH_KNOTS",
                                              "GEOMETRIC_REPRESENTATION_ITEM", "RATIONAL_B_SPLINE_SURFACE",
                                              "REPRESENTATION_ITEM", "SURFACE"}));
   EXPECT_NE(surface.find("RATIONAL_B_SPLINE_SURFACE(((1.,1.),\n  (0.7071067811865476,0.7071067811865476),\n  (1.,1.)))"),
@@ -192,14 +235,13 @@ TEST(Step, NumbersRoundTripExactly) {
   }
   const BSplineSurface s(KnotVector(2, {0, 0, 0, 1, 1, 1}), KnotVector(2, {0, 0, 0, 1, 1, 1}), cp);
   const auto e = entities(step_text(s));
-  const std::regex real(R"([-0-9.E+]+)");
   std::set<double> read;
   for (const auto& [n, body] : e) {
     if (body.rfind("CARTESIAN_POINT('',(", 0) != 0 || std::count(body.begin(), body.end(), ',') != 3) continue;
     const std::string list = body.substr(20, body.size() - 22);
     std::stringstream ss(list);
     for (std::string tok; std::getline(ss, tok, ',');) {
-      EXPECT_TRUE(std::regex_match(tok, std::regex(R"(-?[0-9]+\.[0-9]*(E[-+]?[0-9]+)?)"))) << tok;
+      EXPECT_TRUE(is_step_real(tok)) << tok;
       double v = 0;
       const auto r = std::from_chars(tok.data(), tok.data() + tok.size(), v);
       EXPECT_EQ(r.ptr, tok.data() + tok.size()) << tok;
