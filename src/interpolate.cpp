@@ -6,6 +6,7 @@
 
 #include "detail/banded.hpp"
 #include "detail/collocation.hpp"
+#include "detail/kernel.hpp"
 #include "detail/parallel.hpp"
 #include "detail/text.hpp"
 #include "interpatch/memory.hpp"
@@ -164,7 +165,7 @@ constexpr double pole_ratio = 1e-14;
 
 // Chord lengths |b[i] − a[i]| (square roots of them, centripetal) for i < count.
 // Squares first, roots in a loop of their own, which the compiler vectorizes.
-void chord_lengths(const Vec3* a, const Vec3* b, std::size_t count, double* out, Parametrization param) {
+INTERPATCH_KERNEL void chord_lengths(const Vec3* a, const Vec3* b, std::size_t count, double* out, Parametrization param) {
   for (std::size_t i = 0; i < count; ++i) {
     const double dx = b[i].x - a[i].x, dy = b[i].y - a[i].y, dz = b[i].z - a[i].z;
     out[i] = dx * dx + dy * dy + dz * dz;
@@ -505,6 +506,7 @@ GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional
   const GridShape g = grid_shape(shape);
   const GridChords chords(points.data(), g, param);
   chords.check_lines();
+
   GridSolution r;
   r.params.resize(Rank);
   r.knots.reserve(Rank);

@@ -1,5 +1,6 @@
 #include "detail/banded.hpp"
 
+#include "detail/kernel.hpp"
 #include "detail/parallel.hpp"
 
 #include <algorithm>
@@ -41,7 +42,7 @@ bool BandedLU::factor() {
   return true;
 }
 
-void BandedLU::solve(double* b, std::size_t width, std::size_t stride) const noexcept {
+INTERPATCH_KERNEL void BandedLU::solve(double* b, std::size_t width, std::size_t stride) const noexcept {
   const int kuu = kl_ + ku_;
   auto row = [&](int i) { return b + static_cast<std::size_t>(i) * stride; };
   for (int k = 0; k < n_; ++k) {

@@ -1,0 +1,12 @@
+#pragma once
+// Hot loops compiled twice: for x86-64-v3 (AVX2 and fused multiply-add, on every
+// x86-64 CPU since 2013) and for the baseline, the loader choosing by the CPU it
+// runs on. A fused multiply-add rounds once where a multiply and an add round
+// twice, so results can differ between CPUs in the last bits; on one machine they
+// never depend on the number of threads.
+
+#if defined(__x86_64__) && defined(__GNUC__) && defined(__ELF__)
+#define INTERPATCH_KERNEL __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define INTERPATCH_KERNEL
+#endif
