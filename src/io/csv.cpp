@@ -66,8 +66,10 @@ std::size_t split(std::string_view line, std::string_view* fields, std::size_t m
 /// Reads a stream line by line in large blocks (no per-line allocation).
 class LineReader {
  public:
-  /// `name` names the stream in messages.
-  LineReader(std::istream& in, const std::string& name) : name_(name), in_(in) {}
+  /// `name` names the stream in messages; `size` is its length when known (0 if not),
+  /// so that a small input is read in one small block.
+  LineReader(std::istream& in, const std::string& name, std::uintmax_t size)
+      : block_(size > 0 && size < max_block ? static_cast<std::size_t>(size) + 1 : max_block), name_(name), in_(in) {}
 
   /// The next line without its '\n'; nullopt at the end.
   std::optional<std::string_view> next() {
@@ -95,17 +97,16 @@ class LineReader {
     buf_.erase(0, pos_);
     pos_ = 0;
     const std::size_t old = buf_.size();
-    constexpr std::size_t block = std::size_t{1} << 20;
-    buf_.resize(old + block);
+    buf_.resize(old + block_);
     errno = 0;
-    in_.read(buf_.data() + old, static_cast<std::streamsize>(block));
+    in_.read(buf_.data() + old, static_cast<std::streamsize>(block_));
     const auto got = static_cast<std::size_t>(in_.gcount());
     buf_.resize(old + got);
     if (in_.bad() || (!in_ && !in_.eof())) {
       const int e = errno;
       detail::fail(errc::file_unreadable, "cannot read '", name_, "': ", e != 0 ? std::strerror(e) : "read error");
     }
-    if (got < block) eof_ = true;
+    if (got < block_) eof_ = true;
     if (buf_.size() > max_line && buf_.find('\n') == std::string::npos) {
       detail::fail(errc::malformed_file, name_, ":", line_, ": line longer than ", max_line,
                    " bytes; not a text file of points?");
@@ -113,6 +114,8 @@ class LineReader {
   }
 
   static constexpr std::size_t max_line = std::size_t{1} << 24;
+  static constexpr std::size_t max_block = std::size_t{1} << 20;
+  std::size_t block_;
   const std::string& name_;
   std::size_t line_ = 0;
   std::istream& in_;
@@ -136,7 +139,7 @@ void append_number(std::string& out, double v) {
 /// The points in `in`, of `size` bytes when known (0 otherwise); `name` names it in
 /// messages. What read_csv_points and parse_csv_points share.
 std::vector<Vec3> read_csv_stream(std::istream& in, std::uintmax_t size, const std::string& name, std::size_t expected) {
-  LineReader reader(in, name);
+  LineReader reader(in, name, size);
 
   std::vector<Vec3> points;
   if (expected > 0) {
