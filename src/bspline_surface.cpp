@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "detail/basis_table.hpp"
+#include "detail/kernel.hpp"
 #include "detail/parallel.hpp"
 #include "detail/text.hpp"
 #include "interpatch/bspline_curve.hpp"
@@ -24,6 +25,37 @@ using detail::check_parameter;
 using Basis = detail::BasisRow<3>;
 std::vector<Basis> bases(const KnotVector& k, std::span<const double> ts, int nd, const char* dir) {
   return detail::basis_table<3>(k, ts, nd, dir);
+}
+
+// out[x] = Σ_a w[a] first[a·stride + x] for x < n: rows of the control net
+// (3 doubles a point) weighted by the basis functions of one u.
+INTERPATCH_KERNEL void weighted_rows(const double* w, int count, const double* first, std::size_t stride,
+                                     std::size_t n, double* out) {
+  for (std::size_t x = 0; x < n; ++x) out[x] = w[0] * first[x];
+  for (int a = 1; a < count; ++a) {
+    const double c = w[a];
+    const double* r = first + static_cast<std::size_t>(a) * stride;
+    for (std::size_t x = 0; x < n; ++x) out[x] += c * r[x];
+  }
+}
+
+// The points of one u row: out[j] = Σ_k weights[j][k] row[spans[j] − q + k].
+INTERPATCH_KERNEL void sample_row(const int* spans, const double* weights, int q, std::size_t nv, const double* row,
+                                  double* out) {
+  const auto q1 = static_cast<std::size_t>(q + 1);
+  for (std::size_t j = 0; j < nv; ++j) {
+    const double* h = row + 3 * static_cast<std::size_t>(spans[j] - q);
+    const double* f = weights + j * q1;
+    double x = 0, y = 0, z = 0;
+    for (std::size_t k = 0; k < q1; ++k) {
+      x += f[k] * h[3 * k];
+      y += f[k] * h[3 * k + 1];
+      z += f[k] * h[3 * k + 2];
+    }
+    out[3 * j] = x;
+    out[3 * j + 1] = y;
+    out[3 * j + 2] = z;
+  }
 }
 
 // A line of homogeneous control points along u at column j (or along v at row i).
@@ -161,9 +193,35 @@ PointGrid BSplineSurface::evaluate(std::span<const double> us, std::span<const d
   // One parallel region: opening one costs microseconds with pinned threads but up
   // to milliseconds on a loaded machine, where the idle thread spins. Progress is
   // reported by the calling thread (thread 0) from a shared row count.
-  const bool threads = us.size() * (nv + ncv) >= detail::parallel_min_work;
+  [[maybe_unused]] const bool threads = us.size() * (nv + ncv) >= detail::parallel_min_work;
   std::atomic<std::size_t> done{0};
   const auto nu = static_cast<long long>(us.size());
+  if (!rat) {
+    // The control net as rows of doubles, the v bases packed: both loops run along memory.
+    std::vector<int> spans(nv);
+    std::vector<double> weights(nv * static_cast<std::size_t>(q + 1));
+    for (std::size_t j = 0; j < nv; ++j) {
+      spans[j] = bv[j].span;
+      std::copy_n(bv[j].d, q + 1, weights.data() + j * static_cast<std::size_t>(q + 1));
+    }
+    const std::size_t row_doubles = 3 * ncv;
+#pragma omp parallel if (threads)
+    {
+      std::vector<double> row(row_doubles);
+      const bool reporter = detail::thread_index() == 0;
+#pragma omp for schedule(static, 16)
+      for (long long ri = 0; ri < nu; ++ri) {
+        const auto i = static_cast<std::size_t>(ri);
+        const Basis& b = bu[i];
+        weighted_rows(b.d, p + 1, &cp_(static_cast<std::size_t>(b.span - p), 0).x, row_doubles, row_doubles, row.data());
+        sample_row(spans.data(), weights.data(), q, nv, row.data(), &out(i, 0).x);
+        const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
+        if (progress && reporter && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(us.size()));
+      }
+    }
+    if (progress) progress(1.0);
+    return out;
+  }
 #pragma omp parallel if (threads)
   {
     // One contracted row of homogeneous points per thread, reused for every u.

@@ -154,7 +154,7 @@ void contract_all(const BSplineVolume& b, std::span<const double> us, std::span<
   const auto bw = bases(b.knots_w(), ws, nd, "w");
   const std::size_t ncv = b.control_points().extent(1), ncw = b.control_points().extent(2);
   // Starting the second thread costs milliseconds: small grids stay on one.
-  const bool threads = us.size() * (vs.size() * ws.size() + ncv * ncw) >= detail::parallel_min_work;
+  [[maybe_unused]] const bool threads = us.size() * (vs.size() * ws.size() + ncv * ncw) >= detail::parallel_min_work;
   constexpr std::size_t chunk = 16;
   for (std::size_t r0 = 0; r0 < us.size(); r0 += chunk) {
     const std::size_t r1 = std::min(us.size(), r0 + chunk);

@@ -5,7 +5,9 @@
 // twice, so results can differ between CPUs in the last bits; on one machine they
 // never depend on the number of threads.
 
-#if defined(__x86_64__) && defined(__GNUC__) && defined(__ELF__)
+// GCC only: clang 14 does not emit the plain symbol of a cloned function that other
+// translation units call.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__ELF__)
 #define INTERPATCH_KERNEL __attribute__((target_clones("arch=x86-64-v3", "default")))
 #else
 #define INTERPATCH_KERNEL
