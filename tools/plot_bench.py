@@ -140,6 +140,7 @@ def plot(data, path):
     jobs = [("evaluate", "evaluate\n10⁶ points"), ("coons", "Coons patch\nbuild + 10⁶ points"),
             ("process", "whole process\n`eval`, .npy in/out")]
     width = 0.2
+    tallest = 0.0
     for k, lib in enumerate(LIBS):
         xs, ys = [], []
         for j, (job, _) in enumerate(jobs):
@@ -149,9 +150,11 @@ def plot(data, path):
                 ys.append(r["median_s"])
         if xs:
             ax2.bar(xs, ys, width, color=COLORS[lib], label=NAMES[lib] + (" (fastest variant)" if lib == "interpatch" else ""))
+            tallest = max([tallest] + ys)
             for x, y in zip(xs, ys):
                 ax2.text(x, y * 1.08, fmt_time(y), ha="center", va="bottom", fontsize=6.5, rotation=90)
     ax2.set_yscale("log")
+    ax2.set_ylim(top=tallest * 20)  # room for the labels above the bars
     ax2.set_xticks(range(len(jobs)))
     ax2.set_xticklabels([label for _, label in jobs], fontsize=8)
     ax2.set_ylabel("wall-clock time, median [s]")
@@ -175,9 +178,10 @@ def main():
         data = json.load(f)
     meta, rows = data["meta"], data["rows"]
     print(f"Run {meta['date']} on {meta['cpu']}: {meta['nproc']} CPUs at {meta['mhz']} MHz, "
-          f"load average {meta['load_average'].split()[:3]} at the start, {meta['load_average_end'].split()[:3]} at the end.")
+          f"load average {', '.join(meta['load_average'].split()[:3])} at the start, "
+          f"{', '.join(meta['load_average_end'].split()[:3])} at the end.")
     print(f"interpatch {meta['interpatch_commit']}, OpenCASCADE {meta['occt_version']}, SISL {meta['sisl_version']}, "
-          f"{meta['compiler']}; OpenMP threads {meta['threads']} (OMP_PROC_BIND={meta['omp_proc_bind'] or 'unset'}); "
+          f"g++ {meta['compiler']}; OpenMP threads {meta['threads']} (OMP_PROC_BIND={meta['omp_proc_bind'] or 'unset'}); "
           f"median of {meta['reps']} repetitions, wall clock.\n")
     print("### Bicubic interpolation of N × N grids\n")
     print(interpolation_table(rows, data["skipped"], meta["threads"]) + "\n")
