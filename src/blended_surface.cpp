@@ -256,7 +256,7 @@ PointGrid BlendedSurface::evaluate(std::span<const double> us, std::span<const d
     for (std::size_t l = 0; l < L; ++l) G[j * L + l] = value(T.g[l], v);
     for (std::size_t k = 0; k < T.a.size(); ++k) A[j * T.a.size() + k] = T.a[k].point(v);
   }
-  PointGrid out({nu, nv});
+  PointGrid out({nu, nv}, zeroed);
   const std::size_t KA = T.a.size();
   const auto rows = static_cast<long long>(nu);
   std::atomic<std::size_t> done{0};

@@ -4,6 +4,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 
 #include "detail/basis_table.hpp"
 #include "detail/kernel.hpp"
@@ -28,9 +29,15 @@ std::vector<Basis> bases(const KnotVector& k, std::span<const double> ts, int nd
 }
 
 // out[x] = Σ_a w[a] first[a·stride + x] for x < n: rows of the control net
-// (3 doubles a point) weighted by the basis functions of one u.
+// (3 doubles a point) weighted by the basis functions of one u. Cubics (4 rows) in
+// one sweep; other degrees row by row.
 INTERPATCH_KERNEL void weighted_rows(const double* w, int count, const double* first, std::size_t stride,
                                      std::size_t n, double* out) {
+  if (count == 4) {
+    const double *r0 = first, *r1 = first + stride, *r2 = first + 2 * stride, *r3 = first + 3 * stride;
+    for (std::size_t x = 0; x < n; ++x) out[x] = w[0] * r0[x] + w[1] * r1[x] + w[2] * r2[x] + w[3] * r3[x];
+    return;
+  }
   for (std::size_t x = 0; x < n; ++x) out[x] = w[0] * first[x];
   for (int a = 1; a < count; ++a) {
     const double c = w[a];
@@ -39,11 +46,30 @@ INTERPATCH_KERNEL void weighted_rows(const double* w, int count, const double* f
   }
 }
 
-// The points of one u row: out[j] = Σ_k weights[j][k] row[spans[j] − q + k].
+// The points of one u row: out[j] = Σ_k weights[j][k] row[spans[j] − q + k], row
+// holding 3 doubles a point and one double of slack after them. Each point is
+// summed in four lanes (x, y, z and the next point's x, which is discarded) and
+// stored four doubles wide, the fourth overwritten by the next point; the last
+// point is summed in the same order one coordinate at a time.
 INTERPATCH_KERNEL void sample_row(const int* spans, const double* weights, int q, std::size_t nv, const double* row,
                                   double* out) {
   const auto q1 = static_cast<std::size_t>(q + 1);
-  for (std::size_t j = 0; j < nv; ++j) {
+  std::size_t j = 0;
+#if defined(__GNUC__)
+  using v4 = double __attribute__((vector_size(32)));
+  for (; j + 1 < nv; ++j) {
+    const double* h = row + 3 * static_cast<std::size_t>(spans[j] - q);
+    const double* f = weights + j * q1;
+    v4 acc = {0, 0, 0, 0};
+    for (std::size_t k = 0; k < q1; ++k) {
+      v4 p;
+      std::memcpy(&p, h + 3 * k, sizeof p);
+      acc += f[k] * p;
+    }
+    std::memcpy(out + 3 * j, &acc, sizeof acc);
+  }
+#endif
+  for (; j < nv; ++j) {
     const double* h = row + 3 * static_cast<std::size_t>(spans[j] - q);
     const double* f = weights + j * q1;
     double x = 0, y = 0, z = 0;
@@ -188,7 +214,7 @@ PointGrid BSplineSurface::evaluate(std::span<const double> us, std::span<const d
   const int p = degree_u(), q = degree_v();
   const std::size_t ncv = cp_.extent(1);
   const std::size_t nv = vs.size();
-  PointGrid out({us.size(), nv});
+  PointGrid out({us.size(), nv}, zeroed);
   const bool rat = rational();
   // One parallel region: opening one costs microseconds with pinned threads but up
   // to milliseconds on a loaded machine, where the idle thread spins. Progress is
@@ -207,7 +233,7 @@ PointGrid BSplineSurface::evaluate(std::span<const double> us, std::span<const d
     const std::size_t row_doubles = 3 * ncv;
 #pragma omp parallel if (threads)
     {
-      std::vector<double> row(row_doubles);
+      std::vector<double> row(row_doubles + 1);  // one double of slack for sample_row
       const bool reporter = detail::thread_index() == 0;
 #pragma omp for schedule(static, 16)
       for (long long ri = 0; ri < nu; ++ri) {
@@ -273,7 +299,7 @@ Grid<SurfaceDerivatives, 2> BSplineSurface::evaluate_derivatives(std::span<const
   const int p = degree_u(), q = degree_v();
   const std::size_t ncv = cp_.extent(1);
   const std::size_t nv = vs.size();
-  Grid<SurfaceDerivatives, 2> out({us.size(), nv});
+  Grid<SurfaceDerivatives, 2> out({us.size(), nv}, zeroed);
   const bool rat = rational();
   const auto nu = static_cast<long long>(us.size());
 #pragma omp parallel if (us.size() * (nv + ncv) >= detail::parallel_min_work)

@@ -359,7 +359,7 @@ VolumeDerivatives BSplineVolume::derivatives(double u, double v, double w) const
 PointGrid3 BSplineVolume::evaluate(std::span<const double> us, std::span<const double> vs, std::span<const double> ws,
                                    const progress_callback& progress) const {
   grid_items(us.size(), vs.size(), ws.size(), sizeof(Vec3), "volume evaluation grid");
-  PointGrid3 out({us.size(), vs.size(), ws.size()});
+  PointGrid3 out({us.size(), vs.size(), ws.size()}, zeroed);
   contract_all<false>(*this, us, vs, ws, progress,
                       [&out](std::size_t i, std::size_t j, std::size_t k, const VolumeDerivatives& d) { out(i, j, k) = d.s; });
   return out;
@@ -368,7 +368,7 @@ PointGrid3 BSplineVolume::evaluate(std::span<const double> us, std::span<const d
 Grid<VolumeDerivatives, 3> BSplineVolume::evaluate_derivatives(std::span<const double> us, std::span<const double> vs,
                                                                std::span<const double> ws) const {
   grid_items(us.size(), vs.size(), ws.size(), sizeof(VolumeDerivatives), "volume derivative grid");
-  Grid<VolumeDerivatives, 3> out({us.size(), vs.size(), ws.size()});
+  Grid<VolumeDerivatives, 3> out({us.size(), vs.size(), ws.size()}, zeroed);
   contract_all<true>(*this, us, vs, ws, {},
                      [&out](std::size_t i, std::size_t j, std::size_t k, const VolumeDerivatives& d) { out(i, j, k) = d; });
   return out;

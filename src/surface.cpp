@@ -13,7 +13,7 @@ PointGrid Surface::evaluate(std::span<const double> us, std::span<const double> 
   detail::check_unit_parameters(us, "u");
   detail::check_unit_parameters(vs, "v");
   require_memory(us.size() * vs.size(), sizeof(Vec3), "surface evaluation grid");
-  PointGrid out({us.size(), vs.size()});
+  PointGrid out({us.size(), vs.size()}, zeroed);
   const auto nu = static_cast<long long>(us.size());
   for (long long r0 = 0; r0 < nu; r0 += 64) {
     const long long r1 = std::min(nu, r0 + 64);
@@ -31,7 +31,7 @@ Grid<SurfaceDerivatives, 2> Surface::evaluate_derivatives(std::span<const double
   detail::check_unit_parameters(us, "u");
   detail::check_unit_parameters(vs, "v");
   require_memory(us.size() * vs.size(), sizeof(SurfaceDerivatives), "surface derivative grid");
-  Grid<SurfaceDerivatives, 2> out({us.size(), vs.size()});
+  Grid<SurfaceDerivatives, 2> out({us.size(), vs.size()}, zeroed);
   const auto nu = static_cast<long long>(us.size());
 #pragma omp parallel for schedule(static) if (us.size() * vs.size() >= detail::parallel_min_work / 16)
   for (long long i = 0; i < nu; ++i)

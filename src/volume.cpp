@@ -69,7 +69,7 @@ Jacobian Volume::jacobian(double u, double v, double w) const { return interpatc
 PointGrid3 Volume::evaluate(std::span<const double> us, std::span<const double> vs, std::span<const double> ws,
                             const progress_callback& progress) const {
   check_grid(*this, us, vs, ws, sizeof(Vec3), "volume evaluation grid");
-  PointGrid3 out({us.size(), vs.size(), ws.size()});
+  PointGrid3 out({us.size(), vs.size(), ws.size()}, zeroed);
   pointwise(us.size(), vs.size(), ws.size(), progress,
             [&](std::size_t i, std::size_t j, std::size_t k) { out(i, j, k) = point(us[i], vs[j], ws[k]); });
   return out;
@@ -78,7 +78,7 @@ PointGrid3 Volume::evaluate(std::span<const double> us, std::span<const double> 
 Grid<VolumeDerivatives, 3> Volume::evaluate_derivatives(std::span<const double> us, std::span<const double> vs,
                                                         std::span<const double> ws) const {
   check_grid(*this, us, vs, ws, sizeof(VolumeDerivatives), "volume derivative grid");
-  Grid<VolumeDerivatives, 3> out({us.size(), vs.size(), ws.size()});
+  Grid<VolumeDerivatives, 3> out({us.size(), vs.size(), ws.size()}, zeroed);
   pointwise(us.size(), vs.size(), ws.size(), {},
             [&](std::size_t i, std::size_t j, std::size_t k) { out(i, j, k) = derivatives(us[i], vs[j], ws[k]); });
   return out;

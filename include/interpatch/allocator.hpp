@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <memory>
 #include <new>
+#include <utility>
 
 namespace interpatch {
 
@@ -18,6 +19,9 @@ inline constexpr std::size_t large_buffer_bytes = std::size_t{1} << 20;
 /// @throws std::bad_alloc.
 void* map_pages(std::size_t bytes);
 void unmap_pages(void* p, std::size_t bytes) noexcept;
+/// Set on a thread while a Grid takes fresh zero pages for its elements: the
+/// allocator then leaves value-initialized elements of large buffers as mapped.
+inline thread_local bool leave_zero_pages = false;
 }  // namespace detail
 
 /// A std::allocator drop-in that maps large buffers with huge pages.
@@ -38,6 +42,15 @@ struct large_allocator {
     const std::size_t bytes = n * sizeof(T);
     if (bytes >= detail::large_buffer_bytes) detail::unmap_pages(p, bytes);
     else std::allocator<T>().deallocate(p, n);
+  }
+  /// Value-initialization of an element of a large buffer while
+  /// detail::leave_zero_pages is set does nothing: the mapping is already zero,
+  /// and its pages are first touched by whoever writes the element.
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    if constexpr (sizeof...(Args) == 0)
+      if (detail::leave_zero_pages) return;
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
   template <class U>
   friend bool operator==(const large_allocator&, const large_allocator<U>&) noexcept { return true; }

@@ -5,12 +5,21 @@
 
 #include <array>
 #include <cstddef>
+#include <type_traits>
 #include <vector>
 
 #include "interpatch/allocator.hpp"
 #include "interpatch/vec3.hpp"
 
 namespace interpatch {
+
+/// Tag of the Grid constructor for outputs: elements zero, and a large grid's pages
+/// are left untouched until written, so threads that fill their own parts also
+/// take the cost of the fresh pages in parallel.
+struct zeroed_t {
+  explicit zeroed_t() = default;
+};
+inline constexpr zeroed_t zeroed{};
 
 /// Dense rank-`Rank` array in C order. `Grid<Vec3, 2>` of shape {n+1, m+1} holds
 /// the points Q[p][q], p along u, q along v.
@@ -31,6 +40,21 @@ class Grid {
   /// Takes `data` in C order; its size must be the product of the shape.
   Grid(const shape_type& shape, storage_type data) : shape_(shape), data_(std::move(data)) {}
   Grid(const shape_type& shape, const std::vector<T>& data) : shape_(shape), data_(data.begin(), data.end()) {}
+  /// Zero elements (for T whose zero value is all zero bits: numbers and aggregates
+  /// of them).
+  Grid(const shape_type& shape, zeroed_t) : shape_(shape) {
+    static_assert(std::is_trivially_copyable_v<T>, "zero pages hold values of trivially copyable types only");
+    const std::size_t n = count(shape);
+    if (n * sizeof(T) < detail::large_buffer_bytes) {  // from operator new: not zero
+      data_.resize(n);
+      return;
+    }
+    struct Guard {
+      Guard() noexcept { detail::leave_zero_pages = true; }
+      ~Guard() { detail::leave_zero_pages = false; }
+    } guard;
+    data_.resize(n);
+  }
 
   [[nodiscard]] const shape_type& shape() const noexcept { return shape_; }
   [[nodiscard]] std::size_t extent(std::size_t axis) const noexcept { return shape_[axis]; }
