@@ -234,9 +234,9 @@ nlohmann::ordered_json info(const io::Construction& c) {
   return io::info_json(c, progress.callback());
 }
 
-io::Construction build_spec(const fs::path& spec) {
+io::Construction build_spec(const fs::path& spec, bool keep_data) {
   ProgressLine progress("building");
-  return io::build_file(spec, progress.callback());
+  return io::build_file(spec, progress.callback(), keep_data);
 }
 
 void report_warnings(const io::Construction& c) {
@@ -246,7 +246,7 @@ void report_warnings(const io::Construction& c) {
 int build_command(const fs::path& spec, const fs::path& out) {
   check_build_output(out);
   io::check_writable(out);
-  const io::Construction c = build_spec(spec);
+  const io::Construction c = build_spec(spec, false);
   write_build(c, out);
   report_warnings(c);
   return 0;
@@ -257,7 +257,7 @@ int mesh_command(const fs::path& spec, const fs::path& out, std::string_view res
   check_mesh_output(out);
   io::check_writable(out);
   if (given) require_mesh_memory(*given);
-  const io::Construction c = build_spec(spec);
+  const io::Construction c = build_spec(spec, false);
   const Resolution res = given ? *given : (io::is_volume(c) ? default_volume_resolution : default_surface_resolution);
   check_mesh_kind(c, out, res);
   if (!given) require_mesh_memory(res);
@@ -271,7 +271,7 @@ int eval_command(const fs::path& spec, const fs::path& out, std::string_view gri
   check_eval_output(out);
   io::check_writable(out);
   require_eval_memory(k, out);
-  const io::Construction c = build_spec(spec);
+  const io::Construction c = build_spec(spec, false);
   if (io::is_volume(c)) require_eval_memory(k, out, 3);
   write_eval(c, out, k);
   report_warnings(c);

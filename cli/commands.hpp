@@ -63,8 +63,9 @@ void write_mesh(const io::Construction& c, const std::filesystem::path& out, con
 void write_eval(const io::Construction& c, const std::filesystem::path& out, std::size_t k);
 nlohmann::ordered_json info(const io::Construction& c);
 
-/// Builds a spec file, showing progress on a terminal.
-io::Construction build_spec(const std::filesystem::path& spec);
+/// Builds a spec file, showing progress on a terminal. `keep_data` false: without the
+/// copy of the data points that only `info`'s error check uses.
+io::Construction build_spec(const std::filesystem::path& spec, bool keep_data = true);
 
 /// The subcommands; each returns the exit status of success (0).
 int build_command(const std::filesystem::path& spec, const std::filesystem::path& out);

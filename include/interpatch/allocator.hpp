@@ -8,7 +8,9 @@
 #include <cstddef>
 #include <memory>
 #include <new>
+#include <type_traits>
 #include <utility>
+#include <vector>
 
 namespace interpatch {
 
@@ -55,5 +57,22 @@ struct large_allocator {
   template <class U>
   friend bool operator==(const large_allocator&, const large_allocator<U>&) noexcept { return true; }
 };
+
+/// Resizes an empty vector that uses large_allocator to n zero elements (for T whose
+/// zero value is all zero bits: numbers and aggregates of them), leaving the pages
+/// of a large buffer untouched until they are written.
+template <class T>
+void resize_zeroed(std::vector<T, large_allocator<T>>& v, std::size_t n) {
+  static_assert(std::is_trivially_copyable_v<T>, "zero pages hold values of trivially copyable types only");
+  if (!v.empty() || n * sizeof(T) < detail::large_buffer_bytes) {  // from operator new: not zero
+    v.resize(n);
+    return;
+  }
+  struct Guard {
+    Guard() noexcept { detail::leave_zero_pages = true; }
+    ~Guard() { detail::leave_zero_pages = false; }
+  } guard;
+  v.resize(n);
+}
 
 }  // namespace interpatch

@@ -5,7 +5,6 @@
 
 #include <array>
 #include <cstddef>
-#include <type_traits>
 #include <vector>
 
 #include "interpatch/allocator.hpp"
@@ -42,19 +41,7 @@ class Grid {
   Grid(const shape_type& shape, const std::vector<T>& data) : shape_(shape), data_(data.begin(), data.end()) {}
   /// Zero elements (for T whose zero value is all zero bits: numbers and aggregates
   /// of them).
-  Grid(const shape_type& shape, zeroed_t) : shape_(shape) {
-    static_assert(std::is_trivially_copyable_v<T>, "zero pages hold values of trivially copyable types only");
-    const std::size_t n = count(shape);
-    if (n * sizeof(T) < detail::large_buffer_bytes) {  // from operator new: not zero
-      data_.resize(n);
-      return;
-    }
-    struct Guard {
-      Guard() noexcept { detail::leave_zero_pages = true; }
-      ~Guard() { detail::leave_zero_pages = false; }
-    } guard;
-    data_.resize(n);
-  }
+  Grid(const shape_type& shape, zeroed_t) : shape_(shape) { resize_zeroed(data_, count(shape)); }
 
   [[nodiscard]] const shape_type& shape() const noexcept { return shape_; }
   [[nodiscard]] std::size_t extent(std::size_t axis) const noexcept { return shape_[axis]; }

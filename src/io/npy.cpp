@@ -271,7 +271,8 @@ void read_exact(std::istream& in, char* dst, std::size_t n, const std::string& n
 
 /// The array in `in`, which holds `file_size` bytes; `name` names it in messages.
 /// What read_npy and parse_npy share: one reader for files and memory.
-NpyArray read_npy_stream(std::istream& in, std::uint64_t file_size, const std::string& name) {
+std::vector<std::size_t> read_npy_stream(std::istream& in, std::uint64_t file_size, const std::string& name,
+                                         const NpyDestination& destination) {
   unsigned char pre[12] = {};
   if (file_size < 10) {
     detail::fail(errc::malformed_file, name, ": not an NPY file (", file_size, " bytes, shorter than the NPY preamble)");
@@ -328,19 +329,17 @@ NpyArray read_npy_stream(std::istream& in, std::uint64_t file_size, const std::s
                  " needs ", need, " bytes of data, found ", have);
   }
 
-  NpyArray out;
-  out.shape = h.shape;
-  out.data.resize(count);
+  double* const out = destination(h.shape, count);
   const bool fortran = h.fortran_order && h.shape.size() > 1;
   const bool native = dt.big_endian == (std::endian::native == std::endian::big);
 
   if (!fortran && dt.size == 8) {
     // The common case: the file's bytes are the result, up to byte order.
-    read_exact(in, reinterpret_cast<char*>(out.data.data()), count * 8, name);
+    read_exact(in, reinterpret_cast<char*>(out), count * 8, name);
     if (!native) {
-      for (double& v : out.data) v = std::bit_cast<double>(byteswap(std::bit_cast<std::uint64_t>(v)));
+      for (std::size_t k = 0; k < count; ++k) out[k] = std::bit_cast<double>(byteswap(std::bit_cast<std::uint64_t>(out[k])));
     }
-    return out;
+    return h.shape;
   }
 
   // Decode in chunks; Fortran order (first index fastest) is scattered into C order.
@@ -367,28 +366,46 @@ NpyArray read_npy_stream(std::istream& in, std::uint64_t file_size, const std::s
     const std::size_t n = std::min(count - done, chunk_elems);
     read_exact(in, reinterpret_cast<char*>(buf.data()), n * dt.size, name);
     for (std::size_t k = 0; k < n; ++k) {
-      out.data[offset] = decode(buf.data() + k * dt.size, dt);
+      out[offset] = decode(buf.data() + k * dt.size, dt);
       advance();
     }
     done += n;
   }
-  return out;
+  return h.shape;
 }
 
 }  // namespace
 
-NpyArray read_npy(const fs::path& path) {
+std::vector<std::size_t> read_npy_into(const fs::path& path, const NpyDestination& destination) {
   std::ifstream in = detail::open_input(path);
   in.seekg(0, std::ios::end);
   const auto end = in.tellg();
   in.seekg(0, std::ios::beg);
   if (end < 0 || !in) fail_read(path.string(), errno);
-  return read_npy_stream(in, static_cast<std::uint64_t>(end), path.string());
+  return read_npy_stream(in, static_cast<std::uint64_t>(end), path.string(), destination);
+}
+
+namespace {
+// An NpyArray's own storage as the destination.
+NpyDestination into(NpyArray& a) {
+  return [&a](std::span<const std::size_t>, std::size_t count) {
+    a.data.resize(count);
+    return a.data.data();
+  };
+}
+}  // namespace
+
+NpyArray read_npy(const fs::path& path) {
+  NpyArray a;
+  a.shape = read_npy_into(path, into(a));
+  return a;
 }
 
 NpyArray parse_npy(std::string_view bytes, std::string_view name) {
   detail::MemoryStream in(bytes);
-  return read_npy_stream(in, bytes.size(), std::string(name));
+  NpyArray a;
+  a.shape = read_npy_stream(in, bytes.size(), std::string(name), into(a));
+  return a;
 }
 
 void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::span<const double> data) {

@@ -130,6 +130,7 @@ std::size_t checked_product(const std::vector<std::size_t>& shape, std::string_v
 struct Context {
   std::filesystem::path base_dir;
   progress_callback progress;
+  bool keep_data = true;  // copy interpolated grids into Construction::data
   std::vector<std::string> warnings;
   Clock::time_point start = Clock::now();
   std::optional<Clock::time_point> parsed_at;
@@ -377,28 +378,24 @@ std::string expected_shape(std::size_t rank) {
 }
 
 // Data from a file: check every value is finite, naming it as if it were inline.
-PointArray points_from_values(const std::vector<std::size_t>& shape, const std::vector<double>& values,
-                              std::string_view ptr, const std::string& file) {
-  const std::size_t n = values.size() / 3;
-  require_memory(n, sizeof(Vec3), cat(place(ptr), ": ", n, " points from ", file));
-  PointArray out{shape, PointStorage(n)};
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 p{values[3 * i], values[3 * i + 1], values[3 * i + 2]};
-    if (!is_finite(p)) {
-      std::vector<std::size_t> idx(shape.size() + 1);
-      std::size_t r = i;
-      for (std::size_t a = shape.size(); a-- > 0;) {
-        idx[a] = r % shape[a];
-        r /= shape[a];
-      }
-      const int k = std::isfinite(p.x) ? (std::isfinite(p.y) ? 2 : 1) : 0;
-      idx[shape.size()] = static_cast<std::size_t>(k);
-      fail(errc::not_finite, index_pointer(ptr, idx, idx.size()), ": coordinate ", coord_name(k), " is ", p[k], " (in ",
-           file, ")");
+// Refuses the first point with a NaN or Inf coordinate, naming it as a JSON Pointer
+// below `ptr` (`/points/3/7/2`) and the file it came from.
+void check_finite_points(const std::vector<std::size_t>& shape, const PointStorage& points, std::string_view ptr,
+                         const std::string& file) {
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec3& p = points[i];
+    if (is_finite(p)) continue;
+    std::vector<std::size_t> idx(shape.size() + 1);
+    std::size_t r = i;
+    for (std::size_t a = shape.size(); a-- > 0;) {
+      idx[a] = r % shape[a];
+      r /= shape[a];
     }
-    out.points[i] = p;
+    const int k = std::isfinite(p.x) ? (std::isfinite(p.y) ? 2 : 1) : 0;
+    idx[shape.size()] = static_cast<std::size_t>(k);
+    fail(errc::not_finite, index_pointer(ptr, idx, idx.size()), ": coordinate ", coord_name(k), " is ", p[k], " (in ",
+         file, ")");
   }
-  return out;
 }
 
 std::string file_name(const json& obj, std::string_view key, std::string_view ptr) {
@@ -410,17 +407,25 @@ std::string file_name(const json& obj, std::string_view key, std::string_view pt
 PointArray npy_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx) {
   check_fields(obj, ptr, {"npy"}, ctx);
   const std::string file = file_name(obj, "npy", ptr);
-  NpyArray a = at(ptr, [&] { return read_npy(ctx.resolve(file)); });
-  if (a.shape.size() != rank + 1 || a.shape.back() != 3)
-    fail(errc::size_mismatch, place(ptr), ": ", file, " has shape ", shape_text(a.shape), "; expected ",
-         expected_shape(rank), ", ", rank == 1 ? "a list" : cat("a ", rank, "-D grid"), " of 3-vectors");
-  std::vector<std::size_t> shape(a.shape.begin(), a.shape.end() - 1);
-  for (std::size_t ax = 0; ax < shape.size(); ++ax)
-    if (shape[ax] == 0) fail(errc::too_few_points, place(ptr), ": ", file, " has shape ", shape_text(a.shape), ", no points");
-  if (a.data.size() != checked_product(a.shape, place(ptr)))
-    fail(errc::malformed_file, place(ptr), ": ", file, " holds ", a.data.size(), " numbers, its shape ",
-         shape_text(a.shape), " says ", checked_product(a.shape, place(ptr)));
-  return points_from_values(shape, a.data, ptr, file);
+  // The values land in the point storage itself: float64 triples in C order are
+  // exactly a grid of Vec3.
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "points are read as triples of doubles");
+  PointArray out;
+  const std::vector<std::size_t> full = at(ptr, [&] {
+    return read_npy_into(ctx.resolve(file), [&](std::span<const std::size_t> shape, std::size_t count) {
+      const std::vector<std::size_t> s(shape.begin(), shape.end());
+      if (s.size() != rank + 1 || s.back() != 3)
+        fail(errc::size_mismatch, file, " has shape ", shape_text(s), "; expected ", expected_shape(rank), ", ",
+             rank == 1 ? "a list" : cat("a ", rank, "-D grid"), " of 3-vectors");
+      for (std::size_t ax = 0; ax + 1 < s.size(); ++ax)
+        if (s[ax] == 0) fail(errc::too_few_points, file, " has shape ", shape_text(s), ", no points");
+      resize_zeroed(out.points, count / 3);
+      return &out.points.data()->x;
+    });
+  });
+  out.shape.assign(full.begin(), full.end() - 1);
+  check_finite_points(out.shape, out.points, ptr, file);
+  return out;
 }
 
 PointArray csv_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx) {
@@ -609,8 +614,10 @@ Construction build_interpolate(const json& spec, Context& ctx) {
   PointGrid grid({nu, nv}, std::move(pts.points));
   DataSet data;
   data.pointer = "/points";
-  require_memory(grid.size(), sizeof(Vec3), cat("/points: a copy of the ", nu, "x", nv, " data points for the error check"));
-  data.points.assign(grid.values().begin(), grid.values().end());
+  if (ctx.keep_data) {
+    require_memory(grid.size(), sizeof(Vec3), cat("/points: a copy of the ", nu, "x", nv, " data points for the error check"));
+    data.points.assign(grid.values().begin(), grid.values().end());
+  }
 
   SurfaceInterpolationOptions options;
   options.degree_u = degree[0];
@@ -624,7 +631,7 @@ Construction build_interpolate(const json& spec, Context& ctx) {
   BSplineSurface s = on_unit_domain(std::move(r.surface));
   nlohmann::ordered_json parameters = {{"grid", {nu, nv}}, {"degree", {s.degree_u(), s.degree_v()}}, {"param", param_name(param)}};
   Construction c{"interpolate", std::move(s), {}, std::move(parameters), {}, {}, {}, {}, {}};
-  c.data.push_back(std::move(data));
+  if (ctx.keep_data) c.data.push_back(std::move(data));
   return c;
 }
 
@@ -1021,8 +1028,10 @@ Construction build_interpolate_volume(const json& spec, Context& ctx) {
   PointGrid3 grid({nu, nv, nw}, std::move(pts.points));
   DataSet data;
   data.pointer = "/points";
-  require_memory(grid.size(), sizeof(Vec3), cat("/points: a copy of the ", shape, " data points for the error check"));
-  data.points.assign(grid.values().begin(), grid.values().end());
+  if (ctx.keep_data) {
+    require_memory(grid.size(), sizeof(Vec3), cat("/points: a copy of the ", shape, " data points for the error check"));
+    data.points.assign(grid.values().begin(), grid.values().end());
+  }
 
   VolumeInterpolationOptions options;
   options.degree_u = degree[0];
@@ -1043,7 +1052,7 @@ Construction build_interpolate_volume(const json& spec, Context& ctx) {
   c.type = "interpolate_volume";
   c.exact = std::move(v);
   c.parameters = std::move(parameters);
-  c.data.push_back(std::move(data));
+  if (ctx.keep_data) c.data.push_back(std::move(data));
   return c;
 }
 
@@ -1270,18 +1279,21 @@ const Volume& volume_evaluator(const Construction& c) {
   return *c.volume_formula;
 }
 
-Construction build(const json& spec, const std::filesystem::path& base_dir, const progress_callback& progress) {
+Construction build(const json& spec, const std::filesystem::path& base_dir, const progress_callback& progress,
+                   bool keep_data) {
   Context ctx;
   ctx.base_dir = base_dir;
   ctx.progress = progress;
+  ctx.keep_data = keep_data;
   return build_impl(spec, ctx);
 }
 
-Construction build_file(const std::filesystem::path& spec_path, const progress_callback& progress) {
+Construction build_file(const std::filesystem::path& spec_path, const progress_callback& progress, bool keep_data) {
   Context ctx;  // starts the clock: reading the file counts as parsing
   const json spec = read_json_file(spec_path);
   ctx.base_dir = spec_path.parent_path();
   ctx.progress = progress;
+  ctx.keep_data = keep_data;
   return build_impl(spec, ctx);
 }
 

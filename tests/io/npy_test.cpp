@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -94,6 +95,31 @@ TEST(Npy, RoundTripIsBitExact) {
   EXPECT_EQ(a.shape, shape);
   ASSERT_EQ(a.data.size(), data.size());
   EXPECT_EQ(std::memcmp(a.data.data(), data.data(), data.size() * sizeof(double)), 0);
+}
+
+TEST(Npy, ReadsIntoTheCallersMemory) {
+  TempDir dir;
+  std::vector<double> data(2 * 3 * 3);
+  for (std::size_t i = 0; i < data.size(); ++i) data[i] = 0.5 * static_cast<double>(i) - 3;
+  const std::vector<std::size_t> shape = {2, 3, 3};
+  write_npy(dir / "p.npy", shape, data);
+  std::vector<double> mine;
+  std::vector<std::size_t> seen;
+  const auto got = read_npy_into(dir / "p.npy", [&](std::span<const std::size_t> s, std::size_t count) {
+    seen.assign(s.begin(), s.end());
+    mine.resize(count);
+    return mine.data();
+  });
+  EXPECT_EQ(got, shape);
+  EXPECT_EQ(seen, shape);  // told the shape before any value is read
+  EXPECT_EQ(mine, data);
+  EXPECT_EQ(read_npy(dir / "p.npy").data, mine);  // the same code path as read_npy
+  // A destination that refuses the shape stops the read with its own error.
+  EXPECT_ERRC((void)read_npy_into(dir / "p.npy",
+                                  [](std::span<const std::size_t>, std::size_t) -> double* {
+                                    throw interpatch::error(errc::size_mismatch, "not a list of points");
+                                  }),
+              size_mismatch, "not a list of points");
 }
 
 TEST(Npy, WrittenHeaderIsVersion1LittleEndianPaddedTo64) {

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -42,6 +43,26 @@ struct NpyArray {
 /// @endcode
 /// @throws error malformed_file, too_large, as read_npy; file_unreadable never.
 [[nodiscard]] NpyArray parse_npy(std::string_view bytes, std::string_view name = "npy");
+
+/// Where read_npy_into puts the values: called once, after the header is read and
+/// the sizes are checked against the file and the memory, with the shape and the
+/// number of values; returns memory for that many doubles, which are then written
+/// in C order. It may throw to refuse the shape.
+using NpyDestination = std::function<double*(std::span<const std::size_t> shape, std::size_t count)>;
+
+/// Reads as read_npy, into memory the caller provides (the storage of a point grid,
+/// say), without an intermediate copy. Returns the shape.
+///
+/// Example:
+/// @code
+///   std::vector<double> v;
+///   auto shape = interpatch::io::read_npy_into("grid.npy", [&](auto, std::size_t n) {
+///     v.resize(n);
+///     return v.data();
+///   });
+/// @endcode
+/// @throws error as read_npy, and whatever `destination` throws.
+std::vector<std::size_t> read_npy_into(const std::filesystem::path& path, const NpyDestination& destination);
 
 /// Writes little-endian float64 in C order, format version 1.0 (header padded to
 /// 64 bytes as NumPy does), atomically.

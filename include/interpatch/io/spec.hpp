@@ -121,13 +121,17 @@ struct Construction {
 ///   file_unreadable and malformed_file (data files), too_large, and whatever the
 ///   construction raises (too_few_points, invalid_degree, zero_chord, non_increasing,
 ///   invalid_knots, invalid_weight, singular, ...), prefixed with the pointer.
+/// `keep_data` false leaves Construction::data empty for grid interpolations: the
+/// copy of the data points the error check at the data needs is as large as the
+/// grid, and commands that only evaluate the result do without it.
 [[nodiscard]] Construction build(const nlohmann::json& spec, const std::filesystem::path& base_dir = {},
-                                 const progress_callback& progress = {});
+                                 const progress_callback& progress = {}, bool keep_data = true);
 
 /// Reads a spec file and builds it; data files are found relative to the spec's
 /// directory. The time spent reading and parsing the file counts into parse_ms.
 /// @throws error file_unreadable, invalid_json, and what build() throws.
-[[nodiscard]] Construction build_file(const std::filesystem::path& spec_path, const progress_callback& progress = {});
+[[nodiscard]] Construction build_file(const std::filesystem::path& spec_path, const progress_callback& progress = {},
+                                      bool keep_data = true);
 
 /// A point array read from a spec field: `shape` is the grid shape without the
 /// trailing 3, `points` the points in C order (first index slowest).
