@@ -504,7 +504,11 @@ int demo_command(const fs::path& requested) {
       return dir / (ex.name + suffix);
     };
     const bool volume = io::is_volume(c);
-    if (c.exact) write_build(c, out(".bspline.json"));
+    if (c.exact) {
+      write_build(c, out(".bspline.json"));
+      write_build(c, out(".step"));  // a face (a closed shell of six for a volume) for CAD systems
+      write_build(c, out(".igs"));
+    }
     write_eval(c, out(".eval.npy"), volume ? volume_eval_grid : eval_grid);
     write_eval(c, out(".eval.csv"), volume ? volume_eval_grid : eval_grid);
     if (volume) {

@@ -229,7 +229,8 @@ TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("outputs in out"), std::string::npos) << r.out;
   for (const char* name : {"hemisphere", "terrain", "wave", "saddle", "half_cylinder", "twisted_strip"}) {
-    for (const char* suffix : {".spec.json", ".bspline.json", ".eval.npy", ".eval.csv", ".obj", ".vtk", ".info.json"})
+    for (const char* suffix :
+         {".spec.json", ".bspline.json", ".step", ".igs", ".eval.npy", ".eval.csv", ".obj", ".vtk", ".info.json"})
       EXPECT_TRUE(fs::exists(at("out") / (std::string(name) + suffix))) << name << suffix;
     const json info = json::parse(read_file(at("out") / (std::string(name) + ".info.json")));
     EXPECT_LT(info["max_data_error"]["relative"].get<double>(), 1e-12) << name;
@@ -238,7 +239,8 @@ TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
   EXPECT_TRUE(fs::exists(at("out") / "twisted_strip.csv"));
   EXPECT_TRUE(fs::exists(at("out") / "hemisphere.stl"));
   for (const char* name : {"trilinear", "coons_volume", "hermite_volume", "annular_sector"}) {
-    for (const char* suffix : {".spec.json", ".bspline.json", ".eval.npy", ".eval.csv", ".vts", ".vtk", ".xyz", ".info.json"})
+    for (const char* suffix : {".spec.json", ".bspline.json", ".step", ".igs", ".eval.npy", ".eval.csv", ".vts", ".vtk", ".xyz",
+                               ".info.json"})
       EXPECT_TRUE(fs::exists(at("out") / (std::string(name) + suffix))) << name << suffix;
     const json info = json::parse(read_file(at("out") / (std::string(name) + ".info.json")));
     EXPECT_EQ(info["kind"], "volume") << name;
