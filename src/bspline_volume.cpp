@@ -45,7 +45,7 @@ std::size_t grid_items(std::size_t nu, std::size_t nv, std::size_t nw, std::size
 // operations whatever their count.
 template <bool Partials, class Sink>
 void contract(const BSplineVolume& b, const std::vector<Basis>& bu, const std::vector<Basis>& bv,
-              const std::vector<Basis>& bw, std::size_t r0, std::size_t r1, bool threads, const Sink& sink) {
+              const std::vector<Basis>& bw, std::size_t r0, std::size_t r1, [[maybe_unused]] bool threads, const Sink& sink) {
   const int p = b.degree_u(), q = b.degree_v(), r = b.degree_w();
   const PointGrid3& cp = b.control_points();
   const Grid<double, 3>& wt = b.weights();

@@ -129,7 +129,7 @@ void solve_along_axis(const BandedLU& lu, double* data, const std::size_t* shape
   for (std::size_t a = axis + 1; a < rank; ++a) inner *= shape[a];
   const std::size_t n = shape[axis];
   const std::size_t block = n * inner;
-  const bool threads = parallel && block * outer >= parallel_min_work;
+  [[maybe_unused]] const bool threads = parallel && block * outer >= parallel_min_work;
   if (inner < 64 && outer > 1) {
     const auto groups = static_cast<long long>((outer + narrow_group - 1) / narrow_group);
 #pragma omp parallel if (threads)
