@@ -89,35 +89,29 @@ std::size_t slice_width(std::size_t inner) {
 // operations; every number still goes through the same operations.
 constexpr std::size_t narrow_group = 8;
 
-// Gathers the m lines (rows of `inner` doubles, `block` apart) side by side into buf
-// and back: plain loops, which the compiler unrolls for the usual 3 doubles a row.
-INTERPATCH_KERNEL void interleave(const double* data, std::size_t n, std::size_t inner, std::size_t block, std::size_t m,
-                                  double* buf) {
+// Copies the m lines (rows of `inner` doubles, `block` apart) side by side into buf
+// (Gather) or back out of it: plain loops, which the compiler unrolls for the usual
+// 3 doubles a row.
+template <bool Gather>
+INTERPATCH_KERNEL void shuffle_lines(double* data, std::size_t n, std::size_t inner, std::size_t block, std::size_t m,
+                                     double* buf) {
   const std::size_t width = m * inner;
   for (std::size_t l = 0; l < m; ++l) {
-    const double* src = data + l * block;
-    double* dst = buf + l * inner;
+    double* line = data + l * block;
+    double* side = buf + l * inner;
     for (std::size_t k = 0; k < n; ++k)
-      for (std::size_t c = 0; c < inner; ++c) dst[k * width + c] = src[k * inner + c];
-  }
-}
-
-INTERPATCH_KERNEL void deinterleave(const double* buf, std::size_t n, std::size_t inner, std::size_t block, std::size_t m,
-                                    double* data) {
-  const std::size_t width = m * inner;
-  for (std::size_t l = 0; l < m; ++l) {
-    const double* src = buf + l * inner;
-    double* dst = data + l * block;
-    for (std::size_t k = 0; k < n; ++k)
-      for (std::size_t c = 0; c < inner; ++c) dst[k * inner + c] = src[k * width + c];
+      for (std::size_t c = 0; c < inner; ++c) {
+        if constexpr (Gather) side[k * width + c] = line[k * inner + c];
+        else line[k * inner + c] = side[k * width + c];
+      }
   }
 }
 
 void solve_narrow_group(const BandedLU& lu, double* data, std::size_t n, std::size_t inner, std::size_t block,
                         std::size_t m, double* buf) {
-  interleave(data, n, inner, block, m, buf);
+  shuffle_lines<true>(data, n, inner, block, m, buf);
   lu.solve(buf, m * inner, m * inner);
-  deinterleave(buf, n, inner, block, m, data);
+  shuffle_lines<false>(data, n, inner, block, m, buf);
 }
 
 }  // namespace
