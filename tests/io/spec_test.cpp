@@ -86,6 +86,21 @@ TEST(Spec, InterpolateReproducesTheDataOverRandomGrids) {
   }
 }
 
+// build, mesh and eval build without the copy of the data points (keep_data false):
+// the same exact form, bit for bit, and no data set; info's error check needs them.
+TEST(Spec, WithoutDataTheSameExactFormAndNoDataSet) {
+  auto g = test::rng(2);
+  const PointGrid q = test::random_grid(g, 6, 9);
+  const json spec = interpolate_spec(q);
+  const Construction kept = build(spec), lean = build(spec, {}, {}, false);
+  EXPECT_EQ(kept.data.size(), 1u);
+  EXPECT_TRUE(lean.data.empty());
+  const auto& a = std::get<BSplineSurface>(*kept.exact);
+  const auto& b = std::get<BSplineSurface>(*lean.exact);
+  EXPECT_EQ(a.control_points().values(), b.control_points().values());
+  EXPECT_EQ(a.knots_u().values(), b.knots_u().values());
+}
+
 TEST(Spec, DegreeAsOneNumberOrOnePerDirection) {
   auto g = test::rng(2);
   json spec = interpolate_spec(test::random_grid(g, 6, 7));
