@@ -61,6 +61,24 @@ std::span<const double> flat_points(const Vec3* p, std::size_t n) {
   return {&p->x, 3 * n};
 }
 
+// An evaluation grid written to .npy block by block along u: evaluate(us, out) fills
+// out with the points of the u values `us` (per_row points each). A block is about
+// 2^17 points (3 MiB): work enough for both threads, still in the cache when it is
+// written, and the whole grid is never held in memory.
+template <class Evaluate>
+void write_npy_by_rows(const fs::path& out, std::span<const std::size_t> shape, std::span<const double> us,
+                       std::size_t per_row, const progress_callback& progress, const Evaluate& evaluate) {
+  const std::size_t rows = std::max<std::size_t>(1, (std::size_t{1} << 17) / per_row);
+  std::vector<Vec3> block(std::min(rows, us.size()) * per_row);
+  io::write_npy(out, shape, 3 * rows * per_row, [&](std::size_t first, std::size_t count) {
+    const std::size_t r0 = first / (3 * per_row), n = count / (3 * per_row);
+    const std::span<Vec3> points(block.data(), n * per_row);
+    evaluate(us.subspan(r0, n), points);
+    if (progress) progress(static_cast<double>(r0 + n) / static_cast<double>(us.size()));
+    return flat_points(points.data(), points.size());
+  });
+}
+
 void mesh_volume(const io::Construction& c, const fs::path& out, const Resolution& res) {
   const Volume& v = io::volume_evaluator(c);
   // Every construction is over the unit cube.
@@ -75,14 +93,18 @@ void eval_volume(const io::Construction& c, const fs::path& out, std::size_t k) 
   const Volume& v = io::volume_evaluator(c);
   const std::vector<std::vector<double>> params{linspace(0, 1, k), linspace(0, 1, k), linspace(0, 1, k)};
   ProgressLine progress("evaluating");
-  const PointGrid3 g = v.evaluate(params[0], params[1], params[2], progress.callback());
-  progress.clear();
   if (lower_extension(out) == ".npy") {
     const std::size_t shape[4] = {k, k, k, 3};
-    io::write_npy(out, shape, flat_points(g.data(), g.size()));
-  } else {
-    io::write_csv_grid(out, params, std::span<const Vec3>(g.data(), g.size()));
+    write_npy_by_rows(out, shape, params[0], k * k, progress.callback(),
+                      [&](std::span<const double> us, std::span<Vec3> points) {
+                        v.evaluate_into(us, params[1], params[2], points);
+                      });
+    progress.clear();
+    return;
   }
+  const PointGrid3 g = v.evaluate(params[0], params[1], params[2], progress.callback());
+  progress.clear();
+  io::write_csv_grid(out, params, std::span<const Vec3>(g.data(), g.size()));
 }
 
 }  // namespace
@@ -140,13 +162,21 @@ void check_info_output(const fs::path& out) {
   throw usage_error("cannot tell the output format of '" + out.string() + "': info writes .json");
 }
 
-void require_eval_memory(std::size_t k, const fs::path& out, int dims) {
+void require_eval_room(std::size_t k, const fs::path& out, int dims) {
   const std::string size = dims == 3 ? what_size(k, k, k) : what_size(k, k);
   const std::string what = "evaluation grid " + (k == std::numeric_limits<std::size_t>::max() ? std::string("beyond 2^64") : size);
   if (k >= (std::size_t{1} << (dims == 3 ? 21 : 32))) throw error(errc::too_large, what + ": more points than can be addressed");
-  // The points (.npy writes them from the grid's memory), plus the text of a row for .csv.
-  const std::size_t per_point = lower_extension(out) == ".npy" ? sizeof(Vec3) : sizeof(Vec3) + 8;
-  require_memory(dims == 3 ? k * k * k : k * k, per_point, what);
+  const std::size_t points = dims == 3 ? k * k * k : k * k;
+  if (lower_extension(out) == ".npy") {
+    // Evaluated and written a block at a time: the memory of one block, the disk
+    // space of the whole file (the header is at most a few hundred bytes).
+    if (points > (std::numeric_limits<std::size_t>::max() - 4096) / sizeof(Vec3))
+      throw error(errc::too_large, what + ": more bytes than a file can hold");
+    io::check_disk_space(out, points * sizeof(Vec3) + 4096, what);
+    return;
+  }
+  // The points, plus the text of a row for .csv.
+  require_memory(points, sizeof(Vec3) + 8, what);
 }
 
 void require_mesh_memory(const Resolution& res) {
@@ -219,14 +249,16 @@ void write_eval(const io::Construction& c, const fs::path& out, std::size_t k) {
   constexpr double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  // every construction is over the unit square
   std::vector<std::vector<double>> params{linspace(u0, u1, k), linspace(v0, v1, k)};
   ProgressLine progress("evaluating");
-  const PointGrid g = s.evaluate(params[0], params[1], progress.callback());
-  progress.clear();
   if (lower_extension(out) == ".npy") {
     const std::size_t shape[3] = {k, k, 3};
-    io::write_npy(out, shape, flat_points(g.data(), g.size()));
-  } else {
-    io::write_csv_grid(out, params, std::span<const Vec3>(g.data(), g.size()));
+    write_npy_by_rows(out, shape, params[0], k, progress.callback(),
+                      [&](std::span<const double> us, std::span<Vec3> points) { s.evaluate_into(us, params[1], points); });
+    progress.clear();
+    return;
   }
+  const PointGrid g = s.evaluate(params[0], params[1], progress.callback());
+  progress.clear();
+  io::write_csv_grid(out, params, std::span<const Vec3>(g.data(), g.size()));
 }
 
 nlohmann::ordered_json info(const io::Construction& c) {
@@ -270,9 +302,9 @@ int eval_command(const fs::path& spec, const fs::path& out, std::string_view gri
   const std::size_t k = parse_grid(grid);
   check_eval_output(out);
   io::check_writable(out);
-  require_eval_memory(k, out);
+  require_eval_room(k, out);
   const io::Construction c = build_spec(spec, false);
-  if (io::is_volume(c)) require_eval_memory(k, out, 3);
+  if (io::is_volume(c)) require_eval_room(k, out, 3);
   write_eval(c, out, k);
   report_warnings(c);
   return 0;

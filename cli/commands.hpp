@@ -48,9 +48,10 @@ void check_mesh_output(const std::filesystem::path& out);
 void check_eval_output(const std::filesystem::path& out);
 void check_info_output(const std::filesystem::path& out);
 
-/// Refuse (error too_large) an evaluation grid or a mesh that cannot fit in memory.
-/// `dims` is 2 for a K×K grid, 3 for K×K×K.
-void require_eval_memory(std::size_t k, const std::filesystem::path& out, int dims = 2);
+/// Refuse (error too_large) an evaluation grid whose .npy file cannot fit on the
+/// output's disk (it is written a block at a time) or whose .csv text cannot be made
+/// in memory. `dims` is 2 for a K×K grid, 3 for K×K×K.
+void require_eval_room(std::size_t k, const std::filesystem::path& out, int dims = 2);
 void require_mesh_memory(const Resolution& res);
 
 /// Refuse (usage_error) a resolution or a mesh format that does not fit the kind of

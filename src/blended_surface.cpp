@@ -227,13 +227,13 @@ SurfaceDerivatives BlendedSurface::derivatives(double u, double v) const {
   return d;
 }
 
-PointGrid BlendedSurface::evaluate(std::span<const double> us, std::span<const double> vs,
-                                  const progress_callback& progress) const {
+void BlendedSurface::evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
+                                   const progress_callback& progress) const {
   const auto& T = *t_;
-  if (!T.gregory.empty()) return Surface::evaluate(us, vs, progress);
+  if (!T.gregory.empty()) return Surface::evaluate_into(us, vs, out, progress);
+  detail::check_output_size(out.size(), {us.size(), vs.size()}, "surface evaluation");
   detail::check_unit_parameters(us, "u");
   detail::check_unit_parameters(vs, "v");
-  require_memory(us.size() * vs.size(), sizeof(Vec3), "surface evaluation grid");
   const std::size_t nu = us.size(), nv = vs.size(), K = T.f.size(), L = T.g.size();
   auto value = [](const detail::Scalar& f, double t) { return f.spline ? f.spline->point(t).x : f.fn(t, 0); };
   auto clamp = [](double t) { return std::clamp(t, 0.0, 1.0); };
@@ -256,7 +256,6 @@ PointGrid BlendedSurface::evaluate(std::span<const double> us, std::span<const d
     for (std::size_t l = 0; l < L; ++l) G[j * L + l] = value(T.g[l], v);
     for (std::size_t k = 0; k < T.a.size(); ++k) A[j * T.a.size() + k] = T.a[k].point(v);
   }
-  PointGrid out({nu, nv}, zeroed);
   const std::size_t KA = T.a.size();
   const auto rows = static_cast<long long>(nu);
   std::atomic<std::size_t> done{0};
@@ -265,7 +264,7 @@ PointGrid BlendedSurface::evaluate(std::span<const double> us, std::span<const d
     const auto i = static_cast<std::size_t>(ri);
     const double* f = F.data() + i * K;
     const Vec3* p = P.data() + i * L;
-    Vec3* o = &out(i, 0);
+    Vec3* o = out.data() + i * nv;
     for (std::size_t j = 0; j < nv; ++j) {
       Vec3 s{};
       for (std::size_t k = 0; k < KA; ++k) s += f[k] * A[j * KA + k];
@@ -276,7 +275,6 @@ PointGrid BlendedSurface::evaluate(std::span<const double> us, std::span<const d
     if (progress && detail::thread_index() == 0 && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(nu));
   }
   if (progress) progress(1.0);
-  return out;
 }
 
 bool BlendedSurface::has_exact_form() const noexcept {

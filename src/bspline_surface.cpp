@@ -206,15 +206,14 @@ SurfaceDerivatives BSplineSurface::derivatives(double u, double v) const {
           derivative(u, v, 2, 0), derivative(u, v, 1, 1), derivative(u, v, 0, 2)};
 }
 
-PointGrid BSplineSurface::evaluate(std::span<const double> us, std::span<const double> vs,
+void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
                                    const progress_callback& progress) const {
-  require_memory(us.size() * vs.size(), sizeof(Vec3), "surface evaluation grid");
+  detail::check_output_size(out.size(), {us.size(), vs.size()}, "surface evaluation");
   const auto bu = bases(ku_, us, 0, "u");
   const auto bv = bases(kv_, vs, 0, "v");
   const int p = degree_u(), q = degree_v();
   const std::size_t ncv = cp_.extent(1);
   const std::size_t nv = vs.size();
-  PointGrid out({us.size(), nv}, zeroed);
   const bool rat = rational();
   // One parallel region: opening one costs microseconds with pinned threads but up
   // to milliseconds on a loaded machine, where the idle thread spins. Progress is
@@ -240,13 +239,13 @@ PointGrid BSplineSurface::evaluate(std::span<const double> us, std::span<const d
         const auto i = static_cast<std::size_t>(ri);
         const Basis& b = bu[i];
         weighted_rows(b.d, p + 1, &cp_(static_cast<std::size_t>(b.span - p), 0).x, row_doubles, row_doubles, row.data());
-        sample_row(spans.data(), weights.data(), q, nv, row.data(), &out(i, 0).x);
+        sample_row(spans.data(), weights.data(), q, nv, row.data(), &out[i * nv].x);
         const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
         if (progress && reporter && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(us.size()));
       }
     }
     if (progress) progress(1.0);
-    return out;
+    return;
   }
 #pragma omp parallel if (threads)
   {
@@ -270,7 +269,7 @@ PointGrid BSplineSurface::evaluate(std::span<const double> us, std::span<const d
         }
         row[l] = {x, y, z, w};
       }
-      Vec3* o = &out(i, 0);
+      Vec3* o = out.data() + i * nv;
       for (std::size_t j = 0; j < nv; ++j) {
         const Basis& c = bv[j];
         double x = 0, y = 0, z = 0, w = 0;
@@ -288,7 +287,6 @@ PointGrid BSplineSurface::evaluate(std::span<const double> us, std::span<const d
     }
   }
   if (progress) progress(1.0);
-  return out;
 }
 
 Grid<SurfaceDerivatives, 2> BSplineSurface::evaluate_derivatives(std::span<const double> us,

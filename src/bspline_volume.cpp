@@ -356,13 +356,14 @@ VolumeDerivatives BSplineVolume::derivatives(double u, double v, double w) const
   return {s, (vec(h[1]) - h[1][3] * s) / wt, (vec(h[2]) - h[2][3] * s) / wt, (vec(h[3]) - h[3][3] * s) / wt};
 }
 
-PointGrid3 BSplineVolume::evaluate(std::span<const double> us, std::span<const double> vs, std::span<const double> ws,
-                                   const progress_callback& progress) const {
-  grid_items(us.size(), vs.size(), ws.size(), sizeof(Vec3), "volume evaluation grid");
-  PointGrid3 out({us.size(), vs.size(), ws.size()}, zeroed);
+void BSplineVolume::evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<const double> ws,
+                                  std::span<Vec3> out, const progress_callback& progress) const {
+  detail::check_output_size(out.size(), {us.size(), vs.size(), ws.size()}, "volume evaluation");
+  const std::size_t nv = vs.size(), nw = ws.size();
   contract_all<false>(*this, us, vs, ws, progress,
-                      [&out](std::size_t i, std::size_t j, std::size_t k, const VolumeDerivatives& d) { out(i, j, k) = d.s; });
-  return out;
+                      [&](std::size_t i, std::size_t j, std::size_t k, const VolumeDerivatives& d) {
+                        out[(i * nv + j) * nw + k] = d.s;
+                      });
 }
 
 Grid<VolumeDerivatives, 3> BSplineVolume::evaluate_derivatives(std::span<const double> us, std::span<const double> vs,

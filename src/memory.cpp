@@ -156,22 +156,6 @@ std::uint64_t cgroup_v2_available() {
   return best;
 }
 
-/// Bytes in a short human form: "240 GB", "22.9 GB", "512 bytes" (decimal units,
-/// three significant digits).
-std::string human_bytes(std::uint64_t bytes) {
-  static constexpr const char* units[] = {"bytes", "kB", "MB", "GB", "TB", "PB", "EB"};
-  if (bytes < 1000) return std::to_string(bytes) + " bytes";
-  double v = static_cast<double>(bytes);
-  std::size_t u = 0;
-  // Move up while the value would print as 1000 or more at three significant digits.
-  while (v >= 999.5 && u + 1 < std::size(units)) {
-    v /= 1000.0;
-    ++u;
-  }
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g %s", v, units[u]);
-  return buf;
-}
 
 }  // namespace
 
@@ -191,8 +175,8 @@ void require_memory(std::size_t count, std::size_t item_bytes, std::string_view 
   const std::size_t need = count * item_bytes;
   const std::size_t avail = available_memory();
   if (need > avail) {
-    detail::fail(errc::too_large, std::string(what), " needs ", human_bytes(need), " (", need, " bytes), ",
-                 human_bytes(avail), " available (", avail, " bytes)");
+    detail::fail(errc::too_large, std::string(what), " needs ", detail::human_bytes(need), " (", need, " bytes), ",
+                 detail::human_bytes(avail), " available (", avail, " bytes)");
   }
 }
 

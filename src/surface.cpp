@@ -10,20 +10,27 @@ namespace interpatch {
 
 PointGrid Surface::evaluate(std::span<const double> us, std::span<const double> vs,
                             const progress_callback& progress) const {
-  detail::check_unit_parameters(us, "u");
-  detail::check_unit_parameters(vs, "v");
   require_memory(us.size() * vs.size(), sizeof(Vec3), "surface evaluation grid");
   PointGrid out({us.size(), vs.size()}, zeroed);
+  evaluate_into(us, vs, std::span<Vec3>(out.data(), out.size()), progress);
+  return out;
+}
+
+void Surface::evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
+                            const progress_callback& progress) const {
+  detail::check_output_size(out.size(), {us.size(), vs.size()}, "surface evaluation");
+  detail::check_unit_parameters(us, "u");
+  detail::check_unit_parameters(vs, "v");
+  const std::size_t nv = vs.size();
   const auto nu = static_cast<long long>(us.size());
   for (long long r0 = 0; r0 < nu; r0 += 64) {
     const long long r1 = std::min(nu, r0 + 64);
-#pragma omp parallel for schedule(static) if (us.size() * vs.size() >= detail::parallel_min_work / 16)
+#pragma omp parallel for schedule(static) if (us.size() * nv >= detail::parallel_min_work / 16)
     for (long long i = r0; i < r1; ++i)
-      for (std::size_t j = 0; j < vs.size(); ++j)
-        out(static_cast<std::size_t>(i), j) = point(us[static_cast<std::size_t>(i)], vs[j]);
+      for (std::size_t j = 0; j < nv; ++j)
+        out[static_cast<std::size_t>(i) * nv + j] = point(us[static_cast<std::size_t>(i)], vs[j]);
     if (progress) progress(static_cast<double>(r1) / static_cast<double>(nu));
   }
-  return out;
 }
 
 Grid<SurfaceDerivatives, 2> Surface::evaluate_derivatives(std::span<const double> us,

@@ -70,9 +70,21 @@ PointGrid3 Volume::evaluate(std::span<const double> us, std::span<const double> 
                             const progress_callback& progress) const {
   check_grid(*this, us, vs, ws, sizeof(Vec3), "volume evaluation grid");
   PointGrid3 out({us.size(), vs.size(), ws.size()}, zeroed);
-  pointwise(us.size(), vs.size(), ws.size(), progress,
-            [&](std::size_t i, std::size_t j, std::size_t k) { out(i, j, k) = point(us[i], vs[j], ws[k]); });
+  evaluate_into(us, vs, ws, std::span<Vec3>(out.data(), out.size()), progress);
   return out;
+}
+
+void Volume::evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<const double> ws,
+                           std::span<Vec3> out, const progress_callback& progress) const {
+  detail::check_output_size(out.size(), {us.size(), vs.size(), ws.size()}, "volume evaluation");
+  const auto dom = domain();
+  check_domain(us, dom[0], "u");
+  check_domain(vs, dom[1], "v");
+  check_domain(ws, dom[2], "w");
+  const std::size_t nv = vs.size(), nw = ws.size();
+  pointwise(us.size(), nv, nw, progress, [&](std::size_t i, std::size_t j, std::size_t k) {
+    out[(i * nv + j) * nw + k] = point(us[i], vs[j], ws[k]);
+  });
 }
 
 Grid<VolumeDerivatives, 3> Volume::evaluate_derivatives(std::span<const double> us, std::span<const double> vs,

@@ -282,8 +282,8 @@ std::vector<Row> rows() {
        R"(cannot write 'missing/out\.json')", errc::file_unwritable, false},
       // too large: refused before allocating. The bytes needed are an estimate that may
   // change; what stays is the size asked for, the bytes needed and the bytes available.
-      {"EvalGridTooLarge", {{grid_file, grid}}, {"eval", grid_file, "--grid", "100000", "-o", "out.npy"}, 5,
-       R"(evaluation grid 100000x100000 needs [0-9.]+ [GT]B \([0-9]+ bytes\), [0-9.]+ [kMGT]?B available)",
+      {"EvalGridTooLarge", {{grid_file, grid}}, {"eval", grid_file, "--grid", "1000000", "-o", "out.npy"}, 5,
+       R"(evaluation grid 1000000x1000000 needs [0-9.]+ [TP]B \([0-9]+ bytes\), [0-9.]+ [kMGT]?B available)",
        errc::too_large, false},
       {"EvalGridBeyondCounting", {{grid_file, grid}},
        {"eval", grid_file, "--grid", "123456789012345678901234567890", "-o", "out.csv"}, 5,

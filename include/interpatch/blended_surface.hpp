@@ -72,13 +72,13 @@ class BlendedSurface final : public Surface {
   explicit BlendedSurface(std::shared_ptr<const detail::BlendedTerms> terms);
 
   [[nodiscard]] SurfaceDerivatives derivatives(double u, double v) const override;
-  /// Points at every (us[i], vs[j]): each blending function and curve is evaluated
-  /// once per parameter, then every point is a short sum of products of those
-  /// values (Gregory-corrected patches go point by point). Both cores share the
-  /// rows; the result does not depend on the thread count.
-  /// @throws error out_of_domain, too_large.
-  [[nodiscard]] PointGrid evaluate(std::span<const double> us, std::span<const double> vs,
-                                   const progress_callback& progress = {}) const override;
+  /// Points at every (us[i], vs[j]) into out[i * vs.size() + j]: each blending
+  /// function and curve is evaluated once per parameter, then every point is a
+  /// short sum of products of those values (Gregory-corrected patches go point by
+  /// point). Both cores share the rows; the result does not depend on the thread
+  /// count. @throws error out_of_domain, size_mismatch.
+  void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
+                     const progress_callback& progress = {}) const override;
   /// @throws error no_exact_form (rational boundary curves, Gregory's twists).
   [[nodiscard]] BSplineSurface to_bspline() const override;
   /// Whether to_bspline() succeeds.

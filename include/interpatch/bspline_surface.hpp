@@ -49,12 +49,12 @@ class BSplineSurface final : public Surface {
   /// ∂^{ku+kv} S / ∂u^ku ∂v^kv for any orders. @throws error out_of_domain.
   [[nodiscard]] Vec3 derivative(double u, double v, int ku, int kv) const;
 
-  /// Points at every (us[i], vs[j]): a us.size() × vs.size() grid. Basis functions
+  /// Points at every (us[i], vs[j]) into out[i * vs.size() + j]. Basis functions
   /// are computed once per parameter; each u row first contracts the control net
   /// to one curve in v. Both cores share the rows; the result does not depend on
-  /// the thread count. @throws error out_of_domain, too_large.
-  [[nodiscard]] PointGrid evaluate(std::span<const double> us, std::span<const double> vs,
-                                   const progress_callback& progress = {}) const override;
+  /// the thread count. @throws error out_of_domain, size_mismatch.
+  void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
+                     const progress_callback& progress = {}) const override;
   /// Points and derivatives at every (us[i], vs[j]). @throws error out_of_domain, too_large.
   [[nodiscard]] Grid<SurfaceDerivatives, 2> evaluate_derivatives(std::span<const double> us,
                                                                  std::span<const double> vs) const override;

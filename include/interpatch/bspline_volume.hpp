@@ -62,13 +62,13 @@ class BSplineVolume final : public Volume {
   /// @throws error out_of_domain, invalid_degree (an order outside 0..3).
   [[nodiscard]] Vec3 derivative(double u, double v, double w, int ku, int kv, int kw) const;
 
-  /// Points at every (us[i], vs[j], ws[k]). Basis functions are computed once per
-  /// parameter; for each u the control net is contracted with the u-basis to a net
-  /// in (v, w), then per v to a row in w, then per w to the point. Both cores share
-  /// the u values; the result does not depend on the thread count.
-  /// @throws error out_of_domain, too_large.
-  [[nodiscard]] PointGrid3 evaluate(std::span<const double> us, std::span<const double> vs,
-                                    std::span<const double> ws, const progress_callback& progress = {}) const override;
+  /// Points at every (us[i], vs[j], ws[k]) into out[(i * vs.size() + j) * ws.size() + k].
+  /// Basis functions are computed once per parameter; for each u the control net is
+  /// contracted with the u-basis to a net in (v, w), then per v to a row in w, then
+  /// per w to the point. Both cores share the u values; the result does not depend
+  /// on the thread count. @throws error out_of_domain, size_mismatch.
+  void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<const double> ws,
+                     std::span<Vec3> out, const progress_callback& progress = {}) const override;
   /// Points and first partials at every (us[i], vs[j], ws[k]), by the same contraction.
   /// @throws error out_of_domain, too_large.
   [[nodiscard]] Grid<VolumeDerivatives, 3> evaluate_derivatives(std::span<const double> us,

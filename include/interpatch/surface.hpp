@@ -29,9 +29,26 @@ class Surface {
   /// S and its partial derivatives up to second order, from the construction's own
   /// formula. @throws error out_of_domain.
   [[nodiscard]] virtual SurfaceDerivatives derivatives(double u, double v) const = 0;
-  /// Points at every (us[i], vs[j]). @throws error out_of_domain, too_large.
-  [[nodiscard]] virtual PointGrid evaluate(std::span<const double> us, std::span<const double> vs,
-                                           const progress_callback& progress = {}) const;
+  /// Points at every (us[i], vs[j]): a us.size() × vs.size() grid, through
+  /// evaluate_into(). @throws error out_of_domain, too_large.
+  [[nodiscard]] PointGrid evaluate(std::span<const double> us, std::span<const double> vs,
+                                   const progress_callback& progress = {}) const;
+  /// Points at every (us[i], vs[j]) into memory the caller owns: out[i * vs.size() + j].
+  /// A block of rows at a time into one reused buffer, or straight into a mapped
+  /// file, costs no memory for the whole grid.
+  ///
+  /// Example:
+  /// @code
+  ///   std::vector<interpatch::Vec3> rows(16 * vs.size());
+  ///   for (std::size_t i = 0; i < us.size(); i += 16) {
+  ///     const auto block = std::span(us).subspan(i, std::min<std::size_t>(16, us.size() - i));
+  ///     surface.evaluate_into(block, vs, std::span(rows).first(block.size() * vs.size()));
+  ///     consume(rows);
+  ///   }
+  /// @endcode
+  /// @throws error out_of_domain; size_mismatch when out.size() != us.size() * vs.size().
+  virtual void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
+                             const progress_callback& progress = {}) const;
   /// Points and derivatives at every (us[i], vs[j]). @throws error out_of_domain, too_large.
   [[nodiscard]] virtual Grid<SurfaceDerivatives, 2> evaluate_derivatives(std::span<const double> us,
                                                                          std::span<const double> vs) const;

@@ -65,10 +65,16 @@ class Volume {
   /// The Jacobian at (u, v, w). @throws error out_of_domain.
   [[nodiscard]] Jacobian jacobian(double u, double v, double w) const;
 
-  /// Points at every (us[i], vs[j], ws[k]): a us.size() × vs.size() × ws.size() grid.
-  /// @throws error out_of_domain, too_large.
-  [[nodiscard]] virtual PointGrid3 evaluate(std::span<const double> us, std::span<const double> vs,
-                                            std::span<const double> ws, const progress_callback& progress = {}) const;
+  /// Points at every (us[i], vs[j], ws[k]): a us.size() × vs.size() × ws.size() grid,
+  /// through evaluate_into(). @throws error out_of_domain, too_large.
+  [[nodiscard]] PointGrid3 evaluate(std::span<const double> us, std::span<const double> vs,
+                                    std::span<const double> ws, const progress_callback& progress = {}) const;
+  /// Points at every (us[i], vs[j], ws[k]) into memory the caller owns:
+  /// out[(i * vs.size() + j) * ws.size() + k]. Slab by slab along u into one reused
+  /// buffer, a grid of any size costs memory for one slab only.
+  /// @throws error out_of_domain; size_mismatch when out.size() is not the product of the sizes.
+  virtual void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<const double> ws,
+                             std::span<Vec3> out, const progress_callback& progress = {}) const;
   /// Points and first partials at every (us[i], vs[j], ws[k]). @throws error out_of_domain, too_large.
   [[nodiscard]] virtual Grid<VolumeDerivatives, 3> evaluate_derivatives(std::span<const double> us,
                                                                         std::span<const double> vs,

@@ -2,7 +2,10 @@
 // Small text helpers for error messages: numbers printed short and exact enough
 // to act on.
 
+#include <cstdint>
 #include <cstdio>
+#include <iterator>
+#include <initializer_list>
 #include <string>
 
 #include "interpatch/error.hpp"
@@ -32,6 +35,23 @@ std::string cat(const A&... a) {
   return s;
 }
 
+/// Bytes in a short human form: "240 GB", "22.9 GB", "512 bytes" (decimal units,
+/// three significant digits).
+inline std::string human_bytes(std::uint64_t bytes) {
+  static constexpr const char* units[] = {"bytes", "kB", "MB", "GB", "TB", "PB", "EB"};
+  if (bytes < 1000) return std::to_string(bytes) + " bytes";
+  double v = static_cast<double>(bytes);
+  std::size_t u = 0;
+  // Move up while the value would print as 1000 or more at three significant digits.
+  while (v >= 999.5 && u + 1 < std::size(units)) {
+    v /= 1000.0;
+    ++u;
+  }
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g %s", v, units[u]);
+  return buf;
+}
+
 /// Throws interpatch::error with a message made of the parts.
 template <class... A>
 [[noreturn]] void fail(errc code, const A&... parts) {
@@ -46,6 +66,22 @@ void check_unit_parameters(const Range& ts, const char* dir) {
   for (double t : ts)
     if (!(t >= -1e-12 && t <= 1 + 1e-12))
       fail(errc::out_of_domain, "parameter ", dir, " = ", t, " is outside the domain [0, 1]");
+}
+
+/// Refuses caller memory for a batch evaluation whose size is not the product of
+/// the parameter counts (an overflowing product matches no buffer).
+inline void check_output_size(std::size_t got, std::initializer_list<std::size_t> counts, const char* what) {
+  std::size_t want = 1;
+  bool overflow = false;
+  std::string dims;
+  for (std::size_t n : counts) {
+    if (n != 0 && want > static_cast<std::size_t>(-1) / n) overflow = true;
+    want *= n;
+    dims += (dims.empty() ? "" : "x") + std::to_string(n);
+  }
+  if (overflow || got != want)
+    fail(errc::size_mismatch, what, ": the output holds ", got, " points, the ", dims, " grid has ",
+         overflow ? std::string("more than can be addressed") : std::to_string(want));
 }
 
 }  // namespace interpatch::detail

@@ -202,6 +202,17 @@ void check_writable(const fs::path& path) {
   }
 }
 
+void check_disk_space(const fs::path& path, std::uintmax_t bytes, std::string_view what) {
+  std::error_code ec;
+  const fs::path dir = directory_of(path);
+  const fs::space_info space = fs::space(dir, ec);
+  if (ec || space.available == static_cast<std::uintmax_t>(-1)) return;
+  if (bytes > space.available)
+    detail::fail(errc::too_large, std::string(what), " needs ", detail::human_bytes(bytes), " (", bytes, " bytes), ",
+                 detail::human_bytes(space.available), " available on disk in ", quoted(dir), " (", space.available,
+                 " bytes)");
+}
+
 void write_atomically(const fs::path& requested, const std::function<void(std::ostream&)>& write) {
   check_writable(requested);
   const fs::path path = resolve_links(requested);

@@ -408,20 +408,21 @@ NpyArray parse_npy(std::string_view bytes, std::string_view name) {
   return a;
 }
 
-void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::span<const double> data) {
-  const std::vector<std::size_t> dims(shape.begin(), shape.end());
+namespace {
+
+// The array's element count, refused when the shape overflows.
+std::size_t element_count(const fs::path& path, const std::vector<std::size_t>& dims) {
   std::size_t count = 1;
-  bool overflow = false;
   for (std::size_t d : dims) {
-    if (d != 0 && count > std::numeric_limits<std::size_t>::max() / d) overflow = true;
+    if (d != 0 && count > std::numeric_limits<std::size_t>::max() / d)
+      detail::fail(errc::size_mismatch, "cannot write '", path.string(), "': shape ", shape_text(dims), " overflows");
     count *= d;
   }
-  if (overflow || count != data.size()) {
-    detail::fail(errc::size_mismatch, "cannot write '", path.string(), "': shape ", shape_text(dims),
-                 overflow ? std::string(" overflows") : " has " + std::to_string(count) + " elements", ", data has ",
-                 data.size());
-  }
+  return count;
+}
 
+// Magic, version, header length and the header dictionary padded to 64 bytes.
+std::string npy_header(const std::vector<std::size_t>& dims) {
   std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': " + shape_text(dims) + ", }";
   // Version 1.0 holds header lengths below 65536; only an absurd rank needs 2.0.
   const bool v1 = header.size() + 1 + 10 + 64 <= 65535;
@@ -429,33 +430,58 @@ void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::sp
   const std::size_t total = (prefix + header.size() + 1 + 63) / 64 * 64;
   header.append(total - prefix - header.size() - 1, ' ');
   header += '\n';
+  std::string pre(magic, sizeof magic);
+  pre += static_cast<char>(v1 ? 1 : 2);
+  pre += '\0';
+  std::size_t len = header.size();
+  for (std::size_t i = 0; i < (v1 ? 2u : 4u); ++i, len >>= 8) pre += static_cast<char>(len & 0xffu);
+  return pre + header;
+}
 
+// Little-endian float64 values onto the stream.
+void write_values(std::ostream& os, const double* data, std::size_t n) {
+  if constexpr (std::endian::native == std::endian::little) {
+    os.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(n * sizeof(double)));
+  } else {
+    std::vector<std::uint64_t> chunk(std::min<std::size_t>(n, std::size_t{1} << 16));
+    for (std::size_t done = 0; done < n;) {
+      const std::size_t k = std::min(chunk.size(), n - done);
+      for (std::size_t i = 0; i < k; ++i) chunk[i] = byteswap(std::bit_cast<std::uint64_t>(data[done + i]));
+      os.write(reinterpret_cast<const char*>(chunk.data()), static_cast<std::streamsize>(k * 8));
+      done += k;
+    }
+  }
+}
+
+}  // namespace
+
+void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::span<const double> data) {
+  const std::vector<std::size_t> dims(shape.begin(), shape.end());
+  if (const std::size_t count = element_count(path, dims); count != data.size())
+    detail::fail(errc::size_mismatch, "cannot write '", path.string(), "': shape ", shape_text(dims), " has ", count,
+                 " elements, data has ", data.size());
+  const std::string header = npy_header(dims);
   write_atomically(path, [&](std::ostream& os) {
-    char pre[12];
-    std::memcpy(pre, magic, sizeof magic);
-    pre[6] = static_cast<char>(v1 ? 1 : 2);
-    pre[7] = 0;
-    std::size_t len = header.size();
-    for (std::size_t i = 0; i < (v1 ? 2u : 4u); ++i, len >>= 8) pre[8 + i] = static_cast<char>(len & 0xffu);
-    os.write(pre, static_cast<std::streamsize>(prefix));
     os.write(header.data(), static_cast<std::streamsize>(header.size()));
-    if constexpr (std::endian::native == std::endian::little) {
-      const char* bytes = reinterpret_cast<const char*>(data.data());
-      std::size_t left = data.size() * sizeof(double);
-      while (left > 0) {
-        const std::size_t step = std::min<std::size_t>(left, std::size_t{1} << 26);
-        os.write(bytes, static_cast<std::streamsize>(step));
-        bytes += step;
-        left -= step;
-      }
-    } else {
-      std::vector<std::uint64_t> chunk(std::min<std::size_t>(data.size(), std::size_t{1} << 16));
-      for (std::size_t done = 0; done < data.size();) {
-        const std::size_t n = std::min(chunk.size(), data.size() - done);
-        for (std::size_t k = 0; k < n; ++k) chunk[k] = byteswap(std::bit_cast<std::uint64_t>(data[done + k]));
-        os.write(reinterpret_cast<const char*>(chunk.data()), static_cast<std::streamsize>(n * 8));
-        done += n;
-      }
+    write_values(os, data.data(), data.size());
+  });
+}
+
+void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::size_t block,
+               const NpyProducer& produce) {
+  const std::vector<std::size_t> dims(shape.begin(), shape.end());
+  const std::size_t count = element_count(path, dims);
+  if (block == 0) detail::fail(errc::size_mismatch, "cannot write '", path.string(), "': blocks of 0 values");
+  const std::string header = npy_header(dims);
+  write_atomically(path, [&](std::ostream& os) {
+    os.write(header.data(), static_cast<std::streamsize>(header.size()));
+    for (std::size_t first = 0; first < count; first += block) {
+      const std::size_t n = std::min(block, count - first);
+      const std::span<const double> values = produce(first, n);
+      if (values.size() != n)
+        detail::fail(errc::size_mismatch, "cannot write '", path.string(), "': values ", first, " to ", first + n - 1,
+                     " came as ", values.size(), " values");
+      write_values(os, values.data(), n);
     }
   });
 }

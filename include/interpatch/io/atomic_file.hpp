@@ -3,9 +3,11 @@
 /// Output files written whole or not at all: a temporary file in the target's
 /// directory, renamed into place when complete.
 
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <ostream>
+#include <string_view>
 
 namespace interpatch::io {
 
@@ -14,6 +16,13 @@ namespace interpatch::io {
 /// non-regular file. Creates nothing.
 /// @throws error file_unwritable naming the path and the reason.
 void check_writable(const std::filesystem::path& path);
+
+/// Refuses an output of `bytes` that does not fit in the space free to this user on
+/// the file system of `path`'s directory, before any work is done. A file system
+/// that cannot tell its free space is not refused.
+/// @throws error too_large: "<what> needs 240 GB (240000000000 bytes), 76.2 GB
+/// available on disk in 'dir' (76200000000 bytes)".
+void check_disk_space(const std::filesystem::path& path, std::uintmax_t bytes, std::string_view what);
 
 /// Runs `write` on a stream to a temporary file beside `path` (".name.tmp.XXXXXX"),
 /// flushes and syncs it, then renames it onto `path`. If `write` throws or any

@@ -69,4 +69,28 @@ std::vector<std::size_t> read_npy_into(const std::filesystem::path& path, const 
 /// @throws error file_unwritable, size_mismatch (data size is not the product of shape).
 void write_npy(const std::filesystem::path& path, std::span<const std::size_t> shape, std::span<const double> data);
 
+/// Makes the values [first, first + count) of an array, in C order, in memory of its
+/// own that stays valid until the next call, and returns them.
+using NpyProducer = std::function<std::span<const double>(std::size_t first, std::size_t count)>;
+
+/// Writes as write_npy, with the values made `block` at a time by `produce` while
+/// the file is written: memory for one block, never for the whole array, and each
+/// block is written while it is still in the cache.
+///
+/// Example:
+/// @code
+///   const std::size_t shape[2] = {1000, 1000};
+///   std::vector<double> row;
+///   interpatch::io::write_npy("ramp.npy", shape, 1000, [&](std::size_t first, std::size_t count) {
+///     row.resize(count);
+///     for (std::size_t i = 0; i < count; ++i) row[i] = double(first + i);
+///     return std::span<const double>(row);
+///   });
+/// @endcode
+/// @throws error file_unwritable, size_mismatch (an overflowing shape, a block of 0
+/// values, a block returned with the wrong count), and whatever `produce` throws;
+/// the file is then left as it was.
+void write_npy(const std::filesystem::path& path, std::span<const std::size_t> shape, std::size_t block,
+               const NpyProducer& produce);
+
 }  // namespace interpatch::io
