@@ -13,6 +13,7 @@
 
 #include "commands.hpp"
 #include "interpatch/error.hpp"
+#include "interpatch/threads.hpp"
 
 namespace {
 
@@ -75,6 +76,9 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help
     return fail_with(2, std::string(e.what()) + " (see interpatch --help)");
   }
+
+  // Threads on CPUs of their own before the first parallel loop (threads.hpp).
+  interpatch::bind_threads();
 
   try {
     if (*build) return cli::build_command(spec, out);

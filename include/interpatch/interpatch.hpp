@@ -16,6 +16,7 @@
 #include "interpatch/knot_vector.hpp"
 #include "interpatch/memory.hpp"
 #include "interpatch/progress.hpp"
+#include "interpatch/threads.hpp"
 #include "interpatch/vec3.hpp"
 #include "interpatch/volume.hpp"
 #include "interpatch/volume_patches.hpp"

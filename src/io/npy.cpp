@@ -1,12 +1,17 @@
 #include "interpatch/io/npy.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cerrno>
 #include <charconv>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -271,8 +276,12 @@ void read_exact(std::istream& in, char* dst, std::size_t n, const std::string& n
 
 /// The array in `in`, which holds `file_size` bytes; `name` names it in messages.
 /// What read_npy and parse_npy share: one reader for files and memory.
+// Reads n bytes at byte `offset` of the source into dst: a faster path than the
+// stream for the data block of a file.
+using BulkRead = std::function<void(char* dst, std::size_t n, std::uint64_t offset)>;
+
 std::vector<std::size_t> read_npy_stream(std::istream& in, std::uint64_t file_size, const std::string& name,
-                                         const NpyDestination& destination) {
+                                         const NpyDestination& destination, const BulkRead& bulk = {}) {
   unsigned char pre[12] = {};
   if (file_size < 10) {
     detail::fail(errc::malformed_file, name, ": not an NPY file (", file_size, " bytes, shorter than the NPY preamble)");
@@ -335,7 +344,8 @@ std::vector<std::size_t> read_npy_stream(std::istream& in, std::uint64_t file_si
 
   if (!fortran && dt.size == 8) {
     // The common case: the file's bytes are the result, up to byte order.
-    read_exact(in, reinterpret_cast<char*>(out), count * 8, name);
+    if (bulk) bulk(reinterpret_cast<char*>(out), count * 8, file_size - count * 8);
+    else read_exact(in, reinterpret_cast<char*>(out), count * 8, name);
     if (!native) {
       for (std::size_t k = 0; k < count; ++k) out[k] = std::bit_cast<double>(byteswap(std::bit_cast<std::uint64_t>(out[k])));
     }
@@ -376,13 +386,45 @@ std::vector<std::size_t> read_npy_stream(std::istream& in, std::uint64_t file_si
 
 }  // namespace
 
+namespace {
+
+// The data block of a file, read by both threads at once in pieces with pread:
+// copying out of the page cache, and the first touch of the destination's pages,
+// are most of the cost of reading, and both go twice as fast on two cores.
+void read_pieces(const fs::path& path, char* dst, std::size_t n, std::uint64_t offset) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) fail_read(path.string(), errno);
+  constexpr std::size_t piece = std::size_t{1} << 20;
+  const auto pieces = static_cast<long long>((n + piece - 1) / piece);
+  std::atomic<int> failure{0};
+#pragma omp parallel for schedule(static) if (n >= 8 * piece)
+  for (long long k = 0; k < pieces; ++k) {
+    std::size_t at = static_cast<std::size_t>(k) * piece;
+    const std::size_t end = std::min(n, at + piece);
+    while (at < end && failure.load(std::memory_order_relaxed) == 0) {
+      const ssize_t got = ::pread(fd, dst + at, end - at, static_cast<off_t>(offset + at));
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0) {
+        failure = got < 0 ? errno : EIO;  // 0: the file shrank while being read
+        break;
+      }
+      at += static_cast<std::size_t>(got);
+    }
+  }
+  ::close(fd);
+  if (const int e = failure.load(); e != 0) fail_read(path.string(), e);
+}
+
+}  // namespace
+
 std::vector<std::size_t> read_npy_into(const fs::path& path, const NpyDestination& destination) {
   std::ifstream in = detail::open_input(path);
   in.seekg(0, std::ios::end);
   const auto end = in.tellg();
   in.seekg(0, std::ios::beg);
   if (end < 0 || !in) fail_read(path.string(), errno);
-  return read_npy_stream(in, static_cast<std::uint64_t>(end), path.string(), destination);
+  return read_npy_stream(in, static_cast<std::uint64_t>(end), path.string(), destination,
+                         [&](char* dst, std::size_t n, std::uint64_t offset) { read_pieces(path, dst, n, offset); });
 }
 
 namespace {
