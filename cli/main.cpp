@@ -3,16 +3,19 @@
 // every failure prints exactly one line on stderr, "interpatch: <message>".
 
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <new>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
 #include "interpatch/error.hpp"
+#include "interpatch/io/atomic_file.hpp"
 #include "interpatch/threads.hpp"
 
 namespace {
@@ -79,6 +82,9 @@ int main(int argc, char** argv) {
 
   // Threads on CPUs of their own before the first parallel loop (threads.hpp).
   interpatch::bind_threads();
+  // Outputs are always replaced atomically; INTERPATCH_SYNC=1 also waits for the disk.
+  if (const char* sync = std::getenv("INTERPATCH_SYNC"); sync && std::string_view(sync) == "1")
+    interpatch::io::set_durable_writes(true);
 
   try {
     if (*build) return cli::build_command(spec, out);

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -66,10 +67,14 @@ mode_t default_file_mode() {
   return static_cast<mode_t>(0666 & ~mask);
 }
 
+std::atomic<bool> durable_flag{false};
+
 /// An output buffer over a file descriptor that remembers the first write error.
 class fd_buffer : public std::streambuf {
  public:
-  explicit fd_buffer(int fd) : fd_(fd), buf_(std::size_t{1} << 20) { setp(buf_.data(), buf_.data() + buf_.size()); }
+  fd_buffer(int fd, bool durable) : fd_(fd), durable_(durable), buf_(std::size_t{1} << 20) {
+    setp(buf_.data(), buf_.data() + buf_.size());
+  }
   fd_buffer(const fd_buffer&) = delete;
   fd_buffer& operator=(const fd_buffer&) = delete;
 
@@ -108,9 +113,9 @@ class fd_buffer : public std::streambuf {
     return ok;
   }
 
-  // Writes in pieces of a few MiB and, on Linux, starts the disk writeback of each
-  // piece at once (sync_file_range, which does not wait): the fsync before the
-  // rename then waits for the last pieces only, not for the whole file.
+  // Writes in pieces of a few MiB. For a durable write, on Linux, the disk
+  // writeback of each piece starts at once (sync_file_range, which does not wait):
+  // the fsync before the rename then waits for the last pieces only.
   bool write_all(const char* s, std::size_t n) {
     if (errno_ != 0) return false;
     constexpr std::size_t piece = std::size_t{4} << 20;
@@ -122,7 +127,7 @@ class fd_buffer : public std::streambuf {
         return false;
       }
 #ifdef __linux__
-      ::sync_file_range(fd_, static_cast<off_t>(written_), static_cast<off_t>(w), SYNC_FILE_RANGE_WRITE);
+      if (durable_) ::sync_file_range(fd_, static_cast<off_t>(written_), static_cast<off_t>(w), SYNC_FILE_RANGE_WRITE);
 #endif
       written_ += static_cast<std::size_t>(w);
       s += w;
@@ -132,6 +137,7 @@ class fd_buffer : public std::streambuf {
   }
 
   int fd_;
+  bool durable_;
   std::size_t written_ = 0;
   std::vector<char> buf_;
   int errno_ = 0;
@@ -202,6 +208,9 @@ void check_writable(const fs::path& path) {
   }
 }
 
+void set_durable_writes(bool on) noexcept { durable_flag.store(on); }
+bool durable_writes() noexcept { return durable_flag.load(); }
+
 void check_disk_space(const fs::path& path, std::uintmax_t bytes, std::string_view what) {
   std::error_code ec;
   const fs::path dir = directory_of(path);
@@ -234,8 +243,9 @@ void write_atomically(const fs::path& requested, const std::function<void(std::o
     fail_write(path, std::string("cannot set permissions of the temporary file: ") + std::strerror(e));
   }
 
+  const bool sync = durable_writes();
   {
-    fd_buffer buf(tmp.fd());
+    fd_buffer buf(tmp.fd(), sync);
     std::ostream os(&buf);
     os.exceptions(std::ios::badbit);
     try {
@@ -247,7 +257,7 @@ void write_atomically(const fs::path& requested, const std::function<void(std::o
     if (!os || buf.error() != 0) fail_write(path, buf.error() != 0 ? std::strerror(buf.error()) : "stream error");
   }
 
-  if (::fsync(tmp.fd()) != 0) {
+  if (sync && ::fsync(tmp.fd()) != 0) {
     const int e = errno;
     fail_write(path, std::string("fsync failed: ") + std::strerror(e));
   }
@@ -259,6 +269,7 @@ void write_atomically(const fs::path& requested, const std::function<void(std::o
   tmp.mark_renamed();
 
   // Make the rename itself durable; a failure here loses nothing already written.
+  if (!sync) return;
   const int dfd = ::open(directory_of(path).c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dfd >= 0) {
     ::fsync(dfd);

@@ -24,8 +24,20 @@ void check_writable(const std::filesystem::path& path);
 /// available on disk in 'dir' (76200000000 bytes)".
 void check_disk_space(const std::filesystem::path& path, std::uintmax_t bytes, std::string_view what);
 
+/// Whether write_atomically also waits until the file and its directory entry are
+/// on the disk (fsync) before it returns. Off by default: the rename alone already
+/// keeps every promise of a failed run (no half-written file, no good file replaced
+/// by a bad one), and on ext4 (data=ordered, auto_da_alloc) a rename over an
+/// existing file is ordered after its data, so even a power loss leaves the old
+/// file or the new one. On, it protects new files on any file system against a
+/// power loss or a kernel crash, at the price of waiting for the disk: about 6 ms
+/// per 25 MB on the machine of docs/BENCHMARKS.md. The interpatch command turns it
+/// on when the environment holds INTERPATCH_SYNC=1. Process-wide.
+void set_durable_writes(bool on) noexcept;
+[[nodiscard]] bool durable_writes() noexcept;
+
 /// Runs `write` on a stream to a temporary file beside `path` (".name.tmp.XXXXXX"),
-/// flushes and syncs it, then renames it onto `path`. If `write` throws or any
+/// flushes it (and syncs it, when durable_writes()), then renames it onto `path`. If `write` throws or any
 /// write fails, the temporary file is removed, `path` is left as it was, and the
 /// error propagates: the writer's own exception unchanged, a failed write (disk
 /// full, file too large) as file_unwritable naming the path and the reason; the
