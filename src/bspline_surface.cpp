@@ -239,7 +239,8 @@ void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const d
         const auto i = static_cast<std::size_t>(ri);
         const Basis& b = bu[i];
         weighted_rows(b.d, p + 1, &cp_(static_cast<std::size_t>(b.span - p), 0).x, row_doubles, row_doubles, row.data());
-        sample_row(spans.data(), weights.data(), q, nv, row.data(), &out[i * nv].x);
+        // Not &out[i * nv].x: with no v values there is no element to index.
+        sample_row(spans.data(), weights.data(), q, nv, row.data(), reinterpret_cast<double*>(out.data() + i * nv));
         const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
         if (progress && reporter && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(us.size()));
       }

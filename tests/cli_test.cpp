@@ -9,14 +9,18 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <span>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
 #include "cli_specs.hpp"
+#include "interpatch/evaluate.hpp"
+#include "interpatch/io/spec.hpp"
 #include "temp_dir.hpp"
 #include "test_util.hpp"
 
@@ -171,6 +175,77 @@ TEST_F(CliTest, EvalWritesNpyKxKx3LittleEndianCOrderUFirst) {
     EXPECT_NEAR(value(16, 0, k), pts[3][0][k].get<double>(), 1e-12);
     EXPECT_NEAR(value(16, 16, k), pts[3][5][k].get<double>(), 1e-12);
   }
+}
+
+// The index of the first value whose bits differ between two arrays of one size;
+// the size when all agree.
+std::size_t first_difference(std::span<const double> got, std::span<const double> expected) {
+  for (std::size_t i = 0; i < got.size(); ++i)
+    if (std::memcmp(&got[i], &expected[i], sizeof(double)) != 0) return i;
+  return got.size();
+}
+
+TEST_F(CliTest, EvalToNpyInBlocksIsTheLibrarysEvaluateBitForBit) {
+  // eval evaluates and writes .npy about 2^17 points at a time along u
+  // (cli/commands.cpp): K = 700 is 4 blocks of 187 rows of a surface, the last one
+  // shorter, and K = 70 is 3 blocks of 26 slabs of a volume. Every value is the one
+  // evaluate() gives for the same construction on linspace(0, 1, K), exactly.
+  write_file(at("grid.json"), grid_spec(5, 12, 9).dump());
+  const fs::path examples = INTERPATCH_EXAMPLES;
+  const std::vector<std::pair<fs::path, std::size_t>> cases{{at("grid.json"), 700},
+                                                            {examples / "coons.json", 700},
+                                                            {examples / "coons_volume.json", 70},
+                                                            {examples / "annular_sector.json", 70}};
+  for (const auto& [spec, k] : cases) {
+    SCOPED_TRACE(spec.filename().string());
+    const Result r = run({"eval", spec.string(), "--grid", std::to_string(k), "-o", "g.npy"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const Npy n = parse_npy(read_file(at("g.npy")));
+    const io::Construction c = io::build_file(spec);
+    const std::vector<double> t = linspace(0, 1, k);
+    std::vector<std::size_t> shape;
+    std::span<const double> expected;
+    PointGrid surface_points;
+    PointGrid3 volume_points;
+    if (io::is_volume(c)) {
+      volume_points = io::volume_evaluator(c).evaluate(t, t, t);
+      shape = {k, k, k, 3};
+      expected = {&volume_points.data()->x, 3 * volume_points.size()};
+    } else {
+      surface_points = io::evaluator(c).evaluate(t, t);
+      shape = {k, k, 3};
+      expected = {&surface_points.data()->x, 3 * surface_points.size()};
+    }
+    EXPECT_EQ(n.shape, shape);
+    ASSERT_EQ(n.data.size(), expected.size());
+    const std::size_t i = first_difference(n.data, expected);
+    EXPECT_EQ(i, expected.size()) << "value " << i << " is " << n.data[i] << ", evaluate() gives " << expected[i];
+  }
+}
+
+TEST_F(CliTest, DurableOutputsAreTheSameBytes) {
+  // INTERPATCH_SYNC=1 waits for the disk before each output is renamed into place;
+  // the files are those of a run without it, and an existing file is replaced.
+  write_grid_spec("s.json", 4, 30, 20);
+  write_file(at("durable.npy"), "an older file\n");
+  const std::vector<std::string> eval{"eval", "s.json", "--grid", "123", "-o"};
+  const auto with = [&](const std::vector<std::string>& args, const std::string& out, const std::string& sync) {
+    std::vector<std::string> a = args;
+    a.push_back(out);
+    const Result r = test::run_cli(work(), a, {"INTERPATCH_SYNC=" + sync});
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(r.err.empty()) << r.err;
+    return read_file(at(out));
+  };
+  const std::string plain = with(eval, "plain.npy", "0");
+  EXPECT_EQ(parse_npy(plain).data.size(), 123u * 123u * 3u);
+  EXPECT_TRUE(with(eval, "durable.npy", "1") == plain);
+  const std::vector<std::string> build{"build", "s.json", "-o"};
+  EXPECT_TRUE(with(build, "durable.json", "1") == with(build, "plain.json", "0"));
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(work())) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"durable.json", "durable.npy", "plain.json", "plain.npy", "s.json"}));
 }
 
 TEST_F(CliTest, EvalWritesCsvWithHeaderAndRowsUOutermost) {

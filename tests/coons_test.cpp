@@ -5,14 +5,8 @@
 namespace interpatch {
 namespace {
 
-CoonsBoundary boundary_of(const BSplineSurface& s) {
-  return {test::iso_curve(s, 1, 0.0), test::iso_curve(s, 1, 1.0), test::iso_curve(s, 0, 0.0), test::iso_curve(s, 0, 1.0)};
-}
-
-CoonsCrossDerivatives cross_of(const BSplineSurface& s) {
-  return {test::iso_curve(s, 1, 0.0, 1), test::iso_curve(s, 1, 1.0, 1), test::iso_curve(s, 0, 0.0, 1),
-          test::iso_curve(s, 0, 1.0, 1)};
-}
+using test::boundary_of;
+using test::cross_of;
 
 void expect_boundary(const Surface& c, const BSplineSurface& s, double tol) {
   for (double t : linspace(0, 1, 23)) {

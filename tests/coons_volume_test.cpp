@@ -6,12 +6,8 @@
 namespace interpatch {
 namespace {
 
+using test::faces_of;
 using test::iso_surface;
-
-VolumeFaces faces_of(const BSplineVolume& b) {
-  return {iso_surface(b, 0, 0), iso_surface(b, 0, 1), iso_surface(b, 1, 0),
-          iso_surface(b, 1, 1), iso_surface(b, 2, 0), iso_surface(b, 2, 1)};
-}
 
 VolumeCrossDerivatives cross_of(const BSplineVolume& b) {
   return {iso_surface(b, 0, 0, 1), iso_surface(b, 0, 1, 1), iso_surface(b, 1, 0, 1),

@@ -4,6 +4,7 @@
 // that consistent boundary data come with a surface to compare against.
 
 #include "interpatch/bspline_surface.hpp"
+#include "interpatch/coons.hpp"
 #include "interpatch/evaluate.hpp"
 #include "test_util.hpp"
 
@@ -40,6 +41,16 @@ inline BSplineCurve iso_curve(const BSplineSurface& s, int axis, double t, int k
       cp[l] += d[k * (p + 1) + a] * (axis == 0 ? s.control_points()(i, l) : s.control_points()(l, i));
     }
   return BSplineCurve(along, cp);
+}
+
+/// The four boundary curves of a surface over [0,1]², as a Coons patch takes them.
+inline CoonsBoundary boundary_of(const BSplineSurface& s) {
+  return {iso_curve(s, 1, 0.0), iso_curve(s, 1, 1.0), iso_curve(s, 0, 0.0), iso_curve(s, 0, 1.0)};
+}
+
+/// Its cross-boundary derivative curves, as the Hermite-blended Coons patch takes them.
+inline CoonsCrossDerivatives cross_of(const BSplineSurface& s) {
+  return {iso_curve(s, 1, 0.0, 1), iso_curve(s, 1, 1.0, 1), iso_curve(s, 0, 0.0, 1), iso_curve(s, 0, 1.0, 1)};
 }
 
 /// Largest distance between two surfaces on an n × n grid over [0,1]².

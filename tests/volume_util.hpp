@@ -7,6 +7,7 @@
 
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/bspline_volume.hpp"
+#include "interpatch/coons_volume.hpp"
 #include "interpatch/evaluate.hpp"
 #include "test_util.hpp"
 
@@ -74,6 +75,12 @@ inline BSplineSurface iso_surface(const BSplineVolume& b, int axis, double t, in
       if (b.rational()) W(x, y) = ws;
     }
   return BSplineSurface(*ks[o0], *ks[o1], P, W);
+}
+
+/// The six faces of a volume over [0,1]³, as a transfinite volume takes them.
+inline VolumeFaces faces_of(const BSplineVolume& b) {
+  return {iso_surface(b, 0, 0), iso_surface(b, 0, 1), iso_surface(b, 1, 0),
+          iso_surface(b, 1, 1), iso_surface(b, 2, 0), iso_surface(b, 2, 1)};
 }
 
 /// Largest distance between two volumes on an n × n × n grid over [0,1]³.

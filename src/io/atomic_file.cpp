@@ -94,7 +94,7 @@ class fd_buffer : public std::streambuf {
   std::streamsize xsputn(const char* s, std::streamsize n) override {
     const auto room = static_cast<std::streamsize>(epptr() - pptr());
     if (n <= room) {
-      std::memcpy(pptr(), s, static_cast<std::size_t>(n));
+      if (n > 0) std::memcpy(pptr(), s, static_cast<std::size_t>(n));  // s may be null for nothing (an empty array)
       pbump(static_cast<int>(n));
       return n;
     }

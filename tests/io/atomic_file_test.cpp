@@ -7,8 +7,10 @@
 #include <algorithm>
 #include <atomic>
 #include <csignal>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -46,6 +48,18 @@ class UmaskGuard {
 
  private:
   mode_t old_;
+};
+
+/// Sets durable_writes() for the life of the object: the setting is process-wide.
+class DurableWritesGuard {
+ public:
+  explicit DurableWritesGuard(bool on) : old_(durable_writes()) { set_durable_writes(on); }
+  DurableWritesGuard(const DurableWritesGuard&) = delete;
+  DurableWritesGuard& operator=(const DurableWritesGuard&) = delete;
+  ~DurableWritesGuard() { set_durable_writes(old_); }
+
+ private:
+  bool old_;
 };
 
 TEST(AtomicFile, WritesNewFile) {
@@ -231,6 +245,76 @@ TEST(AtomicFile, CheckWritableRefusesReadOnlyDirectory) {
   fs::permissions(dir / "ro", fs::perms::owner_read | fs::perms::owner_exec);
   EXPECT_ERRC(check_writable(dir / "ro" / "out.txt"), file_unwritable, "is not writable (Permission denied)");
   fs::permissions(dir / "ro", fs::perms::owner_all);
+}
+
+TEST(AtomicFile, CheckDiskSpaceAcceptsWhatFits) {
+  TempDir dir;
+  EXPECT_NO_THROW(check_disk_space(dir / "out.npy", 0, "nothing"));
+  EXPECT_NO_THROW(check_disk_space(dir / "out.npy", 4096, "a small grid"));
+  const fs::path old = fs::current_path();
+  fs::current_path(dir.path());
+  EXPECT_NO_THROW(check_disk_space("out.npy", 4096, "a small grid"));  // the current directory's file system
+  fs::current_path(old);
+  EXPECT_TRUE(dir.entries().empty());  // checking creates nothing
+}
+
+TEST(AtomicFile, CheckDiskSpaceRefusesMoreThanIsAvailable) {
+  TempDir dir;
+  const std::uintmax_t available = fs::space(dir.path()).available;
+  // Half as much again as is free now, and at least 1 GB more: other processes
+  // writing or deleting files while the test runs do not make it fit.
+  constexpr std::uintmax_t margin = std::uintmax_t{1} << 30;
+  if (available > (std::numeric_limits<std::uintmax_t>::max() - margin) / 2)
+    GTEST_SKIP() << "the file system reports no limit on its free space";
+  const std::uintmax_t bytes = available + available / 2 + margin;
+  EXPECT_ERRC(check_disk_space(dir / "out.npy", bytes, "evaluation grid 9x9x9"), too_large,
+              "evaluation grid 9x9x9 needs ");
+  try {
+    check_disk_space(dir / "out.npy", bytes, "evaluation grid 9x9x9");
+  } catch (const error& e) {
+    const std::string m = e.what();
+    for (const std::string& part : {"(" + std::to_string(bytes) + " bytes)", std::string(" available on disk in "),
+                                    "'" + dir.path().string() + "'"})
+      EXPECT_NE(m.find(part), std::string::npos) << "message '" << m << "' lacks '" << part << "'";
+  }
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+TEST(AtomicFile, DurableWritesAreOffByDefault) {
+  EXPECT_FALSE(durable_writes());
+  {
+    DurableWritesGuard on(true);
+    EXPECT_TRUE(durable_writes());
+  }
+  EXPECT_FALSE(durable_writes());
+}
+
+TEST(AtomicFile, DurableWritesGiveTheSameBytesAndReplaceTheOldFile) {
+  TempDir dir;
+  auto g = test::rng(32);
+  std::string text;
+  while (text.size() < (std::size_t{9} << 20)) text += std::to_string(g()) + '\n';  // several 4 MiB pieces
+  const auto writer = [&](std::ostream& os) { os << text; };
+  write_atomically(dir / "plain.txt", writer);
+  write_text(dir / "durable.txt", "old content\n");
+  {
+    DurableWritesGuard on(true);
+    write_atomically(dir / "durable.txt", writer);
+    write_atomically(dir / "new.txt", writer);
+    // A failed durable write keeps the old file as well.
+    EXPECT_THROW(write_atomically(dir / "durable.txt",
+                                  [](std::ostream& os) {
+                                    os << "half";
+                                    throw std::runtime_error("writer failed");
+                                  }),
+                 std::runtime_error);
+  }
+  EXPECT_FALSE(durable_writes());
+  const std::string plain = read_text(dir / "plain.txt");
+  EXPECT_TRUE(plain == text);
+  EXPECT_TRUE(read_text(dir / "durable.txt") == plain);
+  EXPECT_TRUE(read_text(dir / "new.txt") == plain);
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"durable.txt", "new.txt", "plain.txt"}));
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <bit>
 #include <cstdint>
@@ -11,7 +12,9 @@
 #include <limits>
 #include <span>
 #include <sstream>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "temp_dir.hpp"
@@ -183,6 +186,48 @@ TEST(Npy, RoundTripLargeArray) {
   const auto a = read_npy(dir / "big.npy");
   EXPECT_EQ(a.shape, shape);
   EXPECT_TRUE(a.data == data);
+}
+
+TEST(Npy, RoundTripOfFilesReadInPiecesIsBitExact) {
+  // Data blocks of 8 MiB and more are read in pieces of 1 MiB by both threads: sizes
+  // just above that, not whole pieces, with distinct values, so that a piece read at
+  // the wrong offset or left out shows.
+  constexpr std::size_t threshold = std::size_t{8} << 20, piece = std::size_t{1} << 20;
+  TempDir dir;
+  auto g = test::rng(13);
+  using Shape = std::vector<std::size_t>;
+  for (const Shape& shape : {Shape{350001, 3}, Shape{1100001}}) {
+    const std::size_t count = shape.size() == 2 ? shape[0] * shape[1] : shape[0];
+    SCOPED_TRACE(std::to_string(count) + " values");
+    ASSERT_GT(count * sizeof(double), threshold);
+    ASSERT_NE(count * sizeof(double) % piece, 0u);
+    std::vector<double> data(count);
+    for (std::size_t i = 0; i < count; ++i) data[i] = static_cast<double>(i) + test::uniform(g, 0, 0.5);
+    write_npy(dir / "big.npy", shape, data);
+    const NpyArray a = read_npy(dir / "big.npy");
+    EXPECT_EQ(a.shape, shape);
+    ASSERT_EQ(a.data.size(), count);
+    EXPECT_EQ(std::memcmp(a.data.data(), data.data(), count * sizeof(double)), 0);
+    std::vector<double> mine;
+    EXPECT_EQ(read_npy_into(dir / "big.npy",
+                            [&](std::span<const std::size_t>, std::size_t n) {
+                              mine.assign(n, -1.0);
+                              return mine.data();
+                            }),
+              shape);
+    ASSERT_EQ(mine.size(), count);
+    EXPECT_EQ(std::memcmp(mine.data(), data.data(), count * sizeof(double)), 0);
+  }
+  // Big-endian behind a version 2 header: the pieces are found from the end of the
+  // file and swapped after they are read.
+  const std::size_t count = threshold / sizeof(double) + 1;
+  std::vector<double> data(count);
+  for (std::size_t i = 0; i < count; ++i) data[i] = -static_cast<double>(i) - test::uniform(g, 0, 0.5);
+  const std::string dict = "{'descr': '>f8', 'fortran_order': False, 'shape': (" + std::to_string(count) + ",), }";
+  write_bytes(dir / "be.npy", make_npy(dict, be_bytes(data), 2));
+  const NpyArray a = read_npy(dir / "be.npy");
+  ASSERT_EQ(a.data.size(), count);
+  EXPECT_EQ(std::memcmp(a.data.data(), data.data(), count * sizeof(double)), 0);
 }
 
 // --- Hand-made files in the variants NumPy produces ------------------------------
@@ -438,6 +483,147 @@ TEST(Npy, FailedWriteKeepsTheOldFile) {
   const std::vector<double> bad = {1, 2};
   EXPECT_ERRC(write_npy(dir / "keep.npy", shape, bad), size_mismatch, "keep.npy");
   EXPECT_EQ(read_npy(dir / "keep.npy").data, good);
+}
+
+// --- Writing from a producer, block by block -------------------------------------------
+
+// A producer of `data` that copies each block into memory of its own, reused from
+// call to call, and records the calls.
+struct RecordingProducer {
+  std::span<const double> data;
+  std::vector<std::pair<std::size_t, std::size_t>> calls;  // (first, count)
+  std::vector<double> block;
+
+  NpyProducer producer() {
+    return [this](std::size_t first, std::size_t count) {
+      calls.emplace_back(first, count);
+      block.assign(data.begin() + static_cast<std::ptrdiff_t>(first),
+                   data.begin() + static_cast<std::ptrdiff_t>(first + count));
+      return std::span<const double>(block);
+    };
+  }
+};
+
+TEST(Npy, WriteFromAProducerGivesTheBytesOfWriteFromData) {
+  TempDir dir;
+  auto g = test::rng(14);
+  struct Case {
+    std::vector<std::size_t> shape;
+    std::vector<std::size_t> blocks;
+  };
+  const std::size_t many = (std::size_t{3} << 20) / sizeof(double) + 5;  // more than the file writer's buffer
+  const std::vector<Case> cases{
+      {{4, 5, 3}, {1, 12, 60, 7, 11, 61, 1000, std::numeric_limits<std::size_t>::max()}},
+      {{many}, {std::size_t{1} << 16, 65537, many - 1}},
+      {{}, {1, 5}},      // a scalar: one value
+      {{0, 3}, {1, 4}},  // empty: no value at all
+      {{3, 0, 2}, {2}},
+  };
+  for (const Case& c : cases) {
+    std::size_t count = 1;
+    for (std::size_t d : c.shape) count *= d;
+    std::vector<double> data(count);
+    for (double& v : data) v = test::uniform(g, -1e3, 1e3);
+    if (count >= 3) {
+      data[0] = -0.0;
+      data[1] = std::numeric_limits<double>::denorm_min();
+      data[2] = std::numeric_limits<double>::max();
+    }
+    write_npy(dir / "whole.npy", c.shape, data);
+    const std::string expected = read_bytes(dir / "whole.npy");
+    for (const std::size_t block : c.blocks) {
+      SCOPED_TRACE(std::to_string(count) + " values in blocks of " + std::to_string(block));
+      RecordingProducer p{data, {}, {}};
+      write_npy(dir / "blocks.npy", c.shape, block, p.producer());
+      EXPECT_TRUE(read_bytes(dir / "blocks.npy") == expected);
+      // Consecutive blocks from 0, each full but the last, covering every value once.
+      std::size_t next = 0;
+      for (const auto& [first, n] : p.calls) {
+        EXPECT_EQ(first, next);
+        EXPECT_EQ(n, std::min(block, count - first));
+        EXPECT_GT(n, 0u);
+        next = first + n;
+      }
+      EXPECT_EQ(next, count);
+      EXPECT_EQ(p.calls.size(), count == 0 ? std::size_t{0} : (count - 1) / block + 1);
+    }
+  }
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"blocks.npy", "whole.npy"}));  // no temporary file left
+}
+
+TEST(Npy, WriteFromAProducerOfAWrongCountIsSizeMismatchAndKeepsTheOldFile) {
+  TempDir dir;
+  const std::vector<std::size_t> shape = {5, 6};
+  const auto data = iota_values(30);
+  write_npy(dir / "keep.npy", shape, iota_values(30, -1.5));
+  const std::string old = read_bytes(dir / "keep.npy");
+  for (const std::ptrdiff_t wrong : {-1, 1, -10}) {
+    SCOPED_TRACE(wrong);
+    std::vector<double> block;
+    const NpyProducer produce = [&](std::size_t first, std::size_t count) {
+      const std::size_t n = first == 10 ? static_cast<std::size_t>(static_cast<std::ptrdiff_t>(count) + wrong) : count;
+      const auto from = data.begin() + static_cast<std::ptrdiff_t>(first);
+      block.assign(from, from + static_cast<std::ptrdiff_t>(n));
+      return std::span<const double>(block);
+    };
+    EXPECT_ERRC(write_npy(dir / "keep.npy", shape, 10, produce), size_mismatch,
+                "values 10 to 19 came as " + std::to_string(10 + wrong) + " values");
+    EXPECT_TRUE(read_bytes(dir / "keep.npy") == old);
+    EXPECT_EQ(dir.entries(), std::vector<std::string>{"keep.npy"});
+  }
+}
+
+TEST(Npy, WriteFromAProducerThatThrowsPassesItOnAndKeepsTheOldFile) {
+  struct producer_failed : std::runtime_error {
+    using std::runtime_error::runtime_error;
+  };
+  TempDir dir;
+  const std::vector<std::size_t> shape = {1000, 3};
+  write_npy(dir / "keep.npy", shape, iota_values(3000));
+  const std::string old = read_bytes(dir / "keep.npy");
+  std::vector<double> block;
+  const auto failing_at = [&](std::size_t at, auto failure) {
+    return NpyProducer([&block, at, failure](std::size_t first, std::size_t count) {
+      if (first == at) throw failure;
+      block.assign(count, 1.0);
+      return std::span<const double>(block);
+    });
+  };
+  try {
+    write_npy(dir / "keep.npy", shape, 512, failing_at(2048, producer_failed("block 4 failed")));
+    ADD_FAILURE() << "expected the producer's exception";
+  } catch (const producer_failed& e) {
+    EXPECT_STREQ(e.what(), "block 4 failed");
+  }
+  EXPECT_TRUE(read_bytes(dir / "keep.npy") == old);
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"keep.npy"});
+  // The library's own errors pass unchanged too, from the first block as from a later one.
+  for (const std::size_t at : {std::size_t{0}, std::size_t{2560}}) {
+    EXPECT_ERRC(write_npy(dir / "keep.npy", shape, 512, failing_at(at, error(errc::not_finite, "point 7 is nan"))),
+                not_finite, "point 7 is nan");
+    EXPECT_TRUE(read_bytes(dir / "keep.npy") == old);
+    EXPECT_EQ(dir.entries(), std::vector<std::string>{"keep.npy"});
+  }
+  // A new file is not created.
+  EXPECT_THROW(write_npy(dir / "new.npy", shape, 512, failing_at(0, producer_failed("no"))), producer_failed);
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"keep.npy"});
+}
+
+TEST(Npy, WriteFromAProducerInBlocksOfNothingIsSizeMismatch) {
+  TempDir dir;
+  const std::vector<std::size_t> shape = {4};
+  write_npy(dir / "keep.npy", shape, iota_values(4));
+  const std::string old = read_bytes(dir / "keep.npy");
+  bool called = false;
+  const NpyProducer produce = [&](std::size_t, std::size_t) {
+    called = true;
+    return std::span<const double>();
+  };
+  EXPECT_ERRC(write_npy(dir / "keep.npy", shape, 0, produce), size_mismatch, "blocks of 0 values");
+  EXPECT_ERRC(write_npy(dir / "new.npy", shape, 0, produce), size_mismatch, "new.npy");
+  EXPECT_FALSE(called);
+  EXPECT_TRUE(read_bytes(dir / "keep.npy") == old);
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"keep.npy"});
 }
 
 }  // namespace
