@@ -28,6 +28,7 @@
 #include <TColgp_HArray1OfPnt.hxx>
 #include <gp_Pnt.hxx>
 #include <sisl.h>
+#include <sched.h>
 #include <spawn.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -870,11 +871,12 @@ struct ProcessResult {
   std::string out;
 };
 
-// Spawns argv with OMP_NUM_THREADS set and waits for it; stdout captured if asked.
+// Spawns argv with OMP_NUM_THREADS set (threads > 0; 0 passes this process's
+// environment on unchanged) and waits for it; stdout captured if asked.
 ProcessResult spawn_and_wait(const std::vector<std::string>& args, int threads, bool capture) {
   std::vector<std::string> env_strings;
   for (char** e = environ; *e; ++e)
-    if (std::strncmp(*e, "OMP_NUM_THREADS=", 16) != 0) env_strings.emplace_back(*e);
+    if (threads == 0 || std::strncmp(*e, "OMP_NUM_THREADS=", 16) != 0) env_strings.emplace_back(*e);
   if (threads > 0) env_strings.push_back("OMP_NUM_THREADS=" + std::to_string(threads));
   std::vector<char*> envp, argvp;
   for (auto& s : env_strings) envp.push_back(s.data());
@@ -919,6 +921,13 @@ ProcessResult spawn_and_wait(const std::vector<std::string>& args, int threads, 
 // rather than from the benchmark holding its grids.
 int time_child(int argc, char** argv) {
   const std::vector<std::string> args(argv, argv + argc);
+  // With OMP_PROC_BIND set, OpenMP pinned this helper's (and the benchmark's) main
+  // thread to one CPU at start, and a spawned program inherits that mask: it would
+  // run all its threads on one CPU. It gets every online CPU back.
+  cpu_set_t all;
+  CPU_ZERO(&all);
+  for (long c = 0; c < sysconf(_SC_NPROCESSORS_ONLN) && c < CPU_SETSIZE; ++c) CPU_SET(static_cast<int>(c), &all);
+  sched_setaffinity(0, sizeof all, &all);
   const auto r = spawn_and_wait(args, 0, false);
   std::cout << '\n' << r.seconds << ' ' << r.maxrss_kb << ' ' << r.status << std::endl;
   return 0;
