@@ -503,10 +503,13 @@ void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::sp
     detail::fail(errc::size_mismatch, "cannot write '", path.string(), "': shape ", shape_text(dims), " has ", count,
                  " elements, data has ", data.size());
   const std::string header = npy_header(dims);
-  write_atomically(path, [&](std::ostream& os) {
-    os.write(header.data(), static_cast<std::streamsize>(header.size()));
-    write_values(os, data.data(), data.size());
-  });
+  write_atomically(
+      path,
+      [&](std::ostream& os) {
+        os.write(header.data(), static_cast<std::streamsize>(header.size()));
+        write_values(os, data.data(), data.size());
+      },
+      header.size() + data.size() * sizeof(double));
 }
 
 void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::size_t block,
@@ -515,6 +518,11 @@ void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::si
   const std::size_t count = element_count(path, dims);
   if (block == 0) detail::fail(errc::size_mismatch, "cannot write '", path.string(), "': blocks of 0 values");
   const std::string header = npy_header(dims);
+  // The file's size, for write_atomically to allocate at once; 0 (unknown) for a
+  // shape whose bytes cannot be counted, which the writes then refuse.
+  const std::uintmax_t bytes = count <= (std::numeric_limits<std::uintmax_t>::max() - header.size()) / sizeof(double)
+                                   ? header.size() + count * sizeof(double)
+                                   : 0;
   write_atomically(path, [&](std::ostream& os) {
     os.write(header.data(), static_cast<std::streamsize>(header.size()));
     for (std::size_t first = 0; first < count; first += block) {
@@ -525,7 +533,7 @@ void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::si
                      " came as ", values.size(), " values");
       write_values(os, values.data(), n);
     }
-  });
+  }, bytes);
 }
 
 }  // namespace interpatch::io

@@ -43,13 +43,16 @@ void set_durable_writes(bool on) noexcept;
 /// full, file too large) as file_unwritable naming the path and the reason; the
 /// stream throws on the first failure, so a writer stops early. The result gets
 /// the permissions of the file it replaces, or 0666 minus the umask when new; a
-/// symbolic link at `path` is kept and the file it points to replaced.
+/// symbolic link at `path` is kept and the file it points to replaced. `size`, when
+/// the writer knows it, is the number of bytes it will write: the file's space is
+/// then allocated in one go (a file that ends up shorter is cut to what was written).
 ///
 /// Example:
 /// @code
 ///   interpatch::io::write_atomically("out.txt", [](std::ostream& os) { os << "hello\n"; });
 /// @endcode
 /// @throws error file_unwritable.
-void write_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& write);
+void write_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& write,
+                      std::uintmax_t size = 0);
 
 }  // namespace interpatch::io
