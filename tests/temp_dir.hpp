@@ -4,7 +4,8 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
+#include <cerrno>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -18,11 +19,13 @@ namespace interpatch::test {
 /// (made writable first, for tests that take permissions away).
 class TempDir {
  public:
+  // mkdtemp: a directory that did not exist before, even when a process that had
+  // this one's pid left its directory behind.
   TempDir() {
-    static std::atomic<int> counter{0};
-    path_ = std::filesystem::temp_directory_path() /
-            ("interpatch-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-    std::filesystem::create_directories(path_);
+    std::string templ = (std::filesystem::temp_directory_path() / "interpatch-test-XXXXXX").string();
+    if (::mkdtemp(templ.data()) == nullptr)
+      throw std::filesystem::filesystem_error("mkdtemp", templ, std::error_code(errno, std::generic_category()));
+    path_ = templ;
   }
   TempDir(const TempDir&) = delete;
   TempDir& operator=(const TempDir&) = delete;
