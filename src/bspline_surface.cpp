@@ -298,7 +298,7 @@ Grid<SurfaceDerivatives, 2> BSplineSurface::evaluate_derivatives(std::span<const
   const int p = degree_u(), q = degree_v();
   const std::size_t ncv = cp_.extent(1);
   const std::size_t nv = vs.size();
-  Grid<SurfaceDerivatives, 2> out({us.size(), nv}, zeroed);
+  Grid<SurfaceDerivatives, 2> out({us.size(), nv}, for_overwrite);
   const bool rat = rational();
   const auto nu = static_cast<long long>(us.size());
 #pragma omp parallel if (us.size() * (nv + ncv) >= detail::parallel_min_work)

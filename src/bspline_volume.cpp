@@ -369,7 +369,7 @@ void BSplineVolume::evaluate_into(std::span<const double> us, std::span<const do
 Grid<VolumeDerivatives, 3> BSplineVolume::evaluate_derivatives(std::span<const double> us, std::span<const double> vs,
                                                                std::span<const double> ws) const {
   grid_items(us.size(), vs.size(), ws.size(), sizeof(VolumeDerivatives), "volume derivative grid");
-  Grid<VolumeDerivatives, 3> out({us.size(), vs.size(), ws.size()}, zeroed);
+  Grid<VolumeDerivatives, 3> out({us.size(), vs.size(), ws.size()}, for_overwrite);
   contract_all<true>(*this, us, vs, ws, {},
                      [&out](std::size_t i, std::size_t j, std::size_t k, const VolumeDerivatives& d) { out(i, j, k) = d; });
   return out;

@@ -11,7 +11,7 @@ namespace interpatch {
 PointGrid Surface::evaluate(std::span<const double> us, std::span<const double> vs,
                             const progress_callback& progress) const {
   require_memory(us.size() * vs.size(), sizeof(Vec3), "surface evaluation grid");
-  PointGrid out({us.size(), vs.size()}, zeroed);
+  PointGrid out({us.size(), vs.size()}, for_overwrite);
   evaluate_into(us, vs, std::span<Vec3>(out.data(), out.size()), progress);
   return out;
 }
@@ -38,7 +38,7 @@ Grid<SurfaceDerivatives, 2> Surface::evaluate_derivatives(std::span<const double
   detail::check_unit_parameters(us, "u");
   detail::check_unit_parameters(vs, "v");
   require_memory(us.size() * vs.size(), sizeof(SurfaceDerivatives), "surface derivative grid");
-  Grid<SurfaceDerivatives, 2> out({us.size(), vs.size()}, zeroed);
+  Grid<SurfaceDerivatives, 2> out({us.size(), vs.size()}, for_overwrite);
   const auto nu = static_cast<long long>(us.size());
 #pragma omp parallel for schedule(static) if (us.size() * vs.size() >= detail::parallel_min_work / 16)
   for (long long i = 0; i < nu; ++i)

@@ -69,7 +69,7 @@ Jacobian Volume::jacobian(double u, double v, double w) const { return interpatc
 PointGrid3 Volume::evaluate(std::span<const double> us, std::span<const double> vs, std::span<const double> ws,
                             const progress_callback& progress) const {
   check_grid(*this, us, vs, ws, sizeof(Vec3), "volume evaluation grid");
-  PointGrid3 out({us.size(), vs.size(), ws.size()}, zeroed);
+  PointGrid3 out({us.size(), vs.size(), ws.size()}, for_overwrite);
   evaluate_into(us, vs, ws, std::span<Vec3>(out.data(), out.size()), progress);
   return out;
 }
@@ -90,7 +90,7 @@ void Volume::evaluate_into(std::span<const double> us, std::span<const double> v
 Grid<VolumeDerivatives, 3> Volume::evaluate_derivatives(std::span<const double> us, std::span<const double> vs,
                                                         std::span<const double> ws) const {
   check_grid(*this, us, vs, ws, sizeof(VolumeDerivatives), "volume derivative grid");
-  Grid<VolumeDerivatives, 3> out({us.size(), vs.size(), ws.size()}, zeroed);
+  Grid<VolumeDerivatives, 3> out({us.size(), vs.size(), ws.size()}, for_overwrite);
   pointwise(us.size(), vs.size(), ws.size(), {},
             [&](std::size_t i, std::size_t j, std::size_t k) { out(i, j, k) = derivatives(us[i], vs[j], ws[k]); });
   return out;

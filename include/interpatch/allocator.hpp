@@ -17,13 +17,21 @@ namespace interpatch {
 namespace detail {
 /// Buffers at least this large are mapped directly.
 inline constexpr std::size_t large_buffer_bytes = std::size_t{1} << 20;
-/// A zero-filled, 2 MiB-aligned anonymous mapping of at least `bytes`.
+/// A 2 MiB-aligned anonymous mapping of at least `bytes`, marked for transparent
+/// huge pages. With `zero`, a fresh one: zero-filled, its pages untouched. Without,
+/// possibly one given back before with the same rounded size, its pages already
+/// touched and its contents whatever they were.
 /// @throws std::bad_alloc.
-void* map_pages(std::size_t bytes);
+void* map_pages(std::size_t bytes, bool zero = true);
+/// Gives a mapping back. A few of the most recent ones, up to 256 MiB in all, are
+/// kept for map_pages(bytes, false) of the same size; the others are unmapped.
 void unmap_pages(void* p, std::size_t bytes) noexcept;
-/// Set on a thread while a Grid takes fresh zero pages for its elements: the
-/// allocator then leaves value-initialized elements of large buffers as mapped.
-inline thread_local bool leave_zero_pages = false;
+
+/// How the elements of a large buffer start: constructed (values), as the fresh
+/// zero pages of a new mapping (zero_pages), or as they are, to be overwritten by
+/// the caller (overwrite). Set on a thread by resize_zeroed and resize_for_overwrite.
+enum class Start { values, zero_pages, overwrite };
+inline thread_local Start start = Start::values;
 }  // namespace detail
 
 /// A std::allocator drop-in that maps large buffers with huge pages.
@@ -37,7 +45,10 @@ struct large_allocator {
   T* allocate(std::size_t n) {
     if (n > static_cast<std::size_t>(-1) / sizeof(T)) throw std::bad_array_new_length();
     const std::size_t bytes = n * sizeof(T);
-    if (bytes >= detail::large_buffer_bytes) return static_cast<T*>(detail::map_pages(bytes));
+    // Only zero pages must be fresh: constructed elements and overwritten ones may
+    // reuse a mapping whose pages are touched already.
+    if (bytes >= detail::large_buffer_bytes)
+      return static_cast<T*>(detail::map_pages(bytes, detail::start == detail::Start::zero_pages));
     return std::allocator<T>().allocate(n);
   }
   void deallocate(T* p, std::size_t n) noexcept {
@@ -45,34 +56,51 @@ struct large_allocator {
     if (bytes >= detail::large_buffer_bytes) detail::unmap_pages(p, bytes);
     else std::allocator<T>().deallocate(p, n);
   }
-  /// Value-initialization of an element of a large buffer while
-  /// detail::leave_zero_pages is set does nothing: the mapping is already zero,
-  /// and its pages are first touched by whoever writes the element.
+  /// Value-initialization of an element while detail::start is zero_pages or
+  /// overwrite does nothing: the mapping is already zero, or the caller writes every
+  /// element; pages are first touched by whoever writes.
   template <class U, class... Args>
   void construct(U* p, Args&&... args) {
     if constexpr (sizeof...(Args) == 0)
-      if (detail::leave_zero_pages) return;
+      if (detail::start != detail::Start::values) return;
     ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
   template <class U>
   friend bool operator==(const large_allocator&, const large_allocator<U>&) noexcept { return true; }
 };
 
+namespace detail {
+// Resizes an empty vector to n elements that start as `how` says.
+template <class T>
+void resize_started(std::vector<T, large_allocator<T>>& v, std::size_t n, Start how) {
+  static_assert(std::is_trivially_copyable_v<T>, "only trivially copyable values can start unconstructed");
+  if (!v.empty() || n * sizeof(T) < large_buffer_bytes) {  // from operator new: constructed
+    v.resize(n);
+    return;
+  }
+  struct Guard {
+    explicit Guard(Start s) noexcept { start = s; }
+    ~Guard() { start = Start::values; }
+  } guard(how);
+  v.resize(n);
+}
+}  // namespace detail
+
 /// Resizes an empty vector that uses large_allocator to n zero elements (for T whose
 /// zero value is all zero bits: numbers and aggregates of them), leaving the pages
 /// of a large buffer untouched until they are written.
 template <class T>
 void resize_zeroed(std::vector<T, large_allocator<T>>& v, std::size_t n) {
-  static_assert(std::is_trivially_copyable_v<T>, "zero pages hold values of trivially copyable types only");
-  if (!v.empty() || n * sizeof(T) < detail::large_buffer_bytes) {  // from operator new: not zero
-    v.resize(n);
-    return;
-  }
-  struct Guard {
-    Guard() noexcept { detail::leave_zero_pages = true; }
-    ~Guard() { detail::leave_zero_pages = false; }
-  } guard;
-  v.resize(n);
+  detail::resize_started(v, n, detail::Start::zero_pages);
+}
+
+/// Resizes an empty vector that uses large_allocator to n elements the caller will
+/// all overwrite (trivially copyable T): a large buffer may reuse the pages of one
+/// freed before, already touched, instead of fresh ones, which on a virtual machine
+/// cost as much as writing them twice. Small buffers are value-initialized.
+template <class T>
+void resize_for_overwrite(std::vector<T, large_allocator<T>>& v, std::size_t n) {
+  detail::resize_started(v, n, detail::Start::overwrite);
 }
 
 }  // namespace interpatch

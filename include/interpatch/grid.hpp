@@ -20,6 +20,14 @@ struct zeroed_t {
 };
 inline constexpr zeroed_t zeroed{};
 
+/// Tag of the Grid constructor for outputs the caller overwrites whole: elements
+/// unspecified until written, and a large grid may take the touched pages of one
+/// freed before (see resize_for_overwrite).
+struct for_overwrite_t {
+  explicit for_overwrite_t() = default;
+};
+inline constexpr for_overwrite_t for_overwrite{};
+
 /// Dense rank-`Rank` array in C order. `Grid<Vec3, 2>` of shape {n+1, m+1} holds
 /// the points Q[p][q], p along u, q along v.
 ///
@@ -42,6 +50,9 @@ class Grid {
   /// Zero elements (for T whose zero value is all zero bits: numbers and aggregates
   /// of them).
   Grid(const shape_type& shape, zeroed_t) : shape_(shape) { resize_zeroed(data_, count(shape)); }
+  /// Elements to be overwritten, every one, before they are read (trivially
+  /// copyable T).
+  Grid(const shape_type& shape, for_overwrite_t) : shape_(shape) { resize_for_overwrite(data_, count(shape)); }
 
   [[nodiscard]] const shape_type& shape() const noexcept { return shape_; }
   [[nodiscard]] std::size_t extent(std::size_t axis) const noexcept { return shape_[axis]; }

@@ -1,6 +1,8 @@
 #include <sys/mman.h>
 
+#include <array>
 #include <cstdint>
+#include <mutex>
 
 #include "interpatch/allocator.hpp"
 
@@ -9,11 +11,50 @@ namespace interpatch::detail {
 namespace {
 constexpr std::size_t huge = std::size_t{2} << 20;
 std::size_t rounded(std::size_t bytes) noexcept { return (bytes + huge - 1) / huge * huge; }
+
+// Mappings given back and kept for reuse: a batch evaluation repeated on grids of
+// one size then writes into pages it touched before instead of fresh ones, whose
+// first touch (the kernel zeroing them, the hypervisor backing them) costs more
+// than the evaluation's own writes on a virtual machine.
+constexpr std::size_t keep_limit = std::size_t{256} << 20;  // bytes kept in all
+struct Kept {
+  void* p = nullptr;
+  std::size_t size = 0;
+};
+std::mutex kept_mutex;
+std::array<Kept, 4> kept;
+std::size_t kept_bytes = 0;
+
+void* take_kept(std::size_t size) noexcept {
+  const std::lock_guard<std::mutex> lock(kept_mutex);
+  for (Kept& k : kept)
+    if (k.p != nullptr && k.size == size) {
+      void* p = k.p;
+      k = {};
+      kept_bytes -= size;
+      return p;
+    }
+  return nullptr;
+}
+
+bool keep(void* p, std::size_t size) noexcept {
+  const std::lock_guard<std::mutex> lock(kept_mutex);
+  if (kept_bytes + size > keep_limit) return false;
+  for (Kept& k : kept)
+    if (k.p == nullptr) {
+      k = {p, size};
+      kept_bytes += size;
+      return true;
+    }
+  return false;
+}
 }  // namespace
 
-void* map_pages(std::size_t bytes) {
+void* map_pages(std::size_t bytes, bool zero) {
   const std::size_t size = rounded(bytes);
   if (size < bytes) throw std::bad_alloc();
+  if (!zero)
+    if (void* p = take_kept(size)) return p;
   // Map one huge page more than needed, then trim to a 2 MiB-aligned window so
   // every page of the buffer can be a huge page.
   void* raw = ::mmap(nullptr, size + huge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
@@ -28,6 +69,9 @@ void* map_pages(std::size_t bytes) {
   return p;
 }
 
-void unmap_pages(void* p, std::size_t bytes) noexcept { ::munmap(p, rounded(bytes)); }
+void unmap_pages(void* p, std::size_t bytes) noexcept {
+  const std::size_t size = rounded(bytes);
+  if (!keep(p, size)) ::munmap(p, size);
+}
 
 }  // namespace interpatch::detail

@@ -427,7 +427,7 @@ PointArray npy_points(const json& obj, std::size_t rank, std::string_view ptr, C
              rank == 1 ? "a list" : cat("a ", rank, "-D grid"), " of 3-vectors");
       for (std::size_t ax = 0; ax + 1 < s.size(); ++ax)
         if (s[ax] == 0) fail(errc::too_few_points, file, " has shape ", shape_text(s), ", no points");
-      resize_zeroed(out.points, count / 3);
+      resize_for_overwrite(out.points, count / 3);
       return &out.points.data()->x;
     });
   });
