@@ -133,15 +133,15 @@ BSplineSurface::BSplineSurface(KnotVector knots_u, KnotVector knots_v, PointGrid
   if (!w_.empty() && (w_.extent(0) != nu || w_.extent(1) != nv))
     fail(errc::size_mismatch, nu, " x ", nv, " control points need as many weights, got ", w_.extent(0), " x ",
          w_.extent(1));
-  for (std::size_t i = 0; i < nu; ++i)
-    for (std::size_t j = 0; j < nv; ++j) {
-      if (!is_finite(cp_(i, j))) fail(errc::not_finite, "control point [", i, "][", j, "] is ", cp_(i, j));
-      if (!w_.empty()) {
+  if (const std::size_t k = detail::first_non_finite(cp_.data(), cp_.size()); k < cp_.size())
+    fail(errc::not_finite, "control point [", k / nv, "][", k % nv, "] is ", cp_.data()[k]);
+  if (!w_.empty())
+    for (std::size_t i = 0; i < nu; ++i)
+      for (std::size_t j = 0; j < nv; ++j) {
         if (!std::isfinite(w_(i, j))) fail(errc::not_finite, "weight [", i, "][", j, "] is ", w_(i, j));
         if (!(w_(i, j) > 0))
           fail(errc::invalid_weight, "weight [", i, "][", j, "] is ", w_(i, j), "; weights must be positive");
       }
-    }
 }
 
 Vec3 BSplineSurface::point(double u, double v) const { return derivative(u, v, 0, 0); }

@@ -227,18 +227,17 @@ BSplineVolume::BSplineVolume(KnotVector knots_u, KnotVector knots_v, KnotVector 
   if (!w_.empty() && w_.shape() != cp_.shape())
     fail(errc::size_mismatch, nu, " x ", nv, " x ", nw, " control points need as many weights, got ", w_.extent(0),
          " x ", w_.extent(1), " x ", w_.extent(2));
-  for (std::size_t i = 0; i < nu; ++i)
-    for (std::size_t j = 0; j < nv; ++j)
-      for (std::size_t k = 0; k < nw; ++k) {
-        if (!is_finite(cp_(i, j, k)))
-          fail(errc::not_finite, "control point [", i, "][", j, "][", k, "] is ", cp_(i, j, k));
-        if (!w_.empty()) {
+  if (const std::size_t m = detail::first_non_finite(cp_.data(), cp_.size()); m < cp_.size())
+    fail(errc::not_finite, "control point [", m / (nv * nw), "][", m / nw % nv, "][", m % nw, "] is ", cp_.data()[m]);
+  if (!w_.empty())
+    for (std::size_t i = 0; i < nu; ++i)
+      for (std::size_t j = 0; j < nv; ++j)
+        for (std::size_t k = 0; k < nw; ++k) {
           const double x = w_(i, j, k);
           if (!std::isfinite(x)) fail(errc::not_finite, "weight [", i, "][", j, "][", k, "] is ", x);
           if (!(x > 0))
             fail(errc::invalid_weight, "weight [", i, "][", j, "][", k, "] is ", x, "; weights must be positive");
         }
-      }
 }
 
 std::array<std::pair<double, double>, 3> BSplineVolume::domain() const {

@@ -253,7 +253,7 @@ class GridChords {
         const std::size_t r1 = std::min(n0, (c + 1) * rows_per_chunk);
         for (std::size_t r = c * rows_per_chunk; r < r1; ++r) {
           const Vec3* row = q + r * M;
-          if (const std::size_t m = first_non_finite(row, M); m != no_point) {
+          if (const std::size_t m = detail::first_non_finite(row, M); m < M) {
             bad[c] = r * M + m;
             break;
           }
@@ -346,15 +346,10 @@ class GridChords {
  private:
   static constexpr std::size_t no_point = static_cast<std::size_t>(-1);
 
-  static std::size_t first_non_finite(const Vec3* p, std::size_t count) {
-    for (std::size_t m = 0; m < count; ++m)
-      if (!is_finite(p[m])) return m;
-    return no_point;
-  }
 
   void check_finite(const Vec3* q) const {
     const std::size_t total = g_.n[0] * g_.row;
-    if (const std::size_t k = first_non_finite(q, total); k != no_point) fail_not_finite(q, k);
+    if (const std::size_t k = detail::first_non_finite(q, total); k < total) fail_not_finite(q, k);
   }
 
   [[noreturn]] void fail_not_finite(const Vec3* q, std::size_t k) const {

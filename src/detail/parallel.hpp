@@ -6,6 +6,8 @@
 
 #include <cstddef>
 
+#include "interpatch/vec3.hpp"
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -30,6 +32,18 @@ inline std::size_t thread_count() noexcept {
 #else
   return 1;
 #endif
+}
+
+/// Index of the first point with a NaN or infinite coordinate, `count` if none:
+/// both threads scan a large array, and the first in storage order is the one found
+/// whatever the thread count.
+inline std::size_t first_non_finite(const Vec3* p, std::size_t count) noexcept {
+  const auto n = static_cast<long long>(count);
+  long long first = n;
+#pragma omp parallel for schedule(static) reduction(min : first) if (count >= parallel_min_work)
+  for (long long i = 0; i < n; ++i)
+    if (!is_finite(p[i]) && i < first) first = i;
+  return static_cast<std::size_t>(first);
 }
 
 }  // namespace interpatch::detail

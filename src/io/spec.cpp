@@ -383,15 +383,7 @@ std::string expected_shape(std::size_t rank) {
 // below `ptr` (`/points/3/7/2`) and the file it came from.
 void check_finite_points(const std::vector<std::size_t>& shape, const PointStorage& points, std::string_view ptr,
                          const std::string& file) {
-  // Both threads scan (a million points take a millisecond on one); the first bad
-  // point in storage order is the one named, whatever the thread count.
-  const auto n = static_cast<long long>(points.size());
-  long long first = n;
-#pragma omp parallel for schedule(static) reduction(min : first) if (points.size() >= detail::parallel_min_work)
-  for (long long i = 0; i < n; ++i)
-    if (!is_finite(points[static_cast<std::size_t>(i)])) first = std::min(first, i);
-  if (first < n) {
-    const auto i = static_cast<std::size_t>(first);
+  if (const std::size_t i = detail::first_non_finite(points.data(), points.size()); i < points.size()) {
     const Vec3& p = points[i];
     std::vector<std::size_t> idx(shape.size() + 1);
     std::size_t r = i;
