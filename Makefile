@@ -69,7 +69,7 @@ BENCH_OUT ?= build/bench/results.json
 # bench/compare then runs interpatch, OpenCASCADE and SISL on the same data (interpatch
 # on 1 and on all threads), writes $(COMPARE_OUT), and tools/plot_bench.py draws
 # docs/bench_interpolation.png and prints the Markdown tables of docs/BENCHMARKS.md.
-COMPARE_FLAGS ?= --reps 3
+COMPARE_FLAGS ?= --reps 5
 COMPARE_OUT ?= build/bench/compare.json
 bench: deps
 	cmake --preset bench
