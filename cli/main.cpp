@@ -38,7 +38,8 @@ int main(int argc, char** argv) {
                "meshes, evaluation grids and a description.",
                "interpatch"};
   app.require_subcommand(1);
-  app.footer("Exit status: 0 ok, 2 bad usage, 3 invalid input, 4 unreadable/unwritable file, 5 too large, 1 other.");
+  app.footer("Exit status: 0 ok, 2 bad usage, 3 invalid input, 4 unreadable/unwritable file, 5 too large, 1 other.\n"
+             "Outputs replace files atomically; INTERPATCH_SYNC=1 also waits until they are on the disk.");
 
   std::string spec, out, res, grid, demo_dir = "interpatch-demo";
 

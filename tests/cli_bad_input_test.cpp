@@ -283,13 +283,15 @@ std::vector<Row> rows() {
       // too large: refused before allocating. The bytes needed are an estimate that may
   // change; what stays is the size asked for, the bytes needed and the bytes available.
       {"EvalGridTooLarge", {{grid_file, grid}}, {"eval", grid_file, "--grid", "1000000", "-o", "out.npy"}, 5,
-       R"(evaluation grid 1000000x1000000 needs [0-9.]+ [TP]B \([0-9]+ bytes\), [0-9.]+ [kMGT]?B available)",
+       R"(evaluation grid 1000000x1000000 needs [0-9.]+ [TP]B \([0-9]+ bytes\), [0-9.]+ [kMGT]?B available on disk in '.+' \([0-9]+ bytes\))",
        errc::too_large, false},
+      {"EvalFileBeyondBytes", {{grid_file, grid}}, {"eval", grid_file, "--grid", "1000000000", "-o", "out.npy"}, 5,
+       R"(evaluation grid 1000000000x1000000000: more bytes than a file can hold)", errc::too_large, false},
       {"EvalGridBeyondCounting", {{grid_file, grid}},
        {"eval", grid_file, "--grid", "123456789012345678901234567890", "-o", "out.csv"}, 5,
        R"(evaluation grid beyond 2\^64)", errc::too_large, false},
       {"VolumeEvalGridTooLarge", {{grid_file, vol}}, {"eval", grid_file, "--grid", "5000", "-o", "out.npy"}, 5,
-       R"(evaluation grid 5000x5000x5000 needs [0-9.]+ [GT]B \([0-9]+ bytes\), [0-9.]+ [kMGT]?B available)", errc::too_large, false},
+       R"(evaluation grid 5000x5000x5000 needs [0-9.]+ [GT]B \([0-9]+ bytes\), [0-9.]+ [kMGT]?B available on disk in '.+' \([0-9]+ bytes\))", errc::too_large, false},
       {"MeshTooLarge", {{grid_file, grid}}, {"mesh", grid_file, "--res", "200000x200000", "-o", "out.obj"}, 5,
        R"(mesh of 200000x200000 vertices needs [0-9.]+ [GT]B \([0-9]+ bytes\), [0-9.]+ [kMGT]?B available)", errc::too_large, false},
       {"VolumeMeshTooLarge", {{grid_file, vol}}, {"mesh", grid_file, "--res", "5000x5000x5000", "-o", "out.vts"}, 5,

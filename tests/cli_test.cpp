@@ -356,6 +356,7 @@ TEST_F(CliTest, HelpExits0AndListsTheCommands) {
   const Result help = run({"--help"});
   EXPECT_EQ(help.status, 0);
   EXPECT_NE(help.out.find("build"), std::string::npos);
+  EXPECT_NE(help.out.find("INTERPATCH_SYNC=1"), std::string::npos) << help.out;  // the one environment switch
 }
 
 TEST_F(CliTest, UnknownFieldIsAWarningNotAFailure) {

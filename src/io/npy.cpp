@@ -274,12 +274,12 @@ void read_exact(std::istream& in, char* dst, std::size_t n, const std::string& n
   }
 }
 
-/// The array in `in`, which holds `file_size` bytes; `name` names it in messages.
-/// What read_npy and parse_npy share: one reader for files and memory.
 // Reads n bytes at byte `offset` of the source into dst: a faster path than the
 // stream for the data block of a file.
 using BulkRead = std::function<void(char* dst, std::size_t n, std::uint64_t offset)>;
 
+/// The array in `in`, which holds `file_size` bytes; `name` names it in messages.
+/// What read_npy and parse_npy share: one reader for files and memory.
 std::vector<std::size_t> read_npy_stream(std::istream& in, std::uint64_t file_size, const std::string& name,
                                          const NpyDestination& destination, const BulkRead& bulk = {}) {
   unsigned char pre[12] = {};
@@ -502,14 +502,9 @@ void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::sp
   if (const std::size_t count = element_count(path, dims); count != data.size())
     detail::fail(errc::size_mismatch, "cannot write '", path.string(), "': shape ", shape_text(dims), " has ", count,
                  " elements, data has ", data.size());
-  const std::string header = npy_header(dims);
-  write_atomically(
-      path,
-      [&](std::ostream& os) {
-        os.write(header.data(), static_cast<std::streamsize>(header.size()));
-        write_values(os, data.data(), data.size());
-      },
-      header.size() + data.size() * sizeof(double));
+  // The data in one block, the caller's memory as it is.
+  write_npy(path, shape, std::max<std::size_t>(data.size(), 1),
+            [&](std::size_t first, std::size_t count) { return data.subspan(first, count); });
 }
 
 void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::size_t block,

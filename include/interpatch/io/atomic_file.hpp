@@ -30,15 +30,15 @@ void check_disk_space(const std::filesystem::path& path, std::uintmax_t bytes, s
 /// by a bad one), and on ext4 (data=ordered, auto_da_alloc) a rename over an
 /// existing file is ordered after its data, so even a power loss leaves the old
 /// file or the new one. On, it protects new files on any file system against a
-/// power loss or a kernel crash, at the price of waiting for the disk: about 6 ms
-/// per 25 MB on the machine of docs/BENCHMARKS.md. The interpatch command turns it
-/// on when the environment holds INTERPATCH_SYNC=1. Process-wide.
+/// power loss or a kernel crash, at the price of waiting for the disk: 4–12 ms per
+/// 25 MB on the machine of docs/BENCHMARKS.md. The interpatch command turns it on
+/// when the environment holds INTERPATCH_SYNC=1. Process-wide.
 void set_durable_writes(bool on) noexcept;
 [[nodiscard]] bool durable_writes() noexcept;
 
 /// Runs `write` on a stream to a temporary file beside `path` (".name.tmp.XXXXXX"),
-/// flushes it (and syncs it, when durable_writes()), then renames it onto `path`. If `write` throws or any
-/// write fails, the temporary file is removed, `path` is left as it was, and the
+/// flushes it (and syncs it, when durable_writes()), then renames it onto `path`.
+/// If `write` throws or any write fails, the temporary file is removed, `path` is left as it was, and the
 /// error propagates: the writer's own exception unchanged, a failed write (disk
 /// full, file too large) as file_unwritable naming the path and the reason; the
 /// stream throws on the first failure, so a writer stops early. The result gets
