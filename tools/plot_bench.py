@@ -103,6 +103,18 @@ def memory_table(memory):
     return "\n".join(out)
 
 
+def scaling_table(scaling):
+    """The alternated runs of N and 2N (bench/compare's measure_scaling)."""
+    head = ["N → 2N", "threads", "rounds", "t(N × N), median", "t(2N × 2N), median", "ratio of the medians",
+            "median of the rounds' ratios", "check"]
+    out = ["| " + " | ".join(head) + " |", "|---|---:|---:|---:|---:|---:|---:|---|"]
+    for s in scaling:
+        out.append(f"| {s['n']} → {s['n_large']} | {s['threads']} | {s['rounds']} | {fmt_time(s['median_s'])} | "
+                   f"{fmt_time(s['median_large_s'])} | {s['ratio_of_medians']:.2f} | {s['median_of_ratios']:.2f} | "
+                   f"{'ok' if s['check_ok'] else 'FAILED'} |")
+    return "\n".join(out)
+
+
 def agreement_table(agreement):
     out = ["| job | N | compared | max deviation / diagonal | why they differ |", "|---|---:|---|---:|---|"]
     for a in agreement:
@@ -188,6 +200,9 @@ def main():
           f"median of {meta['reps']} repetitions, wall clock.\n")
     print("### Bicubic interpolation of N × N grids\n")
     print(interpolation_table(rows, data["skipped"], meta["threads"]) + "\n")
+    if data.get("scaling"):
+        print("### Linear cost: N × N and 2N × 2N grids interpolated in turn\n")
+        print(scaling_table(data["scaling"]) + "\n")
     print("### Evaluation, Coons patch, whole process\n")
     print(jobs_table(rows) + "\n")
     if data["memory"]:
