@@ -123,6 +123,23 @@ TEST(InterpolateSurface, PassesThroughRandomGridsOfManyShapesAndDegrees) {
   }
 }
 
+TEST(InterpolateSurface, PassesThroughGridsWhoseRowsAreSolvedInSeveralColumnSlices) {
+  // The solve along u takes the rows' 3 × nv numbers a column slice at a time: 512
+  // wide (or a multiple of the thread count of slices) when nu ≤ 2048, a quarter of
+  // the row beyond. These shapes give several slices with a short last one on both
+  // sides of that bound.
+  auto g = test::rng(42);
+  for (const auto& [nu, nv] : {std::pair<std::size_t, std::size_t>{40, 700}, {2049, 190}}) {
+    const auto q = test::random_grid(g, nu, nv, 0.35);
+    const auto r = interpolate_surface(q);
+    const PointGrid at_data = r.surface.evaluate(r.params_u, r.params_v);
+    double e = 0;
+    for (std::size_t k = 0; k < q.size(); ++k) e = std::max(e, distance(at_data.data()[k], q.data()[k]));
+    // As for the small random grids above: two banded solves of small condition number.
+    EXPECT_LT(e, 1e-12 * test::bbox_diagonal(q.values())) << nu << "x" << nv;
+  }
+}
+
 TEST(InterpolateSurface, SevenByThirteenDegreesTwoThreeAndFiveFive) {
   auto g = test::rng(41);
   PointGrid q({7, 13});
