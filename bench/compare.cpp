@@ -3,6 +3,8 @@
 //
 // Jobs (each selectable with --jobs):
 //   interpolate  bicubic interpolation of N x N terrain grids (bench/terrain.hpp)
+//                (then, for sizes N and 2N from 1024 on, interpatch on both in turn:
+//                the linear-cost ratio)
 //   evaluate     1000 x 1000 points on the bicubic surface through an M x M grid
 //   coons        a Coons patch from four interpolated boundary curves, built and evaluated
 //   process      `interpatch eval SPEC --grid K` against bench/sisl_eval, as whole processes
