@@ -346,7 +346,6 @@ class GridChords {
  private:
   static constexpr std::size_t no_point = static_cast<std::size_t>(-1);
 
-
   void check_finite(const Vec3* q) const {
     const std::size_t total = g_.n[0] * g_.row;
     if (const std::size_t k = detail::first_non_finite(q, total); k < total) fail_not_finite(q, k);

@@ -124,10 +124,10 @@ TEST(InterpolateSurface, PassesThroughRandomGridsOfManyShapesAndDegrees) {
 }
 
 TEST(InterpolateSurface, PassesThroughGridsWhoseRowsAreSolvedInSeveralColumnSlices) {
-  // The solve along u takes the rows' 3 × nv numbers a column slice at a time: 512
-  // wide (or a multiple of the thread count of slices) when nu ≤ 2048, a quarter of
-  // the row beyond. These shapes give several slices with a short last one on both
-  // sides of that bound.
+  // The solve along u takes the rows' 3 × nv numbers a column slice at a time: about
+  // 512 wide (a multiple of the thread count of slices) when nu ≤ 2048; beyond, a
+  // quarter of the row but at least 512. These shapes give several slices with a
+  // short last one on both sides of that bound.
   auto g = test::rng(42);
   for (const auto& [nu, nv] : {std::pair<std::size_t, std::size_t>{40, 700}, {2049, 190}}) {
     const auto q = test::random_grid(g, nu, nv, 0.35);
