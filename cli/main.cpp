@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "exit_status.hpp"
 #include "interpatch/error.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/threads.hpp"
@@ -99,7 +100,7 @@ int main(int argc, char** argv) {
     if (*demo) return cli::demo_command(demo_dir);
     return fail_with(2, "no command given (see interpatch --help)");
   } catch (const interpatch::error& e) {
-    return fail_with(interpatch::exit_status(e.code()), e.what());
+    return fail_with(cli::exit_status(e.code()), e.what());
   } catch (const cli::usage_error& e) {
     return fail_with(2, e.what());
   } catch (const std::bad_alloc&) {

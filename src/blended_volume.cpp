@@ -3,7 +3,7 @@
 #include <algorithm>
 
 #include "detail/text.hpp"
-#include "detail/volume_terms.hpp"
+#include "volume_terms.hpp"
 
 namespace interpatch {
 

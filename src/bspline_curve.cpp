@@ -246,4 +246,6 @@ std::vector<BSplineCurve> make_compatible(std::span<const BSplineCurve> curves) 
   return out;
 }
 
+BSplineCurve line(const Vec3& a, const Vec3& b) { return BSplineCurve(KnotVector::bezier(1), {a, b}); }
+
 }  // namespace interpatch

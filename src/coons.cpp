@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "detail/blended_terms.hpp"
+#include "blended_terms.hpp"
 #include "detail/text.hpp"
 
 namespace interpatch {

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <vector>
 
-#include "detail/blended_terms.hpp"
+#include "blended_terms.hpp"
 #include "detail/text.hpp"
-#include "detail/volume_terms.hpp"
+#include "volume_terms.hpp"
 
 namespace interpatch {
 

@@ -34,14 +34,4 @@ std::string_view to_string(errc code) noexcept {
   return "internal";
 }
 
-int exit_status(errc code) noexcept {
-  switch (code) {
-    case errc::file_unreadable:
-    case errc::file_unwritable: return 4;
-    case errc::too_large: return 5;
-    case errc::internal: return 1;
-    default: return 3;
-  }
-}
-
 }  // namespace interpatch

@@ -47,6 +47,14 @@ KnotVector::KnotVector(int degree, std::vector<double> knots) : p_(degree), u_(s
   }
 }
 
+KnotVector KnotVector::bezier(int degree) {
+  if (degree < 1 || degree > max_degree)
+    detail::fail(errc::invalid_degree, "degree ", degree, " is outside 1..", max_degree);
+  std::vector<double> k(2 * static_cast<std::size_t>(degree) + 2, 0.0);
+  std::fill(k.begin() + degree + 1, k.end(), 1.0);
+  return KnotVector(degree, std::move(k));
+}
+
 KnotVector KnotVector::uniform(int degree, int count, double a, double b) {
   if (degree < 1 || degree > max_degree) fail(errc::invalid_degree, "degree ", degree, " is outside 1..", max_degree);
   if (count <= degree) fail(errc::too_few_points, "degree ", degree, " needs at least ", degree + 1, " control points, got ", count);

@@ -1,6 +1,6 @@
 #include "interpatch/patches.hpp"
 
-#include "detail/blended_terms.hpp"
+#include "blended_terms.hpp"
 #include "detail/text.hpp"
 
 namespace interpatch {
@@ -9,7 +9,7 @@ using detail::fail;
 
 namespace {
 
-BSplineCurve linear_scalar(bool rising) { return detail::scalar(KnotVector(1, {0, 0, 1, 1}), {rising ? 0.0 : 1.0, rising ? 1.0 : 0.0}); }
+BSplineCurve linear_scalar(bool rising) { return detail::scalar(KnotVector::bezier(1), {rising ? 0.0 : 1.0, rising ? 1.0 : 0.0}); }
 
 }  // namespace
 

@@ -1,8 +1,8 @@
 #include "interpatch/volume_patches.hpp"
 
-#include "detail/blended_terms.hpp"
+#include "blended_terms.hpp"
 #include "detail/text.hpp"
-#include "detail/volume_terms.hpp"
+#include "volume_terms.hpp"
 
 namespace interpatch {
 
@@ -18,7 +18,7 @@ BlendedVolume trilinear(const std::array<Vec3, 8>& corners) {
   for (std::size_t n = 0; n < 8; ++n)
     if (!is_finite(corners[n])) fail(errc::not_finite, "corner ", corner_name(n), " is ", corners[n]);
   auto t = std::make_shared<detail::VolumeTerms>();
-  const BSplineCurve rise = detail::scalar(KnotVector(1, {0, 0, 1, 1}), {0, 1});
+  const BSplineCurve rise = detail::scalar(KnotVector::bezier(1), {0, 1});
   for (auto& b : t->blends) b = {detail::one_minus(rise), rise};
   for (std::size_t n = 0; n < 8; ++n) t->corners.push_back({{n >> 2, (n >> 1) & 1, n & 1}, corners[n]});
   return BlendedVolume(std::move(t));

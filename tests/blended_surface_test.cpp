@@ -31,7 +31,7 @@ TEST(BlendedSurface, NetworkCardinalFunctionsAreDeltas) {
   // Every curve zero except v_curves[k], a bump that vanishes at the node parameters:
   // the surface is that bump along u = u_k and zero along every other network line.
   const std::vector<double> tu{0, 0.3, 0.65, 1}, tv{0, 0.4, 1};
-  const BSplineCurve zero(KnotVector(1, {0, 0, 1, 1}), {{0, 0, 0}, {0, 0, 0}});
+  const BSplineCurve zero(KnotVector::bezier(1), {{0, 0, 0}, {0, 0, 0}});
   // Cubic through (0,0), (0.4, 0) and (1, 0) with a non-zero middle: t (t − 0.4)(t − 1) · (1,2,3).
   auto bump_at = [](double t) { return (t * (t - 0.4) * (t - 1)) * Vec3{1, 2, 3}; };
   std::vector<Vec3> samples;
@@ -129,7 +129,6 @@ TEST(BlendedSurface, BatchEvaluationMatchesPointwise) {
 }
 
 TEST(BlendedSurface, BatchEvaluationRefusesParametersOutsideTheDomain) {
-  auto line = [](Vec3 a, Vec3 b) { return BSplineCurve(KnotVector(1, {0, 0, 1, 1}), {a, b}); };
   const auto s = coons(CoonsBoundary{line({0, 0, 0}, {1, 0, 0}), line({0, 1, 0}, {1, 1, 1}), line({0, 0, 0}, {0, 1, 0}),
                                      line({1, 0, 0}, {1, 1, 1})});
   const std::vector<double> good{0, 0.5, 1}, bad{0, 1.5};

@@ -31,7 +31,7 @@ TEST(BSplineSurface, BilinearByHand) {
   cp(1, 0) = {1, 0, 0};
   cp(0, 1) = {0, 1, 0};
   cp(1, 1) = {1, 1, 1};
-  BSplineSurface s(KnotVector(1, {0, 0, 1, 1}), KnotVector(1, {0, 0, 1, 1}), cp);
+  BSplineSurface s(KnotVector::bezier(1), KnotVector::bezier(1), cp);
   EXPECT_EQ(s.point(0.5, 0.5), (Vec3{0.5, 0.5, 0.25}));
   EXPECT_EQ(s.derivative(0.5, 0.5, 1, 1), (Vec3{0, 0, 1}));
   EXPECT_EQ(s.derivative(0.5, 0.5, 2, 0), (Vec3{0, 0, 0}));

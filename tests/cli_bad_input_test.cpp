@@ -22,6 +22,7 @@
 
 #include "cli_runner.hpp"
 #include "cli_specs.hpp"
+#include "exit_status.hpp"
 #include "interpatch/error.hpp"
 #include "interpatch/io/spec.hpp"
 #include "temp_dir.hpp"
@@ -402,7 +403,7 @@ TEST_P(BadInput, OneLineNamingPlaceAndSizeAndNothingWritten) {
   }
 
   if (row.code) {
-    EXPECT_EQ(exit_status(*row.code), row.status) << to_string(*row.code);
+    EXPECT_EQ(cli::exit_status(*row.code), row.status) << to_string(*row.code);
     if (row.in_spec) {
       test::TempDir dir;
       write_files(dir, row.files);

@@ -58,7 +58,7 @@ TEST(Coons, LinearReproducesRuledSurfacesAndHermiteBlendDoesNot) {
     cp(0, j) = c0.control_points()[j];
     cp(1, j) = c1.control_points()[j];
   }
-  const BSplineSurface s(KnotVector(1, {0, 0, 1, 1}), c0.knots(), cp);
+  const BSplineSurface s(KnotVector::bezier(1), c0.knots(), cp);
   const auto lin = coons(boundary_of(s));
   EXPECT_LT(test::max_distance(lin, s), 1e-14 * 8);
   CoonsOptions h;
@@ -177,7 +177,7 @@ TEST(Coons, InvalidInput) {
   xc.front() += Vec3{1, 0, 0};
   x.v1 = BSplineCurve(x.v1.knots(), xc);
   EXPECT_ERRC((void)coons(boundary_of(s), x), tangent_mismatch, "at corner p01");
-  EXPECT_ERRC(Blend(KnotVector(1, {0, 0, 1, 1}), {0.1, 1}), invalid_blend, "0 at 0");
+  EXPECT_ERRC(Blend(KnotVector::bezier(1), {0.1, 1}), invalid_blend, "0 at 0");
   EXPECT_ERRC(Blend(KnotVector(2, {0, 0, 0, 1, 1, 1}), {0, 1.2, 1}), invalid_blend, "must not decrease");
   EXPECT_ERRC(Blend(KnotVector(1, {0, 0, 2, 2}), {0, 1}), invalid_knots, "over [0, 1]");
 }

@@ -28,17 +28,6 @@ TEST(Error, EveryCodeHasItsOwnName) {
   EXPECT_EQ(to_string(errc::no_exact_form), "no_exact_form");
 }
 
-TEST(Error, ExitStatusesFollowTheCommandLineContract) {
-  // SPEC section 5: 3 invalid input, 4 files, 5 too large, 1 anything else.
-  for (errc c : kAll) {
-    const int expected = c == errc::file_unreadable || c == errc::file_unwritable ? 4
-                         : c == errc::too_large                                    ? 5
-                         : c == errc::internal                                     ? 1
-                                                                                   : 3;
-    EXPECT_EQ(exit_status(c), expected) << to_string(c);
-  }
-}
-
 TEST(Error, CarriesCodeAndMessage) {
   const error e(errc::corner_gap, "corner p11: gap 0.5");
   EXPECT_EQ(e.code(), errc::corner_gap);

@@ -65,6 +65,18 @@ class BSplineCurve {
   std::vector<double> w_;
 };
 
+/// The straight segment C(t) = (1 − t)·a + t·b over [0, 1], as a degree-1 B-spline:
+/// a boundary edge, a ruling, the side of a Coons patch. a == b is allowed (a
+/// boundary collapsed to a point).
+///
+/// Example:
+/// @code
+///   interpatch::BSplineCurve edge = interpatch::line({0, 0, 0}, {2, 0, 0});
+///   interpatch::Vec3 mid = edge.point(0.5);  // (1, 0, 0)
+/// @endcode
+/// @throws error not_finite.
+[[nodiscard]] BSplineCurve line(const Vec3& a, const Vec3& b);
+
 /// The same curves over one knot vector and one degree: each is elevated to the
 /// highest degree among them, then every knot value gets the highest multiplicity
 /// it has in any of them (knot merging). Geometry unchanged.

@@ -23,7 +23,7 @@ namespace interpatch {
 ///   using namespace interpatch;
 ///   PointGrid cp({2, 2});
 ///   cp(0, 0) = {0, 0, 0}; cp(1, 0) = {1, 0, 0}; cp(0, 1) = {0, 1, 0}; cp(1, 1) = {1, 1, 1};
-///   BSplineSurface s(KnotVector(1, {0, 0, 1, 1}), KnotVector(1, {0, 0, 1, 1}), cp);
+///   BSplineSurface s(KnotVector::bezier(1), KnotVector::bezier(1), cp);
 ///   Vec3 p = s.point(0.5, 0.5);  // (0.5, 0.5, 0.25)
 /// @endcode
 class BSplineSurface final : public Surface {
@@ -41,6 +41,8 @@ class BSplineSurface final : public Surface {
   [[nodiscard]] bool rational() const noexcept { return !w_.empty(); }
   [[nodiscard]] std::pair<double, double> domain_u() const noexcept { return {ku_.front(), ku_.back()}; }
   [[nodiscard]] std::pair<double, double> domain_v() const noexcept { return {kv_.front(), kv_.back()}; }
+  /// The knot domains [knots[p], knots[n+1]] in u and v.
+  [[nodiscard]] std::array<std::pair<double, double>, 2> domain() const override { return {domain_u(), domain_v()}; }
 
   /// S(u, v). @throws error out_of_domain.
   [[nodiscard]] Vec3 point(double u, double v) const override;

@@ -41,7 +41,6 @@ struct CoonsOptions {
 /// Example:
 /// @code
 ///   using namespace interpatch;
-///   auto line = [](Vec3 a, Vec3 b) { return BSplineCurve(KnotVector(1, {0, 0, 1, 1}), {a, b}); };
 ///   CoonsBoundary b{line({0,0,0}, {1,0,0}), line({0,1,0}, {1,1,1}), line({0,0,0}, {0,1,0}), line({1,0,0}, {1,1,1})};
 ///   auto s = coons(b);            // the bilinear patch of those corners
 ///   CoonsOptions o;

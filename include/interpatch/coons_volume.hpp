@@ -6,7 +6,7 @@
 
 #include <optional>
 
-#include "interpatch/blended_surface.hpp"
+#include "interpatch/blend.hpp"
 #include "interpatch/blended_volume.hpp"
 #include "interpatch/bspline_surface.hpp"
 

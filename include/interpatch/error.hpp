@@ -45,10 +45,6 @@ enum class errc {
 /// The name of a code, e.g. "zero_chord".
 std::string_view to_string(errc code) noexcept;
 
-/// The exit status the `interpatch` command uses for a code (SPEC section 5):
-/// 3 for invalid input, 4 for files, 5 for too large, 1 otherwise.
-int exit_status(errc code) noexcept;
-
 /// Bad input at the API. The message names the place (a JSON Pointer, a file
 /// with row and column, a curve, a corner, an index) and the size of the problem.
 class error : public std::runtime_error {

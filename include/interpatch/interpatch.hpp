@@ -1,22 +1,14 @@
 #pragma once
 /// @file interpatch.hpp
-/// Everything of interpatch in one include.
+/// Everything of interpatch in one include: the core (core.hpp) and the readers and
+/// writers of io/ (library interpatch::interpatch, which links both).
 
-#include "interpatch/allocator.hpp"
-#include "interpatch/blended_volume.hpp"
-#include "interpatch/bspline_curve.hpp"
-#include "interpatch/bspline_surface.hpp"
-#include "interpatch/bspline_volume.hpp"
-#include "interpatch/coons_volume.hpp"
-#include "interpatch/error.hpp"
-#include "interpatch/evaluate.hpp"
-#include "interpatch/grid.hpp"
-#include "interpatch/hermite.hpp"
-#include "interpatch/interpolate.hpp"
-#include "interpatch/knot_vector.hpp"
-#include "interpatch/memory.hpp"
-#include "interpatch/progress.hpp"
-#include "interpatch/threads.hpp"
-#include "interpatch/vec3.hpp"
-#include "interpatch/volume.hpp"
-#include "interpatch/volume_patches.hpp"
+#include "interpatch/core.hpp"
+#include "interpatch/io/atomic_file.hpp"
+#include "interpatch/io/csv.hpp"
+#include "interpatch/io/iges.hpp"
+#include "interpatch/io/json_out.hpp"
+#include "interpatch/io/mesh.hpp"
+#include "interpatch/io/npy.hpp"
+#include "interpatch/io/spec.hpp"
+#include "interpatch/io/step.hpp"

@@ -37,6 +37,11 @@ class KnotVector {
   /// @throws error invalid_degree, too_few_points (count <= degree).
   static KnotVector uniform(int degree, int count, double a = 0.0, double b = 1.0);
 
+  /// The knots of one Bézier segment of the given degree over [0, 1]: degree + 1
+  /// zeros, then degree + 1 ones (bezier(1) is {0, 0, 1, 1}, a straight line's).
+  /// @throws error invalid_degree.
+  static KnotVector bezier(int degree);
+
   [[nodiscard]] int degree() const noexcept { return p_; }
   [[nodiscard]] std::size_t size() const noexcept { return u_.size(); }
   /// Number of basis functions, n+1.

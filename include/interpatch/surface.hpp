@@ -3,7 +3,9 @@
 /// What every surface of interpatch offers: exact evaluation with derivatives,
 /// batch evaluation over parameter grids, and its exact B-spline form.
 
+#include <array>
 #include <span>
+#include <utility>
 
 #include "interpatch/grid.hpp"
 #include "interpatch/progress.hpp"
@@ -23,6 +25,10 @@ struct SurfaceDerivatives {
 class Surface {
  public:
   virtual ~Surface() = default;
+
+  /// The parameter box [u0, u1] × [v0, v1]; [0, 1]² unless the surface says otherwise
+  /// (a B-spline surface: its knot domain).
+  [[nodiscard]] virtual std::array<std::pair<double, double>, 2> domain() const { return {{{0.0, 1.0}, {0.0, 1.0}}}; }
 
   /// S(u, v). @throws error out_of_domain.
   [[nodiscard]] virtual Vec3 point(double u, double v) const { return derivatives(u, v).s; }

@@ -41,7 +41,7 @@ BSplineSurface quarter_cylinder() {
   cp(0, 0) = {2, 0, 0}, cp(1, 0) = {2, 2, 0}, cp(2, 0) = {0, 2, 0};
   for (int i = 0; i < 3; ++i) cp(i, 1) = cp(i, 0) + Vec3{0, 0, 3};
   w(1, 0) = w(1, 1) = std::sqrt(0.5);
-  return BSplineSurface(KnotVector(2, {0, 0, 0, 1, 1, 1}), KnotVector(1, {0, 0, 1, 1}), cp, w);
+  return BSplineSurface(KnotVector(2, {0, 0, 0, 1, 1, 1}), KnotVector::bezier(1), cp, w);
 }
 
 BSplineSurface random_surface(unsigned seed, std::size_t n, std::size_t m) {
@@ -170,7 +170,7 @@ TEST(Iges, ClosedSurfaceSaysSo) {
   PointGrid cp({2, 5});
   const Vec3 ring[5] = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {1, 0, 0}};
   for (int j = 0; j < 5; ++j) cp(0, j) = ring[j], cp(1, j) = ring[j] + Vec3{0, 0, 1};
-  const BSplineSurface tube(KnotVector(1, {0, 0, 1, 1}), KnotVector(1, {0, 0, 0.25, 0.5, 0.75, 1, 1}), cp);
+  const BSplineSurface tube(KnotVector::bezier(1), KnotVector(1, {0, 0, 0.25, 0.5, 0.75, 1, 1}), cp);
   const auto tok = parameters(parse(iges_text(tube)), 1);
   EXPECT_EQ(tok[5], "0");  // not closed in u
   EXPECT_EQ(tok[6], "1");  // closed in v

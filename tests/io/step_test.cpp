@@ -109,7 +109,7 @@ BSplineSurface bilinear_patch() {
   cp(1, 0) = {1, 0, 0};
   cp(0, 1) = {0, 1, 0};
   cp(1, 1) = {1, 1, 1};
-  return BSplineSurface(KnotVector(1, {0, 0, 1, 1}), KnotVector(1, {0, 0, 1, 1}), cp);
+  return BSplineSurface(KnotVector::bezier(1), KnotVector::bezier(1), cp);
 }
 
 BSplineVolume unit_cube() {
@@ -170,7 +170,7 @@ TEST(Step, PoleHasNoEdgeAndSeamIsOneEdgeUsedTwice) {
     cp(0, j) = {0, 0, 1};
     cp(1, j) = ring[j];
   }
-  const BSplineSurface cone(KnotVector(1, {0, 0, 1, 1}), KnotVector(1, {0, 0, 0.25, 0.5, 0.75, 1, 1}), cp);
+  const BSplineSurface cone(KnotVector::bezier(1), KnotVector(1, {0, 0, 0.25, 0.5, 0.75, 1, 1}), cp);
   const auto e = entities(step_text(cone));
   expect_counts(e, {{"VERTEX_POINT(", 2}, {"EDGE_CURVE(", 2}, {"SEAM_CURVE(", 1}, {"ORIENTED_EDGE(", 3},
                     {"B_SPLINE_SURFACE_WITH_KNOTS('',1,1,", 1}});
@@ -203,7 +203,7 @@ TEST(Step, RationalSurfaceIsTheComplexEntityInAlphabeticalOrder) {
   cp(0, 0) = {1, 0, 0}, cp(1, 0) = {1, 1, 0}, cp(2, 0) = {0, 1, 0};
   for (int i = 0; i < 3; ++i) cp(i, 1) = cp(i, 0) + Vec3{0, 0, 1};
   w(1, 0) = w(1, 1) = std::sqrt(0.5);
-  const BSplineSurface s(KnotVector(2, {0, 0, 0, 1, 1, 1}), KnotVector(1, {0, 0, 1, 1}), cp, w);
+  const BSplineSurface s(KnotVector(2, {0, 0, 0, 1, 1, 1}), KnotVector::bezier(1), cp, w);
   const auto e = entities(step_text(s));
   std::string surface;
   for (const auto& [n, body] : e)

@@ -1,6 +1,6 @@
 #pragma once
 /// @file io/spec.hpp
-/// Reading a SPEC.json (SPEC section 5) into a construction: the exact B-spline
+/// Reading a spec (docs/spec-format.md) into a construction: the exact B-spline
 /// form, the data it interpolates, and the options in effect.
 ///
 /// Every error names the place as a JSON Pointer into the spec (`/points/3/7/2`,
@@ -90,6 +90,21 @@ struct Construction {
 /// The construction types a spec's "type" may name, in the order they are documented.
 [[nodiscard]] std::vector<std::string_view> known_types();
 
+/// One form of object a spec holds, with the fields it takes: a construction type
+/// (kind "type": its top-level fields, "type" included), a curve form (kind
+/// "curve": interpolate, bspline, hermite, line — for bspline and hermite the fields
+/// of the object under that key), or a point array given as a file (kind "points":
+/// npy, csv). docs/spec-format.md documents exactly these; a field not listed is
+/// reported as unknown and ignored.
+struct SpecForm {
+  std::string_view kind;
+  std::string_view name;
+  std::vector<std::string_view> fields;
+};
+
+/// Every form a spec may hold, construction types first in documented order.
+[[nodiscard]] std::vector<SpecForm> spec_forms();
+
 /// Parses JSON text. `source` names the text in messages (the file name).
 /// NaN and Infinity literals, which some writers emit, are refused as non-finite
 /// values rather than as a syntax error.
@@ -114,7 +129,7 @@ struct Construction {
 ///   auto spec = nlohmann::json::parse(R"({"type": "interpolate", "degree": 1,
 ///       "points": [[[0,0,0],[0,1,0]], [[1,0,0],[1,1,1]]]})");
 ///   interpatch::io::Construction c = interpatch::io::build(spec);
-///   const auto& s = std::get<interpatch::BSplineSurface>(c.exact);  // bilinear, 2 × 2 control points
+///   const auto& s = std::get<interpatch::BSplineSurface>(*c.exact);  // bilinear, 2 × 2 control points
 /// @endcode
 /// @throws error unknown_type (listing the known types), missing_field and wrong_type
 ///   (naming the pointer and the expected type), ragged_grid, not_finite, size_mismatch,

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "detail/blended_terms.hpp"
+#include "blended_terms.hpp"
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/bspline_surface.hpp"
 

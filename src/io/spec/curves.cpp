@@ -1,0 +1,126 @@
+// Curves in a spec — {"interpolate": points}, {"bspline": {...}}, {"hermite": {...}},
+// {"line": [A, B]} — each mapped onto [0, 1].
+
+#include <array>
+
+#include "interpatch/hermite.hpp"
+#include "interpatch/interpolate.hpp"
+#include "io/spec/forms.hpp"
+#include "io/spec/reader.hpp"
+
+namespace interpatch::io::reader {
+
+namespace {
+
+BSplineCurve on_unit_domain(BSplineCurve c) {
+  const auto [a, b] = c.domain();
+  if (a == 0.0 && b == 1.0) return c;
+  return c.mapped(0.0, 1.0);
+}
+
+std::vector<Vec3> curve_points(const json& j, std::string_view ptr, Context& ctx) {
+  const PointArray a = points_impl(j, 1, ptr, ctx);
+  if (a.points.size() < 2) fail(errc::too_few_points, place(ptr), ": a curve needs at least 2 points, got ", a.points.size());
+  return {a.points.begin(), a.points.end()};
+}
+
+BSplineCurve interpolated_curve(const json& obj, std::string_view ptr, Context& ctx) {
+  check_fields(obj, ptr, forms::interpolate_curve, ctx);
+  const std::string pts_at = child(ptr, "interpolate");
+  const std::vector<Vec3> pts = curve_points(obj.at("interpolate"), pts_at, ctx);
+  const auto degree = degrees(obj, ptr, 1)[0];
+  if (degree && static_cast<std::size_t>(*degree) >= pts.size())
+    fail(errc::too_few_points, degree_pointer(obj, ptr, 0), ": degree ", *degree, " needs at least ", *degree + 1,
+         " points, ", pts_at, " has ", pts.size());
+  const Parametrization param = parametrization(obj, ptr);
+  if (param != Parametrization::uniform)
+    for (std::size_t i = 1; i < pts.size(); ++i)
+      if (pts[i] == pts[i - 1])
+        fail(errc::zero_chord, child(pts_at, i), ": point ", i, " ", pts[i], " coincides with point ", i - 1,
+             " (a zero chord); ", param_name(param), " parameters need distinct consecutive points");
+  CurveInterpolationOptions options;
+  options.degree = degree;
+  options.param = param;
+  return at(ptr, [&] { return on_unit_domain(interpolate_curve(pts, options).curve); });
+}
+
+BSplineCurve bspline_curve(const json& b, std::string_view ptr, Context& ctx) {
+  expect_object(b, ptr, "an object {\"degree\", \"knots\", \"control_points\", \"weights\"}");
+  check_fields(b, ptr, forms::bspline_curve, ctx);
+  const int p = degree_value(member(b, "degree", ptr, "an integer degree"), child(ptr, "degree"));
+  const std::string kptr = child(ptr, "knots"), cptr = child(ptr, "control_points"), wptr = child(ptr, "weights");
+  std::vector<double> knots = numbers(member(b, "knots", ptr, "an array of knots"), kptr);
+  const PointStorage cps = points_impl(member(b, "control_points", ptr, "a list of points"), 1, cptr, ctx).points;
+  std::vector<Vec3> cp(cps.begin(), cps.end());
+  std::vector<double> w;
+  if (const json* wj = find_member(b, "weights")) w = numbers(*wj, wptr);
+  KnotVector k = at(kptr, [&] { return KnotVector(p, std::move(knots)); });
+  if (static_cast<std::size_t>(k.count()) != cp.size())
+    fail(errc::size_mismatch, cptr, ": ", k.size(), " knots of degree ", p, " need ", k.count(), " control points, got ",
+         cp.size());
+  if (!w.empty() && w.size() != cp.size())
+    fail(errc::size_mismatch, wptr, ": ", cp.size(), " control points need ", cp.size(), " weights, got ", w.size());
+  for (std::size_t i = 0; i < w.size(); ++i)
+    if (!(w[i] > 0)) fail(errc::invalid_weight, child(wptr, i), ": weight ", w[i], " is not positive");
+  return at(ptr, [&] { return on_unit_domain(BSplineCurve(std::move(k), std::move(cp), std::move(w))); });
+}
+
+BSplineCurve hermite_curve(const json& h, std::string_view ptr, Context& ctx) {
+  expect_object(h, ptr, "an object {\"points\", \"tangents\", \"params\"}");
+  check_fields(h, ptr, forms::hermite_curve, ctx);
+  const std::string pptr = child(ptr, "points"), tptr = child(ptr, "tangents"), uptr = child(ptr, "params");
+  std::vector<Vec3> pts = curve_points(member(h, "points", ptr, "a list of points"), pptr, ctx);
+  std::vector<Vec3> tangents;
+  if (const json* t = find_member(h, "tangents")) {
+    const PointStorage ts = points_impl(*t, 1, tptr, ctx).points;
+    tangents.assign(ts.begin(), ts.end());
+    if (tangents.size() != pts.size())
+      fail(errc::size_mismatch, tptr, ": ", pts.size(), " points need ", pts.size(), " tangents, got ", tangents.size());
+  }
+  std::vector<double> params;
+  if (const json* u = find_member(h, "params")) {
+    params = numbers(*u, uptr);
+    if (params.size() != pts.size())
+      fail(errc::size_mismatch, uptr, ": ", pts.size(), " points need ", pts.size(), " params, got ", params.size());
+    for (std::size_t i = 1; i < params.size(); ++i)
+      if (!(params[i] > params[i - 1]))
+        fail(errc::non_increasing, child(uptr, i), ": param ", params[i], " is not greater than the one before, ",
+             params[i - 1]);
+  }
+  return at(ptr, [&] {
+    return on_unit_domain(HermiteCurve(std::move(pts), std::move(tangents), std::move(params)).to_bspline());
+  });
+}
+
+BSplineCurve line_curve(const json& l, std::string_view ptr, Context& ctx) {
+  const PointStorage pts = points_impl(l, 1, ptr, ctx).points;
+  if (pts.size() != 2) fail(errc::size_mismatch, place(ptr), ": a line needs exactly 2 points [A, B], got ", pts.size());
+  // A == B is allowed: a collapsed boundary (a triangular patch) is a point.
+  return line(pts[0], pts[1]);
+}
+
+}  // namespace
+
+BSplineCurve curve_impl(const json& j, std::string_view ptr, Context& ctx) {
+  static constexpr std::array<std::string_view, 4> forms{"interpolate", "bspline", "hermite", "line"};
+  constexpr std::string_view expected =
+      "a curve: an object with one of \"interpolate\", \"bspline\", \"hermite\", \"line\"";
+  if (!j.is_object()) wrong_type(ptr, expected, j);
+  std::vector<std::string_view> present;
+  for (const auto f : forms)
+    if (j.contains(std::string(f))) present.push_back(f);
+  if (present.empty()) fail(errc::missing_field, place(ptr), ": expected ", expected);
+  if (present.size() > 1)
+    fail(errc::wrong_type, place(ptr), ": a curve has exactly one of \"interpolate\", \"bspline\", \"hermite\", \"line\"; got \"",
+         present[0], "\" and \"", present[1], "\"");
+  const std::string_view form = present[0];
+  if (form == "interpolate") return interpolated_curve(j, ptr, ctx);
+  check_fields(j, ptr, {form}, ctx);
+  const json& body = j.at(std::string(form));
+  const std::string bptr = child(ptr, form);
+  if (form == "bspline") return bspline_curve(body, bptr, ctx);
+  if (form == "hermite") return hermite_curve(body, bptr, ctx);
+  return line_curve(body, bptr, ctx);
+}
+
+}  // namespace interpatch::io::reader

@@ -1,0 +1,220 @@
+// Point arrays in a spec: nested lists, {"npy": file} and {"csv": file, "shape"}.
+
+#include <algorithm>
+#include <cmath>
+
+#include "detail/parallel.hpp"
+#include "interpatch/io/csv.hpp"
+#include "interpatch/io/npy.hpp"
+#include "interpatch/memory.hpp"
+#include "io/spec/reader.hpp"
+#include "io/spec/forms.hpp"
+
+namespace interpatch::io::reader {
+
+namespace {
+
+std::string grid_form(std::size_t rank, bool points) {
+  if (points && rank == 1) return "a list of points [[x, y, z], ...]";
+  return cat("a ", rank == 1 ? "list" : cat(rank, "-D grid"), " of ", points ? "points" : "numbers", ": lists nested ",
+             rank + (points ? 1 : 0), " deep");
+}
+
+// Walks lists nested `rank` deep whose every row has the length of the first one,
+// calling leaf(entry, idx) on each entry at depth `rank` in C order. `leaf_depth`
+// is how many more levels of lists an entry has (1 for a point [x, y, z], 0 for a
+// number); it only serves to tell a grid of the wrong rank from a ragged one.
+// Returns the shape.
+template <class Leaf>
+std::vector<std::size_t> walk_grid(const json& j, std::size_t rank, std::size_t leaf_depth, bool points,
+                                   std::string_view ptr, std::vector<std::size_t>& idx, Leaf&& leaf) {
+  std::vector<std::size_t> shape;
+  std::size_t depth = 0;
+  for (const json* node = &j; node->is_array(); node = &(*node)[0]) {
+    if (node->empty()) {
+      const std::vector<std::size_t> zeros(depth, 0);
+      fail(errc::too_few_points, place(index_pointer(ptr, zeros, depth)), ": empty list; expected ",
+           grid_form(rank, points));
+    }
+    if (depth < rank) shape.push_back(node->size());
+    ++depth;
+  }
+  if (depth != rank + leaf_depth) {
+    if (depth == 0) wrong_type(ptr, grid_form(rank, points), j);
+    fail(errc::wrong_type, place(ptr), ": expected ", grid_form(rank, points), ", got lists nested ", depth, " deep");
+  }
+  idx.assign(rank + leaf_depth, 0);
+  auto walk = [&](auto& self, const json& node, std::size_t level) -> void {
+    if (level == rank) {
+      leaf(node);
+      return;
+    }
+    if (!node.is_array())
+      fail(errc::wrong_type, place(index_pointer(ptr, idx, level)), ": expected a list of ",
+           level + 1 < rank ? "rows" : (points ? "points" : "numbers"), ", got ", kind(node));
+    if (node.size() != shape[level]) {
+      std::vector<std::size_t> first(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(level));
+      std::fill(first.begin(), first.end(), 0);
+      fail(errc::ragged_grid, place(index_pointer(ptr, idx, level)), ": has ", node.size(),
+           level + 1 < rank ? " rows" : (points ? " points" : " numbers"), ", but ",
+           place(index_pointer(ptr, first, level)), " has ", shape[level]);
+    }
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      idx[level] = i;
+      self(self, node[i], level + 1);
+    }
+  };
+  walk(walk, j, 0);
+  return shape;
+}
+PointArray inline_points(const json& j, std::size_t rank, std::string_view ptr) {
+  PointArray out;
+  std::vector<std::size_t> idx;
+  // Size the result from the first entries before walking; the walk checks the rest.
+  std::vector<std::size_t> first_shape;
+  for (const json* node = &j; node->is_array() && !node->empty() && first_shape.size() < rank; node = &(*node)[0])
+    first_shape.push_back(node->size());
+  if (first_shape.size() == rank) {
+    const std::size_t n = checked_product(first_shape, place(ptr));
+    require_memory(n, sizeof(Vec3), cat(place(ptr), ": ", n, " points"));
+    out.points.reserve(n);
+  }
+  out.shape = walk_grid(j, rank, 1, true, ptr, idx, [&](const json& node) {
+    if (!node.is_array()) fail(errc::wrong_type, place(index_pointer(ptr, idx, rank)), ": expected a point [x, y, z], got ", kind(node));
+    if (node.size() != 3)
+      fail(errc::ragged_grid, place(index_pointer(ptr, idx, rank)), ": a point must be 3 numbers [x, y, z], got ",
+           node.size(), node.size() == 1 ? " entry" : " entries");
+    Vec3 p;
+    for (int k = 0; k < 3; ++k) {
+      const json& c = node[static_cast<std::size_t>(k)];
+      idx[rank] = static_cast<std::size_t>(k);
+      if (!c.is_number())
+        fail(errc::wrong_type, place(index_pointer(ptr, idx, rank + 1)), ": expected a number (coordinate ", coord_name(k),
+             "), got ", kind(c));
+      p[k] = c.get<double>();
+      if (!std::isfinite(p[k]))
+        fail(errc::not_finite, place(index_pointer(ptr, idx, rank + 1)), ": coordinate ", coord_name(k), " is ", p[k]);
+    }
+    idx[rank] = 0;
+    out.points.push_back(p);
+  });
+  return out;
+}
+
+
+std::string expected_shape(std::size_t rank) {
+  static constexpr const char* names[] = {"n", "m", "l"};
+  std::string s = "(";
+  for (std::size_t i = 0; i < rank; ++i) s += cat(names[std::min<std::size_t>(i, 2)], ", ");
+  return s + "3)";
+}
+
+// Data from a file: check every value is finite, naming it as if it were inline.
+// Refuses the first point with a NaN or Inf coordinate, naming it as a JSON Pointer
+// below `ptr` (`/points/3/7/2`) and the file it came from.
+void check_finite_points(const std::vector<std::size_t>& shape, const PointStorage& points, std::string_view ptr,
+                         const std::string& file) {
+  if (const std::size_t i = interpatch::detail::first_non_finite(points.data(), points.size()); i < points.size()) {
+    const Vec3& p = points[i];
+    std::vector<std::size_t> idx(shape.size() + 1);
+    std::size_t r = i;
+    for (std::size_t a = shape.size(); a-- > 0;) {
+      idx[a] = r % shape[a];
+      r /= shape[a];
+    }
+    const int k = std::isfinite(p.x) ? (std::isfinite(p.y) ? 2 : 1) : 0;
+    idx[shape.size()] = static_cast<std::size_t>(k);
+    fail(errc::not_finite, place(index_pointer(ptr, idx, idx.size())), ": coordinate ", coord_name(k), " is ", p[k], " (in ",
+         file, ")");
+  }
+}
+
+std::string file_name(const json& obj, std::string_view key, std::string_view ptr) {
+  const json& f = member(obj, key, ptr, "a file name");
+  if (!f.is_string() || f.get_ref<const std::string&>().empty()) wrong_type(child(ptr, key), "a file name", f);
+  return f.get<std::string>();
+}
+
+PointArray npy_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx) {
+  check_fields(obj, ptr, forms::npy, ctx);
+  const std::string file = file_name(obj, "npy", ptr);
+  // The values land in the point storage itself: float64 triples in C order are
+  // exactly a grid of Vec3.
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "points are read as triples of doubles");
+  PointArray out;
+  const std::vector<std::size_t> full = at(ptr, [&] {
+    return read_npy_into(ctx.resolve(file), [&](std::span<const std::size_t> shape, std::size_t count) {
+      const std::vector<std::size_t> s(shape.begin(), shape.end());
+      if (s.size() != rank + 1 || s.back() != 3)
+        fail(errc::size_mismatch, file, " has shape ", shape_text(s), "; expected ", expected_shape(rank), ", ",
+             rank == 1 ? "a list" : cat("a ", rank, "-D grid"), " of 3-vectors");
+      for (std::size_t ax = 0; ax + 1 < s.size(); ++ax)
+        if (s[ax] == 0) fail(errc::too_few_points, file, " has shape ", shape_text(s), ", no points");
+      resize_for_overwrite(out.points, count / 3);
+      return &out.points.data()->x;
+    });
+  });
+  out.shape.assign(full.begin(), full.end() - 1);
+  check_finite_points(out.shape, out.points, ptr, file);
+  return out;
+}
+
+PointArray csv_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx) {
+  check_fields(obj, ptr, forms::csv, ctx);
+  const std::string file = file_name(obj, "csv", ptr);
+  const std::string sptr = child(ptr, "shape");
+  const json& sj = member(obj, "shape", ptr, cat("the grid shape, e.g. ", expected_shape(rank)));
+  if (!sj.is_array()) wrong_type(sptr, cat("an array of ", rank, " extents (a trailing 3 may follow)"), sj);
+  std::vector<std::size_t> shape;
+  for (std::size_t i = 0; i < sj.size(); ++i) {
+    const std::int64_t e = integer(sj[i], child(sptr, i), "an integer extent");
+    if (e < 1) fail(errc::too_few_points, place(child(sptr, i)), ": extent ", e, " is below 1");
+    shape.push_back(static_cast<std::size_t>(e));
+  }
+  if (shape.size() == rank + 1 && shape.back() == 3) shape.pop_back();
+  if (shape.size() != rank)
+    fail(errc::size_mismatch, place(sptr), ": shape ", shape_text(shape), " does not describe ", grid_form(rank, true),
+         "; expected [", rank == 1 ? "n" : (rank == 2 ? "n, m" : "n, m, l"), "] or [", rank == 1 ? "n" : (rank == 2 ? "n, m" : "n, m, l"),
+         ", 3]");
+  const std::size_t n = checked_product(shape, sptr);
+  require_memory(n, sizeof(Vec3), cat(place(ptr), ": ", n, " points from ", file));
+  const std::vector<Vec3> pts = at(ptr, [&] { return read_csv_points(ctx.resolve(file), n); });
+  if (pts.size() != n)
+    fail(errc::size_mismatch, place(ptr), ": ", file, " has ", pts.size(), " points, shape ", shape_text(shape), " needs ", n);
+  for (std::size_t i = 0; i < n; ++i)
+    if (!is_finite(pts[i])) fail(errc::not_finite, place(ptr), ": ", file, " point ", i, " is ", pts[i]);
+  return {shape, PointStorage(pts.begin(), pts.end())};
+}
+
+}  // namespace
+
+PointArray points_impl(const json& j, std::size_t rank, std::string_view ptr, Context& ctx) {
+  if (j.is_object()) {
+    const bool npy = j.contains("npy"), csv = j.contains("csv");
+    if (npy && csv) fail(errc::wrong_type, place(ptr), ": give either \"npy\" or \"csv\", not both");
+    if (npy) return npy_points(j, rank, ptr, ctx);
+    if (csv) return csv_points(j, rank, ptr, ctx);
+    fail(errc::missing_field, place(ptr), ": a point array given as an object needs \"npy\": file or \"csv\": file with \"shape\"");
+  }
+  return inline_points(j, rank, ptr);
+}
+
+template <std::size_t Rank>
+Grid<double, Rank> inline_number_grid(const json& j, std::string_view ptr) {
+  std::vector<double> values;
+  std::vector<std::size_t> idx;
+  const auto shape = walk_grid(j, Rank, 0, false, ptr, idx, [&](const json& node) {
+    if (!node.is_number()) fail(errc::wrong_type, place(index_pointer(ptr, idx, Rank)), ": expected a number, got ", kind(node));
+    const double v = node.get<double>();
+    if (!std::isfinite(v)) fail(errc::not_finite, place(index_pointer(ptr, idx, Rank)), ": value is ", v);
+    values.push_back(v);
+  });
+  typename Grid<double, Rank>::shape_type sh{};
+  for (std::size_t a = 0; a < Rank; ++a) sh[a] = shape[a];
+  return Grid<double, Rank>(sh, std::move(values));
+}
+
+template Grid<double, 2> inline_number_grid<2>(const json& j, std::string_view ptr);
+template Grid<double, 3> inline_number_grid<3>(const json& j, std::string_view ptr);
+
+}  // namespace interpatch::io::reader

@@ -1,0 +1,176 @@
+#pragma once
+// What every part of the spec reader shares (src/io/spec/): JSON Pointers into the
+// spec, the reading context, and readers of fields that many constructions take.
+// One file per part: points.cpp (point arrays), curves.cpp (curve forms),
+// surfaces.cpp and volumes.cpp (constructions from corners, curves and faces),
+// grids.cpp (interpolation through grids and the exact forms, surfaces and volumes
+// alike), spec.cpp (the table of construction types and the public functions).
+
+#include <array>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <initializer_list>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "detail/text.hpp"
+#include "interpatch/grid.hpp"
+#include "interpatch/interpolate.hpp"
+#include "interpatch/blended_surface.hpp"
+#include "interpatch/blended_volume.hpp"
+#include "interpatch/io/spec.hpp"
+
+namespace interpatch::io::reader {
+
+using json = nlohmann::json;
+using interpatch::detail::cat;
+using interpatch::detail::fail;
+using Clock = std::chrono::steady_clock;
+using Fields = std::span<const std::string_view>;
+
+// ---------------------------------------------------------------------------
+// Places: JSON Pointers (RFC 6901) into the spec.
+
+/// ptr + "/" + key, with '~' and '/' escaped. Pointers into absurdly deep documents
+/// are shortened in messages by place(), not here.
+std::string child(std::string_view ptr, std::string_view key);
+std::string child(std::string_view ptr, std::size_t index);
+/// ptr followed by the first n indices of idx.
+std::string index_pointer(std::string_view ptr, const std::vector<std::size_t>& idx, std::size_t n);
+/// The pointer as a message shows it: "(top level)" for the whole document, and at
+/// most about 200 characters (the start and the end) of a pointer into a deeply
+/// nested document.
+std::string place(std::string_view ptr);
+/// "a number", "an array", ...: what a JSON value is, for messages.
+const char* kind(const json& j);
+[[noreturn]] void wrong_type(std::string_view ptr, std::string_view expected, const json& got);
+
+/// Runs a library call; an error it throws keeps its code and gets the place in front.
+template <class F>
+decltype(auto) at(std::string_view ptr, F&& f) {
+  try {
+    return f();
+  } catch (const error& e) {
+    throw error(e.code(), cat(place(ptr), ": ", e.what()));
+  }
+}
+
+constexpr const char* axis_name(std::size_t a) { return a == 0 ? "u" : (a == 1 ? "v" : "w"); }
+constexpr const char* coord_name(int k) { return k == 0 ? "x" : (k == 1 ? "y" : "z"); }
+/// "(3, 4)", "(5,)".
+std::string shape_text(std::span<const std::size_t> shape);
+/// "3x4", "3x4x5".
+std::string extents_text(std::span<const std::size_t> shape);
+/// The product of extents, refusing (too_large) a product that overflows.
+std::size_t checked_product(std::span<const std::size_t> shape, std::string_view what);
+
+// ---------------------------------------------------------------------------
+// The reading context: where relative files are, progress, warnings, timing.
+
+struct Context {
+  std::filesystem::path base_dir;
+  progress_callback progress;
+  bool keep_data = true;  // copy interpolated grids into Construction::data
+  std::vector<std::string> warnings;
+  Clock::time_point start = Clock::now();
+  std::optional<Clock::time_point> parsed_at;
+
+  // The spec is read and checked; what follows is the construction proper.
+  void parsed() { parsed_at = Clock::now(); }
+  void warn(std::string w) { warnings.push_back(std::move(w)); }
+  [[nodiscard]] std::filesystem::path resolve(const std::string& file) const;
+};
+
+// ---------------------------------------------------------------------------
+// Fields.
+
+const json* find_member(const json& obj, std::string_view key);
+/// A required member; its absence names the member's pointer and what it should hold.
+const json& member(const json& obj, std::string_view key, std::string_view ptr, std::string_view expected);
+void expect_object(const json& j, std::string_view ptr, std::string_view expected);
+/// Names a reader does not know are reported (a typo would otherwise be silently
+/// ignored) but not refused: newer specs may carry options this build lacks.
+/// "comment", "description" and "name" are always allowed.
+void check_fields(const json& obj, std::string_view ptr, Fields known, Context& ctx);
+inline void check_fields(const json& obj, std::string_view ptr, std::initializer_list<std::string_view> known,
+                         Context& ctx) {
+  check_fields(obj, ptr, Fields(known.begin(), known.size()), ctx);
+}
+
+double number(const json& j, std::string_view ptr);
+/// An integer; a float with an integral value (3.0) is accepted.
+std::int64_t integer(const json& j, std::string_view ptr, std::string_view expected);
+std::vector<double> numbers(const json& j, std::string_view ptr, std::string_view expected = "an array of numbers");
+Vec3 point_value(const json& j, std::string_view ptr);
+int degree_value(const json& j, std::string_view ptr);
+/// "degree": p for every direction, or [p, q(, r)]; unset entries mean the default.
+std::vector<std::optional<int>> degrees(const json& obj, std::string_view ptr, std::size_t dims);
+/// Where the degree of `axis` is in the spec (the array entry, or the single number).
+std::string degree_pointer(const json& obj, std::string_view ptr, std::size_t axis);
+const char* param_name(Parametrization p);
+/// "param": uniform, chord (default) or centripetal.
+Parametrization parametrization(const json& obj, std::string_view ptr);
+/// "tolerance": a non-negative number, or nothing.
+std::optional<double> tolerance_of(const json& spec);
+/// A string member that must be one of `allowed`; `fallback` when absent.
+std::string choice(const json& obj, std::string_view key, std::string_view ptr,
+                   std::initializer_list<std::string_view> allowed, std::string_view fallback);
+
+// ---------------------------------------------------------------------------
+// Point arrays (points.cpp) and curves (curves.cpp).
+
+/// A point array of the given rank in any of its forms (inline lists, npy, csv).
+PointArray points_impl(const json& j, std::size_t rank, std::string_view ptr, Context& ctx);
+/// A grid of numbers (weights) given as nested lists, Rank 2 or 3.
+template <std::size_t Rank>
+Grid<double, Rank> inline_number_grid(const json& j, std::string_view ptr);
+/// A curve in any of its forms, mapped onto [0, 1].
+BSplineCurve curve_impl(const json& j, std::string_view ptr, Context& ctx);
+
+// ---------------------------------------------------------------------------
+// Construction types (spec.cpp holds the table).
+
+struct ConstructionType {
+  std::string_view name;
+  Construction (*build)(const json& spec, Context& ctx);
+  int dims;       // 2: a surface, 3: a volume
+  Fields fields;  // the top-level fields, "type" included
+};
+
+/// The type of that name; nullptr when there is none.
+const ConstructionType* find_type(std::string_view name);
+/// The names of the types, comma-separated; only those of `dims` dimensions when it is not 0.
+std::string type_list(int dims = 0);
+
+/// The builders, one per type (surfaces.cpp, grids.cpp, volumes.cpp). The caller has
+/// checked the top-level fields against the type's list.
+Construction build_bilinear(const json& spec, Context& ctx);
+Construction build_ruled(const json& spec, Context& ctx);
+Construction build_coons(const json& spec, Context& ctx);
+Construction build_network(const json& spec, Context& ctx);
+Construction build_hermite_patch(const json& spec, Context& ctx);
+template <std::size_t Dims>
+Construction build_interpolate(const json& spec, Context& ctx);
+template <std::size_t Dims>
+Construction build_bspline(const json& spec, Context& ctx);
+Construction build_trilinear(const json& spec, Context& ctx);
+Construction build_hermite_volume(const json& spec, Context& ctx);
+Construction build_coons_volume(const json& spec, Context& ctx);
+
+/// Construction helpers shared by the builders.
+/// A blended surface or volume construction: the formula, and its exact form if it has one.
+Construction blended(std::string_view type, BlendedSurface s, std::vector<DataSet> data,
+                     nlohmann::ordered_json parameters);
+Construction blended(std::string_view type, BlendedVolume v, std::vector<DataSet> data,
+                     nlohmann::ordered_json parameters);
+/// Parameters t mapped from `domain` onto [0, 1].
+std::vector<double> to_unit(std::vector<double> t, std::pair<double, double> domain);
+
+}  // namespace interpatch::io::reader

@@ -1,0 +1,217 @@
+// The spec reader's front: the table of construction types, and the public
+// functions of io/spec.hpp. Adding a construction type: its builder (surfaces.cpp,
+// volumes.cpp or grids.cpp), its field list (forms.hpp), one line in
+// `construction_types` below, and its section in docs/spec-format.md.
+
+#include "interpatch/io/spec.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include "detail/excerpt.hpp"
+#include "interpatch/memory.hpp"
+#include "io/spec/forms.hpp"
+#include "io/spec/reader.hpp"
+
+namespace interpatch::io {
+
+namespace reader {
+
+namespace {
+
+double ms_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+constexpr ConstructionType construction_types[] = {
+    {"bilinear", build_bilinear, 2, forms::bilinear},
+    {"ruled", build_ruled, 2, forms::ruled},
+    {"coons", build_coons, 2, forms::coons},
+    {"network", build_network, 2, forms::network},
+    {"interpolate", build_interpolate<2>, 2, forms::interpolate},
+    {"hermite_patch", build_hermite_patch, 2, forms::hermite_patch},
+    {"bspline_surface", build_bspline<2>, 2, forms::bspline},
+    {"trilinear", build_trilinear, 3, forms::trilinear},
+    {"coons_volume", build_coons_volume, 3, forms::coons_volume},
+    {"hermite_volume", build_hermite_volume, 3, forms::hermite_volume},
+    {"interpolate_volume", build_interpolate<3>, 3, forms::interpolate},
+    {"bspline_volume", build_bspline<3>, 3, forms::bspline},
+};
+
+Construction build_impl(const json& spec, Context& ctx) {
+  if (!spec.is_object())
+    fail(errc::wrong_type, "(top level): the spec must be a JSON object with a \"type\", got ", kind(spec));
+  const json& t = member(spec, "type", "", cat("a string, one of ", type_list()));
+  if (!t.is_string()) wrong_type("/type", cat("a string, one of ", type_list()), t);
+  const auto& name = t.get_ref<const std::string&>();
+  const ConstructionType* type = find_type(name);
+  if (!type)
+    fail(errc::unknown_type, "/type: unknown type \"", interpatch::detail::excerpt(name), "\"; known types: ", type_list());
+  check_fields(spec, "", type->fields, ctx);
+  Construction c = type->build(spec, ctx);
+  const auto done = Clock::now();
+  const auto parsed = ctx.parsed_at.value_or(done);
+  c.type = name;
+  c.warnings = std::move(ctx.warnings);
+  c.timings.parse_ms = ms_between(ctx.start, parsed);
+  c.timings.build_ms = ms_between(parsed, done);
+  return c;
+}
+
+std::pair<std::size_t, std::size_t> line_column(std::string_view text, std::size_t pos) {
+  pos = std::min(pos, text.size());
+  std::size_t line = 1, start = 0;
+  for (std::size_t i = 0; i < pos; ++i)
+    if (text[i] == '\n') {
+      ++line;
+      start = i + 1;
+    }
+  return {line, pos - start + 1};
+}
+
+}  // namespace
+
+const ConstructionType* find_type(std::string_view name) {
+  const auto it = std::find_if(std::begin(construction_types), std::end(construction_types),
+                               [&](const ConstructionType& c) { return c.name == name; });
+  return it == std::end(construction_types) ? nullptr : &*it;
+}
+
+std::string type_list(int dims) {
+  std::string s;
+  for (const auto& t : construction_types)
+    if (dims == 0 || t.dims == dims) s += cat(s.empty() ? "" : ", ", t.name);
+  return s;
+}
+
+}  // namespace reader
+
+using namespace reader;
+
+std::vector<std::string_view> known_types() {
+  std::vector<std::string_view> v;
+  for (const auto& t : construction_types) v.push_back(t.name);
+  return v;
+}
+
+std::vector<SpecForm> spec_forms() {
+  std::vector<SpecForm> v;
+  auto add = [&](std::string_view kind, std::string_view name, Fields fields) {
+    v.push_back({kind, name, std::vector<std::string_view>(fields.begin(), fields.end())});
+  };
+  for (const auto& t : construction_types) add("type", t.name, t.fields);
+  add("curve", "interpolate", forms::interpolate_curve);
+  add("curve", "bspline", forms::bspline_curve);
+  add("curve", "hermite", forms::hermite_curve);
+  add("curve", "line", forms::line_curve);
+  add("points", "npy", forms::npy);
+  add("points", "csv", forms::csv);
+  return v;
+}
+
+json parse_json(std::string_view text, std::string_view source) {
+  try {
+    return json::parse(text.begin(), text.end());
+  } catch (const json::parse_error& e) {
+    // e.byte is the 1-based offset of the last character read.
+    std::size_t pos = e.byte == 0 ? 0 : std::min<std::size_t>(e.byte - 1, text.size());
+    // A literal the lexer stopped in: back up to where the word starts.
+    std::size_t start = pos;
+    while (start > 0 && std::isalpha(static_cast<unsigned char>(text[start - 1]))) --start;
+    std::size_t end = start;
+    while (end < text.size() && std::isalpha(static_cast<unsigned char>(text[end]))) ++end;
+    const std::string_view word = text.substr(start, end - start);
+    if (word == "NaN" || word == "nan" || word == "Infinity" || word == "inf" || word == "infinity" || word == "Inf") {
+      const bool minus = start > 0 && text[start - 1] == '-';
+      const auto [line, col] = line_column(text, minus ? start - 1 : start);
+      fail(errc::not_finite, source, ":", line, ":", col, ": ", minus ? "-" : "", word,
+           " is not a JSON number; coordinates, knots and weights must be finite");
+    }
+    const auto [line, col] = line_column(text, pos);
+    std::string what = e.what();
+    // Keep nlohmann's description, drop its prefix with its own position.
+    if (const auto c = what.find("column "); c != std::string::npos)
+      if (const auto colon = what.find(": ", c); colon != std::string::npos) what = what.substr(colon + 2);
+    // nlohmann quotes what it read last, which may be any bytes of any length.
+    fail(errc::invalid_json, source, ":", line, ":", col, ": invalid JSON: ", interpatch::detail::excerpt(what, 160));
+  } catch (const json::out_of_range& e) {
+    // A number beyond the range of double (1e999); nlohmann names the token only.
+    const std::string what = e.what();
+    std::string token;
+    if (const auto q = what.find('\''); q != std::string::npos)
+      if (const auto q2 = what.find('\'', q + 1); q2 != std::string::npos) token = what.substr(q + 1, q2 - q - 1);
+    const std::size_t pos = token.empty() ? std::string_view::npos : text.find(token);
+    if (pos == std::string_view::npos) fail(errc::not_finite, source, ": a number is too large for a double");
+    const auto [line, col] = line_column(text, pos);
+    fail(errc::not_finite, source, ":", line, ":", col, ": number ", interpatch::detail::excerpt(token, 40), " is too large for a double");
+  }
+}
+
+json read_json_file(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::string name = path.string();
+  if (!std::filesystem::exists(path, ec)) fail(errc::file_unreadable, name, ": cannot read: no such file");
+  if (std::filesystem::is_directory(path, ec)) fail(errc::file_unreadable, name, ": cannot read: it is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(errc::file_unreadable, name, ": cannot open: ", std::strerror(errno));
+  const auto size = std::filesystem::file_size(path, ec);
+  // The parsed document takes a few times the text; refuse what cannot fit.
+  if (!ec) require_memory(static_cast<std::size_t>(size), 4, cat(name, ": a JSON spec of ", size, " bytes"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) fail(errc::file_unreadable, name, ": read error: ", std::strerror(errno));
+  return parse_json(text, name);
+}
+
+bool is_volume(const Construction& c) noexcept {
+  return c.exact ? std::holds_alternative<BSplineVolume>(*c.exact) : c.volume_formula != nullptr;
+}
+
+const Surface& evaluator(const Construction& c) {
+  if (is_volume(c)) fail(errc::wrong_type, c.type, ": the construction is a volume, not a surface");
+  if (c.exact) return std::get<BSplineSurface>(*c.exact);
+  if (!c.formula) fail(errc::internal, c.type, ": the construction has neither an exact form nor a formula");
+  return *c.formula;
+}
+
+const Volume& volume_evaluator(const Construction& c) {
+  if (!is_volume(c)) fail(errc::wrong_type, c.type, ": the construction is a surface, not a volume");
+  if (c.exact) return std::get<BSplineVolume>(*c.exact);
+  return *c.volume_formula;
+}
+
+Construction build(const json& spec, const std::filesystem::path& base_dir, const progress_callback& progress,
+                   bool keep_data) {
+  Context ctx;
+  ctx.base_dir = base_dir;
+  ctx.progress = progress;
+  ctx.keep_data = keep_data;
+  return build_impl(spec, ctx);
+}
+
+Construction build_file(const std::filesystem::path& spec_path, const progress_callback& progress, bool keep_data) {
+  Context ctx;  // starts the clock: reading the file counts as parsing
+  const json spec = read_json_file(spec_path);
+  ctx.base_dir = spec_path.parent_path();
+  ctx.progress = progress;
+  ctx.keep_data = keep_data;
+  return build_impl(spec, ctx);
+}
+
+PointArray points_from_json(const json& j, std::size_t rank, const std::filesystem::path& base_dir, std::string_view pointer) {
+  if (rank < 1 || rank > 3) fail(errc::internal, "points_from_json: rank ", rank, " is outside 1..3");
+  Context ctx;
+  ctx.base_dir = base_dir;
+  return points_impl(j, rank, pointer, ctx);
+}
+
+BSplineCurve curve_from_json(const json& j, const std::filesystem::path& base_dir, std::string_view pointer) {
+  Context ctx;
+  ctx.base_dir = base_dir;
+  return curve_impl(j, pointer, ctx);
+}
+
+}  // namespace interpatch::io

@@ -1,0 +1,195 @@
+// Surfaces from corners and curves in a spec: bilinear, ruled, coons, network,
+// hermite_patch. Their data (corners, curves) are checked against the exact form by
+// `info`, as curves sampled at `curve_samples` parameters.
+
+#include <array>
+#include <memory>
+
+#include "interpatch/coons.hpp"
+#include "interpatch/evaluate.hpp"
+#include "interpatch/network.hpp"
+#include "interpatch/patches.hpp"
+#include "io/spec/reader.hpp"
+
+namespace interpatch::io::reader {
+
+namespace {
+
+constexpr std::size_t curve_samples = 65;
+
+// A curve of the spec sampled for the data check: S(u, fixed) (axis 0) or S(fixed, v).
+DataSet curve_data(const BSplineCurve& c, int axis, double fixed, std::string pointer) {
+  DataSet d;
+  const std::vector<double> t = linspace(0, 1, curve_samples);
+  d.params = axis == 0 ? std::vector<std::vector<double>>{t, {fixed}} : std::vector<std::vector<double>>{{fixed}, t};
+  for (double x : t) d.points.push_back(c.point(x));
+  d.pointer = std::move(pointer);
+  return d;
+}
+
+DataSet corner_data(const std::array<Vec3, 4>& p, std::string pointer) {
+  DataSet d;
+  d.params = {{0.0, 1.0}, {0.0, 1.0}};
+  d.points.assign(p.begin(), p.end());  // p00, p01, p10, p11: C order of (u, v)
+  d.pointer = std::move(pointer);
+  return d;
+}
+
+// A blended construction (surface or volume): the formula, stored in `slot`, and
+// its exact form if it has one.
+
+// A blended construction (surface or volume): the formula, stored in `slot`, and
+// its exact form if it has one.
+template <class Formula, class Slot>
+Construction blended_with(std::string_view type, Formula f, std::vector<DataSet> data, nlohmann::ordered_json parameters,
+                          Slot Construction::*slot) {
+  Construction c;
+  c.type = type;
+  auto formula = std::make_shared<const Formula>(std::move(f));
+  try {
+    c.exact = formula->to_bspline();
+  } catch (const error& e) {
+    if (e.code() != errc::no_exact_form) throw;
+    c.no_exact_form = e.what();
+  }
+  if (!formula->notes().empty()) parameters["notes"] = formula->notes();
+  c.*slot = std::move(formula);
+  c.data = std::move(data);
+  c.parameters = std::move(parameters);
+  return c;
+}
+
+}  // namespace
+
+Construction blended(std::string_view type, BlendedSurface s, std::vector<DataSet> data, nlohmann::ordered_json parameters) {
+  return blended_with(type, std::move(s), std::move(data), std::move(parameters), &Construction::formula);
+}
+
+Construction blended(std::string_view type, BlendedVolume v, std::vector<DataSet> data, nlohmann::ordered_json parameters) {
+  return blended_with(type, std::move(v), std::move(data), std::move(parameters), &Construction::volume_formula);
+}
+
+Construction build_bilinear(const json& spec, Context& ctx) {
+  std::array<Vec3, 4> p;
+  const char* names[4] = {"p00", "p01", "p10", "p11"};
+  for (std::size_t k = 0; k < 4; ++k)
+    p[k] = point_value(member(spec, names[k], "", "a point [x, y, z]"), child("", names[k]));
+  ctx.parsed();
+  return blended("bilinear", bilinear(p[0], p[1], p[2], p[3]), {corner_data(p, "/p00")}, nlohmann::ordered_json::object());
+}
+
+Construction build_ruled(const json& spec, Context& ctx) {
+  const json& cs = member(spec, "curves", "", "an array of two curves [c0, c1]");
+  if (!cs.is_array() || cs.size() != 2) wrong_type("/curves", "an array of two curves [c0, c1]", cs);
+  const BSplineCurve c0 = curve_impl(cs[0], "/curves/0", ctx), c1 = curve_impl(cs[1], "/curves/1", ctx);
+  ctx.parsed();
+  return blended("ruled", ruled(c0, c1), {curve_data(c0, 0, 0.0, "/curves/0"), curve_data(c1, 0, 1.0, "/curves/1")},
+                 nlohmann::ordered_json::object());
+}
+
+Construction build_coons(const json& spec, Context& ctx) {
+  const char* sides[4] = {"v0", "v1", "u0", "u1"};
+  auto four_curves = [&](const json& obj, const std::string& ptr) {
+    expect_object(obj, ptr, "an object {\"v0\", \"v1\", \"u0\", \"u1\"} of curves");
+    check_fields(obj, ptr, {"v0", "v1", "u0", "u1"}, ctx);
+    std::vector<BSplineCurve> c;
+    for (const char* side : sides) c.push_back(curve_impl(member(obj, side, ptr, "a curve"), child(ptr, side), ctx));
+    return c;
+  };
+  const auto b = four_curves(member(spec, "boundary", "", "an object {\"v0\", \"v1\", \"u0\", \"u1\"} of curves"), "/boundary");
+  const CoonsBoundary boundary{b[0], b[1], b[2], b[3]};
+  const std::string blending = choice(spec, "blending", "", {"linear", "hermite"}, "linear");
+  const std::optional<double> tol = tolerance_of(spec);
+  std::vector<DataSet> data{curve_data(b[0], 0, 0.0, "/boundary/v0"), curve_data(b[1], 0, 1.0, "/boundary/v1"),
+                            curve_data(b[2], 1, 0.0, "/boundary/u0"), curve_data(b[3], 1, 1.0, "/boundary/u1")};
+  nlohmann::ordered_json parameters = {{"blending", blending}};
+  if (const json* x = find_member(spec, "cross_derivatives")) {
+    const auto d = four_curves(*x, "/cross_derivatives");
+    HermiteCoonsOptions o;
+    o.tolerance = tol;
+    o.twist_correction = choice(spec, "twist_correction", "", {"none", "gregory"}, "none") == "gregory"
+                             ? TwistCorrection::gregory
+                             : TwistCorrection::none;
+    if (const json* tw = find_member(spec, "twists")) {
+      expect_object(*tw, "/twists", "an object {\"p00\", \"p01\", \"p10\", \"p11\"} of vectors");
+      check_fields(*tw, "/twists", {"p00", "p01", "p10", "p11"}, ctx);
+      const char* corners[4] = {"p00", "p01", "p10", "p11"};
+      for (std::size_t k = 0; k < 4; ++k)
+        if (const json* t = find_member(*tw, corners[k])) o.twists[k] = point_value(*t, child("/twists", corners[k]));
+    }
+    ctx.parsed();
+    parameters = {{"blending", "hermite"},
+                  {"cross_derivatives", true},
+                  {"twist_correction", o.twist_correction == TwistCorrection::gregory ? "gregory" : "none"}};
+    return blended("coons", at("", [&] { return coons(boundary, CoonsCrossDerivatives{d[0], d[1], d[2], d[3]}, o); }),
+                   std::move(data), std::move(parameters));
+  }
+  for (const char* k : {"twists", "twist_correction"})
+    if (find_member(spec, k)) ctx.warn(cat("/", k, ": ignored without \"cross_derivatives\""));
+  CoonsOptions o;
+  o.tolerance = tol;
+  if (blending == "hermite") o.blend_u = o.blend_v = Blend::hermite();
+  ctx.parsed();
+  return blended("coons", at("", [&] { return coons(boundary, o); }), std::move(data), std::move(parameters));
+}
+
+Construction build_network(const json& spec, Context& ctx) {
+  auto curves = [&](const char* key) {
+    const std::string ptr = child("", key);
+    const json& a = member(spec, key, "", "an array of curves");
+    if (!a.is_array()) wrong_type(ptr, "an array of curves", a);
+    std::vector<BSplineCurve> c;
+    for (std::size_t i = 0; i < a.size(); ++i) c.push_back(curve_impl(a[i], child(ptr, i), ctx));
+    return c;
+  };
+  CurveNetwork net{curves("u_curves"), curves("v_curves"), {}, {}};
+  if (const json* p = find_member(spec, "u_params")) net.u_params = numbers(*p, "/u_params");
+  if (const json* p = find_member(spec, "v_params")) net.v_params = numbers(*p, "/v_params");
+  const std::string method = choice(spec, "method", "", {"coons_linear", "coons_hermite", "gordon"}, "gordon");
+  NetworkOptions o;
+  o.method = method == "coons_linear" ? NetworkMethod::coons_linear
+             : method == "coons_hermite" ? NetworkMethod::coons_hermite
+                                         : NetworkMethod::gordon;
+  o.tolerance = tolerance_of(spec);
+  ctx.parsed();
+  if (net.u_params.empty() || net.v_params.empty()) {
+    const auto found = at("", [&] { return network_parameters(net); });
+    if (net.u_params.empty()) net.u_params = found.u_params;
+    if (net.v_params.empty()) net.v_params = found.v_params;
+  }
+  BlendedSurface s = at("", [&] { return curve_network(net, o); });
+  std::vector<DataSet> data;
+  for (std::size_t j = 0; j < net.u_curves.size(); ++j)
+    data.push_back(curve_data(net.u_curves[j], 0, net.v_params[j], child("/u_curves", j)));
+  for (std::size_t i = 0; i < net.v_curves.size(); ++i)
+    data.push_back(curve_data(net.v_curves[i], 1, net.u_params[i], child("/v_curves", i)));
+  nlohmann::ordered_json parameters = {{"method", method},
+                                       {"curves", {net.u_curves.size(), net.v_curves.size()}},
+                                       {"u_params", net.u_params},
+                                       {"v_params", net.v_params}};
+  return blended("network", std::move(s), std::move(data), std::move(parameters));
+}
+
+Construction build_hermite_patch(const json& spec, Context& ctx) {
+  const json& cs = member(spec, "corners", "", "an object {\"p00\", \"p01\", \"p10\", \"p11\"} of corners");
+  expect_object(cs, "/corners", "an object {\"p00\", \"p01\", \"p10\", \"p11\"} of corners");
+  check_fields(cs, "/corners", {"p00", "p01", "p10", "p11"}, ctx);
+  std::array<HermiteCorner, 4> c{};
+  std::array<Vec3, 4> p;
+  const char* names[4] = {"p00", "p01", "p10", "p11"};
+  for (std::size_t k = 0; k < 4; ++k) {
+    const std::string ptr = child("/corners", names[k]);
+    const json& o = member(cs, names[k], "/corners", "a corner {\"p\", \"du\", \"dv\", \"duv\"}");
+    expect_object(o, ptr, "a corner {\"p\", \"du\", \"dv\", \"duv\"}");
+    check_fields(o, ptr, {"p", "du", "dv", "duv"}, ctx);
+    c[k].p = point_value(member(o, "p", ptr, "a point [x, y, z]"), child(ptr, "p"));
+    c[k].du = point_value(member(o, "du", ptr, "a vector [x, y, z]"), child(ptr, "du"));
+    c[k].dv = point_value(member(o, "dv", ptr, "a vector [x, y, z]"), child(ptr, "dv"));
+    if (const json* t = find_member(o, "duv")) c[k].duv = point_value(*t, child(ptr, "duv"));
+    p[k] = c[k].p;
+  }
+  ctx.parsed();
+  return blended("hermite_patch", hermite_patch(c), {corner_data(p, "/corners")}, nlohmann::ordered_json::object());
+}
+
+}  // namespace interpatch::io::reader
