@@ -133,7 +133,6 @@ std::vector<std::size_t> parse_counts(std::string_view text, const CountsOption&
   const auto bad = [&](const std::string& why) {
     return usage_error(std::string(o.name) + " '" + std::string(text) + "': " + why);
   };
-  const std::string forms = std::string(o.surface_form) + " (a surface) or " + std::string(o.volume_form) + " (a volume)";
   std::vector<std::string_view> fields;
   for (std::size_t from = 0;;) {
     const auto x = text.find_first_of("xX", from);
@@ -144,12 +143,15 @@ std::vector<std::size_t> parse_counts(std::string_view text, const CountsOption&
   if (fields.size() == 1 && !o.single)
     throw bad("expected " + std::string(o.surface_form) + ", e.g. " + std::string(o.surface_example) + " (" +
               std::string(o.unit) + " along u and v), or " + std::string(o.volume_form) + " for a volume");
-  if (fields.size() > 3) throw bad("expected " + forms + ", not more counts");
+  if (fields.size() > 3)
+    throw bad("expected " + std::string(o.surface_form) + " (a surface) or " + std::string(o.volume_form) +
+              " (a volume), not more counts");
   std::vector<std::size_t> counts;
   for (const std::string_view f : fields) {
     const auto n = parse_count(f);
     if (!n && fields.size() == 1)
-      throw bad("expected a whole number K >= 2 (K " + std::string(o.unit) + " along each direction), or " + forms);
+      throw bad("expected a whole number K >= 2 (K " + std::string(o.unit) + " along each direction), " +
+                std::string(o.surface_form) + " (a surface) or " + std::string(o.volume_form) + " (a volume)");
     if (!n)
       throw bad("expected " + std::string(fields.size() == 2 ? o.surface_form : o.volume_form) + " with whole numbers, e.g. " +
                 std::string(fields.size() == 2 ? o.surface_example : o.volume_example));

@@ -28,7 +28,6 @@ class usage_error : public std::runtime_error {
 /// a surface.
 struct Resolution {
   std::size_t nu = 64, nv = 64, nw = 0;
-  friend bool operator==(const Resolution&, const Resolution&) = default;
 };
 
 /// The default resolutions: 64x64 for a surface, 33x33x33 for a volume.
