@@ -467,7 +467,7 @@ TEST_F(CliTest, HelpOfEveryCommandNamesTheSpecFormatAndTheFormatsItWrites) {
     std::vector<std::string> formats;
   };
   const std::vector<Case> cases{
-      {{"--help"}, {".json", ".npy", ".csv"}},
+      {{"--help"}, {".json", ".step/.stp", ".igs/.iges", ".obj .stl .ply .vtk .vts .xyz", "volumes .vtk .vts .xyz", ".npy", ".csv"}},
       {{"build", "--help"}, {".json", ".step", ".stp", ".igs", ".iges"}},
       {{"mesh", "--help"}, {".obj", ".stl", ".ply", ".vtk", ".vts", ".xyz"}},
       {{"eval", "--help"}, {".npy", ".csv"}},
