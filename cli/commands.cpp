@@ -49,10 +49,31 @@ std::optional<std::size_t> parse_count(std::string_view s) {
   return v;
 }
 
-std::string what_size(std::size_t a, std::size_t b) { return std::to_string(a) + "x" + std::to_string(b); }
-std::string what_size(std::size_t a, std::size_t b, std::size_t c) { return what_size(a, b) + "x" + std::to_string(c); }
+std::string resolution_text(const Resolution& r) {
+  std::string t = std::to_string(r.nu) + "x" + std::to_string(r.nv);
+  return r.nw ? t + "x" + std::to_string(r.nw) : t;
+}
 
-std::string resolution_text(const Resolution& r) { return r.nw ? what_size(r.nu, r.nv, r.nw) : what_size(r.nu, r.nv); }
+// A shape as NumPy prints it: (4, 3), (5,).
+std::string shape_text(const std::vector<std::size_t>& shape) {
+  std::string s = "(";
+  for (std::size_t i = 0; i < shape.size(); ++i) s += (i ? ", " : "") + std::to_string(shape[i]);
+  return s + (shape.size() == 1 ? ",)" : ")");
+}
+
+// The number of points of a grid, or nullopt when it overflows a size_t.
+std::optional<std::size_t> point_count(const Resolution& r) {
+  std::size_t n = 1;
+  for (const std::size_t c : {r.nu, r.nv, r.nw ? r.nw : std::size_t{1}}) {
+    if (c != 0 && n > std::numeric_limits<std::size_t>::max() / c) return std::nullopt;
+    n *= c;
+  }
+  return n;
+}
+
+// The u values of a .npy evaluation block: about 2^17 points (3 MiB), work enough
+// for both threads and still in the cache when it is written; at least one u value.
+std::size_t npy_block_rows(std::size_t per_row) { return std::max<std::size_t>(1, (std::size_t{1} << 17) / per_row); }
 
 // Points as float64 triples in C order, for .npy: a grid's own memory (Vec3 is
 // three doubles), written without a copy.
@@ -62,13 +83,12 @@ std::span<const double> flat_points(const Vec3* p, std::size_t n) {
 }
 
 // An evaluation grid written to .npy block by block along u: evaluate(us, out) fills
-// out with the points of the u values `us` (per_row points each). A block is about
-// 2^17 points (3 MiB): work enough for both threads, still in the cache when it is
-// written, and the whole grid is never held in memory.
+// out with the points of the u values `us` (per_row points each), npy_block_rows of
+// them at a time, so the whole grid is never held in memory.
 template <class Evaluate>
 void write_npy_by_rows(const fs::path& out, std::span<const std::size_t> shape, std::span<const double> us,
                        std::size_t per_row, const progress_callback& progress, const Evaluate& evaluate) {
-  const std::size_t rows = std::max<std::size_t>(1, (std::size_t{1} << 17) / per_row);
+  const std::size_t rows = npy_block_rows(per_row);
   std::vector<Vec3> block(std::min(rows, us.size()) * per_row);
   io::write_npy(out, shape, 3 * rows * per_row, [&](std::size_t first, std::size_t count) {
     const std::size_t r0 = first / (3 * per_row), n = count / (3 * per_row);
@@ -89,13 +109,13 @@ void mesh_volume(const io::Construction& c, const fs::path& out, const Resolutio
   io::write_volume_mesh(out, j.points, j.determinants);
 }
 
-void eval_volume(const io::Construction& c, const fs::path& out, std::size_t k) {
+void eval_volume(const io::Construction& c, const fs::path& out, const Resolution& grid) {
   const Volume& v = io::volume_evaluator(c);
-  const std::vector<std::vector<double>> params{linspace(0, 1, k), linspace(0, 1, k), linspace(0, 1, k)};
+  const std::vector<std::vector<double>> params{linspace(0, 1, grid.nu), linspace(0, 1, grid.nv), linspace(0, 1, grid.nw)};
   ProgressLine progress("evaluating");
   if (lower_extension(out) == ".npy") {
-    const std::size_t shape[4] = {k, k, k, 3};
-    write_npy_by_rows(out, shape, params[0], k * k, progress.callback(),
+    const std::size_t shape[4] = {grid.nu, grid.nv, grid.nw, 3};
+    write_npy_by_rows(out, shape, params[0], grid.nv * grid.nw, progress.callback(),
                       [&](std::span<const double> us, std::span<Vec3> points) {
                         v.evaluate_into(us, params[1], params[2], points);
                       });
@@ -109,34 +129,117 @@ void eval_volume(const io::Construction& c, const fs::path& out, std::size_t k) 
 
 }  // namespace
 
-Resolution parse_resolution(std::string_view text) {
-  const auto x = text.find_first_of("xX");
-  const auto bad = [&](std::string_view why) {
-    return usage_error("--res '" + std::string(text) + "': " + std::string(why));
+std::vector<std::size_t> parse_counts(std::string_view text, const CountsOption& o) {
+  const auto bad = [&](const std::string& why) {
+    return usage_error(std::string(o.name) + " '" + std::string(text) + "': " + why);
   };
-  if (x == std::string_view::npos)
-    throw bad("expected NUxNV, e.g. 64x64 (vertices along u and v), or NUxNVxNW for a volume");
-  const auto x2 = text.find_first_of("xX", x + 1);
-  if (x2 != std::string_view::npos) {
-    if (text.find_first_of("xX", x2 + 1) != std::string_view::npos)
-      throw bad("expected NUxNV (a surface) or NUxNVxNW (a volume), not more counts");
-    const auto nu = parse_count(text.substr(0, x)), nv = parse_count(text.substr(x + 1, x2 - x - 1)),
-               nw = parse_count(text.substr(x2 + 1));
-    if (!nu || !nv || !nw) throw bad("expected NUxNVxNW with whole numbers, e.g. 33x33x33");
-    if (*nu < 2 || *nv < 2 || *nw < 2) throw bad("a mesh needs at least 2 vertices along each direction");
-    return {*nu, *nv, *nw};
+  std::vector<std::string_view> fields;
+  for (std::size_t from = 0;;) {
+    const auto x = text.find_first_of("xX", from);
+    fields.push_back(text.substr(from, x == std::string_view::npos ? x : x - from));
+    if (x == std::string_view::npos) break;
+    from = x + 1;
   }
-  const auto nu = parse_count(text.substr(0, x)), nv = parse_count(text.substr(x + 1));
-  if (!nu || !nv) throw bad("expected NUxNV with whole numbers, e.g. 64x64");
-  if (*nu < 2 || *nv < 2) throw bad("a mesh needs at least 2 vertices along each direction");
-  return {*nu, *nv, 0};
+  if (fields.size() == 1 && !o.single)
+    throw bad("expected " + std::string(o.surface_form) + ", e.g. " + std::string(o.surface_example) + " (" +
+              std::string(o.unit) + " along u and v), or " + std::string(o.volume_form) + " for a volume");
+  if (fields.size() > 3)
+    throw bad("expected " + std::string(o.surface_form) + " (a surface) or " + std::string(o.volume_form) +
+              " (a volume), not more counts");
+  std::vector<std::size_t> counts;
+  for (const std::string_view f : fields) {
+    const auto n = parse_count(f);
+    if (!n && fields.size() == 1)
+      throw bad("expected a whole number K >= 2 (K " + std::string(o.unit) + " along each direction), " +
+                std::string(o.surface_form) + " (a surface) or " + std::string(o.volume_form) + " (a volume)");
+    if (!n)
+      throw bad("expected " + std::string(fields.size() == 2 ? o.surface_form : o.volume_form) + " with whole numbers, e.g. " +
+                std::string(fields.size() == 2 ? o.surface_example : o.volume_example));
+    counts.push_back(*n);
+  }
+  if (std::any_of(counts.begin(), counts.end(), [](std::size_t n) { return n < 2; }))
+    throw bad("a " + std::string(o.noun) + " needs at least 2 " + std::string(o.unit) + " along each direction");
+  return counts;
 }
 
-std::size_t parse_grid(std::string_view text) {
-  const auto k = parse_count(text);
-  if (!k) throw usage_error("--grid '" + std::string(text) + "': expected a whole number K >= 2 (a KxK grid)");
-  if (*k < 2) throw usage_error("--grid " + std::string(text) + ": a grid needs at least 2 points along each direction");
-  return *k;
+Resolution parse_resolution(std::string_view text) {
+  const std::vector<std::size_t> n = parse_counts(text, res_option);
+  return {n[0], n[1], n.size() == 3 ? n[2] : 0};
+}
+
+std::vector<std::size_t> parse_grid(std::string_view text) { return parse_counts(text, grid_option); }
+
+Resolution grid_resolution(const std::vector<std::size_t>& counts, const io::Construction& c) {
+  if (counts.size() == 1) return {counts[0], counts[0], io::is_volume(c) ? counts[0] : 0};
+  const Resolution grid{counts.at(0), counts.at(1), counts.size() == 3 ? counts[2] : 0};
+  check_counts_kind(c, grid_option, grid);
+  return grid;
+}
+
+void check_counts_kind(const io::Construction& c, const CountsOption& o, const Resolution& counts) {
+  const std::string given = std::string(o.name) + " '" + resolution_text(counts) + "': ";
+  const std::string k_or = o.single ? "K or " : "";
+  if (!io::is_volume(c) && counts.nw)
+    throw usage_error(given + "a surface " + std::string(o.noun) + " takes " + k_or + "two counts, " +
+                      std::string(o.surface_form) + " (" + std::string(o.volume_form) + " is for volumes)");
+  if (io::is_volume(c) && !counts.nw)
+    throw usage_error(given + c.type + " is a volume; its " + std::string(o.noun) + " takes " + k_or + "three counts, " +
+                      std::string(o.volume_form) + " (e.g. " + std::string(o.volume_example) + ")");
+}
+
+Input parse_input(const fs::path& spec, std::string_view shape) {
+  const std::string ext = lower_extension(spec);
+  Input in{spec, ext == ".npy" ? Input::Kind::npy : ext == ".csv" ? Input::Kind::csv : Input::Kind::spec, {}};
+  const std::string name = "'" + spec.string() + "'";
+  if (in.kind == Input::Kind::csv && shape.empty())
+    throw usage_error(name + " is a CSV file of points: give the shape of its grid, --shape NxM (a surface) or "
+                      "--shape NxMxL (a volume), the points one per line in C order (last index fastest)");
+  if (in.kind == Input::Kind::spec && !shape.empty())
+    throw usage_error("--shape '" + std::string(shape) + "': " + name +
+                      " is read as a spec; --shape gives the grid of a .csv file of points given in its place "
+                      "(in a spec, a CSV file's shape is its \"shape\" field)");
+  if (in.kind == Input::Kind::npy && !shape.empty())
+    throw usage_error("--shape '" + std::string(shape) + "': " + name + " is a .npy file, whose header gives its shape; "
+                      "--shape is for .csv files");
+  if (in.kind == Input::Kind::csv) in.shape = parse_counts(shape, shape_option);
+  return in;
+}
+
+namespace {
+
+// The shape of a .npy file, from its header alone; nullopt when the header cannot
+// be read (the build of the spec reports why).
+std::optional<std::vector<std::size_t>> npy_shape(const fs::path& file) {
+  struct header_read {
+    std::vector<std::size_t> shape;
+  };
+  try {
+    // The destination is asked for once the header is read and checked against the
+    // file's size: refusing it there leaves the data unread.
+    (void)io::read_npy_into(file, [](std::span<const std::size_t> shape, std::size_t) -> double* {
+      throw header_read{{shape.begin(), shape.end()}};
+    });
+  } catch (const header_read& h) {
+    return h.shape;
+  } catch (const error&) {
+    return std::nullopt;
+  }
+  return std::nullopt;  // not reached: read_npy_into asks for the memory of every array it reads
+}
+
+}  // namespace
+
+nlohmann::json data_file_spec(const Input& in) {
+  const std::string file = in.path.filename().string();
+  if (in.kind == Input::Kind::csv)
+    return {{"type", in.shape.size() == 3 ? "interpolate_volume" : "interpolate"},
+            {"points", {{"csv", file}, {"shape", in.shape}}}};
+  const std::optional<std::vector<std::size_t>> shape = npy_shape(in.path);
+  if (shape && shape->size() != 3 && shape->size() != 4)
+    throw error(errc::size_mismatch, in.path.string() + " has shape " + shape_text(*shape) +
+                                         ": points to interpolate are an array of shape (n, m, 3) (a surface) "
+                                         "or (n, m, l, 3) (a volume)");
+  return {{"type", shape && shape->size() == 4 ? "interpolate_volume" : "interpolate"}, {"points", {{"npy", file}}}};
 }
 
 void check_build_output(const fs::path& out) {
@@ -162,21 +265,24 @@ void check_info_output(const fs::path& out) {
   throw usage_error("cannot tell the output format of '" + out.string() + "': info writes .json");
 }
 
-void require_eval_room(std::size_t k, const fs::path& out, int dims) {
-  const std::string size = dims == 3 ? what_size(k, k, k) : what_size(k, k);
-  const std::string what = "evaluation grid " + (k == std::numeric_limits<std::size_t>::max() ? std::string("beyond 2^64") : size);
-  if (k >= (std::size_t{1} << (dims == 3 ? 21 : 32))) throw error(errc::too_large, what + ": more points than can be addressed");
-  const std::size_t points = dims == 3 ? k * k * k : k * k;
+void require_eval_room(const Resolution& grid, const fs::path& out) {
+  constexpr std::size_t beyond = std::numeric_limits<std::size_t>::max();  // parse_count's "too large to count"
+  const bool uncountable = grid.nu == beyond || grid.nv == beyond || grid.nw == beyond;
+  const std::string what = "evaluation grid " + (uncountable ? std::string("beyond 2^64") : resolution_text(grid));
+  const std::optional<std::size_t> points = point_count(grid);
+  if (uncountable || !points) throw error(errc::too_large, what + ": more points than can be addressed");
   if (lower_extension(out) == ".npy") {
-    // Evaluated and written a block at a time: the memory of one block, the disk
-    // space of the whole file (the header is at most a few hundred bytes).
-    if (points > (std::numeric_limits<std::size_t>::max() - 4096) / sizeof(Vec3))
+    // Evaluated and written a block at a time: the disk space of the whole file (the
+    // header is at most a few hundred bytes), the memory of one block.
+    if (*points > (std::numeric_limits<std::size_t>::max() - 4096) / sizeof(Vec3))
       throw error(errc::too_large, what + ": more bytes than a file can hold");
-    io::check_disk_space(out, points * sizeof(Vec3) + 4096, what);
+    io::check_disk_space(out, *points * sizeof(Vec3) + 4096, what);
+    const std::size_t per_row = *points / grid.nu;
+    require_memory(std::min(npy_block_rows(per_row), grid.nu) * per_row, sizeof(Vec3), what + ", a block of u values");
     return;
   }
   // The points, plus the text of a row for .csv.
-  require_memory(points, sizeof(Vec3) + 8, what);
+  require_memory(*points, sizeof(Vec3) + 8, what);
 }
 
 void require_mesh_memory(const Resolution& res) {
@@ -196,16 +302,11 @@ void require_mesh_memory(const Resolution& res) {
 }
 
 void check_mesh_kind(const io::Construction& c, const fs::path& out, const Resolution& res) {
-  const std::string r = resolution_text(res);
-  if (!io::is_volume(c)) {
-    if (res.nw) throw usage_error("--res '" + r + "': a surface mesh takes two counts, NUxNV (NUxNVxNW is for volumes)");
-    return;
-  }
   const std::string ext = lower_extension(out);
-  if (ext != ".vts" && ext != ".vtk" && ext != ".xyz")
+  if (io::is_volume(c) && ext != ".vts" && ext != ".vtk" && ext != ".xyz")
     throw usage_error("'" + out.string() + "': " + c.type + " is a volume; " + ext +
                       " holds surfaces only, a volume mesh is written to .vts, .vtk or .xyz (Plot3D)");
-  if (!res.nw) throw usage_error("--res '" + r + "': " + c.type + " is a volume; its mesh takes three counts, NUxNVxNW (e.g. 33x33x33)");
+  check_counts_kind(c, res_option, res);
 }
 
 void write_build(const io::Construction& c, const fs::path& out) {
@@ -243,15 +344,16 @@ void write_mesh(const io::Construction& c, const fs::path& out, const Resolution
   io::write_surface_mesh(out, mesh);
 }
 
-void write_eval(const io::Construction& c, const fs::path& out, std::size_t k) {
-  if (io::is_volume(c)) return eval_volume(c, out, k);
+void write_eval(const io::Construction& c, const fs::path& out, const Resolution& grid) {
+  check_counts_kind(c, grid_option, grid);
+  if (io::is_volume(c)) return eval_volume(c, out, grid);
   const Surface& s = io::evaluator(c);
   constexpr double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  // every construction is over the unit square
-  std::vector<std::vector<double>> params{linspace(u0, u1, k), linspace(v0, v1, k)};
+  std::vector<std::vector<double>> params{linspace(u0, u1, grid.nu), linspace(v0, v1, grid.nv)};
   ProgressLine progress("evaluating");
   if (lower_extension(out) == ".npy") {
-    const std::size_t shape[3] = {k, k, 3};
-    write_npy_by_rows(out, shape, params[0], k, progress.callback(),
+    const std::size_t shape[3] = {grid.nu, grid.nv, 3};
+    write_npy_by_rows(out, shape, params[0], grid.nv, progress.callback(),
                       [&](std::span<const double> us, std::span<Vec3> points) { s.evaluate_into(us, params[1], points); });
     progress.clear();
     return;
@@ -271,25 +373,32 @@ io::Construction build_spec(const fs::path& spec, bool keep_data) {
   return io::build_file(spec, progress.callback(), keep_data);
 }
 
+io::Construction build_input(const Input& in, bool keep_data) {
+  if (in.kind == Input::Kind::spec) return build_spec(in.path, keep_data);
+  const nlohmann::json spec = data_file_spec(in);
+  ProgressLine progress("building");
+  return io::build(spec, in.path.parent_path(), progress.callback(), keep_data);
+}
+
 void report_warnings(const io::Construction& c) {
   for (const std::string& w : c.warnings) std::fprintf(stderr, "interpatch: warning: %s\n", w.c_str());
 }
 
-int build_command(const fs::path& spec, const fs::path& out) {
+int build_command(const Input& in, const fs::path& out) {
   check_build_output(out);
   io::check_writable(out);
-  const io::Construction c = build_spec(spec, false);
+  const io::Construction c = build_input(in, false);
   write_build(c, out);
   report_warnings(c);
   return 0;
 }
 
-int mesh_command(const fs::path& spec, const fs::path& out, std::string_view res_text) {
+int mesh_command(const Input& in, const fs::path& out, std::string_view res_text) {
   const std::optional<Resolution> given = res_text.empty() ? std::nullopt : std::optional(parse_resolution(res_text));
   check_mesh_output(out);
   io::check_writable(out);
   if (given) require_mesh_memory(*given);
-  const io::Construction c = build_spec(spec, false);
+  const io::Construction c = build_input(in, false);
   const Resolution res = given ? *given : (io::is_volume(c) ? default_volume_resolution : default_surface_resolution);
   check_mesh_kind(c, out, res);
   if (!given) require_mesh_memory(res);
@@ -298,24 +407,27 @@ int mesh_command(const fs::path& spec, const fs::path& out, std::string_view res
   return 0;
 }
 
-int eval_command(const fs::path& spec, const fs::path& out, std::string_view grid) {
-  const std::size_t k = parse_grid(grid);
+int eval_command(const Input& in, const fs::path& out, std::string_view grid_text) {
+  const std::vector<std::size_t> counts = parse_grid(grid_text);
   check_eval_output(out);
   io::check_writable(out);
-  require_eval_room(k, out);
-  const io::Construction c = build_spec(spec, false);
-  if (io::is_volume(c)) require_eval_room(k, out, 3);
-  write_eval(c, out, k);
+  // Before the build, the grid as given (K: KxK, the least it can be); after it, the
+  // grid of the construction's kind (K of a volume: KxKxK).
+  require_eval_room({counts[0], counts.size() > 1 ? counts[1] : counts[0], counts.size() > 2 ? counts[2] : 0}, out);
+  const io::Construction c = build_input(in, false);
+  const Resolution grid = grid_resolution(counts, c);
+  require_eval_room(grid, out);
+  write_eval(c, out, grid);
   report_warnings(c);
   return 0;
 }
 
-int info_command(const fs::path& spec, const std::optional<fs::path>& out) {
+int info_command(const Input& in, const std::optional<fs::path>& out) {
   if (out) {
     check_info_output(*out);
     io::check_writable(*out);
   }
-  const io::Construction c = build_spec(spec);
+  const io::Construction c = build_input(in);
   const std::string text = io::pretty_json(info(c));
   if (out) {
     io::write_atomically(*out, [&](std::ostream& os) { os << text; });

@@ -1,5 +1,5 @@
 #pragma once
-// The interpatch subcommands (SPEC section 5), shared by main.cpp and the demo.
+// The interpatch subcommands, shared by main.cpp and the demo.
 // Each command checks its usage and its output path before any work, builds the
 // spec, and writes through the atomic writers. Errors propagate as exceptions:
 // interpatch::error (exit status from exit_status()), usage_error (exit 2).
@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -23,7 +24,8 @@ class usage_error : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Vertices per direction of a mesh; nw is 0 for a surface mesh.
+/// Points (or vertices) per direction of a mesh or an evaluation grid; nw is 0 for
+/// a surface.
 struct Resolution {
   std::size_t nu = 64, nv = 64, nw = 0;
 };
@@ -32,14 +34,64 @@ struct Resolution {
 inline constexpr Resolution default_surface_resolution{64, 64, 0};
 inline constexpr Resolution default_volume_resolution{33, 33, 33};
 
-/// "NUxNV" or, for volumes, "NUxNVxNW" (also with "X"), every count at least 2.
-/// @throws usage_error.
+/// An option that takes counts along each direction, NUxNV or NUxNVxNW: what its
+/// messages call it and, for --grid, whether one count K stands for every direction.
+struct CountsOption {
+  std::string_view name;      ///< "--res"
+  std::string_view noun;      ///< what the counts make: "mesh"
+  std::string_view unit;      ///< what they count: "vertices"
+  std::string_view surface_form, volume_form;  ///< "NUxNV", "NUxNVxNW"
+  std::string_view surface_example, volume_example;  ///< "64x64", "33x33x33"
+  bool single = false;        ///< "K" accepted: K along every direction
+};
+
+inline constexpr CountsOption res_option{"--res", "mesh", "vertices", "NUxNV", "NUxNVxNW", "64x64", "33x33x33"};
+inline constexpr CountsOption grid_option{"--grid", "grid", "points", "NUxNV", "NUxNVxNW", "100x50", "17x17x17", true};
+inline constexpr CountsOption shape_option{"--shape", "grid of data points", "points", "NxM", "NxMxL", "40x50", "10x12x14"};
+
+/// The one parser of counts on the command line: "NUxNV" or "NUxNVxNW" (also with
+/// "X"), or "K" when the option takes one count; every count at least 2. Returns
+/// the 1, 2 or 3 counts. A count too large to represent is returned as the largest
+/// size_t, so the size checks refuse it (exit 5) rather than calling it bad usage.
+/// @throws usage_error, naming the option and the text.
+std::vector<std::size_t> parse_counts(std::string_view text, const CountsOption& option);
+
+/// --res: NUxNV, or NUxNVxNW for a volume. @throws usage_error.
 Resolution parse_resolution(std::string_view text);
 
-/// "K", at least 2. A K too large to count is returned as the largest size_t, so
-/// the memory check refuses it (exit 5) rather than calling it bad usage.
-/// @throws usage_error.
-std::size_t parse_grid(std::string_view text);
+/// --grid: K (K points along every direction), NUxNV or NUxNVxNW. @throws usage_error.
+std::vector<std::size_t> parse_grid(std::string_view text);
+
+/// The evaluation grid `counts` of --grid ask of construction `c`: K becomes KxK or
+/// KxKxK. @throws usage_error when the number of counts does not fit its kind.
+Resolution grid_resolution(const std::vector<std::size_t>& counts, const io::Construction& c);
+
+/// Refuse (usage_error) counts of `option` whose number does not fit the kind of the
+/// construction: three for a surface, two for a volume.
+void check_counts_kind(const io::Construction& c, const CountsOption& option, const Resolution& counts);
+
+/// What SPEC names on the command line: a spec (.json, or any other extension), or a
+/// data file of points to interpolate in its place, told apart by the extension:
+/// .npy (its shape in its header) or .csv (its shape from --shape), case-insensitive.
+struct Input {
+  enum class Kind { spec, npy, csv };
+  std::filesystem::path path;
+  Kind kind = Kind::spec;
+  std::vector<std::size_t> shape;  ///< --shape, for a .csv: NxM or NxMxL
+};
+
+/// Reads SPEC and --shape ("" when not given) without opening any file.
+/// @throws usage_error: a .csv without --shape, --shape with a spec or a .npy, a
+/// malformed --shape.
+Input parse_input(const std::filesystem::path& spec, std::string_view shape);
+
+/// The spec a data file stands for: {"type": "interpolate", "points": {"npy": file}},
+/// or {"csv": file, "shape": [N, M]}; "interpolate_volume" for an (n, m, l, 3) array
+/// or an NxMxL shape. The file is named relative to its own directory, as a spec
+/// beside it would name it. Reads the header of a .npy; a header that cannot be read
+/// gives "interpolate", whose build then reports the problem as it would for the
+/// spec. @throws error size_mismatch (a .npy of a rank other than 3 or 4).
+nlohmann::json data_file_spec(const Input& in);
 
 /// Refuse an output format the command does not write (usage_error), then an output
 /// path that cannot be written (error file_unwritable), before any work.
@@ -49,9 +101,9 @@ void check_eval_output(const std::filesystem::path& out);
 void check_info_output(const std::filesystem::path& out);
 
 /// Refuse (error too_large) an evaluation grid whose .npy file cannot fit on the
-/// output's disk (it is written a block at a time) or whose .csv text cannot be made
-/// in memory. `dims` is 2 for a K×K grid, 3 for K×K×K.
-void require_eval_room(std::size_t k, const std::filesystem::path& out, int dims = 2);
+/// output's disk (it is written a block at a time, and a block must fit in memory)
+/// or whose .csv text cannot be made in memory.
+void require_eval_room(const Resolution& grid, const std::filesystem::path& out);
 void require_mesh_memory(const Resolution& res);
 
 /// Refuse (usage_error) a resolution or a mesh format that does not fit the kind of
@@ -61,19 +113,24 @@ void check_mesh_kind(const io::Construction& c, const std::filesystem::path& out
 /// The outputs, from a built construction.
 void write_build(const io::Construction& c, const std::filesystem::path& out);
 void write_mesh(const io::Construction& c, const std::filesystem::path& out, const Resolution& res);
-void write_eval(const io::Construction& c, const std::filesystem::path& out, std::size_t k);
+/// `grid`: the points along u and v (and w, for a volume).
+void write_eval(const io::Construction& c, const std::filesystem::path& out, const Resolution& grid);
 nlohmann::ordered_json info(const io::Construction& c);
 
 /// Builds a spec file, showing progress on a terminal. `keep_data` false: without the
 /// copy of the data points that only `info`'s error check uses.
 io::Construction build_spec(const std::filesystem::path& spec, bool keep_data = true);
 
+/// Builds SPEC as given: a spec file, or the spec of a data file (data_file_spec),
+/// with data files found in that file's directory.
+io::Construction build_input(const Input& in, bool keep_data = true);
+
 /// The subcommands; each returns the exit status of success (0).
-int build_command(const std::filesystem::path& spec, const std::filesystem::path& out);
+int build_command(const Input& in, const std::filesystem::path& out);
 /// `res` empty: the default resolution of the construction's kind.
-int mesh_command(const std::filesystem::path& spec, const std::filesystem::path& out, std::string_view res);
-int eval_command(const std::filesystem::path& spec, const std::filesystem::path& out, std::string_view grid);
-int info_command(const std::filesystem::path& spec, const std::optional<std::filesystem::path>& out);
+int mesh_command(const Input& in, const std::filesystem::path& out, std::string_view res);
+int eval_command(const Input& in, const std::filesystem::path& out, std::string_view grid);
+int info_command(const Input& in, const std::optional<std::filesystem::path>& out);
 int demo_command(const std::filesystem::path& dir);
 
 /// Prints the warnings of a construction (ignored fields) on stderr.

@@ -476,9 +476,8 @@ std::string short_number(double v) {
 
 int demo_command(const fs::path& requested) {
   const fs::path dir = prepare(requested);
-  constexpr std::size_t eval_grid = 33;
+  constexpr Resolution eval_grid{33, 33, 0}, volume_eval_grid{17, 17, 17};
   const Resolution res = default_surface_resolution, volume_res = default_volume_resolution;
-  constexpr std::size_t volume_eval_grid = 17;
 
   std::size_t files = 0;
   std::string summary;

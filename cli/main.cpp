@@ -1,4 +1,4 @@
-// The interpatch command (SPEC section 5): build, mesh, eval, info, demo.
+// The interpatch command: build, mesh, eval, info, demo.
 // Exit status: 0 ok, 2 bad usage, 3 invalid input, 4 files, 5 too large, 1 else;
 // every failure prints exactly one line on stderr, "interpatch: <message>".
 
@@ -19,6 +19,10 @@
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/threads.hpp"
 
+#ifndef INTERPATCH_VERSION
+#error "INTERPATCH_VERSION (the CMake project version) is defined by CMakeLists.txt"
+#endif
+
 namespace {
 
 // One line, whatever the message holds.
@@ -35,32 +39,64 @@ int main(int argc, char** argv) {
   namespace cli = interpatch::cli;
 
   CLI::App app{"interpatch: interpolating curves, surfaces and solids.\n"
-               "Reads a SPEC.json describing a construction; writes its exact B-spline form,\n"
-               "meshes, evaluation grids and a description.",
+               "Reads SPEC, a spec (.json) describing a construction, or a grid of points to interpolate\n"
+               "(.npy, or .csv with --shape); writes its exact B-spline form, meshes, evaluation grids\n"
+               "and a description. The spec format: docs/spec-format.md",
                "interpatch"};
   app.require_subcommand(1);
-  app.footer("Exit status: 0 ok, 2 bad usage, 3 invalid input, 4 unreadable/unwritable file, 5 too large, 1 other.\n"
-             "Outputs replace files atomically; INTERPATCH_SYNC=1 also waits until they are on the disk.");
+  app.set_version_flag("--version", "interpatch " INTERPATCH_VERSION, "Print the version and exit");
+  // Set before the subcommands are added: they inherit it, and add their own lines.
+  const std::string footer =
+      "Exit status: 0 ok, 2 bad usage, 3 invalid input, 4 unreadable/unwritable file, 5 too large, 1 other.\n"
+      "Outputs replace files atomically; INTERPATCH_SYNC=1 also waits until they are on the disk.";
+  app.footer(footer);
 
-  std::string spec, out, res, grid, demo_dir = "interpatch-demo";
+  std::string spec, shape, out, res, grid, demo_dir = "interpatch-demo";
 
-  CLI::App* build = app.add_subcommand("build", "Write the exact B-spline form of SPEC.json (.json)");
-  build->add_option("SPEC", spec, "The spec file (SPEC.json)")->required();
-  build->add_option("-o,--output", out, "Output file: .json")->required();
+  // SPEC and --shape, the same for the four commands that read a construction.
+  const auto add_input = [&](CLI::App* command) {
+    command->add_option("SPEC", spec,
+                        "A spec .json (the format: docs/spec-format.md) or a .npy/.csv data file of points to\n"
+                        "interpolate: .npy of shape (n,m,3) (a surface) or (n,m,l,3) (a volume); .csv with --shape")
+        ->required();
+    command->add_option("--shape", shape,
+                        "The grid of a .csv SPEC: NxM (a surface) or NxMxL (a volume), one x,y,z line per point\n"
+                        "in C order (the last index fastest)");
+    command->footer("SPEC as a data file stands for {\"type\": \"interpolate\", \"points\": {\"npy\": FILE}} (or\n"
+                    "{\"csv\": FILE, \"shape\": [N, M]}; \"interpolate_volume\" for 3-D grids) with default options.\n"
+                    "The spec format: docs/spec-format.md\n\n" +
+                    footer);
+  };
 
-  CLI::App* mesh = app.add_subcommand("mesh", "Tessellate the construction (.obj .stl .ply .vtk .vts .xyz)");
-  mesh->add_option("SPEC", spec, "The spec file (SPEC.json)")->required();
-  mesh->add_option("-o,--output", out, "Output file: .obj, .stl, .ply, .vtk, .vts or .xyz (Plot3D); volumes: .vtk, .vts or .xyz")->required();
+  CLI::App* build = app.add_subcommand("build", "Write the exact B-spline form (.json, .step/.stp, .igs/.iges)");
+  add_input(build);
+  build->add_option("-o,--output", out,
+                    "Output file: .json (a bspline_surface or bspline_volume spec), .step or .stp (STEP AP214),\n"
+                    ".igs or .iges (IGES 5.3)")
+      ->required();
+
+  CLI::App* mesh = app.add_subcommand("mesh", "Tessellate the construction (surfaces .obj .stl .ply .vtk .vts .xyz; volumes .vtk .vts .xyz)");
+  add_input(mesh);
+  mesh->add_option("-o,--output", out,
+                   "Output file: .obj, .stl, .ply, .vtk, .vts or .xyz (Plot3D); volumes: .vtk, .vts or .xyz\n"
+                   "(with the Jacobian determinant; beside .xyz in a .f file)")
+      ->required();
   mesh->add_option("--res", res,
                    "Vertices along u and v, NUxNV (default 64x64); for a volume NUxNVxNW (default 33x33x33)");
 
-  CLI::App* eval = app.add_subcommand("eval", "Evaluate on a uniform KxK grid over [0,1]^2 (KxKxK over [0,1]^3 for volumes; .npy or .csv)");
-  eval->add_option("SPEC", spec, "The spec file (SPEC.json)")->required();
-  eval->add_option("--grid", grid, "K: points along each direction")->required();
-  eval->add_option("-o,--output", out, "Output file: .npy (K,K,3) or (K,K,K,3), u index first, or .csv (u,v[,w],x,y,z)")->required();
+  CLI::App* eval = app.add_subcommand("eval", "Evaluate on a uniform grid over [0,1]^2 or, for volumes, [0,1]^3 (.npy, .csv)");
+  add_input(eval);
+  eval->add_option("--grid", grid,
+                   "Points along each direction: K (KxK, or KxKxK for a volume), NUxNV (a surface)\n"
+                   "or NUxNVxNW (a volume)")
+      ->required();
+  eval->add_option("-o,--output", out,
+                   "Output file: .npy of shape (NU,NV,3) or (NU,NV,NW,3), u index first, float64;\n"
+                   "or .csv, one row per point in the same order, header u,v,x,y,z or u,v,w,x,y,z")
+      ->required();
 
-  CLI::App* info = app.add_subcommand("info", "Describe the construction as one JSON object on stdout");
-  info->add_option("SPEC", spec, "The spec file (SPEC.json)")->required();
+  CLI::App* info = app.add_subcommand("info", "Describe the construction as one JSON object (stdout, or .json)");
+  add_input(info);
   std::optional<std::string> info_out;
   info->add_option("-o,--output", info_out, "Write the object to this .json file instead of stdout");
 
@@ -89,15 +125,16 @@ int main(int argc, char** argv) {
     interpatch::io::set_durable_writes(true);
 
   try {
-    if (*build) return cli::build_command(spec, out);
-    if (*mesh) return cli::mesh_command(spec, out, res);
-    if (*eval) return cli::eval_command(spec, out, grid);
+    if (*demo) return cli::demo_command(demo_dir);
+    const cli::Input input = cli::parse_input(spec, shape);
+    if (*build) return cli::build_command(input, out);
+    if (*mesh) return cli::mesh_command(input, out, res);
+    if (*eval) return cli::eval_command(input, out, grid);
     if (*info) {
       std::optional<std::filesystem::path> o;
       if (info_out) o = *info_out;
-      return cli::info_command(spec, o);
+      return cli::info_command(input, o);
     }
-    if (*demo) return cli::demo_command(demo_dir);
     return fail_with(2, "no command given (see interpatch --help)");
   } catch (const interpatch::error& e) {
     return fail_with(cli::exit_status(e.code()), e.what());

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +21,7 @@
 #include "cli_runner.hpp"
 #include "cli_specs.hpp"
 #include "interpatch/evaluate.hpp"
+#include "interpatch/io/npy.hpp"
 #include "interpatch/io/spec.hpp"
 #include "temp_dir.hpp"
 #include "test_util.hpp"
@@ -44,11 +46,13 @@ using Result = test::CliResult;
 
 // A fresh working directory per test: listing it shows only what the command wrote.
 class CliTest : public ::testing::Test {
- protected:
+ public:
   [[nodiscard]] fs::path work() const { return dir_.path(); }
   [[nodiscard]] fs::path at(const std::string& name) const { return work() / name; }
 
   Result run(const std::vector<std::string>& args) const { return test::run_cli(work(), args); }
+
+ protected:
 
   // A valid 4x5 grid spec, written to NAME.
   void write_grid_spec(const std::string& name, unsigned seed = 1, std::size_t nu = 4, std::size_t nv = 5) const {
@@ -185,6 +189,32 @@ std::size_t first_difference(std::span<const double> got, std::span<const double
   return got.size();
 }
 
+// What evaluate() gives for construction c on linspace(0, 1, n) along each direction
+// (two counts for a surface, three for a volume): the doubles of a C-order array.
+std::vector<double> library_evaluation(const io::Construction& c, const std::vector<std::size_t>& counts) {
+  std::vector<std::vector<double>> t;
+  for (const std::size_t n : counts) t.push_back(linspace(0, 1, n));
+  const auto doubles = [](const Vec3* p, std::size_t n) { return std::vector<double>(&p->x, &p->x + 3 * n); };
+  if (counts.size() == 3) {
+    const PointGrid3 g = io::volume_evaluator(c).evaluate(t[0], t[1], t[2]);
+    return doubles(g.data(), g.size());
+  }
+  const PointGrid g = io::evaluator(c).evaluate(t.at(0), t.at(1));
+  return doubles(g.data(), g.size());
+}
+
+// An evaluation .npy is the library's evaluation at the grid's counts: its shape
+// (counts..., 3), and every value bit for bit.
+void expect_npy_is_evaluation(const std::string& bytes, const io::Construction& c, std::vector<std::size_t> counts) {
+  const Npy n = parse_npy(bytes);
+  const std::vector<double> expected = library_evaluation(c, counts);
+  counts.push_back(3);
+  EXPECT_EQ(n.shape, counts);
+  ASSERT_EQ(n.data.size(), expected.size());
+  const std::size_t i = first_difference(n.data, expected);
+  EXPECT_EQ(i, expected.size()) << "value " << i << " is " << n.data[i] << ", evaluate() gives " << expected[i];
+}
+
 TEST_F(CliTest, EvalToNpyInBlocksIsTheLibrarysEvaluateBitForBit) {
   // eval evaluates and writes .npy about 2^17 points at a time along u
   // (cli/commands.cpp): K = 700 is 4 blocks of 187 rows of a surface, the last one
@@ -200,26 +230,78 @@ TEST_F(CliTest, EvalToNpyInBlocksIsTheLibrarysEvaluateBitForBit) {
     SCOPED_TRACE(spec.filename().string());
     const Result r = run({"eval", spec.string(), "--grid", std::to_string(k), "-o", "g.npy"});
     ASSERT_EQ(r.status, 0) << r.err;
-    const Npy n = parse_npy(read_file(at("g.npy")));
     const io::Construction c = io::build_file(spec);
-    const std::vector<double> t = linspace(0, 1, k);
-    std::vector<std::size_t> shape;
-    std::span<const double> expected;
-    PointGrid surface_points;
-    PointGrid3 volume_points;
-    if (io::is_volume(c)) {
-      volume_points = io::volume_evaluator(c).evaluate(t, t, t);
-      shape = {k, k, k, 3};
-      expected = {&volume_points.data()->x, 3 * volume_points.size()};
-    } else {
-      surface_points = io::evaluator(c).evaluate(t, t);
-      shape = {k, k, 3};
-      expected = {&surface_points.data()->x, 3 * surface_points.size()};
+    expect_npy_is_evaluation(read_file(at("g.npy")), c, std::vector<std::size_t>(io::is_volume(c) ? 3 : 2, k));
+  }
+}
+
+TEST_F(CliTest, EvalGridOfCountsPerDirectionIsTheLibrarysEvaluateBitForBit) {
+  // --grid NUxNV and NUxNVxNW: the .npy has shape (NU, NV, 3) or (NU, NV, NW, 3), u
+  // index first. 300x1000 is three blocks of 131 rows (the last one of 38), 90x40x50
+  // two blocks of 65 slabs, so the blocks follow the rows of unequal counts.
+  write_file(at("grid.json"), grid_spec(6, 12, 9).dump());
+  const fs::path examples = INTERPATCH_EXAMPLES;
+  struct Case {
+    fs::path spec;
+    std::string grid;
+    std::vector<std::size_t> counts;
+  };
+  const std::vector<Case> cases{{at("grid.json"), "7x13", {7, 13}},
+                                {at("grid.json"), "300X1000", {300, 1000}},
+                                {examples / "coons.json", "2x9", {2, 9}},
+                                {examples / "coons_volume.json", "5x6x7", {5, 6, 7}},
+                                {examples / "annular_sector.json", "90x40X50", {90, 40, 50}}};
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.spec.filename().string() + " --grid " + k.grid);
+    const Result r = run({"eval", k.spec.string(), "--grid", k.grid, "-o", "g.npy"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(r.err.empty()) << r.err;
+    expect_npy_is_evaluation(read_file(at("g.npy")), io::build_file(k.spec), k.counts);
+  }
+}
+
+json box_trilinear();
+
+// The rows of a .csv: its header line, then each line's numbers.
+std::pair<std::string, std::vector<std::vector<double>>> read_csv(const std::string& text) {
+  std::istringstream in(text);
+  std::string header, line;
+  std::getline(in, header);
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::stringstream ss(line);
+    std::string f;
+    while (std::getline(ss, f, ',')) row.push_back(std::strtod(f.c_str(), nullptr));
+    rows.push_back(row);
+  }
+  return {header, rows};
+}
+
+TEST_F(CliTest, EvalGridOfCountsPerDirectionToCsvIsOneRowPerPointInCOrder) {
+  // Parameters, then the point, 17 digits that read back to the library's value.
+  write_file(at("grid.json"), grid_spec(7, 5, 6).dump());
+  write_file(at("box.json"), box_trilinear().dump());
+  struct Case {
+    std::string spec, grid, header;
+    std::vector<std::size_t> counts;
+  };
+  for (const Case& k : {Case{"grid.json", "3x4", "u,v,x,y,z", {3, 4}}, Case{"box.json", "2x3x4", "u,v,w,x,y,z", {2, 3, 4}}}) {
+    SCOPED_TRACE(k.spec + " --grid " + k.grid);
+    const Result run_result = run({"eval", k.spec, "--grid", k.grid, "-o", "g.csv"});
+    ASSERT_EQ(run_result.status, 0) << run_result.err;
+    const auto [header, rows] = read_csv(read_file(at("g.csv")));
+    EXPECT_EQ(header, k.header);
+    const std::vector<double> expected = library_evaluation(io::build_file(at(k.spec)), k.counts);
+    const std::size_t dims = k.counts.size();
+    ASSERT_EQ(rows.size(), expected.size() / 3);
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      ASSERT_EQ(rows[r].size(), dims + 3) << "row " << r;
+      // Row r is point r in C order: its index along each axis, last axis fastest.
+      for (std::size_t a = dims, rest = r; a-- > 0; rest /= k.counts[a])
+        EXPECT_EQ(rows[r][a], linspace(0, 1, k.counts[a])[rest % k.counts[a]]) << "row " << r << ", axis " << a;
+      for (std::size_t c = 0; c < 3; ++c) EXPECT_EQ(rows[r][dims + c], expected[3 * r + c]) << "row " << r;
     }
-    EXPECT_EQ(n.shape, shape);
-    ASSERT_EQ(n.data.size(), expected.size());
-    const std::size_t i = first_difference(n.data, expected);
-    EXPECT_EQ(i, expected.size()) << "value " << i << " is " << n.data[i] << ", evaluate() gives " << expected[i];
   }
 }
 
@@ -357,6 +439,52 @@ TEST_F(CliTest, HelpExits0AndListsTheCommands) {
   EXPECT_EQ(help.status, 0);
   EXPECT_NE(help.out.find("build"), std::string::npos);
   EXPECT_NE(help.out.find("INTERPATCH_SYNC=1"), std::string::npos) << help.out;  // the one environment switch
+}
+
+// The project version, as the top-level CMakeLists.txt declares it.
+std::string project_version() {
+  const std::string cmake = read_file(fs::path(INTERPATCH_EXAMPLES).parent_path() / "CMakeLists.txt");
+  const std::string key = "project(interpatch VERSION ";
+  const auto at = cmake.find(key);
+  if (at == std::string::npos) {
+    ADD_FAILURE() << "CMakeLists.txt declares no project version";
+    return "";
+  }
+  const auto from = at + key.size();
+  return cmake.substr(from, cmake.find_first_of(" )\n", from) - from);
+}
+
+TEST_F(CliTest, VersionPrintsTheProjectVersion) {
+  const Result r = run({"--version"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, "interpatch " + project_version() + "\n");
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST_F(CliTest, HelpOfEveryCommandNamesTheSpecFormatAndTheFormatsItWrites) {
+  struct Case {
+    std::vector<std::string> args;
+    std::vector<std::string> formats;
+  };
+  const std::vector<Case> cases{
+      {{"--help"}, {".json", ".step/.stp", ".igs/.iges", ".obj .stl .ply .vtk .vts .xyz", "volumes .vtk .vts .xyz", ".npy", ".csv"}},
+      {{"build", "--help"}, {".json", ".step", ".stp", ".igs", ".iges"}},
+      {{"mesh", "--help"}, {".obj", ".stl", ".ply", ".vtk", ".vts", ".xyz"}},
+      {{"eval", "--help"}, {".npy", ".csv"}},
+      {{"info", "--help"}, {"stdout", ".json"}},
+  };
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.args.front());
+    const Result r = run(k.args);
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("docs/spec-format.md"), std::string::npos) << r.out;
+    for (const std::string& f : k.formats) EXPECT_NE(r.out.find(f), std::string::npos) << f << " in " << r.out;
+    if (k.args.size() > 1) {  // SPEC may be a data file, and --shape says how to read a .csv
+      EXPECT_NE(r.out.find(".npy/.csv"), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find("--shape"), std::string::npos) << r.out;
+    }
+    for (const char* gone : {"SPEC section", "seed"}) EXPECT_EQ(r.out.find(gone), std::string::npos) << gone;
+  }
 }
 
 TEST_F(CliTest, UnknownFieldIsAWarningNotAFailure) {
@@ -506,6 +634,130 @@ TEST_F(CliTest, FoldedTrilinearVolumeReportsInvertedCells) {
   EXPECT_GT(j["jacobian"]["inverted_points"].get<int>(), 0);
   EXPECT_LE(j["jacobian"]["min_determinant"].get<double>(), 0.0);
   EXPECT_FALSE(j["jacobian"]["inverted_at"].empty());
+}
+
+// --- a data file in place of the spec ------------------------------------------------------
+
+void write_npy_points(const fs::path& p, const std::vector<std::size_t>& grid_shape, const std::vector<Vec3>& points) {
+  std::vector<std::size_t> shape = grid_shape;
+  shape.push_back(3);
+  io::write_npy(p, shape, std::span<const double>(&points.data()->x, 3 * points.size()));
+}
+
+void write_csv_points(const fs::path& p, const std::vector<Vec3>& points) {
+  std::string text = "x,y,z\n";
+  char line[128];
+  for (const Vec3& q : points) {
+    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g\n", q.x, q.y, q.z);
+    text += line;
+  }
+  write_file(p, text);
+}
+
+// Points i, j[, k] along x, y[, z] with noise below half the spacing, in C order.
+std::vector<Vec3> noisy_grid_points(const std::vector<std::size_t>& shape, unsigned seed) {
+  auto g = test::rng(seed);
+  std::size_t n = 1;
+  for (const std::size_t e : shape) n *= e;
+  std::vector<Vec3> points;
+  for (std::size_t r = 0; r < n; ++r) {
+    Vec3 p{0, 0, 0};
+    for (std::size_t a = shape.size(), rest = r; a-- > 0; rest /= shape[a]) p[static_cast<int>(a)] = static_cast<double>(rest % shape[a]);
+    points.push_back(p + test::random_point(g, 0.3));
+  }
+  return points;
+}
+
+// What info prints, without the timings, which differ from run to run.
+json description(const Result& r) {
+  EXPECT_EQ(r.status, 0) << r.err;
+  json j = json::parse(r.out);
+  j.erase("timings");
+  return j;
+}
+
+// Runs eval, mesh, build and info on `data` (a data file and --shape when it takes
+// one) and on `spec` (a spec naming that file), and expects the same outputs: the
+// same bytes from eval, mesh and build, the same description from info. Returns
+// the description.
+json expect_data_file_acts_as_spec(const CliTest& t, const std::vector<std::string>& data, const std::string& spec,
+                                   bool volume) {
+  const auto with = [](std::vector<std::string> args, const std::vector<std::string>& input) {
+    args.insert(args.begin() + 1, input.begin(), input.end());
+    return args;
+  };
+  const std::vector<std::vector<std::string>> commands{
+      {"eval", "--grid", "6", "-o", "OUT.npy"},
+      {"eval", "--grid", volume ? "3x4x5" : "7x5", "-o", "OUT.csv"},
+      {"mesh", "--res", volume ? "4x5x6" : "9x7", "-o", volume ? "OUT.vts" : "OUT.obj"},
+      {"build", "-o", "OUT.json"},
+  };
+  for (const auto& command : commands) {
+    SCOPED_TRACE(command.front() + " " + command[command.size() - 1]);
+    const std::string out = command.back();
+    std::vector<std::string> from_data = with(command, data), from_spec = with(command, {spec});
+    from_data.back() = "data-" + out;
+    from_spec.back() = "spec-" + out;
+    const Result a = t.run(from_data), b = t.run(from_spec);
+    EXPECT_EQ(a.status, 0) << a.err;
+    EXPECT_EQ(b.status, 0) << b.err;
+    EXPECT_TRUE(a.err.empty()) << a.err;
+    if (a.status != 0 || b.status != 0) continue;
+    const std::string got = read_file(t.at("data-" + out));
+    EXPECT_GT(got.size(), 100u);
+    EXPECT_TRUE(got == read_file(t.at("spec-" + out))) << out << " differs";
+  }
+  const json a = description(t.run(with({"info"}, data)));
+  EXPECT_EQ(a, description(t.run({"info", spec})));
+  return a;
+}
+
+TEST_F(CliTest, NpyOrCsvInPlaceOfTheSpecActsAsItsSpec) {
+  // In a directory of their own: the data file is found beside itself, as a spec
+  // beside it names it. The extension decides, in any case.
+  fs::create_directory(at("data"));
+  const std::vector<Vec3> points = noisy_grid_points({4, 5}, 11);
+  write_npy_points(at("data/grid.npy"), {4, 5}, points);
+  write_npy_points(at("data/GRID.NPY"), {4, 5}, points);
+  write_csv_points(at("data/grid.csv"), points);
+  write_file(at("data/npy.json"), R"({"type": "interpolate", "points": {"npy": "grid.npy"}})");
+  write_file(at("data/upper.json"), R"({"type": "interpolate", "points": {"npy": "GRID.NPY"}})");
+  write_file(at("data/csv.json"), R"({"type": "interpolate", "points": {"csv": "grid.csv", "shape": [4, 5]}})");
+  for (const auto& [data, spec] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"data/grid.npy"}, "data/npy.json"},
+           {{"data/GRID.NPY"}, "data/upper.json"},
+           {{"data/grid.csv", "--shape", "4x5"}, "data/csv.json"}}) {
+    SCOPED_TRACE(data.front());
+    const json info = expect_data_file_acts_as_spec(*this, data, spec, false);
+    EXPECT_EQ(info["type"], "interpolate");
+    EXPECT_EQ(info["kind"], "surface");
+    EXPECT_EQ(info["control_points"], json({4, 5}));
+    EXPECT_LT(info["max_data_error"]["relative"].get<double>(), 1e-12);
+  }
+}
+
+TEST_F(CliTest, FourDimensionalNpyOrCsvOfThreeCountsIsAVolume) {
+  fs::create_directory(at("data"));
+  const std::vector<Vec3> points = noisy_grid_points({3, 4, 5}, 12);
+  write_npy_points(at("data/solid.npy"), {3, 4, 5}, points);
+  write_csv_points(at("data/solid.csv"), points);
+  write_file(at("data/npy.json"), R"({"type": "interpolate_volume", "points": {"npy": "solid.npy"}})");
+  write_file(at("data/csv.json"), R"({"type": "interpolate_volume", "points": {"csv": "solid.csv", "shape": [3, 4, 5]}})");
+  for (const auto& [data, spec] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"data/solid.npy"}, "data/npy.json"}, {{"data/solid.csv", "--shape", "3x4x5"}, "data/csv.json"}}) {
+    SCOPED_TRACE(data.front());
+    const json info = expect_data_file_acts_as_spec(*this, data, spec, true);
+    EXPECT_EQ(info["type"], "interpolate_volume");
+    EXPECT_EQ(info["kind"], "volume");
+    EXPECT_EQ(info["control_points"], json({3, 4, 5}));
+    // --grid K is KxKxK for the volume.
+    std::vector<std::string> eval{"eval"};
+    eval.insert(eval.end(), data.begin(), data.end());
+    eval.insert(eval.end(), {"--grid", "4", "-o", "k.npy"});
+    const Result r = run(eval);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(parse_npy(read_file(at("k.npy"))).shape, std::vector<std::size_t>({4, 4, 4, 3}));
+  }
 }
 
 #else
