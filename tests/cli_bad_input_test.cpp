@@ -126,6 +126,13 @@ std::vector<Row> rows() {
       // invalid JSON, types, fields
       {"InvalidJson", {{grid_file, "{\"type\": \"interpolate\",\n  \"points\": [[[0,0,0]],]\n}"}},
        {"build", grid_file, "-o", "out.json"}, 3, R"(s\.json:2:24: invalid JSON)", errc::invalid_json},
+      // bytes that are not text, and nesting beyond reason: quoted short and printable
+      {"BinarySpec", {{grid_file, std::string("\x89PNG\r\n\x1a\n\0\0\0\rIHDR\xff\xfe", 18) + std::string(5000, '\x01')}},
+       {"info", grid_file}, 3, R"(s\.json:1:1: invalid JSON: .*\\x89)", errc::invalid_json},
+      {"DeeplyNestedPoints",
+       {{grid_file, R"({"type": "interpolate", "points": )" + std::string(100000, '[') + std::string(100000, ']') + "}"}},
+       {"build", grid_file, "-o", "out.json"}, 3, R"(/points/0/0/0/0/0/0/.*\.\.\..*/0/0: empty list)",
+       errc::too_few_points},
       {"UnknownType", {{grid_file, R"({"type": "coonz"})"}}, {"build", grid_file, "-o", "out.json"}, 3,
        R"(/type: unknown type "coonz"; known types: .*interpolate)", errc::unknown_type},
       {"MissingField", {{grid_file, R"({"type": "interpolate", "degree": 3})"}},
@@ -438,6 +445,12 @@ TEST_P(BadInput, OneLineNamingPlaceAndSizeAndNothingWritten) {
 
     test::expect_one_line_error(r, row.status, {});
     EXPECT_TRUE(std::regex_search(r.err, std::regex(row.pattern))) << "'" << r.err << "' does not match " << row.pattern;
+    // A message a person can read whatever the input: printable ASCII (user text is
+    // quoted with \xNN escapes) and short (a 100000-deep document is not echoed).
+    EXPECT_TRUE(std::all_of(r.err.begin(), r.err.end() - (r.err.empty() ? 0 : 1),
+                            [](char c) { return c >= 0x20 && c < 0x7f; }))
+        << "not printable: '" << r.err << "'";
+    EXPECT_LE(r.err.size(), 1000u) << r.err.substr(0, 300);
     // Nothing created, removed or changed: no output, no temporary file, no directory.
     EXPECT_EQ(snapshot(dir), before);
 
