@@ -2,16 +2,25 @@
 # Each installs what is missing from Debian's packages first.
 
 SHELL := /bin/bash
-# OpenCASCADE reads back the STEP and IGES files (tests) and, with SISL, runs the
-# side-by-side benchmarks; clang's libFuzzer (and its OpenMP) runs the fuzz targets; matplotlib plots.
-DEBS := cmake ninja-build g++ python3 libeigen3-dev liblapack-dev libcli11-dev nlohmann-json3-dev \
+# What each package is for (the README's "Dependencies" says the same):
+#   cmake ninja-build g++            the build (C++20, CMake presets)
+#   libcli11-dev                     the command line's option parser
+#   nlohmann-json3-dev               specs and JSON output (the io library only; the core needs none)
+#   libgtest-dev libgmock-dev        the tests;  libbenchmark-dev: make bench
+#   python3 python3-numpy            the reference-data script and the read-back checks
+#   python3-vtk9                     VTK's own readers read back the .vts/.vtk/.xyz files interpatch writes
+#   python3-matplotlib               make bench draws docs/bench_interpolation.png
+#   libocct-*-dev                    OpenCASCADE reads back the STEP and IGES files (tests) and races us (make bench)
+#   libsisl-dev                      SISL races us in make bench
+#   clang libclang-rt-14-dev libomp-14-dev   libFuzzer (with its OpenMP) runs the fuzz targets of make test
+DEBS := cmake ninja-build g++ python3 libcli11-dev nlohmann-json3-dev \
         libgtest-dev libgmock-dev libbenchmark-dev python3-numpy python3-vtk9 python3-matplotlib \
         libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
         libocct-foundation-dev libsisl-dev clang libclang-rt-14-dev libomp-14-dev
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
-.PHONY: all deps build demo test test-release test-asan test-fuzz fuzz fuzz-build bench clean
+.PHONY: all deps build install demo test test-release test-asan test-fuzz fuzz fuzz-build bench clean
 
 all: build
 
@@ -28,6 +37,12 @@ deps:
 build: deps
 	cmake --preset release
 	cmake --build --preset release -j $(JOBS)
+
+# The library (interpatch::core, interpatch::io), its headers, CMake package and
+# pkg-config files, and the interpatch command, under PREFIX (sudo for /usr/local).
+PREFIX ?= /usr/local
+install: build
+	cmake --install build/release --prefix $(PREFIX)
 
 demo: build
 	./build/release/interpatch demo -o demo-output

@@ -1,5 +1,5 @@
 // Timings of bicubic grid interpolation and of grid evaluation, each next to a
-// memcpy of the same bytes: SPEC §7 holds the work to the memory-bandwidth limit, so
+// memcpy of the same bytes: the speed target holds the work to the memory-bandwidth limit, so
 // the ratio to a memcpy says how far a call is from it. tools/bench_report.py turns
 // the JSON output into the tables of docs/BENCHMARKS.md.
 //

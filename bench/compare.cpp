@@ -1,5 +1,5 @@
 // bench/compare: interpatch, OpenCASCADE and SISL side by side on the same data in
-// one run, each next to a memcpy of the same bytes (SPEC §7).
+// one run, each next to a memcpy of the same bytes.
 //
 // Jobs (each selectable with --jobs):
 //   interpolate  bicubic interpolation of N x N terrain grids (bench/terrain.hpp)
@@ -587,13 +587,13 @@ void job_interpolate(const Options& o) {
         occt = {n, t, occt.exponent};
       }
     }
-    // SPEC §7 measures the interpolation against a memcpy of its input plus its
+    // The speed target measures the interpolation against a memcpy of its input plus its
     // output: the data points and the control points, N² points each.
     measure_memcpy(o, "interpolate", n, 2 * n * n * sizeof(Vec3));
   }
 }
 
-// SPEC §7 asks for a cost linear in the points: t(2N × 2N) / t(N × N) ≤ 4.4 at
+// The speed target asks for a cost linear in the points: t(2N × 2N) / t(N × N) ≤ 4.4 at
 // N = 1024. The rows above time each size minutes apart, and on a shared machine the
 // memory bandwidth left to this process changes in between; here the two sizes take
 // turns, run by run (moved in, the copy made before the clock starts), so that both

@@ -380,9 +380,9 @@ std::vector<Example> examples() {
                  {"degree", {5, 5}},
                  {"points", grid_json(saddle())}},
                 nullptr, "", false});
-  ex.push_back({"bilinear", "seed 000 Example 6-9: Q(0.5, 0.5) = (0.5, 0.5, 0.5)",
+  ex.push_back({"bilinear", "Rogers & Adams Example 6-9: Q(0.5, 0.5) = (0.5, 0.5, 0.5)",
                 {{"type", "bilinear"},
-                 {"comment", "The hyperbolic paraboloid of seed 000, Example 6-9."},
+                 {"comment", "The hyperbolic paraboloid of Rogers & Adams, Mathematical Elements for Computer Graphics, Example 6-9."},
                  {"p00", {0, 0, 1}},
                  {"p01", {1, 1, 1}},
                  {"p10", {1, 0, 0}},

@@ -144,7 +144,7 @@ namespace {
 
 // ------------------------------------------------------------ tensor grids
 //
-// Interpolation through a grid (seed 003) streams the grid three times and keeps no
+// Interpolation through a grid streams the grid three times and keeps no
 // grid-sized temporary (fresh pages cost more than the arithmetic on them):
 //  1. chord pass: finite check; along every axis inside a row (the slice of one
 //     index along u: a row of a surface, a plane of a volume) each line's chords
@@ -478,7 +478,7 @@ detail::BandedLU factor_axis(const KnotVector& knots, std::span<const double> pa
   }
 }
 
-// The tensor-product interpolation behind surfaces and volumes (seed 003), in the
+// The tensor-product interpolation behind surfaces and volumes, in the
 // three passes described above. The data become the control points.
 template <std::size_t Rank>
 GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional<int>, Rank>& degree,

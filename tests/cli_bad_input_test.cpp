@@ -1,4 +1,4 @@
-// SPEC section 6 as one table: every kind of bad input, run through the real
+// Bad input as one table: every kind of bad input, run through the real
 // `interpatch` command. Each row checks the exit status, that stderr is exactly one
 // line naming the place and the size of the problem (a regex per row), that no
 // output file appears, and — run a second time over a good output file left by an

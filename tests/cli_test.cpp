@@ -1,4 +1,4 @@
-// The interpatch command as other programs use it (SPEC section 5): the real binary,
+// The interpatch command as other programs use it: the real binary,
 // run in a fresh directory, its outputs and exit statuses checked. Failures are the
 // table in cli_bad_input_test.cpp.
 

@@ -1,4 +1,4 @@
-// Results do not depend on the number of threads (SPEC section 4): the same input
+// Results do not depend on the number of threads: the same input
 // gives bit-identical output with 1, 2 and 3 OpenMP threads, for the library's
 // threaded loops and for the files the command writes. Every size below is chosen
 // above the library's threshold for starting threads (detail::parallel_min_work),

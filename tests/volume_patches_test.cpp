@@ -109,7 +109,7 @@ TEST(HermiteVolume, CornerDataAndHermiteEdges) {
           << "corner " << n << " kind " << k;
     EXPECT_LT(distance(h.derivatives(u, v, w).su, c[n].du), 1e-14 * 8);
   }
-  // Edges are the cubic Hermite curves of seed 004 eq. 1.23: S(u,j,k) = Σ_i S(i,j,k) I_i0(u) + S_u(i,j,k) I_i1(u).
+  // Edges are the cubic Hermite curves (cubic Hermite functions I_i0, I_i1): S(u,j,k) = Σ_i S(i,j,k) I_i0(u) + S_u(i,j,k) I_i1(u).
   for (double t : linspace(0, 1, 11))
     for (std::size_t jk = 0; jk < 4; ++jk) {
       const auto a = hermite_basis(t);

@@ -33,7 +33,7 @@ class Blend {
   explicit Blend(std::function<double(double, int)> f);
   /// f(t) = t.
   static Blend linear();
-  /// f(t) = α1(t) = 3t² − 2t³ (seed 004 eq. 1.24): zero slopes at both ends.
+  /// f(t) = α1(t) = 3t² − 2t³ : zero slopes at both ends.
   static Blend hermite();
 
   [[nodiscard]] double operator()(double t) const { return derivative(t, 0); }

@@ -1,6 +1,6 @@
 #pragma once
 /// @file blended_surface.hpp
-/// Surfaces made by blending curves and corner data (seed 002): the bilinear,
+/// Surfaces made by blending curves and corner data: the bilinear,
 /// ruled, Coons, Hermite (Ferguson), curve-network and Gordon surfaces are all
 ///
 ///   S(u,v) = Σ_k f_k(u) a_k(v) + Σ_l b_l(u) g_l(v) + Σ_k Σ_l c_kl f_k(u) g_l(v)

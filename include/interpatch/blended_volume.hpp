@@ -1,6 +1,6 @@
 #pragma once
 /// @file blended_volume.hpp
-/// Volumes made by blending faces, edges and corner data (seed 004): the trilinear,
+/// Volumes made by blending faces, edges and corner data: the trilinear,
 /// tricubic Hermite and transfinite (Coons) volumes are all
 ///
 ///   S(u,v,w) = Σ f_a(t_a) F(other two) + Σ c f_a(t_a) g_b(t_b) E(t_c) + Σ f(u) g(v) h(w) P

@@ -1,6 +1,6 @@
 #pragma once
 /// @file coons.hpp
-/// Coons patches from four boundary curves (seed 002): linear, with general
+/// Coons patches from four boundary curves: linear, with general
 /// blending functions, and bicubically blended with cross-boundary derivatives.
 
 #include <array>

@@ -1,7 +1,6 @@
 #pragma once
 /// @file coons_volume.hpp
-/// Transfinite (Gordon–Hall, Coons) volumes from six boundary surfaces (SPEC 3.2,
-/// 3.4; seed 004): linear or general blending, and the Hermite-blended volume that
+/// Transfinite (Gordon–Hall, Coons) volumes from six boundary surfaces : linear or general blending, and the Hermite-blended volume that
 /// also interpolates cross-boundary derivatives ("generalized Hermite interpolation").
 
 #include <optional>
@@ -79,7 +78,7 @@ struct HermiteCoonsVolumeOptions {
   std::optional<double> tolerance;
 };
 
-/// The Hermite-blended transfinite volume (SPEC 3.4; seed 004, "generalized Hermite
+/// The Hermite-blended transfinite volume ("generalized Hermite
 /// interpolation"): the Boolean sum P_u ⊕ P_v ⊕ P_w = P_u + P_v + P_w − P_uP_v −
 /// P_vP_w − P_uP_w + P_uP_vP_w of the cubic Hermite projectors
 ///

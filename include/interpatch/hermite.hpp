@@ -1,6 +1,6 @@
 #pragma once
 /// @file hermite.hpp
-/// Cubic Hermite functions (seed 004, eqs. 1.18–1.24) and piecewise cubic Hermite curves.
+/// Cubic Hermite functions  and piecewise cubic Hermite curves.
 
 #include <span>
 #include <vector>
@@ -12,7 +12,7 @@ namespace interpatch {
 
 /// The four cubic Hermite functions on [0, 1] and their derivatives:
 /// α0 = 1 − 3g² + 2g³, α1 = 3g² − 2g³, β0 = g − 2g² + g³, β1 = −g² + g³, so that
-/// r(g) = r(0) α0 + r(1) α1 + r'(0) β0 + r'(1) β1 (seed 004, eq. 1.24).
+/// r(g) = r(0) α0 + r(1) α1 + r'(0) β0 + r'(1) β1.
 struct HermiteBasis {
   double a0, a1, b0, b1;
 };

@@ -1,7 +1,7 @@
 #pragma once
 /// @file interpolate.hpp
 /// Global B-spline interpolation of curves and of grids of points, surfaces and
-/// volumes (seed 003; The NURBS Book §9.2), solved as banded systems factored once.
+/// volumes (The NURBS Book §9.2), solved as banded systems factored once.
 
 #include <optional>
 #include <span>
@@ -76,7 +76,7 @@ struct SurfaceInterpolation {
 
 /// Parameters of a grid along `axis` (0: u, 1: v): each line of points along the
 /// axis gets chord parameters; lines of zero length (a pole) are left out; the rest
-/// are averaged (seed 003).
+/// are averaged.
 /// @throws error too_few_points, not_finite, zero_chord (every line has a zero
 ///   chord at the same place, or all lines have zero length).
 [[nodiscard]] std::vector<double> grid_parameters(const PointGrid& points, int axis, Parametrization param);
@@ -119,7 +119,7 @@ struct VolumeInterpolation {
 
 /// The B-spline volume with exactly (n+1) × (m+1) × (l+1) control points through every
 /// point Q[i][j][k] of the grid (indices along u, v, w): the three-pass tensor extension
-/// of interpolate_surface (SPEC 3.5). Every line along u is interpolated, then every
+/// of interpolate_surface . Every line along u is interpolated, then every
 /// line of the result along v, then along w; each pass is one banded solve factored
 /// once, computed in place of the data.
 ///

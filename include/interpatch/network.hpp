@@ -1,6 +1,6 @@
 #pragma once
 /// @file network.hpp
-/// Surfaces through rectangular networks of curves (seed 002): piecewise Coons
+/// Surfaces through rectangular networks of curves: piecewise Coons
 /// patches (C0 with linear blending, C1 with Hermite blending) and the Gordon surface.
 
 #include <optional>
@@ -20,7 +20,7 @@ struct CurveNetwork {
 
 enum class NetworkMethod {
   coons_linear,   ///< bilinearly blended Coons patch per cell: C0 across cells
-  coons_hermite,  ///< Coons patches with cubic Hermite blending: C1 across cells (seed 002 eq. 7)
+  coons_hermite,  ///< Coons patches with cubic Hermite blending: C1 across cells (f'(0) = f'(1) = 0 makes the cells C1)
   gordon,         ///< one smooth surface: spline cardinal functions of degree min(3, count − 1)
 };
 

@@ -1,7 +1,7 @@
 #pragma once
 /// @file patches.hpp
-/// Surfaces from corners and from pairs of curves: bilinear (seed 000, eqs.
-/// 6-41/6-42), ruled (seed 002) and the bicubic Hermite (Ferguson) patch.
+/// Surfaces from corners and from pairs of curves: bilinear (Rogers & Adams, Mathematical Elements for Computer
+/// Graphics, §6-7), ruled and the bicubic Hermite (Ferguson) patch.
 
 #include <array>
 
@@ -12,7 +12,7 @@ namespace interpatch {
 /// Q(u,w) = P00(1−u)(1−w) + P01(1−u)w + P10 u(1−w) + P11 uw; p_uv names the corner
 /// at (u, v). Every isoparametric line is straight.
 ///
-/// Example (seed 000, Example 6-9):
+/// Example (Rogers & Adams, Example 6-9):
 /// @code
 ///   auto s = interpatch::bilinear({0, 0, 1}, {1, 1, 1}, {1, 0, 0}, {0, 1, 0});
 ///   interpatch::Vec3 q = s.point(0.5, 0.5);  // (0.5, 0.5, 0.5)

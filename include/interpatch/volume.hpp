@@ -1,6 +1,6 @@
 #pragma once
 /// @file volume.hpp
-/// What every trivariate volume ("body portion", seed 004) of interpatch offers:
+/// What every trivariate volume ("body portion") of interpatch offers:
 /// exact evaluation with the Jacobian, batch evaluation over parameter grids, its
 /// exact B-spline form, and the search for inverted cells (det J <= 0).
 

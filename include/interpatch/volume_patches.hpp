@@ -1,6 +1,6 @@
 #pragma once
 /// @file volume_patches.hpp
-/// Volumes from corner data (seed 004, "body portions"): the trilinear volume of 8
+/// Volumes from corner data ("body portions"): the trilinear volume of 8
 /// corners and the tricubic Hermite volume of a point frame.
 
 #include <array>
@@ -30,7 +30,7 @@ struct HermiteVolumeCorner {
   Vec3 p{}, du{}, dv{}, dw{}, duv{}, duw{}, dvw{}, duvw{};
 };
 
-/// The tricubic Hermite volume of a point frame (seed 004, eqs. 1.18–1.24 in each
+/// The tricubic Hermite volume of a point frame (cubic Hermite functions in each
 /// direction): with I_i0 = α_i and I_i1 = β_i the cubic Hermite functions,
 ///
 ///   S(u,v,w) = Σ_{ijk ∈ {0,1}³} Σ_{abc ∈ {0,1}³} I_ia(u) I_jb(v) I_kc(w) ∂^{a+b+c}S/∂u^a∂v^b∂w^c (i,j,k),

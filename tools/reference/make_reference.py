@@ -52,7 +52,7 @@ Formulas (The NURBS Book, Piegl & Tiller, 2nd ed.; seeds 003/004)
   sum_i N_{i,p}(ubar_k) P_i = Q_k, plus sum_i N'_{i,p}(0) P_i = D_0 and/or
   sum_i N'_{i,p}(1) P_i = D_n when end derivatives are given.
 * Surface interpolation through Q[p][q] (p = 0..n along u, q = 0..m along v),
-  seed 003 = tensor-product interpolation: u-parameters are the averages over
+  tensor-product interpolation: u-parameters are the averages over
   q of the parameters of the line Q[0..n][q]; v-parameters the averages over p
   of the parameters of the line Q[p][0..m]; lines of zero total length (a
   pole: all points equal) are left out of the average. Knots by averaging in
@@ -60,7 +60,7 @@ Formulas (The NURBS Book, Piegl & Tiller, 2nd ed.; seeds 003/004)
   i-th control points of all rows across u; in exact arithmetic this is the
   unique solution of the tensor-product collocation system, and the script
   checks S(u_p, v_q) == Q[p][q] exactly.
-* Cubic Hermite functions (seed 004, eq. 1.24): a0 = 1-3g^2+2g^3,
+* Cubic Hermite functions : a0 = 1-3g^2+2g^3,
   a1 = 3g^2-2g^3, b0 = g-2g^2+g^3, b1 = -g^2+g^3 and derivatives (orders 0..3).
   Piecewise Hermite curve on params t_i with h_i = t_{i+1}-t_i, g = (t-t_i)/h_i:
   C(t) = P_i a0 + P_{i+1} a1 + h_i T_i b0 + h_i T_{i+1} b1; Catmull-Rom tangents

@@ -173,7 +173,7 @@ struct PointArray {
 [[nodiscard]] PointArray points_from_json(const nlohmann::json& j, std::size_t rank,
                                           const std::filesystem::path& base_dir = {}, std::string_view pointer = "");
 
-/// Reads a curve in any of its forms (SPEC section 5) — `{"interpolate": points,
+/// Reads a curve in any of its forms (docs/spec-format.md) — `{"interpolate": points,
 /// "degree": p, "param": "chord"}`, `{"bspline": {"degree", "knots",
 /// "control_points", "weights"}}`, `{"hermite": {"points", "tangents", "params"}}`,
 /// `{"line": [A, B]}` — as a B-spline curve over [0, 1] (its own domain mapped
