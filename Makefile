@@ -4,6 +4,7 @@
 SHELL := /bin/bash
 # What each package is for (the README's "Dependencies" says the same):
 #   cmake ninja-build g++            the build (C++20, CMake presets)
+#   pkg-config                       the tests build a program against the installed .pc files
 #   libcli11-dev                     the command line's option parser
 #   nlohmann-json3-dev               specs and JSON output (the io library only; the core needs none)
 #   libgtest-dev libgmock-dev        the tests;  libbenchmark-dev: make bench
@@ -13,7 +14,7 @@ SHELL := /bin/bash
 #   libocct-*-dev                    OpenCASCADE reads back the STEP and IGES files (tests) and races us (make bench)
 #   libsisl-dev                      SISL races us in make bench
 #   clang libclang-rt-14-dev libomp-14-dev   libFuzzer (with its OpenMP) runs the fuzz targets of make test
-DEBS := cmake ninja-build g++ python3 libcli11-dev nlohmann-json3-dev \
+DEBS := cmake ninja-build g++ pkg-config python3 libcli11-dev nlohmann-json3-dev \
         libgtest-dev libgmock-dev libbenchmark-dev python3-numpy python3-vtk9 python3-matplotlib \
         libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
         libocct-foundation-dev libsisl-dev clang libclang-rt-14-dev libomp-14-dev
