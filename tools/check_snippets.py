@@ -4,7 +4,8 @@
 Every `@code ... @endcode` block of the public headers (include/interpatch/**/*.hpp,
 the leading `///` and the common indentation stripped) and every ```cpp block of
 README.md must appear as a contiguous run of lines in one of the example programs
-examples/cpp/*.cpp, which CTest builds with the project's warnings and runs. Lines
+examples/cpp/*.cpp, which CTest builds with the project's warnings and runs (a
+program not listed in examples/cpp/CMakeLists.txt is an error). Lines
 are compared with their whitespace normalised (leading and trailing whitespace
 dropped, inner runs of whitespace made one space) and blank lines left out, so
 indentation may differ, but nothing else.
@@ -100,6 +101,15 @@ def main():
                 for p in sorted((root / "examples" / "cpp").glob("*.cpp"))}
     if not programs:
         raise SystemExit(f"no example programs in {root / 'examples' / 'cpp'}")
+    # A program CMake does not know is not compiled: its snippets would count for nothing.
+    cmake = (root / "examples" / "cpp" / "CMakeLists.txt").read_text(encoding="utf-8")
+    built = {name for names in re.findall(r"set\(INTERPATCH_\w+_EXAMPLES\s+([^)]*)\)", cmake) for name in names.split()}
+    unbuilt = [p for p in programs if p.stem not in built]
+    for p in unbuilt:
+        print(f"{p}: not in a set(INTERPATCH_..._EXAMPLES ...) of examples/cpp/CMakeLists.txt, so not built",
+              file=sys.stderr)
+    for p in unbuilt:
+        del programs[p]
 
     missing = 0
     for place, lines in snippets:
@@ -120,7 +130,7 @@ def main():
             print(f"  closest: {program}, {matched} of {len(snippet)} lines in a row, then it lacks:\n"
                   f"    {differing}", file=sys.stderr)
     print(f"{len(snippets) - missing} of {len(snippets)} snippets found in examples/cpp/*.cpp")
-    return 1 if missing else 0
+    return 1 if missing or unbuilt else 0
 
 
 if __name__ == "__main__":
