@@ -19,7 +19,7 @@ namespace interpatch {
 /// Example:
 /// @code
 ///   using namespace interpatch;
-///   BSplineCurve c(KnotVector(2, {0, 0, 0, 1, 1, 1}), {{0, 0, 0}, {1, 2, 0}, {2, 0, 0}});
+///   BSplineCurve c(KnotVector::bezier(2), {{0, 0, 0}, {1, 2, 0}, {2, 0, 0}});  // a parabola
 ///   Vec3 mid = c.point(0.5);            // (1, 1, 0)
 ///   Vec3 tangent = c.derivative(0.5, 1);  // (2, 0, 0)
 /// @endcode

@@ -24,7 +24,7 @@ inline constexpr int max_volume_derivative = 3;
 /// Example:
 /// @code
 ///   using namespace interpatch;
-///   const KnotVector lin(1, {0, 0, 1, 1});
+///   const KnotVector lin = KnotVector::bezier(1);  // a straight line's knots: {0, 0, 1, 1}
 ///   PointGrid3 cp({2, 2, 2});
 ///   for (int i = 0; i < 2; ++i)
 ///     for (int j = 0; j < 2; ++j)

@@ -45,7 +45,7 @@ struct CoonsOptions {
 ///   auto s = coons(b);            // the bilinear patch of those corners
 ///   CoonsOptions o;
 ///   o.blend_u = o.blend_v = Blend::hermite();
-///   auto h = coons(b, o);         // same boundary, zero cross slopes of the blends
+///   auto h = coons(b, o);         // same boundary, blends with zero slope at 0 and 1
 /// @endcode
 /// @throws error corner_gap (naming the corner, both curves and the gap).
 [[nodiscard]] BlendedSurface coons(const CoonsBoundary& boundary, const CoonsOptions& options = {});

@@ -49,7 +49,7 @@ struct CoonsVolumeOptions {
 /// Example (the unit cube from its six bilinear faces):
 /// @code
 ///   using namespace interpatch;
-///   const KnotVector lin(1, {0, 0, 1, 1});
+///   const KnotVector lin = KnotVector::bezier(1);
 ///   auto face = [&](int axis, double t) {  // coordinate `axis` = t, the other two from the parameters
 ///     PointGrid cp({2, 2});
 ///     for (int a = 0; a < 2; ++a)

@@ -46,7 +46,7 @@ enum class TangentRule {
 /// @code
 ///   using namespace interpatch;
 ///   HermiteCurve c({{0, 0, 0}, {1, 1, 0}, {2, 0, 0}});  // params 0, 0.5, 1; Catmull–Rom tangents
-///   Vec3 p = c.point(0.25);
+///   Vec3 p = c.point(0.25);           // (0.5, 0.625, 0)
 ///   BSplineCurve b = c.to_bspline();  // the same curve, cubic, double interior knots
 /// @endcode
 class HermiteCurve {

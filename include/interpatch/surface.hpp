@@ -48,8 +48,9 @@ class Surface {
   ///   std::vector<interpatch::Vec3> rows(16 * vs.size());
   ///   for (std::size_t i = 0; i < us.size(); i += 16) {
   ///     const auto block = std::span(us).subspan(i, std::min<std::size_t>(16, us.size() - i));
-  ///     surface.evaluate_into(block, vs, std::span(rows).first(block.size() * vs.size()));
-  ///     consume(rows);
+  ///     const auto out = std::span(rows).first(block.size() * vs.size());
+  ///     surface.evaluate_into(block, vs, out);
+  ///     consume(block, out);  // S(block[a], vs[b]) is out[a * vs.size() + b]
   ///   }
   /// @endcode
   /// @throws error out_of_domain; size_mismatch when out.size() != us.size() * vs.size().

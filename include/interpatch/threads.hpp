@@ -23,8 +23,8 @@ namespace interpatch {
 /// Example:
 /// @code
 ///   int main() {
-///     interpatch::bind_threads();
-///     // ... interpatch::interpolate_surface(...) ...
+///     interpatch::bind_threads();  // first, before any of interpatch's parallel loops
+///     return run();                // the program's work: interpolate_surface(...), ...
 ///   }
 /// @endcode
 bool bind_threads() noexcept;

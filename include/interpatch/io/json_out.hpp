@@ -31,7 +31,9 @@ namespace interpatch::io {
 ///
 /// Example:
 /// @code
-///   interpatch::io::write_exact_json(std::cout, construction.exact);
+///   std::ostringstream text;
+///   interpatch::io::write_exact_json(text, *c.exact);  // a "bspline_surface" or "bspline_volume" spec
+///   auto again = interpatch::io::build(interpatch::io::parse_json(text.str()));  // the same form
 /// @endcode
 void write_exact_json(std::ostream& os, const ExactForm& exact);
 

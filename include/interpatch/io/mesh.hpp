@@ -33,8 +33,8 @@ struct SurfaceMesh {
 ///
 /// Example:
 /// @code
-///   interpatch::io::SurfaceMesh m{interpatch::PointGrid({64, 64}), {}};
-///   // ... fill m.points ...
+///   const auto t = interpatch::linspace(0, 1, 64);
+///   interpatch::io::SurfaceMesh m{surface.evaluate(t, t), {}};  // 64 × 64 vertices, no normals
 ///   interpatch::io::write_surface_mesh("patch.obj", m);
 /// @endcode
 /// @throws error wrong_type (unknown extension), size_mismatch (no points, or

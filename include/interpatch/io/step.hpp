@@ -49,7 +49,8 @@ struct StepOptions {
 /// Example:
 /// @code
 ///   interpatch::io::Construction c = interpatch::io::build_file("hemisphere.json");
-///   interpatch::io::write_step(std::cout, *c.exact, {.name = "dome"});
+///   std::ostringstream text;
+///   interpatch::io::write_step(text, *c.exact, {.name = "dome", .time_stamp = "2024-05-01T12:00:00"});
 /// @endcode
 /// @throws error file_unwritable (the stream fails).
 void write_step(std::ostream& os, const ExactForm& exact, const StepOptions& options = {});

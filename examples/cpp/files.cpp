@@ -1,0 +1,235 @@
+// Files: atomic output (io/atomic_file.hpp), points as CSV (io/csv.hpp) and NumPy
+// .npy (io/npy.hpp), meshes (io/mesh.hpp), and the exact form as STEP (io/step.hpp)
+// and IGES (io/iges.hpp), each example run and what it writes read back. The
+// examples name files relative to the working directory, so the program works in a
+// scratch directory of its own, removed at the end. Links interpatch::interpatch.
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <span>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <vector>
+
+#include <interpatch/interpatch.hpp>
+
+#include "check.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A fresh directory (mkdtemp: one that did not exist before) made the working
+// directory; on destruction the old working directory is restored and the scratch
+// one removed with everything in it, whether the example succeeded or not.
+class ScratchDir {
+ public:
+  ScratchDir() : old_(fs::current_path()) {
+    std::string templ = (fs::temp_directory_path() / "interpatch-example-XXXXXX").string();
+    if (::mkdtemp(templ.data()) == nullptr)
+      throw fs::filesystem_error("mkdtemp", templ, std::error_code(errno, std::generic_category()));
+    path_ = templ;
+    fs::current_path(path_);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  ~ScratchDir() {
+    std::error_code ec;
+    fs::current_path(old_, ec);
+    fs::remove_all(path_, ec);
+  }
+  [[nodiscard]] const fs::path& path() const { return path_; }
+
+ private:
+  fs::path old_, path_;
+};
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  return lines;
+}
+
+// 40 × 50 points of a wavy surface, C order: the data the CSV and NPY examples read.
+std::vector<interpatch::Vec3> wave() {
+  std::vector<interpatch::Vec3> pts;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 50; ++j) pts.push_back({0.1 * i, 0.1 * j, 0.3 * std::sin(0.2 * i) * std::cos(0.15 * j)});
+  return pts;
+}
+
+void atomic_files() {
+  interpatch::io::write_atomically("out.txt", [](std::ostream& os) { os << "hello\n"; });
+  example::expect(read_text("out.txt") == "hello\n", "out.txt holds what the writer wrote");
+  // A writer that fails leaves nothing behind and the old file as it was.
+  try {
+    interpatch::io::write_atomically("out.txt", [](std::ostream& os) {
+      os << "half";
+      throw std::runtime_error("the writer gives up");
+    });
+    example::expect(false, "the writer's exception propagates");
+  } catch (const std::runtime_error&) {
+  }
+  example::expect(read_text("out.txt") == "hello\n", "a failed write leaves the old file");
+  example::expect(std::distance(fs::directory_iterator("."), fs::directory_iterator()) == 1,
+                  "a failed write leaves no temporary file");
+  std::printf("write_atomically: out.txt written, a failed rewrite left it as it was\n");
+}
+
+void csv_points() {
+  const auto data = wave();
+  interpatch::io::write_atomically("grid.csv", [&](std::ostream& os) {
+    os << "x,y,z\n";
+    for (const auto& p : data) os << example::str(p.x) << ',' << example::str(p.y) << ',' << example::str(p.z) << '\n';
+  });
+  auto pts = interpatch::io::read_csv_points("grid.csv", 40 * 50);  // C order of shape (40, 50)
+  example::expect(pts == data, "read_csv_points reads back the 40 × 50 points exactly");
+  std::printf("grid.csv: %zu points read back\n", pts.size());
+}
+
+void csv_text() {
+  auto pts = interpatch::io::parse_csv_points("x,y,z\n0,0,0\n1,0,0.5\n", 2, "inline.csv");
+  example::expect(pts.size() == 2 && pts[1] == interpatch::Vec3{1, 0, 0.5}, "the header line is skipped");
+  try {
+    (void)interpatch::io::parse_csv_points("0,0,0\n1,0\n", 0, "inline.csv");
+    example::expect(false, "a short row is refused");
+  } catch (const interpatch::error& e) {
+    example::expect(e.code() == interpatch::errc::malformed_file, "a short row is malformed_file");
+    std::printf("refused: %s\n", e.what());
+  }
+}
+
+void npy_arrays() {
+  const auto data = wave();
+  std::vector<double> xyz;
+  for (const auto& p : data) xyz.insert(xyz.end(), {p.x, p.y, p.z});
+  const std::size_t grid_shape[3] = {40, 50, 3};
+  interpatch::io::write_npy("grid.npy", grid_shape, xyz);
+
+  interpatch::io::NpyArray a = interpatch::io::read_npy("grid.npy");  // e.g. shape {40, 50, 3}
+  example::expect(a.shape == std::vector<std::size_t>{40, 50, 3}, "grid.npy has shape {40, 50, 3}");
+  example::expect(a.data == xyz, "read_npy reads back the values exactly");
+
+  std::vector<double> v;
+  auto shape = interpatch::io::read_npy_into("grid.npy", [&](auto, std::size_t n) {
+    v.resize(n);
+    return v.data();
+  });
+  example::expect(shape == a.shape && v == a.data, "read_npy_into reads into the caller's memory");
+  std::printf("grid.npy: shape {%zu, %zu, %zu}\n", a.shape[0], a.shape[1], a.shape[2]);
+}
+
+void npy_bytes() {
+  // Bytes from a network, a database, ...; here those of the file written above.
+  const auto load_from_somewhere = [] { return read_text("grid.npy"); };
+  std::string bytes = load_from_somewhere();
+  interpatch::io::NpyArray a = interpatch::io::parse_npy(bytes, "upload.npy");
+  const interpatch::io::NpyArray from_file = interpatch::io::read_npy("grid.npy");
+  example::expect(a.shape == from_file.shape && a.data == from_file.data, "parse_npy reads the bytes as read_npy the file");
+  // A message names the file by the name given.
+  try {
+    (void)interpatch::io::parse_npy(bytes.substr(0, bytes.size() - 8), "upload.npy");
+    example::expect(false, "parse_npy refuses a truncated array");
+  } catch (const interpatch::error& e) {
+    example::expect(e.code() == interpatch::errc::malformed_file, "a truncated array is malformed_file");
+    example::expect(std::string_view(e.what()).find("upload.npy") != std::string_view::npos, "the message names upload.npy");
+    std::printf("refused: %s\n", e.what());
+  }
+}
+
+void npy_blocks() {
+  const std::size_t shape[2] = {1000, 1000};
+  std::vector<double> row;
+  interpatch::io::write_npy("ramp.npy", shape, 1000, [&](std::size_t first, std::size_t count) {
+    row.resize(count);
+    for (std::size_t i = 0; i < count; ++i) row[i] = double(first + i);
+    return std::span<const double>(row);
+  });
+  const interpatch::io::NpyArray ramp = interpatch::io::read_npy("ramp.npy");
+  example::expect(ramp.shape == std::vector<std::size_t>{1000, 1000}, "ramp.npy has shape {1000, 1000}");
+  for (std::size_t i = 0; i < ramp.data.size(); i += 9973)
+    example::expect(ramp.data[i] == double(i), "ramp.npy holds 0, 1, 2, ... in C order");
+  example::expect(ramp.data.back() == 999999.0, "ramp.npy's last value");
+  std::printf("ramp.npy written a row at a time: %zu values\n", ramp.data.size());
+}
+
+void meshes() {
+  const interpatch::BlendedSurface patch =
+      interpatch::bilinear({0, 0, 0}, {0, 1, 0.5}, {1, 0, 0.5}, {1, 1, 0});  // a saddle
+  const interpatch::Surface& surface = patch;
+  const auto t = interpatch::linspace(0, 1, 64);
+  interpatch::io::SurfaceMesh m{surface.evaluate(t, t), {}};  // 64 × 64 vertices, no normals
+  interpatch::io::write_surface_mesh("patch.obj", m);
+  std::size_t vertices = 0, faces = 0;
+  for (const auto& l : lines_of(read_text("patch.obj"))) {
+    if (l.starts_with("v ")) ++vertices;
+    if (l.starts_with("f ")) ++faces;
+  }
+  example::expect(vertices == 64 * 64, "patch.obj has 64 × 64 vertices");
+  example::expect(faces == 63 * 63, "patch.obj has a quad per grid cell");
+  std::printf("patch.obj: %zu vertices, %zu quads\n", vertices, faces);
+}
+
+void step_files(const fs::path& examples) {
+  fs::copy_file(examples / "hemisphere.json", "hemisphere.json");
+  interpatch::io::Construction c = interpatch::io::build_file("hemisphere.json");
+  std::ostringstream text;
+  interpatch::io::write_step(text, *c.exact, {.name = "dome", .time_stamp = "2024-05-01T12:00:00"});
+  const std::string s = text.str();
+  example::expect(s.starts_with("ISO-10303-21;\n"), "a STEP file starts with ISO-10303-21;");
+  example::expect(s.ends_with("END-ISO-10303-21;\n"), "and ends with END-ISO-10303-21;");
+  example::expect(s.find("PRODUCT('dome'") != std::string::npos, "the product is named dome");
+  example::expect(s.find("'2024-05-01T12:00:00'") != std::string::npos, "FILE_NAME has the time stamp given");
+  example::expect(s.find("B_SPLINE_SURFACE_WITH_KNOTS") != std::string::npos, "the face is the B-spline surface");
+  std::printf("hemisphere as STEP: %zu lines\n", lines_of(s).size());
+}
+
+void iges_files(const fs::path& examples) {
+  fs::copy_file(examples / "terrain.json", "terrain.json");
+  interpatch::io::Construction c = interpatch::io::build_file("terrain.json");
+  interpatch::io::write_iges("terrain.igs", *c.exact);
+  const auto lines = lines_of(read_text("terrain.igs"));
+  for (const auto& l : lines) example::expect(l.size() == 80, "every IGES line has 80 columns");
+  example::expect(lines.front()[72] == 'S' && lines.back()[72] == 'T', "sections from S (start) to T (terminate)");
+  // Each entity has two directory lines (D), the first with an odd sequence number;
+  // both start with the entity type.
+  std::size_t entities = 0;
+  for (const auto& l : lines)
+    if (l[72] == 'D' && std::stoi(l.substr(73)) % 2 == 1 && l.starts_with("     128")) ++entities;
+  example::expect(entities == 1, "one entity 128 for the surface");
+  std::printf("terrain as IGES: %zu lines of 80 columns\n", lines.size());
+}
+
+}  // namespace
+
+int main() {
+  return example::run("files", [] {
+    const ScratchDir dir;
+    std::printf("working in %s\n", dir.path().c_str());
+    atomic_files();
+    csv_points();
+    csv_text();
+    npy_arrays();
+    npy_bytes();
+    npy_blocks();
+    meshes();
+    step_files(INTERPATCH_EXAMPLES_DIR);
+    iges_files(INTERPATCH_EXAMPLES_DIR);
+  });
+}
