@@ -279,7 +279,7 @@ bool named_file_forced() {
 /// The file being written, until it is the output. Where the file system allows,
 /// it has no name at all while it is written (O_TMPFILE): whatever kills the
 /// process, the kernel frees it, and nothing shows in the directory. Elsewhere
-/// (tmpfs before Linux 3.11, NFS, some overlay and FUSE file systems) it is a named
+/// (kernels before 3.11, NFS, some overlay and FUSE file systems) it is a named
 /// file of the leftover pattern, which the next write into the directory removes
 /// if its process died. Either way the file is locked (flock) by this process
 /// until it is in place: see remove_if_unheld.
@@ -356,12 +356,16 @@ class output_file {
         fail_write(target, std::string("cannot give the file its name: ") + std::strerror(e));
       }
       // An existing output is replaced by a rename from a name of the leftover
-      // pattern: linkat never replaces a file, and Linux has no call that gives an
-      // unnamed file a name already taken (renameat2 and its RENAME_EXCHANGE need
-      // two names). A kill between the two calls below leaves that complete file
-      // beside the output, which is intact; the next write into the directory
-      // removes it. The window is two system calls long, far shorter than the write
-      // that the named file of the fallback spends under such a name.
+      // pattern. No way without that window exists: linkat never replaces a file,
+      // and Linux has no call that gives an unnamed file a name already taken
+      // (renameat2, RENAME_EXCHANGE included, needs two names; a link-and-replace
+      // flag for linkat was proposed but never merged). Moving the old output
+      // aside first would leave no output at all to a kill in between, which is
+      // worse. So a kill between the linkat and the rename below leaves the
+      // complete new file under the leftover name beside the intact old output,
+      // locked until this process dies, and the next write into the directory
+      // removes it; the window is from the end of one system call to the end of
+      // the next, where the named fallback spends the whole write.
       int e = EEXIST;
       for (int attempt = 0; attempt < 100 && e == EEXIST; ++attempt) {
         name_ = leftover_name(target_name);
