@@ -38,18 +38,23 @@ void set_durable_writes(bool on) noexcept;
 
 /// Runs `write` on a stream to a new file in `path`'s directory, flushes it (and
 /// syncs it, when durable_writes()), then puts it at `path`, replacing what is
-/// there. Until then the new file is invisible: on Linux file systems with
-/// O_TMPFILE (ext4, XFS, Btrfs, tmpfs) it has no name at all while it is written,
-/// so a process killed at any moment, even by SIGKILL, leaves nothing behind; a new
-/// output then gets its name in one step, and an existing one is replaced by a
-/// rename from a name ".name.interpatch-tmp.<pid>.XXXXXX" that exists for the two
-/// system calls between link and rename. Where O_TMPFILE is not supported (some
-/// NFS, overlay and FUSE file systems) the file has that name while it is written.
-/// Either way, `path` holds the old file or the complete new one at every moment,
-/// and each write first removes the files of that pattern in the directory whose
-/// process no longer exists (and that no live process holds locked), the complete
-/// or partial leftovers of a killed run. (Files ".name.tmp.XXXXXX" of versions
-/// before this scheme carry no pid and are never touched.)
+/// there; `path` holds the old file or the complete new one at every moment.
+///
+/// On Linux file systems with O_TMPFILE (ext4, XFS, Btrfs, tmpfs; /proc mounted)
+/// the new file has no name while it is written, nothing of it shows in the
+/// directory, and a process killed at any moment, even by SIGKILL, leaves nothing
+/// behind. Complete, a new output gets its name in one step (linkat); an existing
+/// one is replaced by a rename from a name ".name.interpatch-tmp.<pid>.XXXXXX"
+/// (the name cut to 199 characters) given to the file just before, so that only a
+/// kill between those two system calls leaves something: that complete file
+/// beside the intact old output. Where O_TMPFILE is not supported (some NFS,
+/// overlay and FUSE file systems) the file has a name of that pattern for the
+/// whole write, and a killed run leaves it there, partial. Either way each write
+/// first removes the files of that pattern in the directory whose process no
+/// longer exists and that no live process holds locked (flock, held by the writer
+/// until its file is in place). Files ".name.tmp.XXXXXX" of earlier versions carry
+/// no pid and are never removed.
+///
 /// If `write` throws or any write fails, the new file is removed, `path` is left as
 /// it was, and the error propagates: the writer's own exception unchanged, a failed
 /// write (disk full, file too large) as file_unwritable naming the path and the
