@@ -329,7 +329,7 @@ void kill_repeatedly(const std::string& output, const std::string& grid, const s
     int status = 0;
     long long seen = -1;  // the bytes written when it was stopped and killed, if it had its file open
     if (k == 0) {
-      ::kill(pid, SIGKILL);  // very early: before the command has read its spec
+      ::kill(pid, SIGKILL);  // very early: the moment it has started
     } else if (k % 2 == 1) {
       const double fraction = k == 1 ? 0.002 : test::uniform(g, 0.0, 1.2);
       std::this_thread::sleep_for(std::chrono::duration<double>(fraction * run_seconds));
