@@ -24,7 +24,7 @@ const char* axis_name(int axis) { return axis == 0 ? "u" : (axis == 1 ? "v" : "w
 
 // Centripetal steps are square roots of chords, and sqrt(2^k c) = 2^(k/2) sqrt(c)
 // holds exactly for even k only. The chords are halved (exact) when the exponent of
-// the data's scale (data_exponent) is odd: scaling the data by any power of two 2^k
+// the data's scale (point_exponent, grid_exponent) is odd: scaling the data by 2^k
 // then scales every halved-or-not chord by an even power of two, every step by an
 // exact power of two, and leaves the parameters as they are, bit for bit.
 double root_scale(int data_exponent) { return (data_exponent & 1) != 0 ? 0.5 : 1.0; }
@@ -187,9 +187,9 @@ constexpr double pole_ratio = 1e-14;
 // root_scale) for i < count. Squares first, roots in a loop of their own, which the
 // compiler vectorizes.
 //
-// A chord outside (2^-450, 2^511) may come from a square that overflowed (inf) or
-// underflowed (below 2^-900 a component's square may have lost digits or all of
-// them: data near 1e-150 and below, or a zero chord): the root loop flags it on
+// A chord outside (2^-450, 2^511), about (3e-136, 7e153), may come from a square
+// that overflowed (inf) or underflowed (below 2^-900 a component's square may have
+// lost digits or all of them; a zero chord is flagged too): the root loop flags it on
 // the way, two comparisons per chord, and only then is each such chord computed
 // again from its components scaled by 2^-e, e the exponent of the largest, its
 // root scaled back by 2^e. Scaling by a power of two is exact and sqrt(4^e x) =

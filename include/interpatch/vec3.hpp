@@ -67,8 +67,8 @@ inline Vec3 ldexp(const Vec3& a, int k) noexcept {
 ///
 /// The plain sqrt(a · a) while a · a lies in [2^-900, DBL_MAX]: no square has
 /// overflowed, and one that underflowed is below 2^-122 of the sum, under its rounding.
-/// Otherwise (|a| beyond about 1e154 or below 1e-135, or a square that underflowed to
-/// zero) the components are scaled by 2^-e, e the exponent of the largest, which is
+/// Otherwise (|a| beyond about 1e154 or below 3e-136, the zero vector among them) the
+/// components are scaled by 2^-e, e the exponent of the largest, which is
 /// exact; and sqrt(4^e x) = 2^e sqrt(x), so scaling the root back by 2^e gives the
 /// plain formula's result as if the exponent range had no limits.
 inline double norm(const Vec3& a) noexcept {
