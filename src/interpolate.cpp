@@ -196,7 +196,11 @@ constexpr double pole_ratio = 1e-14;
 // 2^e sqrt(x), so that is the value the formula has without range limits, the one
 // the first loop gives in range: a chord of data scaled by 2^k is 2^k times the
 // chord, bit for bit. The recomputation sits in this function so that it is
-// compiled, fused multiply-adds and all, like the first loop.
+// compiled, fused multiply-adds and all, like the first loop. (In the clone with
+// fused multiply-adds, whose products are exact, a component's square that
+// underflowed while the sum did not can still, in principle, decide a rounding at a
+// near-tie in the last bit; it needs components 2^60 apart and bits that line up.
+// The flag does not look at single components: that would cost more than it saves.)
 INTERPATCH_KERNEL void chord_lengths(const Vec3* a, const Vec3* b, std::size_t count, double* out, Parametrization param,
                                      double root) {
   for (std::size_t i = 0; i < count; ++i) {

@@ -361,7 +361,12 @@ TEST(Scaling, VolumeInterpolationEveryParametrization) {
 
 // Grids whose chords leave the range of their squares while the grid as a whole is
 // not of extreme scale (it is solved as given, not scaled first), so that the chord
-// pass's recomputation of single chords is what keeps them scale-free.
+// pass's recomputation of single chords is what keeps them scale-free: at scale 2^0
+// every chord takes the vectorized path, at the scales below the out-of-range ones
+// are recomputed, and the two must agree to the bit (fused multiply-adds included).
+// Strip: 2^-300 and 2^-301 underflow the squares to zero (the old code refused the
+// grid: "every line along v has zero length"), 2^-200 leaves them normal but below
+// the 2^-900 mark; bulge: 2^350 and 2^351 overflow them; odd scales for centripetal.
 TEST(Scaling, GridChordsOutOfRangeInsideAnOrdinaryGrid) {
   auto g = test::rng(904);
   // A strip 2^-300 wide: scaled by 2^-300 its chords along v are near 2^-600, whose
