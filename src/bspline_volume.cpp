@@ -381,7 +381,7 @@ VolumeJacobians BSplineVolume::evaluate_jacobians(std::span<const double> us, st
   contract_all<true>(*this, us, vs, ws, progress,
                      [&out](std::size_t i, std::size_t j, std::size_t k, const VolumeDerivatives& d) {
                        out.points(i, j, k) = d.s;
-                       out.determinants(i, j, k) = dot(d.su, cross(d.sv, d.sw));
+                       out.determinants(i, j, k) = triple(d.su, d.sv, d.sw);
                      });
   return out;
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "blended_terms.hpp"
 #include "detail/text.hpp"
@@ -13,7 +14,8 @@ using detail::fail;
 namespace {
 
 double control_diagonal(std::initializer_list<const BSplineCurve*> curves) {
-  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  constexpr double inf = std::numeric_limits<double>::infinity();  // 1e300 would cap data beyond it
+  Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
   for (const auto* c : curves)
     for (const Vec3& p : c->control_points())
       for (int k = 0; k < 3; ++k) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "blended_terms.hpp"
@@ -59,7 +60,8 @@ errc code_for(int total_order) {
 }
 
 double control_diagonal(const Data& d) {
-  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  constexpr double inf = std::numeric_limits<double>::infinity();  // 1e300 would cap data beyond it
+  Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
   for (int a = 0; a < 3; ++a)
     for (int e = 0; e < 2; ++e)
       for (const Vec3& p : d.at[a][e][0]->control_points().values())

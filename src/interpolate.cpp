@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include "detail/banded.hpp"
 #include "detail/collocation.hpp"
@@ -21,9 +22,24 @@ namespace {
 
 const char* axis_name(int axis) { return axis == 0 ? "u" : (axis == 1 ? "v" : "w"); }
 
-double step(const Vec3& a, const Vec3& b, Parametrization param) {
+// Centripetal steps are square roots of chords, and sqrt(2^k c) = 2^(k/2) sqrt(c)
+// holds exactly for even k only. The chords are halved (exact) when the exponent of
+// the data's scale (point_exponent, grid_exponent) is odd: scaling the data by 2^k
+// then scales every halved-or-not chord by an even power of two, every step by an
+// exact power of two, and leaves the parameters as they are, bit for bit.
+double root_scale(int data_exponent) { return (data_exponent & 1) != 0 ? 0.5 : 1.0; }
+
+// The exponent of the largest coordinate of the first point that is not the origin
+// (0 if all are): it follows the scale of the data exactly, which is all it is for.
+int point_exponent(std::span<const Vec3> points) {
+  for (const Vec3& p : points)
+    if (const double m = max_abs(p); m > 0) return scale_exponent(m);
+  return 0;
+}
+
+double step(const Vec3& a, const Vec3& b, Parametrization param, double root) {
   const double d = distance(a, b);
-  return param == Parametrization::centripetal ? std::sqrt(d) : d;
+  return param == Parametrization::centripetal ? std::sqrt(d * root) : d;
 }
 
 void check_params(std::span<const double> t, const char* what) {
@@ -58,13 +74,17 @@ std::vector<double> curve_parameters(std::span<const Vec3> points, Parametrizati
   }
   double total = 0;
   for (std::size_t i = 1; i < n; ++i) total += distance(points[i], points[i - 1]);
+  if (!std::isfinite(total))
+    fail(errc::not_finite, "the polyline's length overflows (", total, "): the points span more than ",
+         std::numeric_limits<double>::max());
+  const double root = root_scale(point_exponent(points));
   for (std::size_t i = 1; i < n; ++i) {
     const double d = distance(points[i], points[i - 1]);
     // Chords below 1e-14 of the polyline's length are rounding noise: the two points coincide.
     if (!(d > 1e-14 * total))
       fail(errc::zero_chord, "points ", i - 1, " and ", i, " coincide (chord ", d, ", polyline length ", total,
            "): parameters must increase");
-    t[i] = t[i - 1] + step(points[i - 1], points[i], param);
+    t[i] = t[i - 1] + step(points[i - 1], points[i], param, root);
   }
   const double len = t.back();
   for (std::size_t i = 1; i + 1 < n; ++i) t[i] /= len;
@@ -163,17 +183,53 @@ constexpr std::size_t rows_per_group = 8;
 // pole) within rounding: it is left out of the averaging.
 constexpr double pole_ratio = 1e-14;
 
-// Chord lengths |b[i] − a[i]| (square roots of them, centripetal) for i < count.
-// Squares first, roots in a loop of their own, which the compiler vectorizes.
-INTERPATCH_KERNEL void chord_lengths(const Vec3* a, const Vec3* b, std::size_t count, double* out, Parametrization param) {
+// Chord lengths |b[i] − a[i]| (centripetal: square roots of them times `root`, see
+// root_scale) for i < count. Squares first, roots in a loop of their own, which the
+// compiler vectorizes.
+//
+// A chord outside (2^-450, 2^511), about (3e-136, 7e153), may come from a square
+// that overflowed (inf) or underflowed (below 2^-900 a component's square may have
+// lost digits or all of them; a zero chord is flagged too): the root loop flags it on
+// the way, two comparisons per chord, and only then is each such chord computed
+// again from its components scaled by 2^-e, e the exponent of the largest, its
+// root scaled back by 2^e. Scaling by a power of two is exact and sqrt(4^e x) =
+// 2^e sqrt(x), so that is the value the formula has without range limits, the one
+// the first loop gives in range: a chord of data scaled by 2^k is 2^k times the
+// chord, bit for bit. The recomputation sits in this function so that it is
+// compiled, fused multiply-adds and all, like the first loop. (In the clone with
+// fused multiply-adds, whose products are exact, a component's square that
+// underflowed while the sum did not can still, in principle, decide a rounding at a
+// near-tie in the last bit; it needs components 2^60 apart and bits that line up.
+// The flag does not look at single components: that would cost more than it saves.)
+INTERPATCH_KERNEL void chord_lengths(const Vec3* a, const Vec3* b, std::size_t count, double* out, Parametrization param,
+                                     double root) {
   for (std::size_t i = 0; i < count; ++i) {
     const double dx = b[i].x - a[i].x, dy = b[i].y - a[i].y, dz = b[i].z - a[i].z;
     out[i] = dx * dx + dy * dy + dz * dz;
   }
-  for (std::size_t i = 0; i < count; ++i) out[i] = std::sqrt(out[i]);
+  unsigned out_of_range = 0;  // not a bool: g++ 12 vectorizes the loop with an unsigned or-reduction only
+  for (std::size_t i = 0; i < count; ++i) {
+    const double c = std::sqrt(out[i]);
+    out[i] = c;
+    out_of_range |= static_cast<unsigned>(c <= 0x1p-450) | static_cast<unsigned>(c >= 0x1p511);
+  }
+  if (out_of_range != 0)
+    for (std::size_t i = 0; i < count; ++i) {
+      if (out[i] > 0x1p-450 && out[i] < 0x1p511) continue;
+      const Vec3 d = b[i] - a[i];
+      const int e = scale_exponent(max_abs(d));
+      const Vec3 u = ldexp(d, -e);
+      const double dx = u.x, dy = u.y, dz = u.z;
+      out[i] = std::ldexp(std::sqrt(dx * dx + dy * dy + dz * dz), e);
+    }
   if (param == Parametrization::centripetal)
-    for (std::size_t i = 0; i < count; ++i) out[i] = std::sqrt(out[i]);
+    for (std::size_t i = 0; i < count; ++i) out[i] = std::sqrt(out[i] * root);
 }
+
+// The weight 1 / length of a line in the averaged parameters; 0 for a line of zero
+// length (left out) or one so short that its reciprocal overflows (a collapsed line
+// of tiny data, left out with the other collapsed lines).
+double line_weight(double length) { return length >= std::numeric_limits<double>::min() ? 1.0 / length : 0.0; }
 
 // Σ a[i] and Σ a[i] b[i] in four interleaved partial sums: a fixed order (the same
 // bits on every run) without one long chain of dependent additions.
@@ -222,13 +278,59 @@ GridShape grid_shape(const std::array<std::size_t, Rank>& shape) {
   return g;
 }
 
+[[noreturn]] void fail_not_finite(const Vec3* q, const GridShape& g, std::size_t k) {
+  std::string at;
+  for (std::size_t a = g.rank, rest = k; a-- > 0; rest /= g.n[a]) at = detail::cat("[", rest % g.n[a], "]", at);
+  fail(errc::not_finite, "point ", at, " is ", q[k]);
+}
+
+void check_grid_finite(const Vec3* q, const GridShape& g) {
+  const std::size_t total = g.n[0] * g.row;
+  if (const std::size_t k = detail::first_non_finite(q, total); k < total) fail_not_finite(q, g, k);
+}
+
+// The exponent of the grid's scale: of the largest coordinate in its first and last
+// rows (in every row when those are all zero), a few thousand points read at most.
+// It follows the scale of the data exactly, which is all it is for.
+int grid_exponent(const Vec3* q, const GridShape& g) {
+  auto largest = [&](std::size_t r0, std::size_t r1) {
+    double m = 0;
+    for (std::size_t k = r0 * g.row; k < r1 * g.row; ++k) m = std::max(m, max_abs(q[k]));
+    return m;
+  };
+  double m = std::max(largest(0, 1), largest(g.n[0] - 1, g.n[0]));
+  if (m == 0) m = largest(0, g.n[0]);
+  return scale_exponent(m);
+}
+
+// Grids of extreme scale, coordinates beyond 2^±400 (about 1e±120), are solved
+// scaled by 2^-e, e = grid_exponent: data near 1e300 or 1e-300 (or subnormal) then
+// run the chord pass at full speed and their line lengths neither overflow nor lose
+// their reciprocals. Parameters do not depend on the scale and the solve is linear,
+// so the control points are scaled back by 2^e: exactly the ones the data give as
+// they are, in the range where the arithmetic has no limits.
+constexpr int extreme_exponent = 400;
+
+int extreme_shift(const Vec3* q, const GridShape& g) {
+  const int e = grid_exponent(q, g);
+  return e > extreme_exponent || e < -extreme_exponent ? e : 0;
+}
+
+// p[i] * 2^k for i < count, exactly (one rounding where the result is subnormal).
+void scale_points(Vec3* p, std::size_t count, int k) {
+  const auto n = static_cast<long long>(count);
+#pragma omp parallel for schedule(static) if (count >= detail::parallel_min_work)
+  for (long long i = 0; i < n; ++i) p[i] = ldexp(p[i], k);
+}
+
 // Pass 1 and what the averaged parameters need from it.
 class GridChords {
  public:
-  GridChords(const Vec3* q, const GridShape& g, Parametrization param) : g_(g), param_(param) {
+  GridChords(const Vec3* q, const GridShape& g, Parametrization param)
+      : g_(g), param_(param), root_(root_scale(grid_exponent(q, g))) {
     const std::size_t n0 = g.n[0], M = g.row, R = g.rank;
     if (param == Parametrization::uniform) {
-      check_finite(q);
+      check_grid_finite(q, g);
       return;
     }
     const std::size_t chunks = (n0 + rows_per_chunk - 1) / rows_per_chunk;
@@ -258,7 +360,7 @@ class GridChords {
             break;
           }
           if (r > 0) {
-            chord_lengths(row - M, row, M, scratch.data(), param);
+            chord_lengths(row - M, row, M, scratch.data(), param, root_);
             double* t0 = part[c * R].data();
             for (std::size_t m = 0; m < M; ++m) t0[m] += scratch[m];
           }
@@ -269,7 +371,8 @@ class GridChords {
       }
     }
     for (std::size_t c = 0; c < chunks; ++c)
-      if (bad[c] != no_point) fail_not_finite(q, bad[c]);
+      if (bad[c] != no_point) fail_not_finite(q, g, bad[c]);
+    for (std::size_t a = 1; a < R; ++a) check_lengths(line_length_[a], a);
     // Nearly collapsed lines were summed like the others: take them out again.
     used_.assign(R, 0);
     for (std::size_t a = 1; a < R; ++a) {
@@ -277,8 +380,8 @@ class GridChords {
       const double cut = pole_ratio * *std::max_element(len.begin(), len.end());
       const std::size_t per_row = g.lines(a);
       for (std::size_t l = 0; l < len.size(); ++l) {
-        if (len[l] > cut) ++used_[a];
-        else if (len[l] > 0) remove_line(q, a, l / per_row, l % per_row, part[(l / per_row / rows_per_chunk) * R + a]);
+        if (len[l] > cut && line_weight(len[l]) > 0) ++used_[a];
+        else if (line_weight(len[l]) > 0) remove_line(q, a, l / per_row, l % per_row, part[(l / per_row / rows_per_chunk) * R + a]);
       }
     }
     sums_.assign(R, {});
@@ -287,12 +390,13 @@ class GridChords {
       for (std::size_t c = 0; c < chunks; ++c)
         for (std::size_t k = 0; k < sums_[a].size(); ++k) sums_[a][k] += part[c * R + a][k];
     }
+    check_lengths(sums_[0], 0);
     // Along u: the weight of each line is 1 / its length, 0 for a collapsed line.
     const double cut0 = pole_ratio * *std::max_element(sums_[0].begin(), sums_[0].end());
     inv_length_.assign(M, 0.0);
     for (std::size_t m = 0; m < M; ++m)
-      if (sums_[0][m] > cut0) {
-        inv_length_[m] = 1.0 / sums_[0][m];
+      if (sums_[0][m] > cut0 && line_weight(sums_[0][m]) > 0) {
+        inv_length_[m] = line_weight(sums_[0][m]);
         ++used_[0];
       }
   }
@@ -312,7 +416,7 @@ class GridChords {
 
   // Row r's step along u: Σ over the lines along u of chord(r − 1, r) / line length.
   double row_step(const Vec3* prev, const Vec3* row, double* scratch) const {
-    chord_lengths(prev, row, g_.row, scratch, param_);
+    chord_lengths(prev, row, g_.row, scratch, param_, root_);
     return dot(scratch, inv_length_.data(), g_.row);
   }
 
@@ -346,15 +450,13 @@ class GridChords {
  private:
   static constexpr std::size_t no_point = static_cast<std::size_t>(-1);
 
-  void check_finite(const Vec3* q) const {
-    const std::size_t total = g_.n[0] * g_.row;
-    if (const std::size_t k = detail::first_non_finite(q, total); k < total) fail_not_finite(q, k);
-  }
-
-  [[noreturn]] void fail_not_finite(const Vec3* q, std::size_t k) const {
-    std::string at;
-    for (std::size_t a = g_.rank, rest = k; a-- > 0; rest /= g_.n[a]) at = detail::cat("[", rest % g_.n[a], "]", at);
-    fail(errc::not_finite, "point ", at, " is ", q[k]);
+  // Lines longer than the largest double: chords or their sums overflowed.
+  static void check_lengths(const std::vector<double>& lengths, std::size_t a) {
+    if (std::all_of(lengths.begin(), lengths.end(), [](double l) { return l <= std::numeric_limits<double>::max(); }))
+      return;
+    const char* ax = axis_name(static_cast<int>(a));
+    fail(errc::not_finite, "the lines of the grid along ", ax, " are longer than ", std::numeric_limits<double>::max(),
+         ": the points span more than a double holds");
   }
 
   [[noreturn]] static void fail_all_collapsed(std::size_t a) {
@@ -388,19 +490,19 @@ class GridChords {
     for (std::size_t o = 0; o < outer; ++o) {
       const Vec3* base = row + o * n * inner;
       if (inner == 1) {
-        chord_lengths(base, base + 1, n - 1, ch, param_);
+        chord_lengths(base, base + 1, n - 1, ch, param_, root_);
         lengths[o] = sum(ch, n - 1);
-        const double w = lengths[o] > 0 ? 1.0 / lengths[o] : 0.0;  // a line of zero length is left out
+        const double w = line_weight(lengths[o]);
         for (std::size_t k = 1; k < n; ++k) acc[k] += ch[k - 1] * w;
         continue;
       }
       for (std::size_t k = 1; k < n; ++k)
-        chord_lengths(base + (k - 1) * inner, base + k * inner, inner, ch + (k - 1) * inner, param_);
+        chord_lengths(base + (k - 1) * inner, base + k * inner, inner, ch + (k - 1) * inner, param_, root_);
       double* len = lengths + o * inner;
       std::fill_n(len, inner, 0.0);
       for (std::size_t k = 1; k < n; ++k)
         for (std::size_t i = 0; i < inner; ++i) len[i] += ch[(k - 1) * inner + i];
-      for (std::size_t i = 0; i < inner; ++i) inv[i] = len[i] > 0 ? 1.0 / len[i] : 0.0;
+      for (std::size_t i = 0; i < inner; ++i) inv[i] = line_weight(len[i]);
       for (std::size_t k = 1; k < n; ++k) acc[k] += dot(ch + (k - 1) * inner, inv, inner);
     }
   }
@@ -409,16 +511,17 @@ class GridChords {
   void remove_line(const Vec3* q, std::size_t a, std::size_t r, std::size_t l, std::vector<double>& acc) const {
     const std::size_t n = g_.n[a], inner = g_.inner(a);
     const Vec3* base = q + r * g_.row + (l / inner) * n * inner + l % inner;
-    const double w = 1.0 / line_length_[a][r * g_.lines(a) + l];
+    const double w = line_weight(line_length_[a][r * g_.lines(a) + l]);
     double d = 0;
     for (std::size_t k = 1; k < n; ++k) {
-      chord_lengths(base + (k - 1) * inner, base + k * inner, 1, &d, param_);
+      chord_lengths(base + (k - 1) * inner, base + k * inner, 1, &d, param_, root_);
       acc[k] -= d * w;
     }
   }
 
   GridShape g_;
   Parametrization param_;
+  double root_;                                    // see root_scale
   std::vector<std::vector<double>> sums_;         // per axis: 0 → line lengths along u; a ≥ 1 → Σ over lines of chord k / line length
   std::vector<std::vector<double>> line_length_;  // per in-row axis: every line's length, row by row
   std::vector<std::size_t> used_;                  // lines averaged per axis
@@ -448,9 +551,18 @@ std::vector<double> grid_parameters_of(const Grid<Vec3, Rank>& q, int axis, Para
   const auto a = static_cast<std::size_t>(axis);
   if (q.extent(a) < 2) fail(errc::too_few_points, "a grid needs at least 2 points along ", axis_name(axis), ", got ", q.extent(a));
   const GridShape g = grid_shape(q.shape());
-  const GridChords chords(q.data(), g, param);
-  if (a > 0) return chords.in_row_parameters(a);
-  return chords.u_parameters(chords.uses_chords() ? row_steps(q.data(), g, chords) : std::vector<double>(g.n[0], 0.0));
+  auto parameters = [&](const Vec3* data) {
+    const GridChords chords(data, g, param);
+    if (a > 0) return chords.in_row_parameters(a);
+    return chords.u_parameters(chords.uses_chords() ? row_steps(data, g, chords) : std::vector<double>(g.n[0], 0.0));
+  };
+  const int shift = param == Parametrization::uniform ? 0 : extreme_shift(q.data(), g);
+  if (shift == 0) return parameters(q.data());
+  check_grid_finite(q.data(), g);  // before scaling: the message shows the point as given
+  require_memory(q.size(), sizeof(Vec3), "a scaled copy of the grid");
+  Grid<Vec3, Rank> scaled = q;
+  scale_points(scaled.data(), scaled.size(), -shift);
+  return parameters(scaled.data());
 }
 
 }  // namespace
@@ -498,6 +610,11 @@ GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional
 
   // Pass 1, then the knots and factorizations of the axes inside the rows.
   const GridShape g = grid_shape(shape);
+  const int shift = param == Parametrization::uniform ? 0 : extreme_shift(points.data(), g);
+  if (shift != 0) {
+    check_grid_finite(points.data(), g);  // before scaling: the message shows the point as given
+    scale_points(points.data(), points.size(), -shift);
+  }
   const GridChords chords(points.data(), g, param);
   chords.check_lines();
 
@@ -549,6 +666,7 @@ GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional
   for (std::size_t a = 1; a < Rank; ++a) r.knots.push_back(averaged_knots(r.params[a], p[a]));
   const detail::BandedLU lu0 = factor_axis(r.knots[0], r.params[0], 0);
   detail::solve_along_axis(lu0, &data->x, shape.data(), Rank, 0, 3);
+  if (shift != 0) scale_points(data, points.size(), shift);
   if (progress) progress(1.0);
   return r;
 }

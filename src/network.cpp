@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "blended_terms.hpp"
 #include "detail/text.hpp"
@@ -35,7 +36,7 @@ std::pair<double, double> closest(const BSplineCurve& U, const BSplineCurve& V) 
     us[k] = U.point(static_cast<double>(k) / samples);
     vs[k] = V.point(static_cast<double>(k) / samples);
   }
-  double best = 1e300, s = 0, t = 0;
+  double best = std::numeric_limits<double>::infinity(), s = 0, t = 0;
   for (int a = 0; a <= samples; ++a)
     for (int b = 0; b <= samples; ++b) {
       const double d = distance(us[a], vs[b]);
@@ -49,10 +50,14 @@ std::pair<double, double> closest(const BSplineCurve& U, const BSplineCurve& V) 
     Vec3 du[2], dv[2];
     U.derivatives(s, 1, du);
     V.derivatives(t, 1, dv);
-    const Vec3 F = du[0] - dv[0];
-    // Normal equations of J = [U'(s), −V'(t)].
-    const double a11 = dot(du[1], du[1]), a12 = -dot(du[1], dv[1]), a22 = dot(dv[1], dv[1]);
-    const double r1 = -dot(du[1], F), r2 = dot(dv[1], F);
+    // Normal equations of J = [U'(s), −V'(t)], with U', V' and F in units of 2^e, e the
+    // exponent of the largest component of U' and V': exact, and it keeps det, a
+    // product of four of them, in range at any scale of the data (and the test below
+    // relative to the tangents), while the steps ds, dt come out as they are.
+    const int e = scale_exponent(std::max(max_abs(du[1]), max_abs(dv[1])));
+    const Vec3 Us = ldexp(du[1], -e), Vs = ldexp(dv[1], -e), F = ldexp(du[0] - dv[0], -e);
+    const double a11 = dot(Us, Us), a12 = -dot(Us, Vs), a22 = dot(Vs, Vs);
+    const double r1 = -dot(Us, F), r2 = dot(Vs, F);
     const double det = a11 * a22 - a12 * a12;
     if (!(std::abs(det) > 1e-300)) break;  // parallel tangents: keep the sampled pair
     const double ds = (r1 * a22 - a12 * r2) / det, dt = (a11 * r2 - a12 * r1) / det;
@@ -76,7 +81,8 @@ void check_params(const std::vector<double>& p, const char* name) {
 }
 
 double control_diagonal(const CurveNetwork& n) {
-  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  constexpr double inf = std::numeric_limits<double>::infinity();  // 1e300 would cap data beyond it
+  Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
   for (const auto* list : {&n.u_curves, &n.v_curves})
     for (const auto& c : *list)
       for (const Vec3& p : c.control_points())

@@ -1,6 +1,7 @@
 #include "interpatch/volume.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "detail/parallel.hpp"
@@ -60,7 +61,7 @@ Jacobian jacobian(const VolumeDerivatives& d) noexcept {
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c)
       j.matrix[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)] = col[c][r];
-  j.determinant = dot(d.su, cross(d.sv, d.sw));
+  j.determinant = triple(d.su, d.sv, d.sw);
   return j;
 }
 
@@ -103,7 +104,7 @@ VolumeJacobians Volume::evaluate_jacobians(std::span<const double> us, std::span
   pointwise(us.size(), vs.size(), ws.size(), progress, [&](std::size_t i, std::size_t j, std::size_t k) {
     const VolumeDerivatives d = derivatives(us[i], vs[j], ws[k]);
     out.points(i, j, k) = d.s;
-    out.determinants(i, j, k) = dot(d.su, cross(d.sv, d.sw));
+    out.determinants(i, j, k) = triple(d.su, d.sv, d.sw);
   });
   return out;
 }
@@ -135,9 +136,15 @@ InvertedCells inverted_cells(const Volume& volume, std::size_t k, std::size_t ma
       for (std::size_t j = 0; j < k; ++j)
         for (std::size_t m = 0; m < k; ++m) {
           const VolumeDerivatives& x = d(i - i0, j, m);
-          const double det = dot(x.su, cross(x.sv, x.sw));
+          // On the columns each scaled by a power of two to a largest component in
+          // [1, 2) (exact): the product of their norms stays in range, the test does
+          // not depend on the scale of the data, and det J is scaled back exactly.
+          const int eu = scale_exponent(max_abs(x.su)), ev = scale_exponent(max_abs(x.sv)), ew = scale_exponent(max_abs(x.sw));
+          const Vec3 su = ldexp(x.su, -eu), sv = ldexp(x.sv, -ev), sw = ldexp(x.sw, -ew);
+          const double unit_det = triple(su, sv, sw);
           // Zero within rounding: a determinant's error is ~1e-16 of the columns' product.
-          const bool bad = det <= 1e-12 * norm(x.su) * norm(x.sv) * norm(x.sw);
+          const bool bad = unit_det <= 1e-12 * norm(su) * norm(sv) * norm(sw);
+          const double det = std::ldexp(unit_det, eu + ev + ew);
           cur[j * k + m] = bad ? 1 : 0;
           if (det < r.min_determinant) {
             r.min_determinant = det;

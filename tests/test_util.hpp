@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -43,7 +44,8 @@ inline PointGrid random_grid(std::mt19937_64& g, std::size_t nu, std::size_t nv,
 /// Diagonal of the bounding box of a set of points: the scale tolerances are relative to.
 template <class Range>
 double bbox_diagonal(const Range& pts) {
-  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  constexpr double inf = std::numeric_limits<double>::infinity();  // data may lie beyond 1e300
+  Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
   for (const Vec3& p : pts)
     for (int k = 0; k < 3; ++k) {
       lo[k] = std::min(lo[k], p[k]);

@@ -268,7 +268,7 @@ std::vector<bool> outward_senses(const BSplineVolume& b) {
   const auto d = b.domain();
   const VolumeDerivatives c = b.derivatives(0.5 * (d[0].first + d[0].second), 0.5 * (d[1].first + d[1].second),
                                             0.5 * (d[2].first + d[2].second));
-  const bool right_handed = dot(c.su, cross(c.sv, c.sw)) >= 0;
+  const bool right_handed = triple(c.su, c.sv, c.sw) >= 0;  // triple(): no overflow at any scale of the data
   std::vector<bool> s{false, true, true, false, false, true};
   if (!right_handed)
     for (std::size_t i = 0; i < s.size(); ++i) s[i] = !s[i];
