@@ -33,32 +33,6 @@ BSplineSurface shifted(const BSplineSurface& s, const Vec3& d) {
   return BSplineSurface(s.knots_u(), s.knots_v(), cp, s.weights());
 }
 
-TEST(CoonsVolume, HeaderExamples) {
-  using namespace interpatch;
-  const KnotVector lin(1, {0, 0, 1, 1});
-  auto face = [&](int axis, double t) {
-    PointGrid cp({2, 2});
-    for (int a = 0; a < 2; ++a)
-      for (int b = 0; b < 2; ++b) {
-        Vec3 p;
-        p[axis] = t;
-        p[axis == 0 ? 1 : 0] = a;
-        p[axis == 2 ? 1 : 2] = b;
-        cp(a, b) = p;
-      }
-    return BSplineSurface(lin, lin, cp);
-  };
-  auto s = coons_volume({face(0, 0), face(0, 1), face(1, 0), face(1, 1), face(2, 0), face(2, 1)});
-  EXPECT_LT(distance(s.point(0.2, 0.3, 0.4), {0.2, 0.3, 0.4}), 1e-15 * 4);  // sums of terms of size ~1: rounding
-  BSplineVolume b = s.to_bspline();
-  EXPECT_EQ(b.degree_u(), 1);
-  VolumeCrossDerivatives d;
-  d.w0 = d.w1 = BSplineSurface(lin, lin, PointGrid({2, 2}, Vec3{0, 0, 1}));
-  auto h = coons_volume({face(0, 0), face(0, 1), face(1, 0), face(1, 1), face(2, 0), face(2, 1)}, d);
-  EXPECT_LT(distance(h.derivatives(0.5, 0.5, 0).sw, {0, 0, 1}), 1e-14);
-  EXPECT_LT(distance(h.point(0.2, 0.3, 0.4), {0.2, 0.3, 0.4}), 1e-15 * 8);  // the cube is cubic in w too
-}
-
 TEST(CoonsVolume, LinearReproducesTrilinearVolumes) {
   auto g = test::rng(220);
   for (int trial = 0; trial < 5; ++trial) {

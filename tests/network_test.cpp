@@ -5,14 +5,6 @@
 namespace interpatch {
 namespace {
 
-CurveNetwork network_on(const BSplineSurface& s, const std::vector<double>& tu, const std::vector<double>& tv) {
-  CurveNetwork n;
-  for (double v : tv) n.u_curves.push_back(test::iso_curve(s, 1, v));
-  for (double u : tu) n.v_curves.push_back(test::iso_curve(s, 0, u));
-  n.u_params = tu;
-  n.v_params = tv;
-  return n;
-}
 
 void expect_interpolates(const Surface& c, const CurveNetwork& n, double tol) {
   for (double t : linspace(0, 1, 29)) {
@@ -29,7 +21,7 @@ TEST(Network, EveryMethodInterpolatesEveryCurveAndConvertsExactly) {
   auto g = test::rng(80);
   for (int trial = 0; trial < 6; ++trial) {
     const auto s = test::random_bspline_surface(g, 3, 2 + trial % 2, 7, 6);
-    const auto n = network_on(s, {0, 0.2, 0.45, 0.7, 1}, {0, 0.3, 0.6, 1});
+    const auto n = test::network_on(s, {0, 0.2, 0.45, 0.7, 1}, {0, 0.3, 0.6, 1});
     for (auto m : kMethods) {
       const auto c = curve_network(n, {m, {}});
       expect_interpolates(c, n, 1e-13);
@@ -42,7 +34,7 @@ TEST(Network, EveryMethodInterpolatesEveryCurveAndConvertsExactly) {
 TEST(Network, GordonReproducesBicubicsAndTwoByTwoIsCoons) {
   auto g = test::rng(81);
   const auto bez = test::random_bspline_surface(g, 3, 3, 4, 4);
-  const auto n = network_on(bez, {0, 0.25, 0.6, 0.8, 1}, {0, 0.4, 0.7, 1});
+  const auto n = test::network_on(bez, {0, 0.25, 0.6, 0.8, 1}, {0, 0.4, 0.7, 1});
   const auto gordon = curve_network(n);
   EXPECT_LT(test::max_distance(gordon, bez), 1e-13);  // cubic cardinal splines reproduce cubics
   EXPECT_EQ(gordon.to_bspline().knots_u().continuity(), 2);  // C2 across the nodes
@@ -52,7 +44,7 @@ TEST(Network, GordonReproducesBicubicsAndTwoByTwoIsCoons) {
 TEST(Network, HermiteBlendingIsC1AcrossCellsLinearIsNot) {
   auto g = test::rng(82);
   const auto s = test::random_bspline_surface(g, 3, 3, 6, 6);
-  const auto n = network_on(s, {0, 0.35, 0.65, 1}, {0, 0.5, 1});
+  const auto n = test::network_on(s, {0, 0.35, 0.65, 1}, {0, 0.5, 1});
   const double h = 1e-7;
   auto jump = [&](const Surface& c) {  // largest jump of S_u across u = 0.35 and of S_v across v = 0.5
     double e = 0;
@@ -73,7 +65,7 @@ TEST(Network, HermiteBlendingIsC1AcrossCellsLinearIsNot) {
 TEST(Network, ParametersFoundFromTheCurves) {
   auto g = test::rng(83);
   const auto s = test::random_bspline_surface(g, 3, 3, 5, 5, 0.1);
-  auto n = network_on(s, {0, 0.3, 0.55, 1}, {0, 0.45, 1});
+  auto n = test::network_on(s, {0, 0.3, 0.55, 1}, {0, 0.45, 1});
   const auto p = network_parameters(n);
   for (std::size_t i = 0; i < 4; ++i) EXPECT_NEAR(p.u_params[i], n.u_params[i], 1e-9);  // Gauss–Newton to rounding
   for (std::size_t j = 0; j < 3; ++j) EXPECT_NEAR(p.v_params[j], n.v_params[j], 1e-9);
@@ -87,7 +79,7 @@ TEST(Network, ParametersFoundFromTheCurves) {
 TEST(Network, InvalidInput) {
   auto g = test::rng(84);
   const auto s = test::random_bspline_surface(g, 3, 3, 5, 5);
-  auto n = network_on(s, {0, 0.5, 1}, {0, 0.5, 1});
+  auto n = test::network_on(s, {0, 0.5, 1}, {0, 0.5, 1});
   auto bad = n;
   auto cp = bad.u_curves[1].control_points();
   for (auto& x : cp) x.z += 0.125;

@@ -6,6 +6,7 @@
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/coons.hpp"
 #include "interpatch/evaluate.hpp"
+#include "interpatch/network.hpp"
 #include "test_util.hpp"
 
 namespace interpatch::test {
@@ -60,6 +61,16 @@ inline double max_distance(const Surface& a, const Surface& b, std::size_t n = 4
   for (double u : t)
     for (double v : t) e = std::max(e, distance(a.point(u, v), b.point(u, v)));
   return e;
+}
+
+// The network of a surface's iso-curves at u = tu[i] and v = tv[j], crossing at those parameters.
+inline CurveNetwork network_on(const BSplineSurface& s, const std::vector<double>& tu, const std::vector<double>& tv) {
+  CurveNetwork n;
+  for (double v : tv) n.u_curves.push_back(test::iso_curve(s, 1, v));
+  for (double u : tu) n.v_curves.push_back(test::iso_curve(s, 0, u));
+  n.u_params = tu;
+  n.v_params = tv;
+  return n;
 }
 
 }  // namespace interpatch::test

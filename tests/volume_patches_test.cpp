@@ -58,17 +58,6 @@ TEST(Trilinear, InvalidInput) {
   EXPECT_ERRC((void)trilinear(c), not_finite, "corner p101 is");
 }
 
-// The point frame of a volume: its corner positions and partial derivatives.
-std::array<HermiteVolumeCorner, 8> frame_of(const BSplineVolume& b) {
-  std::array<HermiteVolumeCorner, 8> c;
-  for (std::size_t n = 0; n < 8; ++n) {
-    const double u = static_cast<double>(n >> 2), v = static_cast<double>((n >> 1) & 1), w = static_cast<double>(n & 1);
-    c[n] = {b.derivative(u, v, w, 0, 0, 0), b.derivative(u, v, w, 1, 0, 0), b.derivative(u, v, w, 0, 1, 0),
-            b.derivative(u, v, w, 0, 0, 1), b.derivative(u, v, w, 1, 1, 0), b.derivative(u, v, w, 1, 0, 1),
-            b.derivative(u, v, w, 0, 1, 1), b.derivative(u, v, w, 1, 1, 1)};
-  }
-  return c;
-}
 
 TEST(HermiteVolume, ReproducesTricubicPolynomialsFromTheirOwnCornerData) {
   auto g = test::rng(211);
@@ -76,7 +65,7 @@ TEST(HermiteVolume, ReproducesTricubicPolynomialsFromTheirOwnCornerData) {
     // One tricubic Bézier volume is a tricubic polynomial; lower degrees are too.
     const auto b = test::random_bspline_volume(g, 3 - trial % 3, 3, 1 + trial % 3, 4 - static_cast<std::size_t>(trial % 3), 4,
                                                2 + static_cast<std::size_t>(trial % 3), 0.4);
-    const auto h = hermite_volume(frame_of(b));
+    const auto h = hermite_volume(test::frame_of(b));
     const double scale = test::scale_of(b);
     // Sums of 64 products of corner data with cubic functions: rounding only.
     EXPECT_LT(test::max_distance(h, b), 1e-13 * scale);

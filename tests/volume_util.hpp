@@ -9,6 +9,7 @@
 #include "interpatch/bspline_volume.hpp"
 #include "interpatch/coons_volume.hpp"
 #include "interpatch/evaluate.hpp"
+#include "interpatch/volume_patches.hpp"
 #include "test_util.hpp"
 
 namespace interpatch::test {
@@ -109,6 +110,18 @@ inline VolumeDerivatives finite_differences(const Volume& s, double u, double v,
     *out[a] = (s.point(hi[0], hi[1], hi[2]) - s.point(lo[0], lo[1], lo[2])) / (hi[a] - lo[a]);
   }
   return d;
+}
+
+// The point frame of a volume: its corner positions and partial derivatives.
+inline std::array<HermiteVolumeCorner, 8> frame_of(const BSplineVolume& b) {
+  std::array<HermiteVolumeCorner, 8> c;
+  for (std::size_t n = 0; n < 8; ++n) {
+    const double u = static_cast<double>(n >> 2), v = static_cast<double>((n >> 1) & 1), w = static_cast<double>(n & 1);
+    c[n] = {b.derivative(u, v, w, 0, 0, 0), b.derivative(u, v, w, 1, 0, 0), b.derivative(u, v, w, 0, 1, 0),
+            b.derivative(u, v, w, 0, 0, 1), b.derivative(u, v, w, 1, 1, 0), b.derivative(u, v, w, 1, 0, 1),
+            b.derivative(u, v, w, 0, 1, 1), b.derivative(u, v, w, 1, 1, 1)};
+  }
+  return c;
 }
 
 }  // namespace interpatch::test

@@ -544,14 +544,6 @@ TEST(Scaling, CoonsLinearHermiteAndWithCrossDerivatives) {
   }
 }
 
-CurveNetwork network_on(const BSplineSurface& s, const std::vector<double>& tu, const std::vector<double>& tv) {
-  CurveNetwork n;
-  for (double v : tv) n.u_curves.push_back(test::iso_curve(s, 1, v));
-  for (double u : tu) n.v_curves.push_back(test::iso_curve(s, 0, u));
-  n.u_params = tu;
-  n.v_params = tv;
-  return n;
-}
 
 CurveNetwork sc(const CurveNetwork& n, int k) {
   CurveNetwork m = n;
@@ -564,7 +556,7 @@ TEST(Scaling, CurveNetworksEveryMethodCrossingsGivenAndFound) {
   auto g = test::rng(909);
   for (int trial = 0; trial < 2; ++trial) {
     const auto s = test::random_bspline_surface(g, 3, 3, 6, 5, 0.2);
-    const CurveNetwork given = network_on(s, {0, 0.3, 0.55, 1}, {0, 0.45, 1});
+    const CurveNetwork given = test::network_on(s, {0, 0.3, 0.55, 1}, {0, 0.45, 1});
     CurveNetwork found = given;
     found.u_params.clear();
     found.v_params.clear();
@@ -588,16 +580,6 @@ TEST(Scaling, CurveNetworksEveryMethodCrossingsGivenAndFound) {
 
 // ------------------------------------------------------------------ volumes
 
-std::array<HermiteVolumeCorner, 8> frame_of(const BSplineVolume& b) {
-  std::array<HermiteVolumeCorner, 8> c;
-  for (std::size_t n = 0; n < 8; ++n) {
-    const double u = static_cast<double>(n >> 2), v = static_cast<double>((n >> 1) & 1), w = static_cast<double>(n & 1);
-    c[n] = {b.derivative(u, v, w, 0, 0, 0), b.derivative(u, v, w, 1, 0, 0), b.derivative(u, v, w, 0, 1, 0),
-            b.derivative(u, v, w, 0, 0, 1), b.derivative(u, v, w, 1, 1, 0), b.derivative(u, v, w, 1, 0, 1),
-            b.derivative(u, v, w, 0, 1, 1), b.derivative(u, v, w, 1, 1, 1)};
-  }
-  return c;
-}
 
 VolumeFaces sc(const VolumeFaces& f, int k) {
   return {sc(f.u0, k), sc(f.u1, k), sc(f.v0, k), sc(f.v1, k), sc(f.w0, k), sc(f.w1, k)};
@@ -631,7 +613,7 @@ TEST(Scaling, TrilinearAndHermiteVolumes) {
       record(out, "trilinear", trilinear(c));
       return out;
     });
-    const auto frame = frame_of(test::random_bspline_volume(g, 3, 2, 3, 4, 3, 4, 0.3));
+    const auto frame = test::frame_of(test::random_bspline_volume(g, 3, 2, 3, 4, 3, 4, 0.3));
     expect_scale_free(detail::cat("hermite_volume ", trial), [&](int k) {
       auto c = frame;
       for (auto& x : c)
@@ -740,7 +722,7 @@ TEST(Scaling, GapsAndTolerancesScaleWithTheData) {
     }
 
     // Network: v_curves[1] moved along z; the first node it misses is (1, 0).
-    CurveNetwork n = network_on(s, {0, 0.4, 1}, {0, 0.5, 1});
+    CurveNetwork n = test::network_on(s, {0, 0.4, 1}, {0, 0.5, 1});
     std::vector<Vec3> all;
     for (const auto* list : {&n.u_curves, &n.v_curves})
       for (const auto& c : *list) all.insert(all.end(), c.control_points().begin(), c.control_points().end());
