@@ -25,6 +25,7 @@
 #include "exit_status.hpp"
 #include "interpatch/error.hpp"
 #include "interpatch/io/spec.hpp"
+#include "npy_util.hpp"
 #include "temp_dir.hpp"
 #include "test_util.hpp"
 
@@ -73,23 +74,8 @@ json network_with_params(const json& u_params) {
   return s;
 }
 
-// A version 1.0 .npy as NumPy writes it: header padded to 64 bytes, then `payload`.
-std::string npy_bytes(const std::string& descr, const std::string& shape, const std::string& payload) {
-  std::string header = "{'descr': '" + descr + "', 'fortran_order': False, 'shape': " + shape + ", }";
-  header.append(63 - (10 + header.size()) % 64, ' ');
-  header += '\n';
-  std::string bytes("\x93NUMPY\x01\x00", 8);
-  bytes += static_cast<char>(header.size() & 0xff);
-  bytes += static_cast<char>(header.size() >> 8);
-  return bytes + header + payload;
-}
-
-// float64 little endian (the test hosts are little endian, as the CLI tests assume).
-std::string f8(const std::vector<double>& v) {
-  std::string s(v.size() * 8, '\0');
-  std::memcpy(s.data(), v.data(), s.size());
-  return s;
-}
+using test::f8;
+using test::npy_bytes;
 
 // The (2, 3, 3) grid of points k, k+1, ... with a NaN at [1][2][0] when asked.
 std::string npy_grid(bool nan) {
