@@ -29,17 +29,8 @@ using test::le_bytes;
 using test::make_npy;
 using test::TempDir;
 
-std::string read_bytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void write_bytes(const fs::path& p, const std::string& bytes) {
-  std::ofstream out(p, std::ios::binary);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
+std::string read_bytes(const fs::path& p) { return test::read_text(p); }
+using test::write_bytes;
 
 template <class T>
 std::string be_bytes(const std::vector<T>& v) {

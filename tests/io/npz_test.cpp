@@ -38,16 +38,8 @@ using test::TempDir;
 using test::zip_archive;
 using test::ZipMember;
 
-std::string read_bytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void write_bytes(const fs::path& p, const std::string& bytes) {
-  std::ofstream(p, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
+std::string read_bytes(const fs::path& p) { return test::read_text(p); }
+using test::write_bytes;
 
 std::uint64_t get_le(const std::string& s, std::size_t at, int bytes) {
   std::uint64_t v = 0;
@@ -175,26 +167,17 @@ bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
   return same_bits(a.data(), a.size(), b.data(), b.size());
 }
 
-void expect_identical(const BSplineSurface& a, const BSplineSurface& b) {
-  EXPECT_EQ(a.degree_u(), b.degree_u());
-  EXPECT_EQ(a.degree_v(), b.degree_v());
-  EXPECT_TRUE(same_bits(a.knots_u().values(), b.knots_u().values()));
-  EXPECT_TRUE(same_bits(a.knots_v().values(), b.knots_v().values()));
-  EXPECT_EQ(a.control_points().shape(), b.control_points().shape());
-  EXPECT_TRUE(same_bits(&a.control_points().data()->x, 3 * a.control_points().size(), &b.control_points().data()->x,
-                        3 * b.control_points().size()));
-  EXPECT_EQ(a.rational(), b.rational());
-  EXPECT_EQ(a.weights().shape(), b.weights().shape());
-  EXPECT_TRUE(same_bits(a.weights().data(), a.weights().size(), b.weights().data(), b.weights().size()));
-}
+std::vector<const KnotVector*> knots_of(const BSplineSurface& s) { return {&s.knots_u(), &s.knots_v()}; }
+std::vector<const KnotVector*> knots_of(const BSplineVolume& v) { return {&v.knots_u(), &v.knots_v(), &v.knots_w()}; }
 
-void expect_identical(const BSplineVolume& a, const BSplineVolume& b) {
-  EXPECT_EQ(a.degree_u(), b.degree_u());
-  EXPECT_EQ(a.degree_v(), b.degree_v());
-  EXPECT_EQ(a.degree_w(), b.degree_w());
-  EXPECT_TRUE(same_bits(a.knots_u().values(), b.knots_u().values()));
-  EXPECT_TRUE(same_bits(a.knots_v().values(), b.knots_v().values()));
-  EXPECT_TRUE(same_bits(a.knots_w().values(), b.knots_w().values()));
+// Degrees, knots, control points and weights, bit for bit.
+template <class Form>
+void expect_identical(const Form& a, const Form& b) {
+  const auto ka = knots_of(a), kb = knots_of(b);
+  for (std::size_t d = 0; d < ka.size(); ++d) {
+    EXPECT_EQ(ka[d]->degree(), kb[d]->degree()) << "direction " << d;
+    EXPECT_TRUE(same_bits(ka[d]->values(), kb[d]->values())) << "knots of direction " << d;
+  }
   EXPECT_EQ(a.control_points().shape(), b.control_points().shape());
   EXPECT_TRUE(same_bits(&a.control_points().data()->x, 3 * a.control_points().size(), &b.control_points().data()->x,
                         3 * b.control_points().size()));
