@@ -418,7 +418,8 @@ TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
   EXPECT_NE(r.out.find("outputs in out"), std::string::npos) << r.out;
   for (const char* name : {"hemisphere", "terrain", "wave", "saddle", "half_cylinder", "twisted_strip"}) {
     for (const char* suffix :
-         {".spec.json", ".bspline.json", ".step", ".igs", ".eval.npy", ".eval.csv", ".obj", ".vtk", ".info.json"})
+         {".spec.json", ".bspline.json", ".bspline.npz", ".step", ".igs", ".eval.npy", ".eval.csv", ".obj", ".vtk",
+          ".info.json"})
       EXPECT_TRUE(fs::exists(at("out") / (std::string(name) + suffix))) << name << suffix;
     const json info = json::parse(read_file(at("out") / (std::string(name) + ".info.json")));
     EXPECT_LT(info["max_data_error"]["relative"].get<double>(), 1e-12) << name;
@@ -427,8 +428,8 @@ TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
   EXPECT_TRUE(fs::exists(at("out") / "twisted_strip.csv"));
   EXPECT_TRUE(fs::exists(at("out") / "hemisphere.stl"));
   for (const char* name : {"trilinear", "coons_volume", "hermite_volume", "annular_sector"}) {
-    for (const char* suffix : {".spec.json", ".bspline.json", ".step", ".igs", ".eval.npy", ".eval.csv", ".vts", ".vtk", ".xyz",
-                               ".info.json"})
+    for (const char* suffix : {".spec.json", ".bspline.json", ".bspline.npz", ".step", ".igs", ".eval.npy", ".eval.csv", ".vts",
+                               ".vtk", ".xyz", ".info.json"})
       EXPECT_TRUE(fs::exists(at("out") / (std::string(name) + suffix))) << name << suffix;
     const json info = json::parse(read_file(at("out") / (std::string(name) + ".info.json")));
     EXPECT_EQ(info["kind"], "volume") << name;
@@ -438,7 +439,13 @@ TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
     EXPECT_EQ(read_file(at("out") / (std::string(name) + ".spec.json")),
               read_file(fs::path(INTERPATCH_EXAMPLES) / (std::string(name) + ".json"))) << name;
   }
-  EXPECT_NE(r.out.find("rebuilt identically"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("rebuilt with differences"), std::string::npos) << r.out;
+  for (const char* name : {"terrain_exact", "terrain_npz"}) {
+    const std::size_t at = r.out.find(std::string("  ") + name + " ");
+    ASSERT_NE(at, std::string::npos) << name;
+    EXPECT_NE(r.out.find("rebuilt identically", at), std::string::npos) << name << ": " << r.out;
+  }
+  EXPECT_EQ(read_file(at("out") / "terrain_npz.bspline.json"), read_file(at("out") / "terrain.bspline.json"));
   const json exact = json::parse(read_file(at("out") / "wave.bspline.json"));
   EXPECT_EQ(exact["degree"], json({2, 3}));
   const json saddle = json::parse(read_file(at("out") / "saddle.info.json"));
