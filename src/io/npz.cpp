@@ -252,7 +252,7 @@ void write_archive(const fs::path& path, const FormView& f, bool force_zip64) {
   check_disk_space(path, total, cat("the archive '", path.string(), "'"));
   write_atomically(path, [&](std::ostream& os) {
     for (OutMember& m : members) {
-      os << local_header(m);
+      os << local_header(m);  // its checksum 0 for now
       m.crc = crc32(m.head.data(), m.head.size());
       os << m.head;
       m.crc = crc32(m.bytes.data(), m.bytes.size(), m.crc);
@@ -296,8 +296,13 @@ class FileSource final : public Source {
       fail(errc::file_unreadable, "cannot open '", name_, "': ", std::strerror(e));
     }
     struct stat st {};
-    if (::fstat(fd_, &st) != 0) fail_read(errno);
-    if (S_ISDIR(st.st_mode)) fail(errc::file_unreadable, "cannot read '", name_, "': it is a directory");
+    const bool known = ::fstat(fd_, &st) == 0;
+    const int e = errno;
+    if (!known || S_ISDIR(st.st_mode)) {
+      ::close(fd_);  // no destructor runs for a constructor that throws
+      if (!known) fail_read(e);
+      fail(errc::file_unreadable, "cannot read '", name_, "': it is a directory");
+    }
     size_ = static_cast<std::uint64_t>(st.st_size);
   }
   ~FileSource() override { ::close(fd_); }
@@ -391,9 +396,6 @@ struct Entry {
   std::uint64_t local = 0;  // offset of the local header
   std::uint64_t data = 0;   // offset of the member's bytes
 };
-
-template <std::size_t D>
-using ExactOf = std::conditional_t<D == 2, BSplineSurface, BSplineVolume>;
 
 class Reader {
  public:
