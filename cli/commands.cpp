@@ -21,6 +21,7 @@
 #include "interpatch/io/json_out.hpp"
 #include "interpatch/io/mesh.hpp"
 #include "interpatch/io/npy.hpp"
+#include "interpatch/io/npz.hpp"
 #include "interpatch/io/step.hpp"
 #include "interpatch/memory.hpp"
 #include "progress.hpp"
@@ -244,9 +245,9 @@ nlohmann::json data_file_spec(const Input& in) {
 
 void check_build_output(const fs::path& out) {
   const std::string ext = lower_extension(out);
-  if (ext == ".json" || ext == ".step" || ext == ".stp" || ext == ".igs" || ext == ".iges") return;
+  if (ext == ".json" || ext == ".npz" || ext == ".step" || ext == ".stp" || ext == ".igs" || ext == ".iges") return;
   throw usage_error("cannot tell the output format of '" + out.string() +
-                    "': build writes .json, .step/.stp (STEP AP214) or .igs/.iges (IGES 5.3)");
+                    "': build writes .json, .npz (NumPy), .step/.stp (STEP AP214) or .igs/.iges (IGES 5.3)");
 }
 
 void check_mesh_output(const fs::path& out) {
@@ -316,6 +317,7 @@ void write_build(const io::Construction& c, const fs::path& out) {
   const std::string name = out.stem().string();
   if (ext == ".step" || ext == ".stp") return io::write_step(out, *c.exact, {.name = name, .time_stamp = {}});
   if (ext == ".igs" || ext == ".iges") return io::write_iges(out, *c.exact, {.name = out.filename().string(), .time_stamp = {}});
+  if (ext == ".npz") return io::write_exact_npz(out, *c.exact);
   io::write_exact_json(out, *c.exact);
 }
 

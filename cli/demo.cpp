@@ -446,6 +446,8 @@ std::vector<Example> examples() {
                 false});
   ex.push_back({"terrain_exact", "terrain.bspline.json (the build output) read back as a bspline_surface spec", nullptr,
                 nullptr, "terrain.bspline.json", false});
+  ex.push_back({"terrain_npz", "terrain.bspline.npz (the build output for NumPy) read back as a bspline_surface spec",
+                {{"type", "bspline_surface"}, {"npz", "terrain.bspline.npz"}}, nullptr, "", false});
   return ex;
 }
 
@@ -505,6 +507,7 @@ int demo_command(const fs::path& requested) {
     const bool volume = io::is_volume(c);
     if (c.exact) {
       write_build(c, out(".bspline.json"));
+      write_build(c, out(".bspline.npz"));  // the same arrays for NumPy (numpy.load)
       write_build(c, out(".step"));  // a face (a closed shell of six for a volume) for CAD systems
       write_build(c, out(".igs"));
     }
@@ -541,8 +544,10 @@ int demo_command(const fs::path& requested) {
     if (err.is_object())
       line += ", max error at the data " + short_number(err["absolute"].get<double>()) + " (relative " +
               short_number(err["relative"].get<double>()) + ")";
-    if (!ex.spec_file.empty()) {
-      const bool same = read_text(spec_path) == read_text(dir / (ex.name + ".bspline.json"));
+    if (!ex.spec_file.empty() || ex.spec.contains("npz")) {
+      // An exact form read back and built again: the same bytes as the file it came from.
+      const fs::path original = ex.spec_file.empty() ? dir / ex.spec["npz"].get<std::string>() : spec_path;
+      const bool same = read_text(original) == read_text(dir / (ex.name + ".bspline" + original.extension().string()));
       line += same ? ", rebuilt identically" : ", rebuilt with differences";
     }
     if (volume) {

@@ -68,11 +68,12 @@ int main(int argc, char** argv) {
                     footer);
   };
 
-  CLI::App* build = app.add_subcommand("build", "Write the exact B-spline form (.json, .step/.stp, .igs/.iges)");
+  CLI::App* build = app.add_subcommand("build", "Write the exact B-spline form (.json, .npz, .step/.stp, .igs/.iges)");
   add_input(build);
   build->add_option("-o,--output", out,
-                    "Output file: .json (a bspline_surface or bspline_volume spec), .step or .stp (STEP AP214),\n"
-                    ".igs or .iges (IGES 5.3)")
+                    "Output file: .json (a bspline_surface or bspline_volume spec), .npz (the same arrays for\n"
+                    "NumPy: numpy.load; read back by {\"type\": \"bspline_surface\", \"npz\": FILE}),\n"
+                    ".step or .stp (STEP AP214), .igs or .iges (IGES 5.3)")
       ->required();
 
   CLI::App* mesh = app.add_subcommand("mesh", "Tessellate the construction (surfaces .obj .stl .ply .vtk .vts .xyz; volumes .vtk .vts .xyz)");

@@ -25,6 +25,7 @@
 #include "exit_status.hpp"
 #include "interpatch/error.hpp"
 #include "interpatch/io/spec.hpp"
+#include "npy_util.hpp"
 #include "temp_dir.hpp"
 #include "test_util.hpp"
 
@@ -73,23 +74,8 @@ json network_with_params(const json& u_params) {
   return s;
 }
 
-// A version 1.0 .npy as NumPy writes it: header padded to 64 bytes, then `payload`.
-std::string npy_bytes(const std::string& descr, const std::string& shape, const std::string& payload) {
-  std::string header = "{'descr': '" + descr + "', 'fortran_order': False, 'shape': " + shape + ", }";
-  header.append(63 - (10 + header.size()) % 64, ' ');
-  header += '\n';
-  std::string bytes("\x93NUMPY\x01\x00", 8);
-  bytes += static_cast<char>(header.size() & 0xff);
-  bytes += static_cast<char>(header.size() >> 8);
-  return bytes + header + payload;
-}
-
-// float64 little endian (the test hosts are little endian, as the CLI tests assume).
-std::string f8(const std::vector<double>& v) {
-  std::string s(v.size() * 8, '\0');
-  std::memcpy(s.data(), v.data(), s.size());
-  return s;
-}
+using test::f8;
+using test::npy_bytes;
 
 // The (2, 3, 3) grid of points k, k+1, ... with a NaN at [1][2][0] when asked.
 std::string npy_grid(bool nan) {
@@ -99,6 +85,19 @@ std::string npy_grid(bool nan) {
 }
 
 const std::string npy_spec = R"({"type": "interpolate", "points": {"npy": "grid.npy"}})";
+const std::string npz_spec = R"({"type": "bspline_surface", "npz": "x.npz"})";
+
+// The archive of a bilinear patch (tests/npy_util.hpp) with one member changed.
+std::string npz_with(const std::string& member, const std::string& data) { return test::bilinear_npz_with(member, data); }
+
+// ... or with one member labelled deflate-compressed.
+std::string npz_with_compressed(const std::string& member) {
+  std::vector<test::ZipMember> m = test::bilinear_members();
+  for (auto& e : m)
+    if (e.name == member) e.method = 8;
+  return test::zip_archive(m);
+}
+
 const std::string csv_spec = R"({"type": "interpolate", "points": {"csv": "grid.csv", "shape": [2, 2]}})";
 
 // --- the table ---------------------------------------------------------------------
@@ -262,6 +261,48 @@ std::vector<Row> rows() {
       {"TruncatedNpy", {{grid_file, npy_spec}, {"grid.npy", npy_grid(false).substr(0, 128 + 100)}},
        {"eval", grid_file, "--grid", "3", "-o", "out.npy"}, 3,
        R"(/points: grid\.npy: truncated: shape \(2, 3, 3\) needs 144 bytes of data, found 100)", errc::malformed_file},
+      // .npz exact forms
+      {"TruncatedNpz", {{grid_file, npz_spec}, {"x.npz", test::zip_archive(test::bilinear_members()).substr(0, 300)}},
+       {"build", grid_file, "-o", "out.json"}, 3,
+       R"(/npz: x\.npz: truncated ZIP archive: no end-of-central-directory record in its last 300 of 300 bytes)",
+       errc::malformed_file},
+      {"NpzMemberMissing", {{grid_file, npz_spec}, {"x.npz", npz_with("knots_v.npy", "")}}, {"info", grid_file}, 3,
+       R"(/npz: x\.npz: no member 'knots_v\.npy' \(an exact form holds degree, knots_u, knots_v, .*; this archive holds degree\.npy, knots_u\.npy, control_points\.npy, periodic\.npy\))",
+       errc::malformed_file},
+      {"NpzMemberCompressed", {{grid_file, npz_spec}, {"x.npz", npz_with_compressed("control_points.npy")}},
+       {"mesh", grid_file, "-o", "out.obj"}, 3,
+       R"(/npz: x\.npz: member 'control_points\.npy' is compressed \(method 8, deflate\); only stored members are read)",
+       errc::malformed_file},
+      {"NpzChecksumMismatch",
+       {{grid_file, npz_spec}, {"x.npz", [] { auto b = test::zip_archive(test::bilinear_members()); b[40 + 130] ^= 1; return b; }()}},
+       {"build", grid_file, "-o", "out.npz"}, 3,
+       R"(/npz: x\.npz: degree\.npy: CRC-32 of its 144 bytes is 0x[0-9a-f]{8}, the archive records 0x[0-9a-f]{8}: the file is damaged)",
+       errc::malformed_file},
+      {"NpzControlPointsOfTheWrongShape",
+       {{grid_file, npz_spec}, {"x.npz", npz_with("control_points.npy", npy_bytes("<f8", "(2, 2, 2)", f8(std::vector<double>(8, 1.0))))}},
+       {"eval", grid_file, "--grid", "3", "-o", "out.npy"}, 3,
+       R"(/npz: x\.npz: control_points\.npy has shape \(2, 2, 2\); expected \(n, m, 3\), the knots need \(2, 2, 3\))",
+       errc::size_mismatch},
+      {"NanInNpzControlPoints",
+       {{grid_file, npz_spec},
+        {"x.npz", npz_with("control_points.npy", npy_bytes("<f8", "(2, 2, 3)", f8({0, 0, 0, 0, 1, std::nan(""), 1, 0, 0, 1, 1, 1})))}},
+       {"build", grid_file, "-o", "out.step"}, 3, R"(/npz: x\.npz: control_points\.npy: control point \[0\]\[1\] is \(0, 1, nan\))",
+       errc::not_finite},
+      {"NpzWithControlPoints",
+       {{grid_file, R"({"type": "bspline_surface", "npz": "x.npz", "control_points": [[[0, 0, 0], [1, 0, 0]]]})"},
+        {"x.npz", test::zip_archive(test::bilinear_members())}},
+       {"build", grid_file, "-o", "out.npz"}, 3,
+       R"(/npz: give either "npz" or "control_points" \(with the other fields of bspline_surface\), not both)", errc::wrong_type},
+      {"NpzOfASurfaceAsAVolume",
+       {{grid_file, R"({"type": "bspline_volume", "npz": "x.npz"})"}, {"x.npz", test::zip_archive(test::bilinear_members())}},
+       {"mesh", grid_file, "-o", "out.vts"}, 3,
+       R"(/npz: x\.npz holds a surface \(degree\.npy has shape \(2,\)\); bspline_surface reads the archive of a surface, bspline_volume that of a volume)",
+       errc::wrong_type},
+      {"NpzFloatDegrees", {{grid_file, npz_spec}, {"x.npz", npz_with("degree.npy", npy_bytes("<f8", "(2,)", f8({1, 1})))}},
+       {"info", grid_file, "-o", "info.json"}, 3, R"(/npz: x\.npz: degree\.npy: dtype '<f8'; expected integers \(int64\))",
+       errc::wrong_type},
+      {"NpzMissing", {{grid_file, npz_spec}}, {"build", grid_file, "-o", "out.npz"}, 4, R"(/npz: cannot open 'x\.npz': No such file)",
+       errc::file_unreadable},
       {"CsvFieldNotANumber", {{grid_file, csv_spec}, {"grid.csv", "x,y,z\n0,0,0\n1,abc,0\n0,1,0\n1,1,0\n"}},
        {"build", grid_file, "-o", "out.json"}, 3, R"(/points: grid\.csv:3:2: 'abc' is not a number)", errc::malformed_file},
       {"CsvRowOfTwoFields", {{grid_file, csv_spec}, {"grid.csv", "x,y,z\n0,0,0\n1,0\n0,1,0\n1,1,0\n"}},
@@ -340,7 +381,7 @@ std::vector<Row> rows() {
       {"VolumeMeshAsObj", {{grid_file, vol}}, {"mesh", grid_file, "-o", "out.obj"}, 2,
        R"('out\.obj': trilinear is a volume; \.obj holds surfaces only)"},
       {"UnknownBuildExtension", {{grid_file, grid}}, {"build", grid_file, "-o", "out.txt"}, 2,
-       R"(cannot tell the output format of 'out\.txt': build writes \.json)"},
+       R"(cannot tell the output format of 'out\.txt': build writes \.json, \.npz \(NumPy\), \.step/\.stp)"},
       {"UnknownEvalExtension", {{grid_file, grid}}, {"eval", grid_file, "--grid", "8", "-o", "out.txt"}, 2,
        R"(cannot tell the output format of 'out\.txt': eval writes \.npy or \.csv)"},
       {"UnknownMeshExtension", {{grid_file, grid}}, {"mesh", grid_file, "-o", "out.foo"}, 2,

@@ -58,4 +58,9 @@ inline std::string read_text(const std::filesystem::path& p) {
   return ss.str();
 }
 
+/// Writes the bytes as they are, replacing the file.
+inline void write_bytes(const std::filesystem::path& p, const std::string& bytes) {
+  std::ofstream(p, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
 }  // namespace interpatch::test

@@ -1,6 +1,6 @@
 // Files: atomic output (io/atomic_file.hpp), points as CSV (io/csv.hpp) and NumPy
 // .npy (io/npy.hpp), meshes (io/mesh.hpp), and the exact form as STEP (io/step.hpp)
-// and IGES (io/iges.hpp), each example run and what it writes read back. The
+// and IGES (io/iges.hpp) and NumPy .npz (io/npz.hpp), each example run and what it writes read back. The
 // examples name files relative to the working directory, so the program works in a
 // scratch directory of its own, removed at the end. Links interpatch::interpatch.
 
@@ -8,6 +8,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -19,6 +20,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <variant>
 #include <vector>
 
 #include <interpatch/interpatch.hpp>
@@ -216,6 +218,35 @@ void iges_files(const fs::path& examples) {
   std::printf("terrain as IGES: %zu lines of 80 columns\n", lines.size());
 }
 
+// The exact form as a NumPy archive (io/npz.hpp): written, read back from the file
+// and from bytes in memory, the same surface each time. Runs after iges_files, which
+// put terrain.json here.
+void npz_files() {
+  {
+    interpatch::io::Construction c = interpatch::io::build_file("terrain.json");
+    interpatch::io::write_exact_npz("terrain.npz", *c.exact);
+    // python3 -c "import numpy; print(numpy.load('terrain.npz')['control_points'].shape)"
+  }
+  const interpatch::io::Construction c = interpatch::io::build_file("terrain.json");
+  const auto& built = std::get<interpatch::BSplineSurface>(*c.exact);
+  {
+    interpatch::io::ExactForm f = interpatch::io::read_exact_npz("terrain.npz");
+    const auto& s = std::get<interpatch::BSplineSurface>(f);
+    example::expect(s.knots_u().values() == built.knots_u().values() &&
+                        s.control_points().values().size() == built.control_points().values().size(),
+                    "read_exact_npz gives back the knots and the control net");
+    example::expect(s.point(0.3, 0.7) == built.point(0.3, 0.7), "read_exact_npz gives back the same surface, bit for bit");
+  }
+  {
+    const auto load_from_somewhere = [] { return read_text("terrain.npz"); };
+    std::string bytes = load_from_somewhere();
+    interpatch::io::ExactForm f = interpatch::io::parse_exact_npz(bytes, "upload.npz");
+    example::expect(std::get<interpatch::BSplineSurface>(f).point(0.5, 0.5) == built.point(0.5, 0.5),
+                    "parse_exact_npz reads the same archive from memory");
+  }
+  std::printf("terrain as .npz: %ju bytes\n", static_cast<std::uintmax_t>(fs::file_size("terrain.npz")));
+}
+
 }  // namespace
 
 int main() {
@@ -231,5 +262,6 @@ int main() {
     meshes();
     step_files(INTERPATCH_EXAMPLES_DIR);
     iges_files(INTERPATCH_EXAMPLES_DIR);
+    npz_files();
   });
 }

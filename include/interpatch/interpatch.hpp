@@ -10,5 +10,6 @@
 #include "interpatch/io/json_out.hpp"
 #include "interpatch/io/mesh.hpp"
 #include "interpatch/io/npy.hpp"
+#include "interpatch/io/npz.hpp"
 #include "interpatch/io/spec.hpp"
 #include "interpatch/io/step.hpp"

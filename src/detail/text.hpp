@@ -58,6 +58,17 @@ template <class... A>
   throw error(code, cat(parts...));
 }
 
+/// Runs f; an error it throws keeps its code and gets `where` and ": " in front of
+/// its message (a spec's JSON Pointer, a file and its member).
+template <class F>
+decltype(auto) prefixed(const std::string& where, F&& f) {
+  try {
+    return f();
+  } catch (const error& e) {
+    throw error(e.code(), where + ": " + e.what());
+  }
+}
+
 /// Refuses a parameter outside [0, 1], the domain of every construction; 1e-12 of
 /// slack absorbs rounding in the caller's parameter mapping. Batch evaluations
 /// check before their parallel loops: an exception must not leave an OpenMP region.

@@ -79,6 +79,8 @@ mode_t default_file_mode() {
 std::atomic<bool> durable_flag{false};
 
 /// An output buffer over a file descriptor that remembers the first write error.
+/// It can seek back into what was written (seekp), so that a writer may fill in a
+/// header once the data after it are known (a ZIP member's checksum).
 class fd_buffer : public std::streambuf {
  public:
   fd_buffer(int fd, bool durable) : fd_(fd), durable_(durable), buf_(std::size_t{1} << 20) {
@@ -89,8 +91,8 @@ class fd_buffer : public std::streambuf {
 
   /// errno of the first failed write, 0 if none.
   [[nodiscard]] int error() const noexcept { return errno_; }
-  /// Bytes handed to the file so far.
-  [[nodiscard]] std::size_t written() const noexcept { return written_; }
+  /// The size of the file so far: the end of the furthest byte handed to it.
+  [[nodiscard]] std::size_t written() const noexcept { return end_; }
 
  protected:
   int_type overflow(int_type ch) override {
@@ -116,6 +118,26 @@ class fd_buffer : public std::streambuf {
 
   int sync() override { return drain() ? 0 : -1; }
 
+  pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode which) override {
+    const auto here = static_cast<off_type>(offset_) + static_cast<off_type>(pptr() - pbase());
+    if (dir == std::ios_base::cur && off == 0) return pos_type(here);  // tellp: no need to write anything
+    const off_type base = dir == std::ios_base::beg   ? 0
+                          : dir == std::ios_base::cur ? here
+                                                      : std::max(here, static_cast<off_type>(end_));
+    return seekpos(pos_type(base + off), which);
+  }
+
+  pos_type seekpos(pos_type pos, std::ios_base::openmode which) override {
+    const off_type to = pos;
+    if (!(which & std::ios_base::out) || to < 0 || !drain()) return pos_type(off_type(-1));
+    if (::lseek(fd_, static_cast<off_t>(to), SEEK_SET) < 0) {
+      errno_ = errno;
+      return pos_type(off_type(-1));
+    }
+    offset_ = static_cast<std::size_t>(to);
+    return pos;
+  }
+
  private:
   bool drain() {
     const auto n = static_cast<std::size_t>(pptr() - pbase());
@@ -138,9 +160,10 @@ class fd_buffer : public std::streambuf {
         return false;
       }
 #ifdef __linux__
-      if (durable_) ::sync_file_range(fd_, static_cast<off_t>(written_), static_cast<off_t>(w), SYNC_FILE_RANGE_WRITE);
+      if (durable_) ::sync_file_range(fd_, static_cast<off_t>(offset_), static_cast<off_t>(w), SYNC_FILE_RANGE_WRITE);
 #endif
-      written_ += static_cast<std::size_t>(w);
+      offset_ += static_cast<std::size_t>(w);
+      end_ = std::max(end_, offset_);
       s += w;
       n -= static_cast<std::size_t>(w);
     }
@@ -149,7 +172,8 @@ class fd_buffer : public std::streambuf {
 
   int fd_;
   bool durable_;
-  std::size_t written_ = 0;
+  std::size_t offset_ = 0;  // where the file descriptor is: the file position of pbase()
+  std::size_t end_ = 0;
   std::vector<char> buf_;
   int errno_ = 0;
 };

@@ -20,7 +20,9 @@
 #include "detail/text.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/memory.hpp"
+#include "io/crc32.hpp"
 #include "io/input_stream.hpp"
+#include "io/npy_format.hpp"
 
 namespace interpatch::io {
 namespace fs = std::filesystem;
@@ -32,15 +34,7 @@ constexpr char magic[6] = {'\x93', 'N', 'U', 'M', 'P', 'Y'};
 // megabyte leaves room for any plausible shape while stopping absurd lengths.
 constexpr std::size_t max_header = std::size_t{1} << 20;
 
-std::string shape_text(const std::vector<std::size_t>& shape) {
-  std::string s = "(";
-  for (std::size_t i = 0; i < shape.size(); ++i) {
-    if (i) s += ", ";
-    s += std::to_string(shape[i]);
-  }
-  if (shape.size() == 1) s += ",";
-  return s + ")";
-}
+std::string shape_text(std::span<const std::size_t> shape) { return internal::npy_shape_text(shape); }
 
 // ---------------------------------------------------------------------------
 // The header is a Python dict literal; this parser accepts what NumPy's
@@ -202,30 +196,10 @@ class HeaderParser {
 // ---------------------------------------------------------------------------
 // Element decoding.
 
-struct Dtype {
-  std::size_t size = 8;  // 4 or 8
-  bool big_endian = false;
-};
-
-Dtype parse_dtype(const std::string& descr, const std::string& name) {
-  auto unsupported = [&]() {
-    detail::fail(errc::malformed_file, name, ": dtype '", descr,
-                 "' is not supported; use float64 or float32");
-  };
-  if (descr.size() != 3) unsupported();
-  Dtype d;
-  switch (descr[0]) {
-    case '<': d.big_endian = false; break;
-    case '>': d.big_endian = true; break;
-    case '=': d.big_endian = std::endian::native == std::endian::big; break;
-    default: unsupported();
-  }
-  if (descr[1] != 'f') unsupported();
-  if (descr[2] == '8') d.size = 8;
-  else if (descr[2] == '4') d.size = 4;
-  else unsupported();
-  return d;
-}
+using internal::crc32;
+using internal::crc32_combine;
+using internal::crc32_serial;
+using internal::NpyDtype;
 
 template <class U>
 U byteswap(U v) noexcept {
@@ -238,18 +212,29 @@ U byteswap(U v) noexcept {
 }
 
 /// One element from its bytes in the file.
-inline double decode(const unsigned char* p, const Dtype& d) noexcept {
+inline double decode(const unsigned char* p, const NpyDtype& d) noexcept {
   const bool swap = d.big_endian != (std::endian::native == std::endian::big);
-  if (d.size == 8) {
+  if (d.kind == 'f' && d.size == 8) {
     std::uint64_t u;
     std::memcpy(&u, p, 8);
     if (swap) u = byteswap(u);
     return std::bit_cast<double>(u);
   }
-  std::uint32_t u;
-  std::memcpy(&u, p, 4);
-  if (swap) u = byteswap(u);
-  return static_cast<double>(std::bit_cast<float>(u));
+  if (d.kind == 'f') {
+    std::uint32_t u;
+    std::memcpy(&u, p, 4);
+    if (swap) u = byteswap(u);
+    return static_cast<double>(std::bit_cast<float>(u));
+  }
+  // Integers and bools: the bytes as an unsigned number, then its sign.
+  std::uint64_t u = 0;
+  for (std::size_t i = 0; i < d.size; ++i) {
+    const std::size_t at = d.big_endian ? i : d.size - 1 - i;  // most significant byte first
+    u = (u << 8) | p[at];
+  }
+  if (d.kind == 'b') return u != 0 ? 1.0 : 0.0;
+  if (d.kind == 'i' && d.size < 8 && (u >> (8 * d.size - 1)) != 0) u |= ~std::uint64_t{0} << (8 * d.size);
+  return d.kind == 'i' ? static_cast<double>(static_cast<std::int64_t>(u)) : static_cast<double>(u);
 }
 
 std::uint32_t read_le(const unsigned char* p, std::size_t n) {
@@ -274,14 +259,41 @@ void read_exact(std::istream& in, char* dst, std::size_t n, const std::string& n
   }
 }
 
-// Reads n bytes at byte `offset` of the source into dst: a faster path than the
-// stream for the data block of a file.
-using BulkRead = std::function<void(char* dst, std::size_t n, std::uint64_t offset)>;
+}  // namespace
 
-/// The array in `in`, which holds `file_size` bytes; `name` names it in messages.
-/// What read_npy and parse_npy share: one reader for files and memory.
-std::vector<std::size_t> read_npy_stream(std::istream& in, std::uint64_t file_size, const std::string& name,
-                                         const NpyDestination& destination, const BulkRead& bulk = {}) {
+namespace internal {
+
+std::string npy_shape_text(std::span<const std::size_t> shape) {
+  std::string s = "(";
+  for (std::size_t i = 0; i < shape.size(); ++i) {
+    if (i) s += ", ";
+    s += std::to_string(shape[i]);
+  }
+  if (shape.size() == 1) s += ",";
+  return s + ")";
+}
+
+std::optional<NpyDtype> parse_npy_dtype(std::string_view descr) {
+  if (descr.size() != 3) return std::nullopt;
+  NpyDtype d;
+  d.kind = descr[1];
+  if (descr[2] < '1' || descr[2] > '8') return std::nullopt;
+  d.size = static_cast<std::size_t>(descr[2] - '0');
+  switch (descr[0]) {
+    case '<': d.big_endian = false; break;
+    case '>': d.big_endian = true; break;
+    case '=': d.big_endian = std::endian::native == std::endian::big; break;
+    case '|': if (d.size != 1) return std::nullopt; break;  // no byte order: single bytes only
+    default: return std::nullopt;
+  }
+  const bool known = (d.kind == 'f' && (d.size == 4 || d.size == 8)) ||
+                     ((d.kind == 'i' || d.kind == 'u') && (d.size == 1 || d.size == 2 || d.size == 4 || d.size == 8)) ||
+                     (d.kind == 'b' && d.size == 1);
+  if (!known) return std::nullopt;
+  return d;
+}
+
+NpyHeader read_npy_header(std::istream& in, std::uint64_t file_size, const std::string& name) {
   unsigned char pre[12] = {};
   if (file_size < 10) {
     detail::fail(errc::malformed_file, name, ": not an NPY file (", file_size, " bytes, shorter than the NPY preamble)");
@@ -312,8 +324,17 @@ std::vector<std::size_t> read_npy_stream(std::istream& in, std::uint64_t file_si
   }
   std::string text(header_len, '\0');
   read_exact(in, text.data(), header_len, name);
-  const Header h = HeaderParser(text, name).parse();
-  const Dtype dt = parse_dtype(h.descr, name);
+  Header h = HeaderParser(text, name).parse();
+  return {std::move(h.descr), h.fortran_order, std::move(h.shape), prefix + header_len};
+}
+
+std::vector<std::size_t> read_npy_data(std::istream& in, const NpyHeader& h, std::uint64_t file_size,
+                                       const std::string& name, const NpyDestination& destination, const BulkRead& bulk,
+                                       bool integers) {
+  const std::optional<NpyDtype> parsed = parse_npy_dtype(h.descr);
+  if (!parsed || (parsed->kind != 'f' && !integers))
+    detail::fail(errc::malformed_file, name, ": dtype '", h.descr, "' is not supported; use float64 or float32");
+  const NpyDtype dt = *parsed;
 
   // Sizes, before allocating anything for the data.
   std::size_t count = 1;
@@ -328,7 +349,7 @@ std::vector<std::size_t> read_npy_stream(std::istream& in, std::uint64_t file_si
   }
   require_memory(count, sizeof(double), name + ": array of shape " + shape_text(h.shape));
   const std::uint64_t need = static_cast<std::uint64_t>(count) * dt.size;
-  const std::uint64_t have = file_size - prefix - header_len;
+  const std::uint64_t have = file_size - h.data_offset;
   if (have < need) {
     detail::fail(errc::malformed_file, name, ": truncated: shape ", shape_text(h.shape), " needs ", need,
                  " bytes of data, found ", have);
@@ -342,7 +363,7 @@ std::vector<std::size_t> read_npy_stream(std::istream& in, std::uint64_t file_si
   const bool fortran = h.fortran_order && h.shape.size() > 1;
   const bool native = dt.big_endian == (std::endian::native == std::endian::big);
 
-  if (!fortran && dt.size == 8) {
+  if (!fortran && dt.kind == 'f' && dt.size == 8) {
     // The common case: the file's bytes are the result, up to byte order.
     if (bulk) bulk(reinterpret_cast<char*>(out), count * 8, file_size - count * 8);
     else read_exact(in, reinterpret_cast<char*>(out), count * 8, name);
@@ -384,23 +405,24 @@ std::vector<std::size_t> read_npy_stream(std::istream& in, std::uint64_t file_si
   return h.shape;
 }
 
-}  // namespace
-
-namespace {
-
 // The data block of a file, read by both threads at once in pieces with pread:
 // copying out of the page cache, and the first touch of the destination's pages,
-// are most of the cost of reading, and both go twice as fast on two cores.
-void read_pieces(const fs::path& path, char* dst, std::size_t n, std::uint64_t offset) {
+// are most of the cost of reading, and both go twice as fast on two cores. The
+// checksum of each piece is taken while the piece is still in the cache, and the
+// pieces' checksums are combined in order afterwards.
+void read_pieces(const fs::path& path, const std::string& name, char* dst, std::size_t n, std::uint64_t offset,
+                 std::uint32_t* crc) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) fail_read(path.string(), errno);
+  if (fd < 0) fail_read(name, errno);
   constexpr std::size_t piece = std::size_t{1} << 20;
   const auto pieces = static_cast<long long>((n + piece - 1) / piece);
+  std::vector<std::uint32_t> sums(crc ? static_cast<std::size_t>(pieces) : 0);
   std::atomic<int> failure{0};
 #pragma omp parallel for schedule(static) if (n >= 8 * piece)
   for (long long k = 0; k < pieces; ++k) {
-    std::size_t at = static_cast<std::size_t>(k) * piece;
-    const std::size_t end = std::min(n, at + piece);
+    const std::size_t begin = static_cast<std::size_t>(k) * piece;
+    const std::size_t end = std::min(n, begin + piece);
+    std::size_t at = begin;
     while (at < end && failure.load(std::memory_order_relaxed) == 0) {
       const ssize_t got = ::pread(fd, dst + at, end - at, static_cast<off_t>(offset + at));
       if (got < 0 && errno == EINTR) continue;
@@ -410,9 +432,64 @@ void read_pieces(const fs::path& path, char* dst, std::size_t n, std::uint64_t o
       }
       at += static_cast<std::size_t>(got);
     }
+    if (crc && at == end) sums[static_cast<std::size_t>(k)] = crc32_serial(dst + begin, end - begin);
   }
   ::close(fd);
-  if (const int e = failure.load(); e != 0) fail_read(path.string(), e);
+  if (const int e = failure.load(); e != 0) fail_read(name, e);
+  if (!crc) return;
+  for (std::size_t k = 0; k < sums.size(); ++k)
+    *crc = crc32_combine(*crc, sums[k], std::min(piece, n - k * piece));
+}
+
+// Magic, version, header length and the header dictionary padded to 64 bytes.
+std::string npy_header(std::string_view descr, std::span<const std::size_t> shape) {
+  std::string header =
+      "{'descr': '" + std::string(descr) + "', 'fortran_order': False, 'shape': " + shape_text(shape) + ", }";
+  // Version 1.0 holds header lengths below 65536; only an absurd rank needs 2.0.
+  const bool v1 = header.size() + 1 + 10 + 64 <= 65535;
+  const std::size_t prefix = v1 ? 10 : 12;
+  const std::size_t total = (prefix + header.size() + 1 + 63) / 64 * 64;
+  header.append(total - prefix - header.size() - 1, ' ');
+  header += '\n';
+  std::string pre(magic, sizeof magic);
+  pre += static_cast<char>(v1 ? 1 : 2);
+  pre += '\0';
+  std::size_t len = header.size();
+  for (std::size_t i = 0; i < (v1 ? 2u : 4u); ++i, len >>= 8) pre += static_cast<char>(len & 0xffu);
+  return pre + header;
+}
+
+void write_values(std::ostream& os, const double* data, std::size_t n, std::uint32_t* crc) {
+  const auto put = [&](const void* bytes, std::size_t count) {
+    if (crc) *crc = crc32(bytes, count, *crc);
+    os.write(static_cast<const char*>(bytes), static_cast<std::streamsize>(count));
+  };
+  if constexpr (std::endian::native == std::endian::little) {
+    // With a checksum, in pieces of 8 MiB: each is summed (by both threads) and
+    // written while it is still in the cache. Without, all at once.
+    const std::size_t step = crc ? std::size_t{1} << 20 : std::max<std::size_t>(n, 1);
+    for (std::size_t done = 0; done < n; done += step) put(data + done, std::min(step, n - done) * sizeof(double));
+  } else {
+    std::vector<std::uint64_t> chunk(std::min<std::size_t>(n, std::size_t{1} << 16));
+    for (std::size_t done = 0; done < n;) {
+      const std::size_t k = std::min(chunk.size(), n - done);
+      for (std::size_t i = 0; i < k; ++i) chunk[i] = byteswap(std::bit_cast<std::uint64_t>(data[done + i]));
+      put(chunk.data(), k * 8);
+      done += k;
+    }
+  }
+}
+
+}  // namespace internal
+
+namespace {
+
+/// The array in `in`, which holds `file_size` bytes; `name` names it in messages.
+/// What read_npy and parse_npy share: one reader for files and memory.
+std::vector<std::size_t> read_npy_stream(std::istream& in, std::uint64_t file_size, const std::string& name,
+                                         const NpyDestination& destination, const internal::BulkRead& bulk = {}) {
+  const internal::NpyHeader h = internal::read_npy_header(in, file_size, name);
+  return internal::read_npy_data(in, h, file_size, name, destination, bulk);
 }
 
 }  // namespace
@@ -424,7 +501,9 @@ std::vector<std::size_t> read_npy_into(const fs::path& path, const NpyDestinatio
   in.seekg(0, std::ios::beg);
   if (end < 0 || !in) fail_read(path.string(), errno);
   return read_npy_stream(in, static_cast<std::uint64_t>(end), path.string(), destination,
-                         [&](char* dst, std::size_t n, std::uint64_t offset) { read_pieces(path, dst, n, offset); });
+                         [&](char* dst, std::size_t n, std::uint64_t offset) {
+                           internal::read_pieces(path, path.string(), dst, n, offset);
+                         });
 }
 
 namespace {
@@ -463,38 +542,6 @@ std::size_t element_count(const fs::path& path, const std::vector<std::size_t>& 
   return count;
 }
 
-// Magic, version, header length and the header dictionary padded to 64 bytes.
-std::string npy_header(const std::vector<std::size_t>& dims) {
-  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': " + shape_text(dims) + ", }";
-  // Version 1.0 holds header lengths below 65536; only an absurd rank needs 2.0.
-  const bool v1 = header.size() + 1 + 10 + 64 <= 65535;
-  const std::size_t prefix = v1 ? 10 : 12;
-  const std::size_t total = (prefix + header.size() + 1 + 63) / 64 * 64;
-  header.append(total - prefix - header.size() - 1, ' ');
-  header += '\n';
-  std::string pre(magic, sizeof magic);
-  pre += static_cast<char>(v1 ? 1 : 2);
-  pre += '\0';
-  std::size_t len = header.size();
-  for (std::size_t i = 0; i < (v1 ? 2u : 4u); ++i, len >>= 8) pre += static_cast<char>(len & 0xffu);
-  return pre + header;
-}
-
-// Little-endian float64 values onto the stream.
-void write_values(std::ostream& os, const double* data, std::size_t n) {
-  if constexpr (std::endian::native == std::endian::little) {
-    os.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(n * sizeof(double)));
-  } else {
-    std::vector<std::uint64_t> chunk(std::min<std::size_t>(n, std::size_t{1} << 16));
-    for (std::size_t done = 0; done < n;) {
-      const std::size_t k = std::min(chunk.size(), n - done);
-      for (std::size_t i = 0; i < k; ++i) chunk[i] = byteswap(std::bit_cast<std::uint64_t>(data[done + i]));
-      os.write(reinterpret_cast<const char*>(chunk.data()), static_cast<std::streamsize>(k * 8));
-      done += k;
-    }
-  }
-}
-
 }  // namespace
 
 void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::span<const double> data) {
@@ -512,7 +559,7 @@ void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::si
   const std::vector<std::size_t> dims(shape.begin(), shape.end());
   const std::size_t count = element_count(path, dims);
   if (block == 0) detail::fail(errc::size_mismatch, "cannot write '", path.string(), "': blocks of 0 values");
-  const std::string header = npy_header(dims);
+  const std::string header = internal::npy_header("<f8", dims);
   // The file's size, for write_atomically to allocate at once; 0 (unknown) for a
   // shape whose bytes cannot be counted, which the writes then refuse.
   const std::uintmax_t bytes = count <= (std::numeric_limits<std::uintmax_t>::max() - header.size()) / sizeof(double)
@@ -526,7 +573,7 @@ void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::si
       if (values.size() != n)
         detail::fail(errc::size_mismatch, "cannot write '", path.string(), "': values ", first, " to ", first + n - 1,
                      " came as ", values.size(), " values");
-      write_values(os, values.data(), n);
+      internal::write_values(os, values.data(), n);
     }
   }, bytes);
 }

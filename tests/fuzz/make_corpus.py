@@ -73,3 +73,59 @@ specs = {
 }
 for name, text in specs.items():
     (corpus["spec"] / name).write_text(text)
+
+# .npz archives of exact forms: as numpy.savez lays them out (ZIP64 local headers,
+# as NumPy always asks for), with fixed dates so that the files do not change.
+import io
+import zipfile
+
+
+def npz_bytes(arrays, compress=False):
+    out = io.BytesIO()
+    method = zipfile.ZIP_DEFLATED if compress else zipfile.ZIP_STORED
+    with zipfile.ZipFile(out, "w", compression=method) as z:
+        for name, a in arrays.items():
+            info = zipfile.ZipInfo(name + ".npy", date_time=(1980, 1, 1, 0, 0, 0))
+            info.compress_type = method
+            with z.open(info, "w", force_zip64=True) as f:
+                np.lib.format.write_array(f, np.asanyarray(a))
+    return out.getvalue()
+
+
+def with_zip64_end(zip_bytes):
+    """The same archive with a ZIP64 end record and locator, the end record's fields escaped."""
+    end = zip_bytes.rfind(b"PK\x05\x06")
+    entries = int.from_bytes(zip_bytes[end + 10:end + 12], "little")
+    size = int.from_bytes(zip_bytes[end + 12:end + 16], "little")
+    offset = int.from_bytes(zip_bytes[end + 16:end + 20], "little")
+    le = lambda v, n: v.to_bytes(n, "little")
+    end64 = (b"PK\x06\x06" + le(44, 8) + le(45, 2) + le(45, 2) + le(0, 4) + le(0, 4) + le(entries, 8) + le(entries, 8)
+             + le(size, 8) + le(offset, 8))
+    locator = b"PK\x06\x07" + le(0, 4) + le(end, 8) + le(1, 4)
+    tail = b"PK\x05\x06" + le(0, 4) + b"\xff\xff" * 2 + b"\xff\xff\xff\xff" * 2 + le(0, 2)
+    return zip_bytes[:end] + end64 + locator + tail
+
+
+npz = here / "corpus" / "npz"
+npz.mkdir(parents=True, exist_ok=True)
+k2 = np.array([0, 0, 1, 1], dtype="<f8")
+bilinear = {"degree": np.array([1, 1], dtype="<i8"), "knots_u": k2, "knots_v": k2,
+            "control_points": np.array([[[0, 0, 0], [0, 1, 0]], [[1, 0, 0], [1, 1, 1]]], dtype="<f8"),
+            "periodic": np.zeros(2, dtype=bool)}
+(npz / "bilinear.npz").write_bytes(npz_bytes(bilinear))
+(npz / "bilinear_zip64_end.npz").write_bytes(with_zip64_end(npz_bytes(bilinear)))
+(npz / "bilinear_compressed.npz").write_bytes(npz_bytes(bilinear, compress=True))
+(npz / "bilinear_truncated.npz").write_bytes(npz_bytes(bilinear)[:-40])
+(npz / "missing_knots.npz").write_bytes(npz_bytes({k: v for k, v in bilinear.items() if k != "knots_v"}))
+k3 = np.array([0, 0, 0, 1, 1, 1], dtype="<f8")
+quarter = np.array([[[1, 0, 0], [1, 0, 1]], [[1, 1, 0], [1, 1, 1]], [[0, 1, 0], [0, 1, 1]]], dtype="<f8")
+(npz / "rational_surface.npz").write_bytes(npz_bytes(
+    {"degree": np.array([2, 1]), "knots_u": k3, "knots_v": k2, "control_points": quarter,
+     "weights": np.array([[1, 1], [0.7071067811865476] * 2, [1, 1]]), "periodic": np.zeros(2, dtype=bool)}))
+(npz / "volume_mixed_dtypes.npz").write_bytes(npz_bytes(
+    {"degree": np.array([1, 1, 1], dtype="<i4"), "knots_u": k2.astype(">f8"), "knots_v": k2.astype("<f4"),
+     "knots_w": k2, "control_points": np.asfortranarray(np.arange(24, dtype="<f8").reshape(2, 2, 2, 3)),
+     "weights": np.full((2, 2, 2), 2.0), "periodic": np.zeros(3, dtype=bool)}))
+(npz / "periodic.npz").write_bytes(npz_bytes({**bilinear, "periodic": np.array([True, False])}))
+(npz / "nan_point.npz").write_bytes(npz_bytes(
+    {**bilinear, "control_points": np.array([[[0, 0, 0], [0, 1, 0]], [[1, 0, np.nan], [1, 1, 1]]])}))

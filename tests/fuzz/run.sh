@@ -12,7 +12,7 @@ seconds=${2:?usage: run.sh BUILD_DIR SECONDS}
 here=$(cd "$(dirname "$0")" && pwd)
 status=0
 
-for target in spec npy csv; do
+for target in spec npy npz csv; do
   bin=$build/tests/fuzz/fuzz_$target
   work=$build/fuzz-work/$target
   mkdir -p "$work/corpus" "$work/crashes"

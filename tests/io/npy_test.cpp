@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "npy_util.hpp"
 #include "temp_dir.hpp"
 #include "test_util.hpp"
 
@@ -24,47 +25,12 @@ namespace interpatch::io {
 namespace {
 namespace fs = std::filesystem;
 
+using test::le_bytes;
+using test::make_npy;
 using test::TempDir;
 
-std::string read_bytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void write_bytes(const fs::path& p, const std::string& bytes) {
-  std::ofstream out(p, std::ios::binary);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
-
-/// An NPY file as NumPy lays it out: magic, version, header length, the dict padded
-/// with spaces and ended by '\n' to a multiple of 64 bytes, then the data.
-std::string make_npy(const std::string& dict, const std::string& data, int major = 1, int minor = 0) {
-  const std::size_t prefix = major == 1 ? 10 : 12;
-  std::string header = dict;
-  const std::size_t total = (prefix + header.size() + 1 + 63) / 64 * 64;
-  header.append(total - prefix - header.size() - 1, ' ');
-  header += '\n';
-  std::string out = "\x93NUMPY";
-  out += static_cast<char>(major);
-  out += static_cast<char>(minor);
-  std::size_t len = header.size();
-  for (std::size_t i = 0; i < (major == 1 ? 2u : 4u); ++i, len >>= 8) out += static_cast<char>(len & 0xff);
-  return out + header + data;
-}
-
-template <class T>
-std::string le_bytes(const std::vector<T>& v) {
-  std::string s;
-  for (T x : v) {
-    char b[sizeof(T)];
-    std::memcpy(b, &x, sizeof(T));
-    if constexpr (std::endian::native == std::endian::big) std::reverse(b, b + sizeof(T));
-    s.append(b, sizeof(T));
-  }
-  return s;
-}
+std::string read_bytes(const fs::path& p) { return test::read_text(p); }
+using test::write_bytes;
 
 template <class T>
 std::string be_bytes(const std::vector<T>& v) {

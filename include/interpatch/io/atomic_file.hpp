@@ -64,6 +64,9 @@ void set_durable_writes(bool on) noexcept;
 /// `size`, when the writer knows it, is the number of bytes it will write: the
 /// file's space is then allocated in one go (a file that ends up shorter is cut to
 /// what was written).
+/// The stream can seek (seekp, tellp) within what was written, so that a header
+/// can be filled in once the data after it are written (a ZIP member's checksum);
+/// the file's size is the end of the furthest byte written.
 ///
 /// Example:
 /// @code

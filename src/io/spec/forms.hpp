@@ -30,7 +30,10 @@ inline constexpr auto network =
     std::to_array({"type"sv, "u_curves"sv, "v_curves"sv, "u_params"sv, "v_params"sv, "method"sv, "tolerance"sv});
 inline constexpr auto interpolate = std::to_array({"type"sv, "points"sv, "degree"sv, "param"sv});
 inline constexpr auto hermite_patch = std::to_array({"type"sv, "corners"sv});
-inline constexpr auto bspline = std::to_array({"type"sv, "degree"sv, "knots"sv, "control_points"sv, "weights"sv});
+// bspline_surface and bspline_volume: the form by its fields, or "npz", an archive
+// that holds them all (and excludes the others).
+inline constexpr auto bspline =
+    std::to_array({"type"sv, "degree"sv, "knots"sv, "control_points"sv, "weights"sv, "npz"sv});
 inline constexpr auto trilinear = std::to_array(
     {"type"sv, "p000"sv, "p001"sv, "p010"sv, "p011"sv, "p100"sv, "p101"sv, "p110"sv, "p111"sv});
 inline constexpr auto coons_volume = std::to_array({"type"sv, "faces"sv, "blending"sv, "cross_derivatives"sv, "tolerance"sv});

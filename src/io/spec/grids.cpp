@@ -10,6 +10,7 @@
 #include "interpatch/bspline_volume.hpp"
 #include "interpatch/interpolate.hpp"
 #include "interpatch/memory.hpp"
+#include "io/npz_internal.hpp"
 #include "io/spec/reader.hpp"
 
 namespace interpatch::io::reader {
@@ -98,6 +99,33 @@ nlohmann::ordered_json domain_json(const Exact& s) {
   return {{"domain", d}};
 }
 
+// A bspline_surface or bspline_volume spec's result: the form over the unit domain,
+// its own domain in the parameters.
+template <std::size_t D>
+Construction exact_construction(typename Tensor<D>::Exact s) {
+  Construction c;
+  c.type = Tensor<D>::bspline_type;
+  c.parameters = domain_json(s);
+  c.exact = on_unit_domain<D>(s) ? std::move(s) : Tensor<D>::on_unit_domain(std::move(s));
+  return c;
+}
+
+// {"type": "bspline_surface", "npz": "x.npz"}: the form from an archive that
+// `build -o x.npz` wrote, which holds every field; none of them may be given too.
+template <std::size_t D>
+Construction bspline_from_npz(const json& spec, Context& ctx) {
+  using T = Tensor<D>;
+  for (const char* field : {"degree", "knots", "control_points", "weights"})
+    if (find_member(spec, field))
+      fail(errc::wrong_type, "/npz: give either \"npz\" or \"", field, "\" (with the other fields of ", T::bspline_type,
+           "), not both: the archive holds the whole form");
+  const std::string file = file_name(spec, "npz", "");
+  typename T::Exact s =
+      std::get<typename T::Exact>(at("/npz", [&] { return internal::read_exact_npz(ctx.resolve(file), D); }));
+  ctx.parsed();
+  return exact_construction<D>(std::move(s));
+}
+
 }  // namespace
 
 template <std::size_t D>
@@ -140,6 +168,7 @@ Construction build_interpolate(const json& spec, Context& ctx) {
 template <std::size_t D>
 Construction build_bspline(const json& spec, Context& ctx) {
   using T = Tensor<D>;
+  if (find_member(spec, "npz")) return bspline_from_npz<D>(spec, ctx);
   member(spec, "degree", "", T::degree_form);
   const auto degree = degrees(spec, "", D);
   const json& knots = member(spec, "knots", "", T::knots_form);
@@ -181,11 +210,7 @@ Construction build_bspline(const json& spec, Context& ctx) {
   typename T::Exact s = at("/control_points", [&] {
     return T::make(std::move(k), typename T::Points(grid_shape<D>(cp.shape), std::move(cp.points)), std::move(weights));
   });
-  Construction c;
-  c.type = T::bspline_type;
-  c.parameters = domain_json(s);
-  c.exact = on_unit_domain<D>(s) ? std::move(s) : T::on_unit_domain(std::move(s));
-  return c;
+  return exact_construction<D>(std::move(s));
 }
 
 template Construction build_interpolate<2>(const json& spec, Context& ctx);

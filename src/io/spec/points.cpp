@@ -129,12 +129,6 @@ void check_finite_points(const std::vector<std::size_t>& shape, const PointStora
   }
 }
 
-std::string file_name(const json& obj, std::string_view key, std::string_view ptr) {
-  const json& f = member(obj, key, ptr, "a file name");
-  if (!f.is_string() || f.get_ref<const std::string&>().empty()) wrong_type(child(ptr, key), "a file name", f);
-  return f.get<std::string>();
-}
-
 PointArray npy_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx) {
   check_fields(obj, ptr, forms::npy, ctx);
   const std::string file = file_name(obj, "npy", ptr);

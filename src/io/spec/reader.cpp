@@ -109,6 +109,12 @@ void check_fields(const json& obj, std::string_view ptr, Fields known, Context& 
   }
 }
 
+std::string file_name(const json& obj, std::string_view key, std::string_view ptr) {
+  const json& f = member(obj, key, ptr, "a file name");
+  if (!f.is_string() || f.get_ref<const std::string&>().empty()) wrong_type(child(ptr, key), "a file name", f);
+  return f.get<std::string>();
+}
+
 double number(const json& j, std::string_view ptr) {
   if (!j.is_number()) wrong_type(ptr, "a number", j);
   const double v = j.get<double>();

@@ -16,6 +16,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -55,11 +56,7 @@ const char* kind(const json& j);
 /// Runs a library call; an error it throws keeps its code and gets the place in front.
 template <class F>
 decltype(auto) at(std::string_view ptr, F&& f) {
-  try {
-    return f();
-  } catch (const error& e) {
-    throw error(e.code(), cat(place(ptr), ": ", e.what()));
-  }
+  return interpatch::detail::prefixed(place(ptr), std::forward<F>(f));
 }
 
 constexpr const char* axis_name(std::size_t a) { return a == 0 ? "u" : (a == 1 ? "v" : "w"); }
@@ -104,6 +101,9 @@ inline void check_fields(const json& obj, std::string_view ptr, std::initializer
   check_fields(obj, ptr, Fields(known.begin(), known.size()), ctx);
 }
 
+/// The name of a data file in obj[key] (relative to the spec's directory): a
+/// non-empty string, else wrong_type naming the field.
+std::string file_name(const json& obj, std::string_view key, std::string_view ptr);
 double number(const json& j, std::string_view ptr);
 /// An integer; a float with an integral value (3.0) is accepted.
 std::int64_t integer(const json& j, std::string_view ptr, std::string_view expected);
