@@ -10,6 +10,7 @@
 #include <span>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -370,16 +371,18 @@ nlohmann::ordered_json info(const io::Construction& c) {
   return io::info_json(c, progress.callback());
 }
 
-io::Construction build_spec(const fs::path& spec, bool keep_data) {
+io::Construction build_spec(const fs::path& spec, io::BuildOptions options) {
   ProgressLine progress("building");
-  return io::build_file(spec, progress.callback(), keep_data);
+  options.progress = progress.callback();
+  return io::build_file(spec, options);
 }
 
-io::Construction build_input(const Input& in, bool keep_data) {
-  if (in.kind == Input::Kind::spec) return build_spec(in.path, keep_data);
+io::Construction build_input(const Input& in, io::BuildOptions options) {
+  if (in.kind == Input::Kind::spec) return build_spec(in.path, std::move(options));
   const nlohmann::json spec = data_file_spec(in);
   ProgressLine progress("building");
-  return io::build(spec, in.path.parent_path(), progress.callback(), keep_data);
+  options.progress = progress.callback();
+  return io::build(spec, in.path.parent_path(), options);
 }
 
 void report_warnings(const io::Construction& c) {
@@ -389,7 +392,7 @@ void report_warnings(const io::Construction& c) {
 int build_command(const Input& in, const fs::path& out) {
   check_build_output(out);
   io::check_writable(out);
-  const io::Construction c = build_input(in, false);
+  const io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = false});
   write_build(c, out);
   report_warnings(c);
   return 0;
@@ -400,7 +403,8 @@ int mesh_command(const Input& in, const fs::path& out, std::string_view res_text
   check_mesh_output(out);
   io::check_writable(out);
   if (given) require_mesh_memory(*given);
-  const io::Construction c = build_input(in, false);
+  // Meshes evaluate the construction; its exact form is built only if that is cheaper.
+  const io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = true});
   const Resolution res = given ? *given : (io::is_volume(c) ? default_volume_resolution : default_surface_resolution);
   check_mesh_kind(c, out, res);
   if (!given) require_mesh_memory(res);
@@ -416,7 +420,8 @@ int eval_command(const Input& in, const fs::path& out, std::string_view grid_tex
   // Before the build, the grid as given (K: KxK, the least it can be); after it, the
   // grid of the construction's kind (K of a volume: KxKxK).
   require_eval_room({counts[0], counts.size() > 1 ? counts[1] : counts[0], counts.size() > 2 ? counts[2] : 0}, out);
-  const io::Construction c = build_input(in, false);
+  // Evaluation goes through the construction's formula; its exact form is not built.
+  const io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = true});
   const Resolution grid = grid_resolution(counts, c);
   require_eval_room(grid, out);
   write_eval(c, out, grid);

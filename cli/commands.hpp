@@ -117,13 +117,15 @@ void write_mesh(const io::Construction& c, const std::filesystem::path& out, con
 void write_eval(const io::Construction& c, const std::filesystem::path& out, const Resolution& grid);
 nlohmann::ordered_json info(const io::Construction& c);
 
-/// Builds a spec file, showing progress on a terminal. `keep_data` false: without the
-/// copy of the data points that only `info`'s error check uses.
-io::Construction build_spec(const std::filesystem::path& spec, bool keep_data = true);
+/// Builds a spec file, showing progress on a terminal (the progress callback of
+/// `options` is the terminal's). keep_data false: without the copy of the data points
+/// that only `info`'s error check uses; defer_exact true: without the exact form,
+/// which evaluation does without.
+io::Construction build_spec(const std::filesystem::path& spec, io::BuildOptions options = {});
 
 /// Builds SPEC as given: a spec file, or the spec of a data file (data_file_spec),
 /// with data files found in that file's directory.
-io::Construction build_input(const Input& in, bool keep_data = true);
+io::Construction build_input(const Input& in, io::BuildOptions options = {});
 
 /// The subcommands; each returns the exit status of success (0).
 int build_command(const Input& in, const std::filesystem::path& out);

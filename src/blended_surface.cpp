@@ -80,6 +80,18 @@ D3 eval(const BSplineCurve& c, double t) {
   return d;
 }
 
+// d += X(u) Y(v) with its derivatives up to second order; x and y hold a value and
+// its first two derivatives (one of them a scalar, the other a point).
+template <class X, class Y>
+void add_product(SurfaceDerivatives& d, const X* x, const Y* y) {
+  d.s += x[0] * y[0];
+  d.su += x[1] * y[0];
+  d.sv += x[0] * y[1];
+  d.suu += x[2] * y[0];
+  d.suv += x[1] * y[1];
+  d.svv += x[0] * y[2];
+}
+
 // Gregory's blend weight w = a / (a + b) and its partials, a = |u − i|, b = |v − j|.
 struct Weight {
   double w, wu, wv, wuu, wuv, wvv;
@@ -218,6 +230,51 @@ void BlendedSurface::evaluate_into(std::span<const double> us, std::span<const d
     if (progress && detail::thread_index() == 0 && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(nu));
   }
   if (progress) progress(1.0);
+}
+
+Grid<SurfaceDerivatives, 2> BlendedSurface::evaluate_derivatives(std::span<const double> us,
+                                                                 std::span<const double> vs) const {
+  const auto& T = *t_;
+  if (!T.gregory.empty()) return Surface::evaluate_derivatives(us, vs);
+  detail::check_unit_parameters(us, "u");
+  detail::check_unit_parameters(vs, "v");
+  require_memory(us.size() * vs.size(), sizeof(SurfaceDerivatives), "surface derivative grid");
+  const std::size_t nu = us.size(), nv = vs.size(), K = T.f.size(), L = T.g.size(), KA = T.a.size();
+  auto clamp = [](double t) { return std::clamp(t, 0.0, 1.0); };
+  // As evaluate_into, with the first two derivatives of every factor: per u, F[i][k]
+  // = f_k(u_i) and P[i][l] = b_l(u_i) + Σ_k c_kl f_k(u_i); per v, G[j][l] = g_l(v_j)
+  // and A[j][k] = a_k(v_j).
+  std::vector<S3> F(nu * K), G(nv * L);
+  std::vector<D3> P(nu * L), A(nv * KA);
+  for (std::size_t i = 0; i < nu; ++i) {
+    const double u = clamp(us[i]);
+    for (std::size_t k = 0; k < K; ++k) T.f[k].eval(u, F[i * K + k].v);
+    for (std::size_t l = 0; l < L; ++l) {
+      D3 p = l < T.b.size() ? eval(T.b[l], u) : D3{};
+      if (!T.c.empty())
+        for (std::size_t k = 0; k < K; ++k)
+          for (int r = 0; r < 3; ++r) p.v[r] += F[i * K + k].v[r] * T.c(k, l);
+      P[i * L + l] = p;
+    }
+  }
+  for (std::size_t j = 0; j < nv; ++j) {
+    const double v = clamp(vs[j]);
+    for (std::size_t l = 0; l < L; ++l) T.g[l].eval(v, G[j * L + l].v);
+    for (std::size_t k = 0; k < KA; ++k) A[j * KA + k] = eval(T.a[k], v);
+  }
+  Grid<SurfaceDerivatives, 2> out({nu, nv}, for_overwrite);
+  const auto rows = static_cast<long long>(nu);
+#pragma omp parallel for schedule(static, 16) if (nu * nv * (KA + L) * 6 >= detail::parallel_min_work)
+  for (long long ri = 0; ri < rows; ++ri) {
+    const auto i = static_cast<std::size_t>(ri);
+    for (std::size_t j = 0; j < nv; ++j) {
+      SurfaceDerivatives d{};
+      for (std::size_t k = 0; k < KA; ++k) add_product(d, F[i * K + k].v, A[j * KA + k].v);
+      for (std::size_t l = 0; l < L; ++l) add_product(d, P[i * L + l].v, G[j * L + l].v);
+      out(i, j) = d;
+    }
+  }
+  return out;
 }
 
 bool BlendedSurface::has_exact_form() const noexcept {

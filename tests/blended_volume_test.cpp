@@ -38,30 +38,7 @@ TEST(BlendedVolume, JacobianMatchesFiniteDifferences) {
     }
 }
 
-TEST(BlendedVolume, BatchEvaluationEqualsPointwise) {
-  auto g = test::rng(241);
-  const auto s = hermite_coons_of(test::random_bspline_volume(g, 2, 3, 2, 4, 5, 4));
-  const std::vector<double> us{0, 0.4, 1, 0.4}, vs{1, 0.25, 0}, ws{0.5, 0, 0.75, 1, 0.1};
-  const auto pts = s.evaluate(us, vs, ws);
-  const auto der = s.evaluate_derivatives(us, vs, ws);
-  const auto jac = s.evaluate_jacobians(us, vs, ws);
-  for (std::size_t i = 0; i < us.size(); ++i)
-    for (std::size_t j = 0; j < vs.size(); ++j)
-      for (std::size_t k = 0; k < ws.size(); ++k) {
-        const auto d = s.derivatives(us[i], vs[j], ws[k]);  // the same code per point: equal
-        EXPECT_EQ(pts(i, j, k), d.s);
-        EXPECT_EQ(der(i, j, k).su, d.su);
-        EXPECT_EQ(der(i, j, k).sw, d.sw);
-        EXPECT_EQ(jac.points(i, j, k), d.s);
-        EXPECT_EQ(jac.determinants(i, j, k), jacobian(d).determinant);
-      }
-  // A grid large enough for both cores, with progress.
-  const auto t = linspace(0, 1, 24);
-  double last = 0;
-  const auto big = s.evaluate(t, t, t, [&](double f) { last = f; });
-  EXPECT_EQ(last, 1.0);
-  EXPECT_EQ(big(23, 5, 17), s.point(1, t[5], t[17]));
-}
+// Grid evaluation against the pointwise formula: tests/blended_grid_test.cpp.
 
 TEST(BlendedVolume, OutOfDomain) {
   std::array<Vec3, 8> c{};

@@ -246,6 +246,9 @@ void expect_npy_is_evaluation(const std::string& bytes, const io::Construction& 
   EXPECT_EQ(i, expected.size()) << "value " << i << " is " << n.data[i] << ", evaluate() gives " << expected[i];
 }
 
+// How eval builds a construction: without its exact form.
+const io::BuildOptions evaluation_options{.progress = {}, .keep_data = false, .defer_exact = true};
+
 TEST_F(CliTest, EvalToNpyInBlocksIsTheLibrarysEvaluateBitForBit) {
   // eval evaluates and writes .npy about 2^17 points at a time along u
   // (cli/commands.cpp): K = 700 is 4 blocks of 187 rows of a surface, the last one
@@ -261,7 +264,8 @@ TEST_F(CliTest, EvalToNpyInBlocksIsTheLibrarysEvaluateBitForBit) {
     SCOPED_TRACE(spec.filename().string());
     const Result r = run({"eval", spec.string(), "--grid", std::to_string(k), "-o", "g.npy"});
     ASSERT_EQ(r.status, 0) << r.err;
-    const io::Construction c = io::build_file(spec);
+    // eval evaluates through the formula, not the exact form it does not build.
+    const io::Construction c = io::build_file(spec, evaluation_options);
     expect_npy_is_evaluation(read_file(at("g.npy")), c, std::vector<std::size_t>(io::is_volume(c) ? 3 : 2, k));
   }
 }
@@ -287,7 +291,7 @@ TEST_F(CliTest, EvalGridOfCountsPerDirectionIsTheLibrarysEvaluateBitForBit) {
     const Result r = run({"eval", k.spec.string(), "--grid", k.grid, "-o", "g.npy"});
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_TRUE(r.err.empty()) << r.err;
-    expect_npy_is_evaluation(read_file(at("g.npy")), io::build_file(k.spec), k.counts);
+    expect_npy_is_evaluation(read_file(at("g.npy")), io::build_file(k.spec, evaluation_options), k.counts);
   }
 }
 

@@ -40,6 +40,11 @@ class BlendedSurface final : public Surface {
   /// count. @throws error out_of_domain, size_mismatch.
   void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
                      const progress_callback& progress = {}) const override;
+  /// Points and derivatives up to second order at every (us[i], vs[j]), the same
+  /// way: each factor with its derivatives once per parameter, then short sums per
+  /// point (Gregory-corrected patches point by point). @throws error out_of_domain, too_large.
+  [[nodiscard]] Grid<SurfaceDerivatives, 2> evaluate_derivatives(std::span<const double> us,
+                                                                 std::span<const double> vs) const override;
   /// @throws error no_exact_form (rational boundary curves, Gregory's twists).
   [[nodiscard]] BSplineSurface to_bspline() const override;
   /// Whether to_bspline() succeeds.

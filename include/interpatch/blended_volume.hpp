@@ -21,6 +21,8 @@ namespace interpatch {
 
 namespace detail {
 struct VolumeTerms;
+struct PlaneCache;
+std::shared_ptr<PlaneCache> make_plane_cache();
 }
 
 /// One of the blended volume constructions. Built by the functions of
@@ -32,6 +34,25 @@ class BlendedVolume final : public Volume {
 
   /// S and its first partials from the terms; no allocation. @throws error out_of_domain.
   [[nodiscard]] VolumeDerivatives derivatives(double u, double v, double w) const override;
+  /// Points at every (us[i], vs[j], ws[k]) into out[(i * vs.size() + j) * ws.size() + k].
+  /// Every term is filed under one of its blending functions, which folds the faces,
+  /// edges and corners into at most four planes per axis, each evaluated once on the
+  /// grid of its two axes; a point is then at most 12 products. The planes of u (over
+  /// vs × ws) are kept for the next call with the same vs and ws (up to 256 MiB), so
+  /// a grid evaluated slab by slab along u makes them once. Both cores share the
+  /// lines along w; the result depends neither on the thread count nor on how the u
+  /// values are split into calls. @throws error out_of_domain, size_mismatch, too_large.
+  void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<const double> ws,
+                     std::span<Vec3> out, const progress_callback& progress = {}) const override;
+  /// Points and first partials at every grid point, folded as evaluate_into().
+  /// @throws error out_of_domain, too_large.
+  [[nodiscard]] Grid<VolumeDerivatives, 3> evaluate_derivatives(std::span<const double> us, std::span<const double> vs,
+                                                                std::span<const double> ws) const override;
+  /// Points and det J at every grid point, folded as evaluate_into().
+  /// @throws error out_of_domain, too_large.
+  [[nodiscard]] VolumeJacobians evaluate_jacobians(std::span<const double> us, std::span<const double> vs,
+                                                   std::span<const double> ws,
+                                                   const progress_callback& progress = {}) const override;
   /// Every function of u made compatible (common degree and knots, by degree
   /// elevation and knot insertion), likewise v and w, then the control points of
   /// the tensor-product terms summed.
@@ -45,6 +66,9 @@ class BlendedVolume final : public Volume {
 
  private:
   std::shared_ptr<const detail::VolumeTerms> t_;
+  // The planes of the last grid evaluation along u, which the slabs of a large grid
+  // share (evaluate_into); shared by copies, as are the terms.
+  std::shared_ptr<detail::PlaneCache> planes_ = detail::make_plane_cache();
 };
 
 }  // namespace interpatch

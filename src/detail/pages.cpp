@@ -15,15 +15,18 @@ std::size_t rounded(std::size_t bytes) noexcept { return (bytes + huge - 1) / hu
 // Mappings given back and kept for reuse: a batch evaluation repeated on grids of
 // one size then writes into pages it touched before instead of fresh ones, whose
 // first touch (the kernel zeroing them, the hypervisor backing them) costs more
-// than the evaluation's own writes on a virtual machine.
+// than the evaluation's own writes on a virtual machine. The most recently given
+// back are kept: a new one pushes out the oldest when the slots or the bytes run out.
 constexpr std::size_t keep_limit = std::size_t{256} << 20;  // bytes kept in all
 struct Kept {
   void* p = nullptr;
   std::size_t size = 0;
+  std::uint64_t age = 0;  // when it was given back
 };
 std::mutex kept_mutex;
 std::array<Kept, 4> kept;
 std::size_t kept_bytes = 0;
+std::uint64_t kept_clock = 0;
 
 void* take_kept(std::size_t size) noexcept {
   const std::lock_guard<std::mutex> lock(kept_mutex);
@@ -38,15 +41,24 @@ void* take_kept(std::size_t size) noexcept {
 }
 
 bool keep(void* p, std::size_t size) noexcept {
+  if (size > keep_limit) return false;
   const std::lock_guard<std::mutex> lock(kept_mutex);
-  if (kept_bytes + size > keep_limit) return false;
-  for (Kept& k : kept)
-    if (k.p == nullptr) {
-      k = {p, size};
+  for (;;) {
+    Kept* free_slot = nullptr;
+    Kept* oldest = nullptr;
+    for (Kept& k : kept) {
+      if (k.p == nullptr) free_slot = &k;
+      else if (oldest == nullptr || k.age < oldest->age) oldest = &k;
+    }
+    if (free_slot != nullptr && kept_bytes + size <= keep_limit) {
+      *free_slot = {p, size, ++kept_clock};
       kept_bytes += size;
       return true;
     }
-  return false;
+    ::munmap(oldest->p, oldest->size);  // not null: the slots or the bytes are full
+    kept_bytes -= oldest->size;
+    *oldest = {};
+  }
 }
 }  // namespace
 

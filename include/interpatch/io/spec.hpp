@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -74,14 +75,41 @@ struct Construction {
   std::string no_exact_form;
   /// The same for a volume construction (trilinear, Coons and Hermite volumes).
   std::shared_ptr<const Volume> volume_formula;
+  /// Built with BuildOptions::defer_exact: the conversion of the formula to its exact
+  /// form, which exact_form() runs on first use (and then empties). Empty otherwise.
+  std::function<ExactForm()> convert;
 };
+
+/// How build() builds a construction.
+struct BuildOptions {
+  /// Gets the fraction done of long constructions.
+  progress_callback progress;
+  /// False leaves Construction::data empty for grid interpolations: the copy of the
+  /// data points the error check at the data needs is as large as the grid, and
+  /// commands that only evaluate the result do without it.
+  bool keep_data = true;
+  /// True leaves the exact form of a construction with its own formula (Coons
+  /// patches, networks, the blended volumes) unbuilt until exact_form() asks for it.
+  /// Evaluation then goes through the formula, which evaluates a grid in about the
+  /// time of writing its points, while the exact form first needs a control net of
+  /// the merged knots of every curve (4.2 million points for four 1024-point curves).
+  bool defer_exact = false;
+};
+
+/// The construction's exact form, converted on first use when the build deferred it.
+/// @throws error no_exact_form (saying why the construction has none).
+[[nodiscard]] const ExactForm& exact_form(Construction& c);
+
+/// Whether the construction has an exact form, built or still to be converted.
+[[nodiscard]] bool has_exact_form(const Construction& c) noexcept;
 
 /// Whether the construction is a volume (its exact form a BSplineVolume, or its
 /// formula a Volume) rather than a surface.
 [[nodiscard]] bool is_volume(const Construction& c) noexcept;
 
-/// What evaluates a surface construction: its exact form when it has one (the fast
-/// path), otherwise its formula. @throws error wrong_type (a volume construction).
+/// What evaluates a surface construction: its exact form when it is built, otherwise
+/// its formula (both exact: they agree to rounding). @throws error wrong_type (a volume
+/// construction).
 [[nodiscard]] const Surface& evaluator(const Construction& c);
 
 /// The same for a volume construction. @throws error wrong_type (a surface construction).
@@ -136,15 +164,19 @@ struct SpecForm {
 ///   file_unreadable and malformed_file (data files), too_large, and whatever the
 ///   construction raises (too_few_points, invalid_degree, zero_chord, non_increasing,
 ///   invalid_knots, invalid_weight, singular, ...), prefixed with the pointer.
-/// `keep_data` false leaves Construction::data empty for grid interpolations: the
-/// copy of the data points the error check at the data needs is as large as the
-/// grid, and commands that only evaluate the result do without it.
+[[nodiscard]] Construction build(const nlohmann::json& spec, const std::filesystem::path& base_dir,
+                                 const BuildOptions& options);
+
+/// build() with the default options but for `progress` and `keep_data` (BuildOptions).
 [[nodiscard]] Construction build(const nlohmann::json& spec, const std::filesystem::path& base_dir = {},
                                  const progress_callback& progress = {}, bool keep_data = true);
 
 /// Reads a spec file and builds it; data files are found relative to the spec's
 /// directory. The time spent reading and parsing the file counts into parse_ms.
 /// @throws error file_unreadable, invalid_json, and what build() throws.
+[[nodiscard]] Construction build_file(const std::filesystem::path& spec_path, const BuildOptions& options);
+
+/// build_file() with the default options but for `progress` and `keep_data`.
 [[nodiscard]] Construction build_file(const std::filesystem::path& spec_path, const progress_callback& progress = {},
                                       bool keep_data = true);
 

@@ -74,7 +74,8 @@ std::size_t checked_product(std::span<const std::size_t> shape, std::string_view
 struct Context {
   std::filesystem::path base_dir;
   progress_callback progress;
-  bool keep_data = true;  // copy interpolated grids into Construction::data
+  bool keep_data = true;     // copy interpolated grids into Construction::data
+  bool defer_exact = false;  // leave a formula's exact form to exact_form()
   std::vector<std::string> warnings;
   Clock::time_point start = Clock::now();
   std::optional<Clock::time_point> parsed_at;

@@ -53,6 +53,7 @@ Construction build_impl(const json& spec, Context& ctx) {
     fail(errc::unknown_type, "/type: unknown type \"", interpatch::detail::excerpt(name), "\"; known types: ", type_list());
   check_fields(spec, "", type->fields, ctx);
   Construction c = type->build(spec, ctx);
+  if (!ctx.defer_exact && c.convert) (void)exact_form(c);
   const auto done = Clock::now();
   const auto parsed = ctx.parsed_at.value_or(done);
   c.type = name;
@@ -170,6 +171,17 @@ bool is_volume(const Construction& c) noexcept {
   return c.exact ? std::holds_alternative<BSplineVolume>(*c.exact) : c.volume_formula != nullptr;
 }
 
+const ExactForm& exact_form(Construction& c) {
+  if (!c.exact && c.convert) {
+    c.exact = c.convert();
+    c.convert = nullptr;
+  }
+  if (!c.exact) fail(errc::no_exact_form, c.type, ": ", c.no_exact_form);
+  return *c.exact;
+}
+
+bool has_exact_form(const Construction& c) noexcept { return c.exact || c.convert; }
+
 const Surface& evaluator(const Construction& c) {
   if (is_volume(c)) fail(errc::wrong_type, c.type, ": the construction is a volume, not a surface");
   if (c.exact) return std::get<BSplineSurface>(*c.exact);
@@ -183,22 +195,32 @@ const Volume& volume_evaluator(const Construction& c) {
   return *c.volume_formula;
 }
 
-Construction build(const json& spec, const std::filesystem::path& base_dir, const progress_callback& progress,
-                   bool keep_data) {
+Construction build(const json& spec, const std::filesystem::path& base_dir, const BuildOptions& options) {
   Context ctx;
   ctx.base_dir = base_dir;
-  ctx.progress = progress;
-  ctx.keep_data = keep_data;
+  ctx.progress = options.progress;
+  ctx.keep_data = options.keep_data;
+  ctx.defer_exact = options.defer_exact;
+  return build_impl(spec, ctx);
+}
+
+Construction build(const json& spec, const std::filesystem::path& base_dir, const progress_callback& progress,
+                   bool keep_data) {
+  return build(spec, base_dir, BuildOptions{.progress = progress, .keep_data = keep_data, .defer_exact = false});
+}
+
+Construction build_file(const std::filesystem::path& spec_path, const BuildOptions& options) {
+  Context ctx;  // starts the clock: reading the file counts as parsing
+  const json spec = read_json_file(spec_path);
+  ctx.base_dir = spec_path.parent_path();
+  ctx.progress = options.progress;
+  ctx.keep_data = options.keep_data;
+  ctx.defer_exact = options.defer_exact;
   return build_impl(spec, ctx);
 }
 
 Construction build_file(const std::filesystem::path& spec_path, const progress_callback& progress, bool keep_data) {
-  Context ctx;  // starts the clock: reading the file counts as parsing
-  const json spec = read_json_file(spec_path);
-  ctx.base_dir = spec_path.parent_path();
-  ctx.progress = progress;
-  ctx.keep_data = keep_data;
-  return build_impl(spec, ctx);
+  return build_file(spec_path, BuildOptions{.progress = progress, .keep_data = keep_data, .defer_exact = false});
 }
 
 PointArray points_from_json(const json& j, std::size_t rank, const std::filesystem::path& base_dir, std::string_view pointer) {

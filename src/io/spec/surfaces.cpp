@@ -36,21 +36,24 @@ DataSet corner_data(const std::array<Vec3, 4>& p, std::string pointer) {
 }
 
 // A blended construction (surface or volume): the formula, stored in `slot`, and
-// its exact form if it has one.
-
-// A blended construction (surface or volume): the formula, stored in `slot`, and
-// its exact form if it has one.
+// its conversion to the exact form when it has one (run by build_impl, or deferred
+// to exact_form()); otherwise the reason it has none.
 template <class Formula, class Slot>
 Construction blended_with(std::string_view type, Formula f, std::vector<DataSet> data, nlohmann::ordered_json parameters,
                           Slot Construction::*slot) {
   Construction c;
   c.type = type;
   auto formula = std::make_shared<const Formula>(std::move(f));
-  try {
-    c.exact = formula->to_bspline();
-  } catch (const error& e) {
-    if (e.code() != errc::no_exact_form) throw;
-    c.no_exact_form = e.what();
+  if (formula->has_exact_form()) {
+    c.convert = [formula] { return ExactForm(formula->to_bspline()); };
+  } else {
+    try {
+      (void)formula->to_bspline();  // refuses at once, saying why
+      fail(errc::internal, type, ": has_exact_form() and to_bspline() disagree");
+    } catch (const error& e) {
+      if (e.code() != errc::no_exact_form) throw;
+      c.no_exact_form = e.what();
+    }
   }
   if (!formula->notes().empty()) parameters["notes"] = formula->notes();
   c.*slot = std::move(formula);

@@ -70,10 +70,10 @@ BSplineSurface face_surface(const json& j, const std::string& ptr, Context& ctx)
     throw error(e.code(), rebased(e.what(), ptr));
   }
   for (const std::string& w : sub.warnings) ctx.warn(rebased(w, ptr));
-  if (!c.exact)
+  if (!has_exact_form(c))
     fail(errc::no_exact_form, place(ptr), ": the ", name, " surface has no exact B-spline form (", c.no_exact_form,
          "); a face needs one");
-  return std::get<BSplineSurface>(*c.exact);
+  return std::get<BSplineSurface>(exact_form(c));
 }
 
 }  // namespace
