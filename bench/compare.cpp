@@ -1056,10 +1056,9 @@ std::optional<ProcessResult> run_program(const std::string& self, const std::str
 // go to g_rows and the console; they are returned in the order of `programs`.
 std::vector<Row> time_in_turn(const std::string& self, const std::string& job, std::size_t n,
                               std::vector<Program>& programs, int runs, double budget) {
-  std::erase_if(programs, [&](Program& p) {
+  for (auto& p : programs)
     if (!p.first) p.first = run_program(self, job, n, p);
-    return !p.first;
-  });
+  std::erase_if(programs, [](const Program& p) { return !p.first; });
   std::vector<Row> rows;
   for (const auto& p : programs) {
     rows.push_back(row_of(job, n, p.library, p.variant, p.threads, p.tolerance));
@@ -1080,9 +1079,14 @@ std::vector<Row> time_in_turn(const std::string& self, const std::string& job, s
       }
       rows[k].times.push_back(r->seconds);
       rows[k].maxrss_bytes = std::max(*rows[k].maxrss_bytes, 1024.0 * static_cast<double>(r->maxrss_kb));
-      rows[k].output_bytes = static_cast<double>(fs::file_size(programs[k].out));
-      rows[k].error = std::max(rows[k].error, programs[k].check(programs[k].out));
       spent += r->seconds;
+      try {
+        rows[k].output_bytes = static_cast<double>(fs::file_size(programs[k].out));
+        rows[k].error = std::max(rows[k].error, programs[k].check(programs[k].out));
+      } catch (const std::exception& e) {
+        rows[k].error = INFINITY;
+        rows[k].note = std::string("output unreadable: ") + e.what();
+      }
     }
   for (auto& row : rows) {
     if (done < runs) row.note += (row.note.empty() ? "" : "; ") + std::to_string(done) + " of " + std::to_string(runs) + " runs (time budget)";
