@@ -1,5 +1,6 @@
 // bench/compare: interpatch, OpenCASCADE and SISL side by side on the same data in
-// one run, each next to a memcpy of the same bytes.
+// one run, each next to a memcpy of the same bytes; and the whole interpatch command
+// on every construction next to a pure-I/O program of the same bytes.
 //
 // Jobs (each selectable with --jobs):
 //   interpolate  bicubic interpolation of N x N terrain grids (bench/terrain.hpp)
@@ -10,10 +11,31 @@
 //   process      `interpatch eval SPEC --grid K` against bench/sisl_eval, as whole processes
 //   memory       peak resident memory of each library's interpolation, in a child process
 //
+// Whole processes of every construction (--jobs processes names them all): each job
+// writes its spec and .npy data files (smooth shapes of bench/shapes.hpp, which the
+// construction reproduces), then times, in turn run by run, the interpatch command,
+// bench/pure_io (reads the same input files, writes an output of the same size as
+// interpatch writes it, computes nothing: the floor) and SISL's whole process where
+// SISL has the job; wall clock from spawn to exit and peak RSS of each.
+//   eval_interpolate         eval --grid 1000 of a 1024² .npy grid; SISL: sisl_eval
+//   eval_coons               eval --grid 1000, linear Coons patch of four 1024-point
+//                            interpolated curves; SISL: sisl_eval --coons (s1357, s1390)
+//   eval_coons_hermite       eval --grid 1000, Coons patch with cross derivatives and
+//                            Hermite blending, eight 256-point Hermite curves
+//   eval_gordon, eval_network  eval --grid 1000, network of 12 x 12 200-point curves,
+//                            method gordon, and coons_hermite (C1 Coons cells)
+//   eval_interpolate_volume  eval --grid 200 of a 128³ .npy grid
+//   eval_coons_volume        eval --grid 200, six faces interpolating 128² grids
+//   eval_hermite_volume, eval_trilinear  eval --grid 200 (eight corners: no data files)
+//   mesh                     mesh --res 1000x1000 of eval_coons's spec, to .vts
+//   build_npz                build -o .npz of an --npz-size² interpolation (8192²: a
+//                            1.6 GB .npy), and eval --grid of the same spec; peak RSS
+//                            against input + output bytes
+//
 // Every timing is the wall clock of one call (median of --reps repetitions), with the
 // data built beforehand; every timed result is checked (points at the data, or against
-// an independent evaluation) so that no figure belongs to a wrong answer. The console
-// gets tables; --json gets everything, read by tools/plot_bench.py.
+// an independent evaluation or a closed form) so that no figure belongs to a wrong
+// answer. The console gets tables; --json gets everything, read by tools/plot_bench.py.
 
 #include <GeomAPI_Interpolate.hxx>
 #include <GeomAPI_PointsToBSplineSurface.hxx>
@@ -66,11 +88,14 @@
 #endif
 
 #include "grid_params.hpp"
+#include "shapes.hpp"
+#include "sisl_coons.hpp"
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/coons.hpp"
 #include "interpatch/evaluate.hpp"
 #include "interpatch/interpolate.hpp"
 #include "interpatch/io/npy.hpp"
+#include "interpatch/io/npz.hpp"
 #include "terrain.hpp"
 
 extern char** environ;
@@ -128,6 +153,12 @@ int max_threads() {
 
 // ---------------------------------------------------------------- options
 
+// The whole-process jobs of every construction (--jobs processes selects them all).
+const std::vector<std::string> process_jobs{"eval_interpolate",   "eval_coons",          "eval_coons_hermite",
+                                            "eval_gordon",        "eval_network",        "eval_interpolate_volume",
+                                            "eval_coons_volume",  "eval_hermite_volume", "eval_trilinear",
+                                            "mesh",               "build_npz"};
+
 struct Options {
   std::vector<std::size_t> sizes{256, 1024, 2048, 4096};
   std::set<std::string> libs{"interpatch", "occt", "sisl", "memcpy"};
@@ -135,12 +166,14 @@ struct Options {
   std::vector<int> threads;
   std::vector<std::size_t> memory_sizes{2048, 4096};
   int reps = 3;
-  std::size_t eval_grid = 1024, eval_points = 1000, coons_points = 1024, process_grid = 1024;
-  double occt_budget = 60;  // seconds one OpenCASCADE interpolation may be predicted to take
+  std::size_t eval_grid = 1024, eval_points = 1000, coons_points = 1024, process_grid = 1024, npz_size = 8192;
+  double occt_budget = 60;      // seconds one OpenCASCADE interpolation may be predicted to take
+  double process_budget = 120;  // seconds of timed runs per whole-process job
   std::string json_out = "build/bench/compare.json";
   std::string workdir = "build/bench/compare-work";
   std::string commit;
-  std::string cli = INTERPATCH_CLI_PATH, sisl_eval = SISL_EVAL_PATH;
+  std::string cli = INTERPATCH_CLI_PATH, sisl_eval = SISL_EVAL_PATH, pure_io = PURE_IO_PATH;
+  Options() { jobs.insert(process_jobs.begin(), process_jobs.end()); }
   bool has(const std::string& lib) const { return libs.count(lib) != 0; }
   bool job(const std::string& j) const { return jobs.count(j) != 0; }
 };
@@ -162,10 +195,15 @@ std::vector<T> split_numbers(const std::string& s) {
 
 const char* usage =
     "usage: compare [--sizes 256,1024,2048,4096] [--libs interpatch,occt,sisl,memcpy]\n"
-    "               [--jobs interpolate,evaluate,coons,process,memory] [--reps 3] [--threads 1,2]\n"
+    "               [--jobs interpolate,evaluate,coons,process,memory,processes] [--reps 3] [--threads 1,2]\n"
     "               [--memory-sizes 2048,4096] [--eval-grid 1024] [--coons-points 1024]\n"
-    "               [--process-grid 1024] [--occt-budget 60] [--json FILE] [--workdir DIR]\n"
-    "               [--commit TEXT] [--cli PATH] [--sisl-eval PATH]\n";
+    "               [--process-grid 1024] [--npz-size 8192] [--occt-budget 60] [--process-budget 120]\n"
+    "               [--json FILE] [--workdir DIR] [--commit TEXT] [--cli PATH] [--sisl-eval PATH]\n"
+    "               [--pure-io PATH]\n"
+    "--jobs processes stands for the whole-process jobs of every construction:\n"
+    "  eval_interpolate, eval_coons, eval_coons_hermite, eval_gordon, eval_network,\n"
+    "  eval_interpolate_volume, eval_coons_volume, eval_hermite_volume, eval_trilinear,\n"
+    "  mesh, build_npz (each may be named alone). Every job runs by default.\n";
 
 Options parse(int argc, char** argv) {
   Options o;
@@ -179,19 +217,28 @@ Options parse(int argc, char** argv) {
     const std::string v = argv[++i];
     if (a == "--sizes") o.sizes = split_numbers<std::size_t>(v);
     else if (a == "--libs") { auto l = split(v); o.libs = {l.begin(), l.end()}; }
-    else if (a == "--jobs") { auto l = split(v); o.jobs = {l.begin(), l.end()}; }
+    else if (a == "--jobs") {
+      o.jobs.clear();
+      for (const auto& j : split(v)) {
+        if (j == "processes") o.jobs.insert(process_jobs.begin(), process_jobs.end());
+        else o.jobs.insert(j);
+      }
+    }
     else if (a == "--reps") o.reps = std::max(1, std::stoi(v));
     else if (a == "--threads") o.threads = split_numbers<int>(v);
     else if (a == "--memory-sizes") o.memory_sizes = split_numbers<std::size_t>(v);
     else if (a == "--eval-grid") o.eval_grid = std::stoul(v);
     else if (a == "--coons-points") o.coons_points = std::stoul(v);
     else if (a == "--process-grid") o.process_grid = std::stoul(v);
+    else if (a == "--npz-size") o.npz_size = std::stoul(v);
+    else if (a == "--process-budget") o.process_budget = std::stod(v);
     else if (a == "--occt-budget") o.occt_budget = std::stod(v);
     else if (a == "--json") o.json_out = v;
     else if (a == "--workdir") o.workdir = v;
     else if (a == "--commit") o.commit = v;
     else if (a == "--cli") o.cli = v;
     else if (a == "--sisl-eval") o.sisl_eval = v;
+    else if (a == "--pure-io") o.pure_io = v;
     else throw std::runtime_error("unknown option " + a + "\n" + usage);
   }
   std::sort(o.sizes.begin(), o.sizes.end());
@@ -213,7 +260,7 @@ struct Row {
   std::map<std::string, std::vector<double>> parts;
   double error = 0, tolerance = 0;
   std::string note;
-  std::optional<double> maxrss_bytes;
+  std::optional<double> maxrss_bytes, output_bytes;  // whole processes
 
   [[nodiscard]] bool ok() const { return error <= tolerance; }
 };
@@ -346,10 +393,6 @@ struct CurveDeleter {
 using SislSurface = std::unique_ptr<SISLSurf, SurfDeleter>;
 using SislCurve = std::unique_ptr<SISLCurve, CurveDeleter>;
 
-void sisl_status(int stat, const char* what) {
-  if (stat < 0) throw std::runtime_error(std::string(what) + " failed with status " + std::to_string(stat));
-}
-
 // SISL's first parameter direction runs fastest in memory, so an interpatch grid
 // (first index along u, slowest) is SISL's (v, u): points pass unchanged and the
 // parameter directions swap.
@@ -359,7 +402,7 @@ SislSurface sisl_interpolate(const PointGrid& grid, const std::vector<double>& p
   auto u = pu, v = pv;  // s1537 takes non-const arrays
   s1537(const_cast<double*>(&grid.data()->x), static_cast<int>(grid.extent(1)), static_cast<int>(grid.extent(0)), 3,
         v.data(), u.data(), 0, 0, 0, 0, 4, 4, 1, 1, &s, &stat);
-  sisl_status(stat, "s1537");
+  ib::sisl_check(stat, "s1537");
   return SislSurface(s);
 }
 
@@ -367,7 +410,7 @@ Vec3 sisl_point(SISLSurf* s, double first, double second) {
   double par[2] = {first, second}, out[3];
   int left1 = 0, left2 = 0, stat = 0;
   s1424(s, 0, 0, par, &left1, &left2, out, &stat);
-  sisl_status(stat, "s1424");
+  ib::sisl_check(stat, "s1424");
   return {out[0], out[1], out[2]};
 }
 
@@ -378,7 +421,7 @@ std::unique_ptr<double[]> sisl_grid(SISLSurf* s, std::vector<double>& first, std
   int stat = 0;
   s1506(s, 0, static_cast<int>(first.size()), first.data(), static_cast<int>(second.size()), second.data(), out.get(),
         nullptr, &stat);
-  sisl_status(stat, "s1506");
+  ib::sisl_check(stat, "s1506");
   return out;
 }
 
@@ -770,32 +813,18 @@ void job_coons(const Options& o) {
     // s1390's edges run around the patch: 1 v = 0 and 3 v = 1 along u, 2 u = 1 and
     // 4 u = 0 along v; its first parameter is u, so s1506's grid is u-fastest.
     std::array<std::vector<double>, 4> params;
+    const std::array<const std::vector<Vec3>*, 4> around{&bottom, &right, &top, &left};
+    auto sisl_patch = [&](Laps& laps) {
+      std::array<SislCurve, 4> curves;
+      for (std::size_t e = 0; e < 4; ++e) curves[e].reset(ib::sisl_interpolate_curve(&around[e]->data()->x, m, params[e]));
+      laps.lap("curves");
+      SislSurface surf(ib::sisl_coons_patch({curves[0].get(), curves[1].get(), curves[2].get(), curves[3].get()}));
+      laps.lap("patch");
+      return surf;
+    };
     measure(row_of("coons", m, "sisl", "s1357 curves + s1390 + s1506", 1, tol), o.reps,
             [&](Laps& laps) {
-              std::array<SislCurve, 4> curves;
-              const std::array<const std::vector<Vec3>*, 4> edges{&bottom, &right, &top, &left};
-              std::vector<int> types(m, 1);
-              for (std::size_t e = 0; e < 4; ++e) {
-                auto pts = *edges[e];
-                params[e] = ib::chord_parameters(&pts.data()->x, m);
-                SISLCurve* c = nullptr;
-                double* gpar = nullptr;
-                double end = 0;
-                int npar = 0, stat = 0;
-                s1357(&pts.data()->x, static_cast<int>(m), 3, types.data(), params[e].data(), 0, 0, 1, 4, 0.0, &end, &c,
-                      &gpar, &npar, &stat);
-                std::free(gpar);
-                sisl_status(stat, "s1357");
-                curves[e].reset(c);
-              }
-              laps.lap("curves");
-              SISLCurve* pc[4] = {curves[0].get(), curves[1].get(), curves[2].get(), curves[3].get()};
-              int nder[4] = {1, 1, 1, 1}, stat = 0;
-              SISLSurf* s = nullptr;
-              s1390(pc, &s, nder, &stat);
-              sisl_status(stat, "s1390");
-              SislSurface surf(s);
-              laps.lap("patch");
+              SislSurface surf = sisl_patch(laps);
               auto g = sisl_grid(surf.get(), us, vs);
               laps.lap("evaluate");
               return std::make_pair(std::move(surf), std::move(g));
@@ -814,25 +843,8 @@ void job_coons(const Options& o) {
             });
     // Deviation from interpatch's patch: the boundary curves differ between the data
     // points (knot placement) and s1390 blends its two lofts with its own weights.
-    std::array<SislCurve, 4> curves;
-    const std::array<const std::vector<Vec3>*, 4> edges{&bottom, &right, &top, &left};
-    std::vector<int> types(m, 1);
-    for (std::size_t e = 0; e < 4; ++e) {
-      auto pts = *edges[e];
-      auto t = ib::chord_parameters(&pts.data()->x, m);
-      SISLCurve* c = nullptr;
-      double* gpar = nullptr;
-      double end = 0;
-      int npar = 0, stat = 0;
-      s1357(&pts.data()->x, static_cast<int>(m), 3, types.data(), t.data(), 0, 0, 1, 4, 0.0, &end, &c, &gpar, &npar, &stat);
-      std::free(gpar);
-      curves[e].reset(c);
-    }
-    SISLCurve* pc[4] = {curves[0].get(), curves[1].get(), curves[2].get(), curves[3].get()};
-    int nder[4] = {1, 1, 1, 1}, stat = 0;
-    SISLSurf* sp = nullptr;
-    s1390(pc, &sp, nder, &stat);
-    SislSurface surf(sp);
+    Laps none;
+    const SislSurface surf = sisl_patch(none);
     auto g = sisl_grid(surf.get(), us, vs);
     agreement("coons", m, "sisl s1390 vs interpatch coons (linear blending)", max_deviation_transposed(*ref, g.get()) / diag, 0,
               "same boundary data and parameters; the curves' knots differ and s1390 is SISL's own blend of two lofts");
@@ -997,6 +1009,99 @@ ProcessResult run_process(const std::string& self, const std::vector<std::string
   return r;
 }
 
+// The largest distance between the points of two .npy files of the same shape.
+double npy_deviation(const fs::path& a_path, const fs::path& b_path) {
+  const auto a = interpatch::io::read_npy(a_path), b = interpatch::io::read_npy(b_path);
+  if (a.shape != b.shape) return INFINITY;
+  double e = 0;
+  for (std::size_t q = 0; q < a.data.size(); q += 3) e = std::max(e, dist(Vec3{a.data[q], a.data[q + 1], a.data[q + 2]}, b.data.data() + q));
+  return e;
+}
+
+// The output's largest error over the diagonal (1 when it is not what was asked).
+using OutputCheck = std::function<double(const fs::path&)>;
+
+// One program of a whole-process job, and the check of what it writes.
+struct Program {
+  Program(std::string library_, std::string variant_, std::vector<std::string> args_, fs::path out_, int threads_,
+          OutputCheck check_, double tolerance_ = 1e-9, std::vector<std::string> env_ = {})
+      : library(std::move(library_)), variant(std::move(variant_)), args(std::move(args_)), out(std::move(out_)),
+        threads(threads_), check(std::move(check_)), tolerance(tolerance_), env(std::move(env_)) {}
+
+  std::string library, variant;
+  std::vector<std::string> args;
+  fs::path out;
+  int threads;
+  OutputCheck check;
+  double tolerance;
+  std::vector<std::string> env;
+  std::optional<ProcessResult> first;  // the untimed first run
+};
+
+// Runs the program once, its output removed first; nullopt (and a note of it among
+// the skipped) when it fails.
+std::optional<ProcessResult> run_program(const std::string& self, const std::string& job, std::size_t n, const Program& p) {
+  fs::remove(p.out);
+  const auto r = run_process(self, p.args, p.threads, p.env);
+  if (r.status == 0) return r;
+  skipped(job, n, p.library, p.variant + ": exited with status " + std::to_string(r.status));
+  return std::nullopt;
+}
+
+// Times whole processes in turn: each program once untimed (page cache, and the size
+// of its output), then `runs` rounds in which every program runs once, so that all
+// of them see the same machine from minute to minute. Each output is removed before
+// its run and checked after it. Rounds stop early once they have taken `budget`
+// seconds. A program that fails is dropped (and listed among the skipped). The rows
+// go to g_rows and the console; they are returned in the order of `programs`.
+std::vector<Row> time_in_turn(const std::string& self, const std::string& job, std::size_t n,
+                              std::vector<Program>& programs, int runs, double budget) {
+  for (auto& p : programs)
+    if (!p.first) p.first = run_program(self, job, n, p);
+  std::erase_if(programs, [](const Program& p) { return !p.first; });
+  std::vector<Row> rows;
+  for (const auto& p : programs) {
+    rows.push_back(row_of(job, n, p.library, p.variant, p.threads, p.tolerance));
+    rows.back().maxrss_bytes = 0.0;
+  }
+  double spent = 0;
+  int done = 0;
+  std::vector<bool> failed(programs.size(), false);
+  for (; done < runs && (done == 0 || spent < budget); ++done)
+    for (std::size_t k = 0; k < programs.size(); ++k) {
+      if (failed[k]) continue;
+      const auto r = run_program(self, job, n, programs[k]);
+      if (!r) {
+        failed[k] = true;
+        rows[k].error = INFINITY;
+        rows[k].note = "failed in a timed run";
+        continue;
+      }
+      rows[k].times.push_back(r->seconds);
+      rows[k].maxrss_bytes = std::max(*rows[k].maxrss_bytes, 1024.0 * static_cast<double>(r->maxrss_kb));
+      spent += r->seconds;
+      try {
+        rows[k].output_bytes = static_cast<double>(fs::file_size(programs[k].out));
+        rows[k].error = std::max(rows[k].error, programs[k].check(programs[k].out));
+      } catch (const std::exception& e) {
+        rows[k].error = INFINITY;
+        rows[k].note = std::string("output unreadable: ") + e.what();
+      }
+    }
+  for (auto& row : rows) {
+    if (done < runs) row.note += (row.note.empty() ? "" : "; ") + std::to_string(done) + " of " + std::to_string(runs) + " runs (time budget)";
+    measure(row, 0, [](Laps&) { return 0; }, [](int) { return 0.0; });
+  }
+  return rows;
+}
+
+// A command line as shown in tables: the files by their names.
+std::string shown(const std::vector<std::string>& args) {
+  std::string s;
+  for (const auto& a : args) s += (s.empty() ? "" : " ") + (a.find('/') != std::string::npos ? fs::path(a).filename().string() : a);
+  return s;
+}
+
 void job_process(const Options& o, const std::string& self) {
   const std::size_t n = o.process_grid;
   std::cout << "\nWhole process: read a " << n << " x " << n << " .npy grid, interpolate, evaluate " << n << " x " << n
@@ -1019,48 +1124,583 @@ void job_process(const Options& o, const std::string& self) {
                                dist(grid(n - 1, 0), p + 3 * n * (n - 1)), dist(grid(n - 1, n - 1), p + 3 * (n * n - 1))});
     return e / diag;
   };
-  auto run = [&](const std::string& library, const std::string& variant, const std::vector<std::string>& args,
-                 const fs::path& out, int threads, const std::vector<std::string>& env = {}) {
-    // The time is the one measured around the program inside the helper.
-    auto row = row_of("process", n, library, variant, threads, 1e-9);
-    double rss = 0;
-    // A whole process varies by several milliseconds from run to run here (page
-    // cache, scheduling): at least 7 runs for its median.
-    for (int r = 0; r < std::max(o.reps, 7); ++r) {
-      fs::remove(out);
-      const auto p = run_process(self, args, threads, env);
-      if (p.status != 0) throw std::runtime_error(args[0] + " exited with status " + std::to_string(p.status));
-      row.times.push_back(p.seconds);
-      rss = std::max(rss, 1024.0 * static_cast<double>(p.maxrss_kb));
-      row.error = std::max(row.error, check_output(out));
-    }
-    row.maxrss_bytes = rss;
-    measure(std::move(row), 0, [](Laps&) { return 0; }, [](int) { return 0.0; });
-  };
+  std::vector<Program> programs;
   if (o.has("interpatch")) {
     const std::vector<std::string> eval_args{o.cli,   "eval", (dir / "spec.json").string(), "--grid", grid_arg,
                                              "-o", (dir / "interpatch_out.npy").string()};
-    for (int threads : o.threads)
-      run("interpatch", "interpatch eval spec.json --grid " + grid_arg + " -o out.npy", eval_args,
-          dir / "interpatch_out.npy", threads);
+    const std::string variant = "interpatch eval spec.json --grid " + grid_arg + " -o out.npy";
+    for (int threads : o.threads) programs.emplace_back("interpatch", variant, eval_args, dir / "interpatch_out.npy", threads, check_output);
     // The same with the output made durable (fsync) before the command returns.
-    run("interpatch", "INTERPATCH_SYNC=1 interpatch eval spec.json --grid " + grid_arg + " -o out.npy", eval_args,
-        dir / "interpatch_out.npy", o.threads.back(), {"INTERPATCH_SYNC=1"});
+    programs.emplace_back("interpatch", "INTERPATCH_SYNC=1 " + variant, eval_args, dir / "interpatch_sync_out.npy",
+                          o.threads.back(), check_output, 1e-9, std::vector<std::string>{"INTERPATCH_SYNC=1"});
+    programs.back().args.back() = programs.back().out.string();
   }
   if (o.has("sisl"))
-    run("sisl", "sisl_eval grid.npy out.npy " + grid_arg,
-        {o.sisl_eval, (dir / "grid.npy").string(), (dir / "sisl_out.npy").string(), grid_arg}, dir / "sisl_out.npy", 1);
-  if (o.has("interpatch") && o.has("sisl")) {
-    const auto a = interpatch::io::read_npy(dir / "interpatch_out.npy"), b = interpatch::io::read_npy(dir / "sisl_out.npy");
-    double e = 0;
-    for (std::size_t q = 0; q < a.data.size(); q += 3)
-      e = std::max(e, dist(Vec3{a.data[q], a.data[q + 1], a.data[q + 2]}, b.data.data() + q));
-    agreement("process", n, "sisl_eval output vs interpatch eval output", e / diag, 0,
+    programs.emplace_back("sisl", "sisl_eval grid.npy out.npy " + grid_arg,
+                          std::vector<std::string>{o.sisl_eval, (dir / "grid.npy").string(), (dir / "sisl_out.npy").string(), grid_arg},
+                          dir / "sisl_out.npy", 1, check_output);
+  // A whole process varies by several milliseconds from run to run here (page
+  // cache, scheduling): at least 7 runs for its median.
+  time_in_turn(self, "process", n, programs, std::max(o.reps, 7), o.process_budget);
+  if (fs::exists(dir / "interpatch_out.npy") && fs::exists(dir / "sisl_out.npy")) {
+    agreement("process", n, "sisl_eval output vs interpatch eval output",
+              npy_deviation(dir / "interpatch_out.npy", dir / "sisl_out.npy") / diag, 0,
               "same parameters; knots at the parameters (SISL) against averaged knots (interpatch)");
   }
   if (o.has("memcpy")) {
     // The bytes a whole process cannot avoid moving: the grid read and the grid written.
     measure_memcpy(o, "process", n, n * n * sizeof(Vec3));
+  }
+}
+
+// ---------------------------------------------------------------- jobs: whole processes against pure I/O
+
+// An (..., 3) .npy of points.
+void write_points(const fs::path& path, std::vector<std::size_t> shape, std::span<const Vec3> points) {
+  shape.push_back(3);
+  interpatch::io::write_npy(path, shape, std::span<const double>(&points.data()->x, 3 * points.size()));
+}
+
+// The .npy a program wrote as a grid of points, when it has the expected shape
+// (without the trailing 3) and every value is finite.
+std::optional<interpatch::io::NpyArray> read_output(const fs::path& path, std::vector<std::size_t> shape) {
+  shape.push_back(3);
+  auto a = interpatch::io::read_npy(path);
+  if (a.shape != shape || !std::all_of(a.data.begin(), a.data.end(), [](double x) { return std::isfinite(x); }))
+    return std::nullopt;
+  return a;
+}
+
+// Every `stride`-th index of 0..n-1 along each direction, the last one included.
+std::vector<std::size_t> strided(std::size_t n, std::size_t stride) {
+  std::vector<std::size_t> s;
+  for (std::size_t i = 0; i < n; i += stride) s.push_back(i);
+  if (s.back() != n - 1) s.push_back(n - 1);
+  return s;
+}
+
+double param(std::size_t i, std::size_t n) { return static_cast<double>(i) / static_cast<double>(n - 1); }
+
+// Checks a K x K x K volume grid in a .npy against the shape it must reproduce, at
+// every third point along each direction.
+OutputCheck volume_check(std::size_t k, double diag, Vec3 (*shape)(double, double, double)) {
+  return [=](const fs::path& out) {
+    const auto a = read_output(out, {k, k, k});
+    if (!a) return 1.0;
+    double e = 0;
+    const auto idx = strided(k, 3);
+    for (std::size_t i : idx)
+      for (std::size_t j : idx)
+        for (std::size_t l : idx)
+          e = std::max(e, dist(shape(param(i, k), param(j, k), param(l, k)), a->data.data() + 3 * ((i * k + j) * k + l)));
+    return e / diag;
+  };
+}
+
+// What run_process_job needs of a job.
+struct ProcessJob {
+  ProcessJob(std::string name_, std::string what_, std::size_t n_, fs::path dir_, std::vector<fs::path> inputs_,
+             std::vector<std::string> command_, fs::path out_, OutputCheck check_, double tolerance_)
+      : name(std::move(name_)), what(std::move(what_)), n(n_), dir(std::move(dir_)), inputs(std::move(inputs_)),
+        command(std::move(command_)), out(std::move(out_)), check(std::move(check_)), tolerance(tolerance_) {}
+
+  std::string name, what;
+  std::size_t n;                     // the size shown (data points along a direction)
+  fs::path dir;                      // where its files are
+  std::vector<fs::path> inputs;      // the spec, then every data file it names
+  std::vector<std::string> command;  // interpatch's arguments
+  fs::path out;
+  OutputCheck check;
+  double tolerance;
+  std::vector<Program> others;       // SISL's whole process, another interpatch command
+  int runs = 0;                      // 0: max(--reps, 5)
+  std::optional<double> rss_target;  // peak RSS over input + output bytes
+};
+
+json g_processes = json::array();
+
+std::uintmax_t total_size(const std::vector<fs::path>& files) {
+  std::uintmax_t s = 0;
+  for (const auto& f : files) s += fs::file_size(f);
+  return s;
+}
+
+// The job's interpatch command(s), the pure-I/O program of the same input files and
+// output size, and the job's other programs, timed in turn; one summary per
+// interpatch command.
+void run_process_job(const Options& o, const std::string& self, ProcessJob job) {
+  const int threads = o.threads.back();
+  std::vector<std::string> args{o.cli};
+  args.insert(args.end(), job.command.begin(), job.command.end());
+  std::vector<Program> programs{{"interpatch", "interpatch " + shown(job.command), args, job.out, threads, job.check, job.tolerance}};
+  programs[0].first = run_program(self, job.name, job.n, programs[0]);
+  if (!programs[0].first) {
+    g_processes.push_back({{"job", job.name}, {"n", job.n}, {"what", job.what}, {"failed", g_skipped.back()["reason"]},
+                           {"check_ok", false}});
+    return;
+  }
+  const std::uintmax_t in_bytes = total_size(job.inputs), out_bytes = fs::file_size(job.out);
+  std::vector<std::string> io_args{o.pure_io, (job.dir / "pure_io_out").string(), std::to_string(out_bytes)};
+  for (const auto& f : job.inputs) io_args.push_back(f.string());
+  programs.push_back({"pure_io",
+                      "pure_io: " + std::to_string(job.inputs.size()) + " input files, " + std::to_string(out_bytes) +
+                          " bytes out",
+                      io_args, job.dir / "pure_io_out", threads,
+                      [out_bytes](const fs::path& out) { return fs::file_size(out) == out_bytes ? 0.0 : 1.0; }, 0});
+  programs.insert(programs.end(), job.others.begin(), job.others.end());
+  const auto rows = time_in_turn(self, job.name, job.n, programs, job.runs ? job.runs : std::max(o.reps, 5), o.process_budget);
+
+  auto find = [&](const std::string& library) -> const Row* {
+    for (const auto& r : rows)
+      if (r.library == library) return &r;
+    return nullptr;
+  };
+  auto side = [](const Row* r) {
+    if (!r) return json(nullptr);
+    return json{{"variant", r->variant}, {"median_s", median(r->times)}, {"maxrss_bytes", r->maxrss_bytes.value_or(0)},
+                {"output_bytes", r->output_bytes.value_or(0)}, {"check_ok", r->ok()},
+                {"check_max_rel_error", r->error}, {"runs", r->times.size()}, {"note", r->note}};
+  };
+  const Row *io = find("pure_io"), *sisl = find("sisl");
+  for (const auto& r : rows) {
+    if (r.library != "interpatch") continue;
+    const double t = median(r.times), io_t = io ? median(io->times) : NAN, sisl_t = sisl ? median(sisl->times) : NAN;
+    const double written = r.output_bytes.value_or(0);
+    const double rss_over_io = r.maxrss_bytes.value_or(0) / (static_cast<double>(in_bytes) + written);
+    json entry{{"job", job.name}, {"n", job.n}, {"what", job.what}, {"threads", r.threads},
+               {"input_files", job.inputs.size()}, {"input_bytes", in_bytes}, {"output_bytes", written},
+               {"interpatch", side(&r)}, {"pure_io", side(io)}, {"sisl", side(sisl)},
+               {"interpatch_over_pure_io", io ? json(t / io_t) : json(nullptr)}, {"target_over_pure_io", 2},
+               {"sisl_over_interpatch", sisl ? json(sisl_t / t) : json(nullptr)},
+               {"rss_over_io", rss_over_io},
+               {"target_rss_over_io", job.rss_target && &r == &rows.front() ? json(*job.rss_target) : json(nullptr)},
+               {"check_ok", r.ok() && (!io || io->ok()) && (!sisl || sisl->ok())}};
+    g_processes.push_back(entry);
+    std::cout << "  => " << job.name << ": " << r.variant.substr(0, 70) << "  " << format_time(t) << " = "
+              << std::setprecision(3) << t / io_t << " x pure I/O (" << format_time(io_t) << ")";
+    if (sisl) std::cout << ", SISL " << format_time(sisl_t) << " = " << sisl_t / t << " x";
+    std::cout << "; peak RSS " << std::setprecision(4) << r.maxrss_bytes.value_or(0) / 1048576 << " MiB = "
+              << std::setprecision(3) << rss_over_io << " x input + output" << std::endl;
+  }
+}
+
+// The four boundary curves of the linear Coons job, 1024 points each, from the
+// translation surface (each side's points equally spaced in its parameter): the
+// files, and the diagonal of the points.
+struct CoonsData {
+  fs::path spec;
+  std::vector<fs::path> inputs;
+  double diag = 0;
+};
+
+CoonsData write_coons_data(const fs::path& dir, std::size_t m) {
+  const ib::GraphSurface shape{};
+  std::vector<Vec3> all;
+  CoonsData d{dir / "coons.json", {dir / "coons.json"}, 0};
+  json boundary = json::object();
+  for (const char* side : {"v0", "v1", "u0", "u1"}) {
+    std::vector<Vec3> p(m);
+    for (std::size_t t = 0; t < m; ++t) {
+      const double s = param(t, m), end = side[1] == '0' ? 0.0 : 1.0;
+      p[t] = side[0] == 'v' ? shape.point(s, end) : shape.point(end, s);
+    }
+    const std::string file = std::string("coons_") + side + ".npy";
+    write_points(dir / file, {m}, p);
+    d.inputs.push_back(dir / file);
+    boundary[side] = {{"interpolate", {{"npy", file}}}};
+    all.insert(all.end(), p.begin(), p.end());
+  }
+  std::ofstream(d.spec) << json{{"type", "coons"}, {"boundary", boundary}}.dump(2) << '\n';
+  d.diag = diagonal(all.data(), all.size());
+  return d;
+}
+
+// The corners of a K x K grid in a .npy against the surface's corners.
+double corner_error(const double* g, std::size_t k, const std::array<Vec3, 4>& corners) {
+  return std::max({dist(corners[0], g), dist(corners[1], g + 3 * (k - 1)), dist(corners[2], g + 3 * k * (k - 1)),
+                   dist(corners[3], g + 3 * (k * k - 1))});
+}
+
+// Corners S(0, 0), S(0, 1), S(1, 0), S(1, 1): the order of a u-slowest grid's corners.
+template <class S>
+std::array<Vec3, 4> corners_of(const S& s) {
+  return {s.point(0, 0), s.point(0, 1), s.point(1, 0), s.point(1, 1)};
+}
+
+// Points on the graph surface, at its corners: what a Coons patch or a network of its
+// curves must give, whatever their parameters.
+OutputCheck graph_check(const ib::GraphSurface& shape, std::size_t k, double diag) {
+  const auto corners = corners_of(shape);
+  return [=](const fs::path& out) {
+    const auto a = read_output(out, {k, k});
+    if (!a) return 1.0;
+    double e = corner_error(a->data.data(), k, corners);
+    for (std::size_t q = 0; q < k * k; ++q) e = std::max(e, shape.height_error(a->data.data() + 3 * q));
+    return e / diag;
+  };
+}
+
+void job_eval_interpolate(const Options& o, const std::string& self, const fs::path& dir) {
+  const std::size_t n = o.process_grid, k = o.eval_points;
+  const PointGrid grid = ib::make_terrain(n);
+  write_points(dir / "grid.npy", {n, n}, std::span<const Vec3>(grid.data(), grid.size()));
+  std::ofstream(dir / "interpolate.json") << R"({"type": "interpolate", "points": {"npy": "grid.npy"}})" << '\n';
+  const double diag = diagonal(grid.data(), grid.size());
+  // interpatch's output: the data's corners at the corners, and at sampled points the
+  // library's own interpolation of the same grid (through its API, not the command).
+  const auto ip = interpatch::interpolate_surface(grid);
+  const auto idx = sample_indices(k);
+  std::map<std::pair<std::size_t, std::size_t>, Vec3> ref;
+  const auto [u0, u1] = ip.surface.domain_u();
+  const auto [v0, v1] = ip.surface.domain_v();
+  for (std::size_t i : idx)
+    for (std::size_t j : idx) ref[{i, j}] = ip.surface.point(u0 + (u1 - u0) * param(i, k), v0 + (v1 - v0) * param(j, k));
+  const std::array<Vec3, 4> corners{grid(0, 0), grid(0, n - 1), grid(n - 1, 0), grid(n - 1, n - 1)};
+  auto check = [=](const fs::path& out) {
+    const auto a = read_output(out, {k, k});
+    if (!a) return 1.0;
+    double e = corner_error(a->data.data(), k, corners);
+    for (const auto& [ij, p] : ref) e = std::max(e, dist(p, a->data.data() + 3 * (ij.first * k + ij.second)));
+    return e / diag;
+  };
+  auto corners_only = [=](const fs::path& out) {
+    const auto a = read_output(out, {k, k});
+    return a ? corner_error(a->data.data(), k, corners) / diag : 1.0;
+  };
+  ProcessJob job{"eval_interpolate", "bicubic interpolation of a " + std::to_string(n) + "² .npy grid, " + std::to_string(k) + "² points",
+                 n, dir, {dir / "interpolate.json", dir / "grid.npy"},
+                 {"eval", (dir / "interpolate.json").string(), "--grid", std::to_string(k), "-o", (dir / "interpatch_out.npy").string()},
+                 dir / "interpatch_out.npy", check, 1e-9};
+  if (o.has("sisl"))
+    job.others.push_back({"sisl", "sisl_eval grid.npy out.npy " + std::to_string(k),
+                          {o.sisl_eval, (dir / "grid.npy").string(), (dir / "sisl_out.npy").string(), std::to_string(k)},
+                          dir / "sisl_out.npy", 1, corners_only});
+  run_process_job(o, self, std::move(job));
+  if (fs::exists(dir / "interpatch_out.npy") && fs::exists(dir / "sisl_out.npy"))
+    agreement("eval_interpolate", n, "sisl_eval output vs interpatch eval output",
+              npy_deviation(dir / "interpatch_out.npy", dir / "sisl_out.npy") / diag, 0,
+              "same parameters; knots at the parameters (SISL) against averaged knots (interpatch)");
+}
+
+void job_eval_coons(const Options& o, const std::string& self, const fs::path& dir) {
+  const std::size_t m = o.coons_points, k = o.eval_points;
+  const auto d = write_coons_data(dir, m);
+  const ib::GraphSurface shape{};
+  const auto corners = corners_of(shape);
+  ProcessJob job{"eval_coons", "linear Coons patch of four " + std::to_string(m) + "-point interpolated curves (.npy), " + std::to_string(k) + "² points",
+                 m, dir, d.inputs,
+                 {"eval", d.spec.string(), "--grid", std::to_string(k), "-o", (dir / "interpatch_out.npy").string()},
+                 dir / "interpatch_out.npy", graph_check(shape, k, d.diag), 1e-7};
+  if (o.has("sisl"))
+    job.others.push_back({"sisl", "sisl_eval --coons v0.npy v1.npy u0.npy u1.npy out.npy " + std::to_string(k),
+                          {o.sisl_eval, "--coons", (dir / "coons_v0.npy").string(), (dir / "coons_v1.npy").string(),
+                           (dir / "coons_u0.npy").string(), (dir / "coons_u1.npy").string(),
+                           (dir / "sisl_out.npy").string(), std::to_string(k)},
+                          dir / "sisl_out.npy", 1,
+                          [=](const fs::path& out) {
+                            const auto a = read_output(out, {k, k});
+                            return a ? corner_error(a->data.data(), k, corners) / d.diag : 1.0;
+                          }});
+  run_process_job(o, self, std::move(job));
+  if (fs::exists(dir / "interpatch_out.npy") && fs::exists(dir / "sisl_out.npy")) {
+    agreement("eval_coons", m, "sisl_eval --coons output vs interpatch eval output",
+              npy_deviation(dir / "interpatch_out.npy", dir / "sisl_out.npy") / d.diag, 0,
+              "the same boundary points and chord parameters; s1390 is SISL's own blend of two lofts");
+    // interpatch's check holds its output to the surface (to 1e-7); SISL's is shown.
+    const auto a = interpatch::io::read_npy(dir / "sisl_out.npy");
+    double e = 0;
+    for (std::size_t q = 0; q < a.data.size(); q += 3) e = std::max(e, shape.height_error(a.data.data() + q));
+    agreement("eval_coons", m, "sisl_eval --coons output vs the translation surface of the boundary", e / d.diag, 0,
+              "a linear Coons patch reproduces z = f(x) + g(y) from its boundary (interpatch's output: within its check)");
+  }
+}
+
+void job_eval_coons_hermite(const Options& o, const std::string& self, const fs::path& dir) {
+  constexpr std::size_t m = 256;
+  const std::size_t k = o.eval_points;
+  const ib::GraphSurface shape{true};
+  std::vector<fs::path> inputs{dir / "coons_hermite.json"};
+  std::vector<Vec3> all;
+  // Each side as a Hermite curve: points and tangents (derivatives along the side),
+  // at equally spaced parameters; the cross derivatives likewise.
+  auto hermite = [&](const std::string& name, auto&& value, auto&& tangent) {
+    std::vector<Vec3> p(m), t(m);
+    for (std::size_t q = 0; q < m; ++q) {
+      p[q] = value(param(q, m));
+      t[q] = tangent(param(q, m));
+    }
+    write_points(dir / (name + "_points.npy"), {m}, p);
+    write_points(dir / (name + "_tangents.npy"), {m}, t);
+    inputs.push_back(dir / (name + "_points.npy"));
+    inputs.push_back(dir / (name + "_tangents.npy"));
+    if (name.starts_with("boundary")) all.insert(all.end(), p.begin(), p.end());
+    return json{{"hermite", {{"points", {{"npy", name + "_points.npy"}}}, {"tangents", {{"npy", name + "_tangents.npy"}}}}}};
+  };
+  json boundary = json::object(), cross = json::object();
+  for (const double e : {0.0, 1.0}) {
+    const std::string end = e == 0 ? "0" : "1";
+    boundary["v" + end] = hermite("boundary_v" + end, [&](double u) { return shape.point(u, e); }, [&](double u) { return shape.du(u, e); });
+    boundary["u" + end] = hermite("boundary_u" + end, [&](double v) { return shape.point(e, v); }, [&](double v) { return shape.dv(e, v); });
+    cross["v" + end] = hermite("cross_v" + end, [&](double u) { return shape.dv(u, e); }, [&](double u) { return shape.duv(u, e); });
+    cross["u" + end] = hermite("cross_u" + end, [&](double v) { return shape.du(e, v); }, [&](double v) { return shape.duv(e, v); });
+  }
+  std::ofstream(inputs[0]) << json{{"type", "coons"}, {"blending", "hermite"}, {"boundary", boundary}, {"cross_derivatives", cross}}.dump(2) << '\n';
+  run_process_job(o, self,
+                  {"eval_coons_hermite", "Coons patch with cross derivatives, Hermite blending, eight " + std::to_string(m) + "-point Hermite curves (.npy), " + std::to_string(k) + "² points",
+                   m, dir, inputs,
+                   {"eval", inputs[0].string(), "--grid", std::to_string(k), "-o", (dir / "interpatch_out.npy").string()},
+                   dir / "interpatch_out.npy", graph_check(shape, k, diagonal(all.data(), all.size())), 1e-7});
+}
+
+// A network of 12 x 12 curves of 200 points from the translation surface, each curve
+// interpolated at equally spaced parameters through points at equally spaced
+// stations; the curves cross at stations, whose parameters are given.
+void job_eval_network(const Options& o, const std::string& self, const fs::path& dir, const std::string& name,
+                      const std::string& method) {
+  constexpr std::size_t curves = 12, m = 200;
+  const std::size_t k = o.eval_points;
+  const ib::GraphSurface shape{};
+  std::vector<fs::path> inputs{dir / (name + ".json")};
+  std::vector<double> crossing(curves);
+  for (std::size_t c = 0; c < curves; ++c) crossing[c] = param((c * (m - 1) + (curves - 1) / 2) / (curves - 1), m);
+  std::vector<Vec3> all;
+  auto family = [&](char dir_name) {
+    json list = json::array();
+    for (std::size_t c = 0; c < curves; ++c) {
+      std::vector<Vec3> p(m);
+      for (std::size_t q = 0; q < m; ++q)
+        p[q] = dir_name == 'u' ? shape.point(param(q, m), crossing[c]) : shape.point(crossing[c], param(q, m));
+      const std::string file = std::string("network_") + dir_name + std::to_string(c) + ".npy";
+      write_points(dir / file, {m}, p);
+      inputs.push_back(dir / file);
+      all.insert(all.end(), p.begin(), p.end());
+      list.push_back({{"interpolate", {{"npy", file}}}, {"param", "uniform"}});
+    }
+    return list;
+  };
+  const json spec{{"type", "network"}, {"method", method}, {"u_curves", family('u')}, {"v_curves", family('v')},
+                  {"u_params", crossing}, {"v_params", crossing}};
+  std::ofstream(inputs[0]) << spec.dump(2) << '\n';
+  run_process_job(o, self,
+                  {name, "network, method " + method + ", " + std::to_string(curves) + " x " + std::to_string(curves) + " curves of " + std::to_string(m) + " points (.npy), " + std::to_string(k) + "² points",
+                   m, dir, inputs,
+                   {"eval", inputs[0].string(), "--grid", std::to_string(k), "-o", (dir / "interpatch_out.npy").string()},
+                   dir / "interpatch_out.npy", graph_check(shape, k, diagonal(all.data(), all.size())), 1e-7});
+}
+
+constexpr std::size_t volume_data = 128, volume_grid = 200;
+
+double twisted_block_diagonal() {
+  std::vector<Vec3> c;
+  for (int q = 0; q < 8; ++q) c.push_back(ib::TwistedBlock::point(q & 4 ? 1 : 0, q & 2 ? 1 : 0, q & 1 ? 1 : 0));
+  return diagonal(c.data(), c.size());
+}
+
+std::vector<std::string> eval_volume_command(const fs::path& spec, const fs::path& out) {
+  return {"eval", spec.string(), "--grid", std::to_string(volume_grid), "-o", out.string()};
+}
+
+void job_eval_interpolate_volume(const Options& o, const std::string& self, const fs::path& dir) {
+  constexpr std::size_t n = volume_data;
+  std::vector<Vec3> p(n * n * n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < n; ++j)
+      for (std::size_t l = 0; l < n; ++l) p[(i * n + j) * n + l] = ib::TwistedBlock::point(param(i, n), param(j, n), param(l, n));
+  write_points(dir / "block.npy", {n, n, n}, p);
+  std::ofstream(dir / "interpolate_volume.json") << R"({"type": "interpolate_volume", "points": {"npy": "block.npy"}})" << '\n';
+  run_process_job(o, self,
+                  {"eval_interpolate_volume", "tricubic interpolation of a " + std::to_string(n) + "³ .npy grid, " + std::to_string(volume_grid) + "³ points",
+                   n, dir, {dir / "interpolate_volume.json", dir / "block.npy"},
+                   eval_volume_command(dir / "interpolate_volume.json", dir / "interpatch_out.npy"), dir / "interpatch_out.npy",
+                   volume_check(volume_grid, twisted_block_diagonal(), &ib::TwistedBlock::point), 1e-7});
+}
+
+void job_eval_coons_volume(const Options& o, const std::string& self, const fs::path& dir) {
+  constexpr std::size_t n = volume_data;
+  std::vector<fs::path> inputs{dir / "coons_volume.json"};
+  json faces = json::object();
+  // Face u0 is S(0, v, w) by (v, w), v0 is S(u, 0, w) by (u, w), w0 S(u, v, 0) by (u, v).
+  for (int axis = 0; axis < 3; ++axis)
+    for (const double e : {0.0, 1.0}) {
+      std::vector<Vec3> p(n * n);
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = 0; j < n; ++j) {
+          const double a = param(i, n), b = param(j, n);
+          p[i * n + j] = axis == 0 ? ib::TwistedBlock::point(e, a, b)
+                         : axis == 1 ? ib::TwistedBlock::point(a, e, b)
+                                     : ib::TwistedBlock::point(a, b, e);
+        }
+      const std::string face = std::string(1, "uvw"[axis]) + (e == 0 ? "0" : "1");
+      write_points(dir / ("face_" + face + ".npy"), {n, n}, p);
+      inputs.push_back(dir / ("face_" + face + ".npy"));
+      faces[face] = {{"type", "interpolate"}, {"points", {{"npy", "face_" + face + ".npy"}}}};
+    }
+  std::ofstream(inputs[0]) << json{{"type", "coons_volume"}, {"faces", faces}}.dump(2) << '\n';
+  run_process_job(o, self,
+                  {"eval_coons_volume", "Coons volume of six faces interpolating " + std::to_string(n) + "² .npy grids, " + std::to_string(volume_grid) + "³ points",
+                   n, dir, inputs, eval_volume_command(inputs[0], dir / "interpatch_out.npy"), dir / "interpatch_out.npy",
+                   volume_check(volume_grid, twisted_block_diagonal(), &ib::TwistedBlock::point), 1e-7});
+}
+
+void job_eval_hermite_volume(const Options& o, const std::string& self, const fs::path& dir) {
+  auto vec = [](const Vec3& v) { return json{v.x, v.y, v.z}; };
+  json corners = json::array();
+  for (int c = 0; c < 8; ++c) {
+    const double u = c & 4 ? 1 : 0, v = c & 2 ? 1 : 0, w = c & 1 ? 1 : 0;
+    auto d = [&](int a, int b, int e) { return vec(ib::TricubicMap::derivative(a, b, e, u, v, w)); };
+    corners.push_back({{"p", d(0, 0, 0)}, {"du", d(1, 0, 0)}, {"dv", d(0, 1, 0)}, {"dw", d(0, 0, 1)}, {"duv", d(1, 1, 0)},
+                       {"duw", d(1, 0, 1)}, {"dvw", d(0, 1, 1)}, {"duvw", d(1, 1, 1)}});
+  }
+  const fs::path spec = dir / "hermite_volume.json";
+  std::ofstream(spec) << json{{"type", "hermite_volume"}, {"corners", corners}}.dump(2) << '\n';
+  std::vector<Vec3> c;
+  for (int q = 0; q < 8; ++q) c.push_back(ib::TricubicMap::point(q & 4 ? 1 : 0, q & 2 ? 1 : 0, q & 1 ? 1 : 0));
+  run_process_job(o, self,
+                  {"eval_hermite_volume", "tricubic Hermite volume of eight corners (inline: the form takes no data files), " + std::to_string(volume_grid) + "³ points",
+                   8, dir, {spec}, eval_volume_command(spec, dir / "interpatch_out.npy"), dir / "interpatch_out.npy",
+                   volume_check(volume_grid, diagonal(c.data(), c.size()), &ib::TricubicMap::point), 1e-12});
+}
+
+void job_eval_trilinear(const Options& o, const std::string& self, const fs::path& dir) {
+  json spec{{"type", "trilinear"}};
+  for (int c = 0; c < 8; ++c) {
+    const Vec3& p = ib::TrilinearBlock::corners[c];
+    spec["p" + std::to_string(c >> 2) + std::to_string((c >> 1) & 1) + std::to_string(c & 1)] = {p.x, p.y, p.z};
+  }
+  const fs::path path = dir / "trilinear.json";
+  std::ofstream(path) << spec.dump(2) << '\n';
+  const auto& c = ib::TrilinearBlock::corners;
+  run_process_job(o, self,
+                  {"eval_trilinear", "trilinear volume of eight corners (inline: the form takes no data files), " + std::to_string(volume_grid) + "³ points",
+                   8, dir, {path}, eval_volume_command(path, dir / "interpatch_out.npy"), dir / "interpatch_out.npy",
+                   volume_check(volume_grid, diagonal(c.data(), c.size()), &ib::TrilinearBlock::point), 1e-12});
+}
+
+// The points and normals of a surface mesh in a .vts (VTK XML, raw appended arrays,
+// UInt64 byte counts, u index fastest), as interpatch writes them; empty when the
+// file is not of that form.
+std::pair<std::vector<double>, std::vector<double>> read_vts(const fs::path& path, std::size_t points) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t data = text.find("<AppendedData encoding=\"raw\">");
+  const std::size_t start = data == std::string::npos ? data : text.find('_', data);
+  auto array = [&](const std::string& name) {
+    std::vector<double> v;
+    const std::size_t at = text.find("Name=\"" + name + "\"");
+    const std::size_t off = at == std::string::npos ? at : text.find("offset=\"", at);
+    if (start == std::string::npos || off == std::string::npos || off > data) return v;
+    const std::size_t pos = start + 1 + std::strtoull(text.c_str() + off + 8, nullptr, 10);
+    std::uint64_t bytes = 0;
+    if (pos + 8 > text.size()) return v;
+    std::memcpy(&bytes, text.data() + pos, 8);
+    if (bytes != 24 * points || pos + 8 + bytes > text.size()) return v;
+    v.resize(3 * points);
+    std::memcpy(v.data(), text.data() + pos + 8, bytes);
+    return v;
+  };
+  return {array("Points"), array("Normals")};
+}
+
+void job_mesh(const Options& o, const std::string& self, const fs::path& dir) {
+  const std::size_t m = o.coons_points, k = o.eval_points;
+  const auto d = write_coons_data(dir, m);
+  const ib::GraphSurface shape{};
+  const auto corners = corners_of(shape);
+  // Every point on the surface, every normal the surface's (to the error of the
+  // boundary curves), the corners in place (u fastest).
+  // The normals' error (a difference of unit vectors) reaches 7e-8 at the corners,
+  // where the boundary curves' derivatives are least accurate.
+  auto check = [=](const fs::path& out) {
+    const auto [points, normals] = read_vts(out, k * k);
+    if (points.empty() || normals.empty() ||
+        !std::all_of(points.begin(), points.end(), [](double x) { return std::isfinite(x); }))
+      return 1.0;
+    double e = std::max({dist(corners[0], points.data()), dist(corners[2], points.data() + 3 * (k - 1)),
+                         dist(corners[1], points.data() + 3 * k * (k - 1)), dist(corners[3], points.data() + 3 * (k * k - 1))}) / d.diag;
+    for (std::size_t q = 0; q < k * k; ++q) {
+      const double* p = points.data() + 3 * q;
+      e = std::max({e, shape.height_error(p) / d.diag, dist(shape.normal_above(p[0], p[1]), normals.data() + 3 * q)});
+    }
+    return e;
+  };
+  const std::string res = std::to_string(k) + "x" + std::to_string(k);
+  run_process_job(o, self,
+                  {"mesh", "mesh of the linear Coons patch (eval_coons's spec), " + res + " vertices with normals, .vts",
+                   m, dir, d.inputs, {"mesh", d.spec.string(), "--res", res, "-o", (dir / "interpatch_out.vts").string()},
+                   dir / "interpatch_out.vts", check, 1e-6});
+}
+
+void job_build_npz(const Options& o, const std::string& self, const fs::path& dir) {
+  const std::size_t n = o.npz_size;
+  std::cout << "  (making the " << n << " x " << n << " terrain, writing its .npy and interpolating it for the checks)" << std::endl;
+  PointGrid grid = ib::make_terrain(n);
+  write_points(dir / "grid.npy", {n, n}, std::span<const Vec3>(grid.data(), grid.size()));
+  std::ofstream(dir / "interpolate.json") << R"({"type": "interpolate", "points": {"npy": "grid.npy"}})" << '\n';
+  const double diag = diagonal(grid.data(), grid.size());
+  // The checks: the exact form passes through sampled data points at their
+  // parameters (computed here by plain code) and is at the corners; eval's output
+  // agrees at sampled points with the library's interpolation of the same grid.
+  const auto idx = sample_indices(n);
+  const auto pu = ib::averaged_chord_parameters(&grid.data()->x, n, n, 0), pv = ib::averaged_chord_parameters(&grid.data()->x, n, n, 1);
+  std::vector<std::tuple<double, double, Vec3>> at_data;
+  for (std::size_t i : idx)
+    for (std::size_t j : idx) at_data.emplace_back(pu[i], pv[j], grid(i, j));
+  const std::array<Vec3, 4> corners{grid(0, 0), grid(0, n - 1), grid(n - 1, 0), grid(n - 1, n - 1)};
+  std::vector<std::tuple<std::size_t, std::size_t, Vec3>> at_grid;
+  {
+    const auto ip = interpatch::interpolate_surface(std::move(grid));
+    for (std::size_t i : idx)
+      for (std::size_t j : idx) at_grid.emplace_back(i, j, ip.surface.point(param(i, n), param(j, n)));
+  }
+  auto check_npz = [=](const fs::path& out) {
+    const auto form = interpatch::io::read_exact_npz(out);
+    const auto* s = std::get_if<BSplineSurface>(&form);
+    if (!s || s->control_points().extent(0) != n || s->control_points().extent(1) != n) return 1.0;
+    double e = std::max({dist(corners[0], s->point(0, 0)), dist(corners[1], s->point(0, 1)), dist(corners[2], s->point(1, 0)),
+                         dist(corners[3], s->point(1, 1))});
+    for (const auto& [u, v, p] : at_data) e = std::max(e, dist(p, s->point(u, v)));
+    return e / diag;
+  };
+  auto check_eval = [=](const fs::path& out) {
+    const auto a = read_output(out, {n, n});
+    if (!a) return 1.0;
+    double e = corner_error(a->data.data(), n, corners);
+    for (const auto& [i, j, p] : at_grid) e = std::max(e, dist(p, a->data.data() + 3 * (i * n + j)));
+    return e / diag;
+  };
+  const fs::path spec = dir / "interpolate.json";
+  ProcessJob job{"build_npz", "exact form of the bicubic interpolation of a " + std::to_string(n) + "² .npy grid, written as .npz",
+                 n, dir, {spec, dir / "grid.npy"}, {"build", spec.string(), "-o", (dir / "interpatch_out.npz").string()},
+                 dir / "interpatch_out.npz", check_npz, 1e-9};
+  const std::vector<std::string> eval{"eval", spec.string(), "--grid", std::to_string(n), "-o", (dir / "interpatch_eval.npy").string()};
+  std::vector<std::string> eval_args{o.cli};
+  eval_args.insert(eval_args.end(), eval.begin(), eval.end());
+  job.others.emplace_back("interpatch", "interpatch " + shown(eval), eval_args, dir / "interpatch_eval.npy", o.threads.back(), check_eval);
+  job.runs = std::min(o.reps, 3);
+  job.rss_target = 1.2;
+  run_process_job(o, self, std::move(job));
+  // Gigabytes each: not kept.
+  for (const char* f : {"grid.npy", "interpatch_out.npz", "interpatch_eval.npy", "pure_io_out"}) fs::remove(dir / f);
+}
+
+void job_processes(const Options& o, const std::string& self) {
+  if (!o.has("interpatch")) return;
+  std::cout << "\nWhole processes of every construction against pure I/O of the same bytes (and SISL's process)\n";
+  for (const auto& name : process_jobs) {
+    if (!o.job(name)) continue;
+    const fs::path dir = fs::absolute(fs::path(o.workdir) / name);
+    fs::create_directories(dir);
+    if (name == "eval_interpolate") job_eval_interpolate(o, self, dir);
+    else if (name == "eval_coons") job_eval_coons(o, self, dir);
+    else if (name == "eval_coons_hermite") job_eval_coons_hermite(o, self, dir);
+    else if (name == "eval_gordon") job_eval_network(o, self, dir, name, "gordon");
+    else if (name == "eval_network") job_eval_network(o, self, dir, name, "coons_hermite");
+    else if (name == "eval_interpolate_volume") job_eval_interpolate_volume(o, self, dir);
+    else if (name == "eval_coons_volume") job_eval_coons_volume(o, self, dir);
+    else if (name == "eval_hermite_volume") job_eval_hermite_volume(o, self, dir);
+    else if (name == "eval_trilinear") job_eval_trilinear(o, self, dir);
+    else if (name == "mesh") job_mesh(o, self, dir);
+    else job_build_npz(o, self, dir);
   }
 }
 
@@ -1186,29 +1826,32 @@ json row_json(const Row& r) {
             {"parts_median_s", parts}, {"check_max_rel_error", r.error}, {"check_tolerance", r.tolerance},
             {"check_ok", r.ok()}, {"note", r.note}};
   if (r.maxrss_bytes) j["maxrss_bytes"] = *r.maxrss_bytes;
+  if (r.output_bytes) j["output_bytes"] = *r.output_bytes;
   return j;
 }
 
-// The console summary: each row against the fastest memcpy of its job and size, and
-// against interpatch's fastest row there.
+// The console summary: each row against the fastest baseline of its job and size (a
+// memcpy of the same bytes, or for the whole processes of every construction the
+// pure-I/O program), and against interpatch's fastest row there.
 void print_summary() {
-  std::cout << "\nSummary (median wall clock; ratios to the faster memcpy of the same bytes and to interpatch's fastest)\n";
-  std::map<std::pair<std::string, std::size_t>, double> best_memcpy, best_interpatch;
+  std::cout << "\nSummary (median wall clock; ratios to the faster memcpy or pure I/O of the same bytes and to interpatch's fastest)\n";
+  std::map<std::pair<std::string, std::size_t>, double> best_baseline, best_interpatch;
   for (const auto& r : g_rows) {
-    auto& m = r.library == "memcpy" ? best_memcpy : best_interpatch;
-    if (r.library != "memcpy" && r.library != "interpatch") continue;
+    const bool baseline = r.library == "memcpy" || r.library == "pure_io";
+    if (!baseline && r.library != "interpatch") continue;
+    auto& m = baseline ? best_baseline : best_interpatch;
     const auto key = std::make_pair(r.job, r.n);
     m[key] = m.count(key) ? std::min(m[key], median(r.times)) : median(r.times);
   }
-  std::cout << std::left << std::setw(12) << "job" << std::setw(6) << "N" << std::setw(12) << "library" << std::setw(64)
-            << "variant" << std::setw(5) << "thr" << std::right << std::setw(11) << "median" << std::setw(11) << "/memcpy"
+  std::cout << std::left << std::setw(24) << "job" << std::setw(6) << "N" << std::setw(12) << "library" << std::setw(64)
+            << "variant" << std::setw(5) << "thr" << std::right << std::setw(11) << "median" << std::setw(11) << "/baseline"
             << std::setw(13) << "/interpatch" << "  check\n";
   for (const auto& r : g_rows) {
     const auto key = std::make_pair(r.job, r.n);
     const double t = median(r.times);
-    std::cout << std::left << std::setw(12) << r.job << std::setw(6) << r.n << std::setw(12) << r.library << std::setw(64)
+    std::cout << std::left << std::setw(24) << r.job << std::setw(6) << r.n << std::setw(12) << r.library << std::setw(64)
               << r.variant.substr(0, 63) << std::setw(5) << r.threads << std::right << std::setw(11) << format_time(t)
-              << std::setw(11) << std::setprecision(3) << (best_memcpy.count(key) ? t / best_memcpy[key] : NAN) << std::setw(13)
+              << std::setw(11) << std::setprecision(3) << (best_baseline.count(key) ? t / best_baseline[key] : NAN) << std::setw(13)
               << (best_interpatch.count(key) ? t / best_interpatch[key] : NAN) << "  " << (r.ok() ? "ok" : "FAILED") << '\n';
   }
 }
@@ -1234,6 +1877,7 @@ int main(int argc, char** argv) {
     if (o.job("evaluate")) job_evaluate(o);
     if (o.job("coons")) job_coons(o);
     if (o.job("process")) job_process(o, self);
+    job_processes(o, self);
     if (o.job("memory")) job_memory(o, self);
     print_summary();
 
@@ -1244,8 +1888,9 @@ int main(int argc, char** argv) {
       all_ok = all_ok && r.ok();
     }
     for (const auto& sc : g_scaling) all_ok = all_ok && sc["check_ok"].get<bool>();
+    for (const auto& p : g_processes) all_ok = all_ok && p["check_ok"].get<bool>();
     json out = {{"meta", meta}, {"rows", rows}, {"agreement", g_agreement}, {"memory", g_memory}, {"skipped", g_skipped},
-                {"scaling", g_scaling}};
+                {"scaling", g_scaling}, {"processes", g_processes}};
     out["meta"]["load_average_end"] = shell_output("cat /proc/loadavg");
     if (!o.json_out.empty()) {
       fs::path p(o.json_out);

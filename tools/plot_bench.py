@@ -5,7 +5,9 @@
 
 Draws interpolation time against N (log-log) for each library next to the memcpy of
 the same bytes, and a second panel with the evaluation, Coons and whole-process jobs;
-prints the Markdown tables of docs/BENCHMARKS.md. Needs python3-matplotlib (Debian).
+prints the Markdown tables of docs/BENCHMARKS.md, among them the whole processes of
+every construction against the pure-I/O program (the "processes" key). Needs
+python3-matplotlib (Debian).
 """
 
 import argparse
@@ -16,7 +18,7 @@ import sys
 from bench_report import fmt_time  # the same time format as the Google Benchmark tables
 
 LIBS = ("interpatch", "occt", "sisl", "memcpy")
-NAMES = {"interpatch": "interpatch", "occt": "OpenCASCADE", "sisl": "SISL", "memcpy": "memcpy"}
+NAMES = {"interpatch": "interpatch", "occt": "OpenCASCADE", "sisl": "SISL", "memcpy": "memcpy", "pure_io": "pure I/O"}
 COLORS = {"interpatch": "tab:blue", "occt": "tab:red", "sisl": "tab:green", "memcpy": "tab:gray"}
 
 
@@ -115,6 +117,42 @@ def scaling_table(scaling):
     return "\n".join(out)
 
 
+def fmt_mib(b):
+    return "–" if b is None else f"{b / 2**20:,.1f} MiB" if b < 10 * 2**20 else f"{b / 2**20:,.0f} MiB"
+
+
+def processes_table(processes):
+    """Whole processes of every construction (bench/compare's --jobs processes): each
+    interpatch command against the pure-I/O program of the same bytes, and SISL's."""
+    head = ["job", "interpatch command", "input + output", "interpatch", "pure I/O", "SISL",
+            "interpatch / pure I/O (target ≤ 2)", "SISL / interpatch", "peak RSS: interpatch / pure I/O / SISL",
+            "interpatch peak RSS / (input + output)", "check"]
+    out = ["| " + " | ".join(head) + " |", "|---|---|---:|---:|---:|---:|---:|---:|---|---:|---|"]
+    for p in processes:
+        if "failed" in p:
+            out.append(f"| {p['job']} | {p['what']} | – | failed: {p['failed']} |" + " – |" * 6 + " FAILED |")
+            continue
+        ip, io, sisl = p["interpatch"], p["pure_io"], p["sisl"]
+        side = lambda s, key: None if s is None else s[key]
+        rss = " / ".join(fmt_mib(side(s, "maxrss_bytes")) for s in (ip, io, sisl) if s is not None)
+        rss_ratio = f"{p['rss_over_io']:.2f}"
+        if p.get("target_rss_over_io") is not None:
+            rss_ratio += f" (target ≤ {p['target_rss_over_io']:g})"
+        check = "ok" if p["check_ok"] else "FAILED"
+        check += f" ({ip['check_max_rel_error']:.1e})"
+        notes = "; ".join(s["note"] for s in (ip, io, sisl) if s is not None and s["note"])
+        out.append("| " + " | ".join([
+            p["job"], ip["variant"].removeprefix("interpatch ").replace("|", "\\|"),
+            fmt_mib(p["input_bytes"] + p["output_bytes"]), fmt_time(ip["median_s"]), fmt_time(side(io, "median_s")),
+            fmt_time(side(sisl, "median_s")), fmt_ratio(p["interpatch_over_pure_io"]), fmt_ratio(p["sisl_over_interpatch"]),
+            rss, rss_ratio, check + (f"; {notes}" if notes else "")]) + " |")
+    out.append("")
+    for job in dict.fromkeys(p["job"] for p in processes):
+        what = next(p["what"] for p in processes if p["job"] == job)
+        out.append(f"- **{job}**: {what}")
+    return "\n".join(out)
+
+
 def agreement_table(agreement):
     out = ["| job | N | compared | max deviation / diagonal | why they differ |", "|---|---:|---|---:|---|"]
     for a in agreement:
@@ -205,6 +243,9 @@ def main():
         print(scaling_table(data["scaling"]) + "\n")
     print("### Evaluation, Coons patch, whole process\n")
     print(jobs_table(rows) + "\n")
+    if data.get("processes"):
+        print("### Whole processes of every construction against pure I/O of the same bytes\n")
+        print(processes_table(data["processes"]) + "\n")
     if data["memory"]:
         print("### Peak memory of one interpolation\n")
         print(memory_table(data["memory"]) + "\n")
@@ -216,6 +257,10 @@ def main():
     failed = [r for r in rows if not r["check_ok"]]
     for r in failed:
         print(f"- CHECK FAILED: {r['job']} {r['n']} {r['library']} {r['variant']}: {r['check_max_rel_error']:.3g}")
+    for p in data.get("processes", []):
+        if "failed" in p:
+            print(f"- FAILED: {p['job']}: {p['failed']}")
+            failed.append(p)
     if not args.no_plot:
         plot(data, args.output)
         print(f"\nwrote {args.output}")
