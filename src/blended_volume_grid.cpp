@@ -202,9 +202,9 @@ std::shared_ptr<const PlaneCache::Entry> u_planes(const detail::VolumeTerms& T, 
 // A slab of u values folded: blending values of every axis, the planes of v and w
 // for the slab, the planes of u shared.
 Folded fold_slab(const detail::VolumeTerms& T, std::span<const double> us, std::span<const double> vs,
-                 std::span<const double> ws, std::shared_ptr<const PlaneCache::Entry> u) {
+                 std::span<const double> ws, bool derivatives, std::shared_ptr<const PlaneCache::Entry> u) {
   Folded F;
-  F.derivatives = u->derivatives;
+  F.derivatives = derivatives;
   F.u = std::move(u);
   set_axis(F, T, 0, us);
   set_axis(F, T, 1, vs);
@@ -217,7 +217,7 @@ Folded fold_slab(const detail::VolumeTerms& T, std::span<const double> us, std::
 // Calls at(i, j, k, S, S_u, S_v, S_w) for every grid point (the partials zero
 // without derivatives), u rows split over the threads; each point is a sum in a
 // fixed order, so the result does not depend on the thread count.
-template <class At>
+template <bool derivatives, class At>
 void for_each_point(const Folded& F, const progress_callback& progress, const At& at) {
   const std::size_t nu = F.extent(0), nv = F.extent(1), nw = F.extent(2);
   const std::size_t Ku = F.blends[0], Kv = F.blends[1], Kw = F.blends[2];
@@ -233,41 +233,57 @@ void for_each_point(const Folded& F, const progress_callback& progress, const At
       const double* dfu = F.df[0].data() + i * Ku;
       const double* fv = F.f[1].data() + j * Kv;
       const double* dfv = F.df[1].data() + j * Kv;
-      // The w planes at (i, j) are the same for the whole line along w.
-      std::array<Vec3, detail::max_volume_blends> w0{}, w0u{}, w0v{};
+      // Along the line: the u planes at (j, ·), the v planes at (i, ·), both
+      // contiguous in k; the w planes at (i, j), the same for the whole line.
+      using Row = std::array<const Vec3*, detail::max_volume_blends>;
+      Row U{}, Uv{}, Uw{}, V{}, Vu{}, Vw{};
+      std::array<Vec3, detail::max_volume_blends> W{}, Wu{}, Wv{};
+      for (std::size_t a = 0; a < Ku; ++a) {
+        const Plane& p = F.plane(0, a);
+        U[a] = p.value.data() + j * nw;
+        if constexpr (derivatives) {
+          Uv[a] = p.d0.data() + j * nw;
+          Uw[a] = p.d1.data() + j * nw;
+        }
+      }
+      for (std::size_t b = 0; b < Kv; ++b) {
+        const Plane& p = F.plane(1, b);
+        V[b] = p.value.data() + i * nw;
+        if constexpr (derivatives) {
+          Vu[b] = p.d0.data() + i * nw;
+          Vw[b] = p.d1.data() + i * nw;
+        }
+      }
       for (std::size_t c = 0; c < Kw; ++c) {
         const Plane& p = F.plane(2, c);
-        w0[c] = p.value[i * nv + j];
-        if (F.derivatives) {
-          w0u[c] = p.d0[i * nv + j];
-          w0v[c] = p.d1[i * nv + j];
+        W[c] = p.value[i * nv + j];
+        if constexpr (derivatives) {
+          Wu[c] = p.d0[i * nv + j];
+          Wv[c] = p.d1[i * nv + j];
         }
       }
       for (std::size_t k = 0; k < nw; ++k) {
         const double* fw = F.f[2].data() + k * Kw;
-        const double* dfw = F.df[2].data() + k * Kw;
-        const std::size_t vw = j * nw + k, uw = i * nw + k;
         Vec3 s{}, su{}, sv{}, sw{};
-        for (std::size_t a = 0; a < Ku; ++a) s += fu[a] * F.plane(0, a).value[vw];
-        for (std::size_t b = 0; b < Kv; ++b) s += fv[b] * F.plane(1, b).value[uw];
-        for (std::size_t c = 0; c < Kw; ++c) s += fw[c] * w0[c];
-        if (F.derivatives) {
+        for (std::size_t a = 0; a < Ku; ++a) s += fu[a] * U[a][k];
+        for (std::size_t b = 0; b < Kv; ++b) s += fv[b] * V[b][k];
+        for (std::size_t c = 0; c < Kw; ++c) s += fw[c] * W[c];
+        if constexpr (derivatives) {
+          const double* dfw = F.df[2].data() + k * Kw;
           for (std::size_t a = 0; a < Ku; ++a) {
-            const Plane& p = F.plane(0, a);
-            su += dfu[a] * p.value[vw];
-            sv += fu[a] * p.d0[vw];
-            sw += fu[a] * p.d1[vw];
+            su += dfu[a] * U[a][k];
+            sv += fu[a] * Uv[a][k];
+            sw += fu[a] * Uw[a][k];
           }
           for (std::size_t b = 0; b < Kv; ++b) {
-            const Plane& p = F.plane(1, b);
-            su += fv[b] * p.d0[uw];
-            sv += dfv[b] * p.value[uw];
-            sw += fv[b] * p.d1[uw];
+            su += fv[b] * Vu[b][k];
+            sv += dfv[b] * V[b][k];
+            sw += fv[b] * Vw[b][k];
           }
           for (std::size_t c = 0; c < Kw; ++c) {
-            su += fw[c] * w0u[c];
-            sv += fw[c] * w0v[c];
-            sw += dfw[c] * w0[c];
+            su += fw[c] * Wu[c];
+            sv += fw[c] * Wv[c];
+            sw += dfw[c] * W[c];
           }
         }
         at(i, j, k, s, su, sv, sw);
@@ -293,12 +309,14 @@ void fold_and_evaluate(const detail::VolumeTerms& T, PlaneCache& cache, std::spa
   const std::size_t rows = std::max<std::size_t>(1, max_slab_plane_points / std::max<std::size_t>(1, per_row));
   for (std::size_t i0 = 0; i0 < nu; i0 += rows) {
     const std::size_t n = std::min(rows, nu - i0);
-    const Folded F = fold_slab(T, us.subspan(i0, n), vs, ws, u);
+    const Folded F = fold_slab(T, us.subspan(i0, n), vs, ws, derivatives, u);
     progress_callback slab_progress;
     if (progress)
       slab_progress = [&](double f) { progress((static_cast<double>(i0) + f * static_cast<double>(n)) / static_cast<double>(nu)); };
-    for_each_point(F, slab_progress, [&](std::size_t i, std::size_t j, std::size_t k, const Vec3& s, const Vec3& su,
-                                         const Vec3& sv, const Vec3& sw) { at(i0 + i, j, k, s, su, sv, sw); });
+    const auto slab_at = [&](std::size_t i, std::size_t j, std::size_t k, const Vec3& s, const Vec3& su, const Vec3& sv,
+                             const Vec3& sw) { at(i0 + i, j, k, s, su, sv, sw); };
+    if (derivatives) for_each_point<true>(F, slab_progress, slab_at);
+    else for_each_point<false>(F, slab_progress, slab_at);
   }
   if (progress && nu == 0) progress(1.0);
 }
