@@ -238,22 +238,18 @@ void for_each_point(const Folded& F, const progress_callback& progress, const At
       using Row = std::array<const Vec3*, detail::max_volume_blends>;
       Row U{}, Uv{}, Uw{}, V{}, Vu{}, Vw{};
       std::array<Vec3, detail::max_volume_blends> W{}, Wu{}, Wv{};
-      for (std::size_t a = 0; a < Ku; ++a) {
-        const Plane& p = F.plane(0, a);
-        U[a] = p.value.data() + j * nw;
-        if constexpr (derivatives) {
-          Uv[a] = p.d0.data() + j * nw;
-          Uw[a] = p.d1.data() + j * nw;
+      const auto line_of = [&](std::size_t axis, std::size_t K, std::size_t at, Row& value, Row& d0, Row& d1) {
+        for (std::size_t a = 0; a < K; ++a) {
+          const Plane& p = F.plane(axis, a);
+          value[a] = p.value.data() + at;
+          if constexpr (derivatives) {
+            d0[a] = p.d0.data() + at;
+            d1[a] = p.d1.data() + at;
+          }
         }
-      }
-      for (std::size_t b = 0; b < Kv; ++b) {
-        const Plane& p = F.plane(1, b);
-        V[b] = p.value.data() + i * nw;
-        if constexpr (derivatives) {
-          Vu[b] = p.d0.data() + i * nw;
-          Vw[b] = p.d1.data() + i * nw;
-        }
-      }
+      };
+      line_of(0, Ku, j * nw, U, Uv, Uw);
+      line_of(1, Kv, i * nw, V, Vu, Vw);
       for (std::size_t c = 0; c < Kw; ++c) {
         const Plane& p = F.plane(2, c);
         W[c] = p.value[i * nv + j];
