@@ -238,13 +238,13 @@ void for_each_point(const Folded& F, const progress_callback& progress, const At
       using Row = std::array<const Vec3*, detail::max_volume_blends>;
       Row U{}, Uv{}, Uw{}, V{}, Vu{}, Vw{};
       std::array<Vec3, detail::max_volume_blends> W{}, Wu{}, Wv{};
-      const auto line_of = [&](std::size_t axis, std::size_t K, std::size_t at, Row& value, Row& d0, Row& d1) {
+      const auto line_of = [&](std::size_t axis, std::size_t K, std::size_t offset, Row& value, Row& d0, Row& d1) {
         for (std::size_t a = 0; a < K; ++a) {
           const Plane& p = F.plane(axis, a);
-          value[a] = p.value.data() + at;
+          value[a] = p.value.data() + offset;
           if constexpr (derivatives) {
-            d0[a] = p.d0.data() + at;
-            d1[a] = p.d1.data() + at;
+            d0[a] = p.d0.data() + offset;
+            d1[a] = p.d1.data() + offset;
           }
         }
       };
