@@ -165,9 +165,61 @@ BSplineCurve BSplineCurve::inserted(double t, int times) const {
 }
 
 BSplineCurve BSplineCurve::refined(std::span<const double> knots) const {
-  BSplineCurve c = *this;
-  for (double t : knots) c = c.inserted(t, 1);
-  return c;
+  if (knots.empty()) return *this;
+  for (double t : knots)
+    if (!(t > knots_.front() && t < knots_.back()))
+      fail(errc::out_of_domain, "knot ", t, " to insert is not inside the open domain (", knots_.front(), ", ",
+           knots_.back(), ")");
+  std::vector<double> X(knots.begin(), knots.end());
+  std::sort(X.begin(), X.end());
+  const int p = degree();
+  for (std::size_t i = 0; i < X.size();) {
+    std::size_t j = i;
+    while (j < X.size() && X[j] == X[i]) ++j;
+    const int s = knots_.multiplicity(X[i]), times = static_cast<int>(j - i);
+    if (s + times > p)
+      fail(errc::invalid_knots, "inserting ", X[i], " ", times, " times gives multiplicity ", s + times,
+           ", more than degree ", p);
+    i = j;
+  }
+  // All knots in one pass (The NURBS Book A5.4): from the last new knot down, each
+  // old control point is moved once and p new ones are formed per new knot, so the
+  // cost is O(n + p·r), not the O(n·r) of r single insertions.
+  const auto& U = knots_.values();
+  const auto P = homogeneous(cp_, w_);
+  const int n = knots_.count() - 1, m = n + p + 1, r = static_cast<int>(X.size()) - 1;
+  const int a = knots_.find_span(X.front()), b = knots_.find_span(X.back()) + 1;
+  std::vector<H> Q(P.size() + X.size());
+  std::vector<double> V(U.size() + X.size());
+  auto at = [](auto& v, int i) -> auto& { return v[static_cast<std::size_t>(i)]; };
+  for (int j = 0; j <= a - p; ++j) at(Q, j) = at(P, j);
+  for (int j = b - 1; j <= n; ++j) at(Q, j + r + 1) = at(P, j);
+  for (int j = 0; j <= a; ++j) at(V, j) = at(U, j);
+  for (int j = b + p; j <= m; ++j) at(V, j + r + 1) = at(U, j);
+  int i = b + p - 1, k = b + p + r;
+  for (int j = r; j >= 0; --j) {
+    const double x = at(X, j);
+    for (; x <= at(U, i) && i > a; --k, --i) {
+      at(Q, k - p - 1) = at(P, i - p - 1);
+      at(V, k) = at(U, i);
+    }
+    at(Q, k - p - 1) = at(Q, k - p);
+    for (int l = 1; l <= p; ++l) {
+      const int ind = k - p + l;
+      const double num = at(V, k + l) - x;
+      if (num == 0.0) {
+        at(Q, ind - 1) = at(Q, ind);
+        continue;
+      }
+      const double alpha = num / (at(V, k + l) - at(U, i - p + l));
+      H& q = at(Q, ind - 1);
+      const H& q1 = at(Q, ind);
+      for (std::size_t c = 0; c < 4; ++c) q[c] = alpha * q[c] + (1.0 - alpha) * q1[c];
+    }
+    at(V, k) = x;
+    --k;
+  }
+  return from_homogeneous(KnotVector(p, std::move(V)), Q, rational());
 }
 
 BSplineCurve BSplineCurve::elevated(int times) const {
@@ -228,15 +280,16 @@ std::vector<BSplineCurve> make_compatible(std::span<const BSplineCurve> curves) 
   std::vector<BSplineCurve> out;
   out.reserve(curves.size());
   for (const auto& c : curves) out.push_back(c.elevated(p - c.degree()));
-  // The merged interior knots: every value with its highest multiplicity.
-  std::vector<std::pair<double, int>> merged;
-  for (const auto& c : out)
-    for (const auto& [t, m] : c.knots().interior_breaks()) {
-      auto it = std::lower_bound(merged.begin(), merged.end(), t,
-                                 [](const std::pair<double, int>& a, double x) { return a.first < x; });
-      if (it != merged.end() && it->first == t) it->second = std::max(it->second, m);
-      else merged.insert(it, {t, m});
-    }
+  // The merged interior knots: every value with its highest multiplicity (sorted by
+  // value, then multiplicity, the last of each run is the one kept).
+  std::vector<std::pair<double, int>> all, merged;
+  for (const auto& c : out) {
+    const auto breaks = c.knots().interior_breaks();
+    all.insert(all.end(), breaks.begin(), breaks.end());
+  }
+  std::sort(all.begin(), all.end());
+  for (std::size_t i = 0; i < all.size(); ++i)
+    if (i + 1 == all.size() || all[i + 1].first != all[i].first) merged.push_back(all[i]);
   for (auto& c : out) {
     std::vector<double> missing;
     for (const auto& [t, m] : merged)
