@@ -58,4 +58,42 @@ std::vector<Scalar> hermite_scalars();
 /// The curve over [0, 1].
 BSplineCurve unit(const BSplineCurve& c);
 
+// The row kernel of the exact conversions (to_bspline of BlendedSurface and
+// BlendedVolume): every control point of a row is a short sum of terms of two
+// kinds, a line of points times a number and a point times a line of numbers, and
+// is written once, summed in the order the terms are given, whichever thread fills
+// its row.
+
+/// s · a[i] along a row (a: three doubles a point).
+struct LineTerm {
+  double s;
+  const double* a;
+};
+
+/// g[3i] · p along a row, each number of the line given three times (g[3i] = g[3i+1]
+/// = g[3i+2]) and p four times: four points are then twelve products of equal
+/// numbers with p4, as those of a line term are.
+struct PointTerm {
+  const double* g;
+  double p4[12];
+  PointTerm(const double* g3, const Vec3& p) : g(g3) {
+    for (int c = 0; c < 12; ++c) p4[c] = p[c % 3];
+  }
+};
+
+/// o[i] = Σ line terms + Σ point terms, in that order, i < n (o: three doubles a
+/// point). Four points at a time are summed in registers over all terms, so the
+/// row is read from no memory but the terms' and written once.
+void sum_terms(double* o, std::size_t n, const std::vector<LineTerm>& lines, const std::vector<PointTerm>& points);
+
+/// The B-spline coefficients of a scalar function, and the range [lo, hi) outside
+/// which they are all zero: a blend of local support (a Coons network's cardinal
+/// functions) is added only where it is not zero, and knot insertion keeps zero
+/// coefficients exactly zero.
+struct Coefficients {
+  std::vector<double> c;  // each coefficient three times, as PointTerm takes them
+  std::size_t lo = 0, hi = 0;
+};
+Coefficients coefficients(const BSplineCurve& f);
+
 }  // namespace interpatch::detail

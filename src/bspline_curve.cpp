@@ -280,20 +280,40 @@ std::vector<BSplineCurve> make_compatible(std::span<const BSplineCurve> curves) 
   std::vector<BSplineCurve> out;
   out.reserve(curves.size());
   for (const auto& c : curves) out.push_back(c.elevated(p - c.degree()));
-  // The merged interior knots: every value with its highest multiplicity (sorted by
-  // value, then multiplicity, the last of each run is the one kept).
-  std::vector<std::pair<double, int>> all, merged;
-  for (const auto& c : out) {
-    const auto breaks = c.knots().interior_breaks();
-    all.insert(all.end(), breaks.begin(), breaks.end());
+  // The merged interior knots: every value with its highest multiplicity, each
+  // curve's breaks merged in one pass (both lists are sorted); knot vectors met
+  // before add nothing.
+  std::vector<std::pair<double, int>> merged, next;
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    const KnotVector& kv = out[k].knots();
+    if (std::any_of(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(k),
+                    [&](const BSplineCurve& c) { return c.knots().values() == kv.values(); }))
+      continue;
+    const auto breaks = kv.interior_breaks();
+    next.clear();
+    std::size_t i = 0, j = 0;
+    while (i < merged.size() || j < breaks.size()) {
+      if (j == breaks.size() || (i < merged.size() && merged[i].first < breaks[j].first)) {
+        next.push_back(merged[i++]);
+      } else if (i == merged.size() || breaks[j].first < merged[i].first) {
+        next.push_back(breaks[j++]);
+      } else {
+        next.emplace_back(breaks[j].first, std::max(merged[i].second, breaks[j].second));
+        ++i;
+        ++j;
+      }
+    }
+    merged.swap(next);
   }
-  std::sort(all.begin(), all.end());
-  for (std::size_t i = 0; i < all.size(); ++i)
-    if (i + 1 == all.size() || all[i + 1].first != all[i].first) merged.push_back(all[i]);
   for (auto& c : out) {
     std::vector<double> missing;
-    for (const auto& [t, m] : merged)
-      missing.insert(missing.end(), static_cast<std::size_t>(m - c.knots().multiplicity(t)), t);
+    const auto have = c.knots().interior_breaks();
+    std::size_t j = 0;
+    for (const auto& [t, m] : merged) {
+      while (j < have.size() && have[j].first < t) ++j;
+      const int h = j < have.size() && have[j].first == t ? have[j].second : 0;
+      missing.insert(missing.end(), static_cast<std::size_t>(m - h), t);
+    }
     if (!missing.empty()) c = c.refined(missing);
   }
   return out;
