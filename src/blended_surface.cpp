@@ -336,9 +336,8 @@ BSplineSurface BlendedSurface::to_bspline() const {
     }
   std::vector<detail::Coefficients> G;
   for (std::size_t l = 0; l < nb; ++l) G.push_back(detail::coefficients(cv[l]));
-  // One pass over the net: each control point written once, by one thread. A row is
-  // summed a stretch at a time, with the g_l that are not zero over the stretch.
-  constexpr std::size_t stretch = 256;
+  // One pass over the net: each control point written once, by one thread, with the
+  // a_k of the nonzero F[x][k] and the g_l that are not zero over each stretch.
   PointGrid P({nu, nv}, for_overwrite);
   const auto rows = static_cast<long long>(nu);
 #pragma omp parallel if (nu * nv * (na + nb) >= detail::parallel_min_work)
@@ -348,17 +347,13 @@ BSplineSurface BlendedSurface::to_bspline() const {
 #pragma omp for schedule(static)
     for (long long r = 0; r < rows; ++r) {
       const auto x = static_cast<std::size_t>(r);
-      for (std::size_t y0 = 0; y0 < nv; y0 += stretch) {
-        const std::size_t y1 = std::min(nv, y0 + stretch);
-        lines.clear();
-        points.clear();
+      detail::fill_row(&P(x, 0).x, nv, lines, points, [&](std::size_t y0, std::size_t y1, auto& ls, auto& ps) {
         for (std::size_t k = 0; k < na; ++k)
-          if (const double f = F[x * nf + k]; f != 0.0) lines.push_back({f, &cv[ng + k].control_points()[y0].x});
+          if (const double f = F[x * nf + k]; f != 0.0) ls.push_back({f, &cv[ng + k].control_points()[y0].x});
         for (std::size_t l = 0; l < nb; ++l)
           if (const Vec3& b = B[x * nb + l]; b != Vec3{} && G[l].lo < y1 && G[l].hi > y0)
-            points.emplace_back(G[l].c.data() + 3 * y0, b);
-        detail::sum_terms(&P(x, y0).x, y1 - y0, lines, points);
-      }
+            ps.emplace_back(G[l].c.data() + 3 * y0, b);
+      });
     }
   }
   return BSplineSurface(ku, kv, std::move(P));

@@ -4,6 +4,7 @@
 // Scalar functions f, g are B-spline curves whose x coordinate is the value; every
 // function and curve is over [0, 1].
 
+#include <algorithm>
 #include <functional>
 #include <optional>
 #include <string>
@@ -85,6 +86,21 @@ struct PointTerm {
 /// point). Four points at a time are summed in registers over all terms, so the
 /// row is read from no memory but the terms' and written once.
 void sum_terms(double* o, std::size_t n, const std::vector<LineTerm>& lines, const std::vector<PointTerm>& points);
+
+/// Fills the row o[0..n) (three doubles a point) a stretch of at most 256 points at a
+/// time: terms(y0, y1, lines, points) lists, in the empty vectors, the terms over
+/// [y0, y1), their lines and numbers starting at y0.
+template <class Terms>
+void fill_row(double* o, std::size_t n, std::vector<LineTerm>& lines, std::vector<PointTerm>& points, Terms terms) {
+  constexpr std::size_t stretch = 256;
+  for (std::size_t y0 = 0; y0 < n; y0 += stretch) {
+    const std::size_t y1 = std::min(n, y0 + stretch);
+    lines.clear();
+    points.clear();
+    terms(y0, y1, lines, points);
+    sum_terms(o + 3 * y0, y1 - y0, lines, points);
+  }
+}
 
 /// The B-spline coefficients of a scalar function, and the range [lo, hi) outside
 /// which they are all zero: a blend of local support (a Coons network's cardinal
