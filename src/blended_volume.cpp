@@ -280,10 +280,16 @@ BSplineVolume BlendedVolume::to_bspline() const {
   std::array<std::vector<detail::Coefficients>, 3> coef;
   for (std::size_t a = 0; a < 3; ++a)
     for (const auto& b : T.blends[a]) coef[a].push_back(detail::coefficients(fitted(*b.spline, target[a])));
-  std::vector<BSplineSurface> Q;
+  // A face on the common knots already is used as it is: no copy of its net.
+  std::vector<BSplineSurface> refit;
+  refit.reserve(T.faces.size());
+  std::vector<const PointGrid*> Q;
   for (const auto& face : T.faces) {
     const auto o = detail::other_axes(face.axis);
-    Q.push_back(fitted(face.surface, target[static_cast<std::size_t>(o[0])], target[static_cast<std::size_t>(o[1])]));
+    const KnotVector& ku = target[static_cast<std::size_t>(o[0])];
+    const KnotVector& kv = target[static_cast<std::size_t>(o[1])];
+    const bool fits = face.surface.knots_u().values() == ku.values() && face.surface.knots_v().values() == kv.values();
+    Q.push_back(fits ? &face.surface.control_points() : &refit.emplace_back(fitted(face.surface, ku, kv)).control_points());
   }
   std::vector<std::vector<Vec3>> E;
   for (const auto& e : T.edges) E.push_back(fitted(e.line.curve(), target[static_cast<std::size_t>(e.axis)]).control_points());
@@ -293,12 +299,55 @@ BSplineVolume BlendedVolume::to_bspline() const {
   // Control point (x, y, z) is a sum over the terms of rows along w: a line along w
   // times a number of (x, y) (faces of u and v, edges along w), or a point of (x, y)
   // times a blend of w (faces of w, edges along u and v, corners), the points of one
-  // blend of w added first. Each control point is written once, by one thread.
-  const std::size_t nh = T.blends[2].size(), terms = T.faces.size() + T.edges.size() + nh;
+  // blend of w added first. Each control point is written once, by one thread, each
+  // point's terms added in one order.
+  struct RowTerm {  // scale · fu[x] · fv[y] (a missing blend is 1) times the line or point at base + x sx + y sy
+    double scale;
+    const detail::Coefficients *fu, *fv;
+    const Vec3* base;
+    std::size_t sx, sy, blend;  // blend: of w, for points
+  };
+  std::vector<RowTerm> line_terms, point_terms;
+  auto blend = [&coef](std::size_t axis, std::size_t k) { return &coef[axis][k]; };
+  // The faces of u and the edges along w of one blend of u first make one grid of
+  // (v, w), R_i = Σ faces + Σ scale g_b(v) E(w), so rows take one term for them.
+  std::vector<PointGrid> R;
+  R.reserve(T.blends[0].size());
+  for (std::size_t i = 0; i < T.blends[0].size(); ++i) {
+    std::vector<std::size_t> faces, edges;
+    for (std::size_t k = 0; k < T.faces.size(); ++k)
+      if (T.faces[k].axis == 0 && T.faces[k].blend == i) faces.push_back(k);
+    for (std::size_t k = 0; k < T.edges.size(); ++k)
+      if (T.edges[k].axis == 2 && T.edges[k].blends[0] == i) edges.push_back(k);
+    if (faces.empty() && edges.empty()) continue;
+    PointGrid& g = R.emplace_back(PointGrid::shape_type{n[1], n[2]}, for_overwrite);
+    for (std::size_t y = 0; y < n[1]; ++y)
+      for (std::size_t z = 0; z < n[2]; ++z) {
+        Vec3 p{};
+        for (std::size_t k : faces) p += (*Q[k])(y, z);
+        for (std::size_t k : edges) p += (T.edges[k].scale * coef[1][T.edges[k].blends[1]].c[3 * y]) * E[k][z];
+        g(y, z) = p;
+      }
+    line_terms.push_back({1.0, blend(0, i), nullptr, g.data(), 0, n[2], 0});
+  }
+  for (std::size_t k = 0; k < T.faces.size(); ++k) {
+    const auto& f = T.faces[k];
+    const Vec3* q = Q[k]->data();
+    if (f.axis == 1) line_terms.push_back({1.0, nullptr, blend(1, f.blend), q, n[2], 0, 0});
+    if (f.axis == 2) point_terms.push_back({1.0, nullptr, nullptr, q, n[1], 1, f.blend});
+  }
+  for (std::size_t k = 0; k < T.edges.size(); ++k) {
+    const auto& e = T.edges[k];
+    const Vec3* l = E[k].data();
+    if (e.axis == 0) point_terms.push_back({e.scale, nullptr, blend(1, e.blends[0]), l, 1, 0, e.blends[1]});
+    if (e.axis == 1) point_terms.push_back({e.scale, blend(0, e.blends[0]), nullptr, l, 0, 1, e.blends[1]});
+  }
+  for (const auto& k : T.corners)
+    point_terms.push_back({1.0, blend(0, k.blends[0]), blend(1, k.blends[1]), &k.point, 0, 0, k.blends[2]});
+  const std::size_t nh = T.blends[2].size();
   PointGrid3 P(n, for_overwrite);
   const auto rows = static_cast<long long>(n[0] * n[1]);
-  auto c = [&coef](std::size_t axis, std::size_t blend, std::size_t i) { return coef[axis][blend].c[3 * i]; };
-#pragma omp parallel if (n[0] * n[1] * n[2] * terms >= detail::parallel_min_work)
+#pragma omp parallel if (n[0] * n[1] * n[2] * (line_terms.size() + nh) >= detail::parallel_min_work)
   {
     std::vector<detail::LineTerm> lines;
     std::vector<detail::PointTerm> points;
@@ -306,27 +355,15 @@ BSplineVolume BlendedVolume::to_bspline() const {
 #pragma omp for schedule(static)
     for (long long r = 0; r < rows; ++r) {
       const std::size_t x = static_cast<std::size_t>(r) / n[1], y = static_cast<std::size_t>(r) % n[1];
+      auto factor = [x, y](const RowTerm& t) {
+        const double a = t.fu ? t.scale * t.fu->c[3 * x] : t.scale;
+        return t.fv ? a * t.fv->c[3 * y] : a;
+      };
       h.fill(Vec3{});
-      for (std::size_t k = 0; k < T.faces.size(); ++k)
-        if (T.faces[k].axis == 2) h[T.faces[k].blend] += Q[k].control_points()(x, y);
-      for (std::size_t k = 0; k < T.edges.size(); ++k) {
-        const auto& e = T.edges[k];
-        if (e.axis == 0) h[e.blends[1]] += (e.scale * c(1, e.blends[0], y)) * E[k][x];
-        if (e.axis == 1) h[e.blends[1]] += (e.scale * c(0, e.blends[0], x)) * E[k][y];
-      }
-      for (const auto& k : T.corners)
-        h[k.blends[2]] += (c(0, k.blends[0], x) * c(1, k.blends[1], y)) * k.point;
+      for (const auto& t : point_terms) h[t.blend] += factor(t) * t.base[x * t.sx + y * t.sy];
       detail::fill_row(&P(x, y, 0).x, n[2], lines, points, [&](std::size_t z0, std::size_t z1, auto& ls, auto& ps) {
-        for (std::size_t k = 0; k < T.faces.size(); ++k) {
-          const auto& face = T.faces[k];
-          const auto& q = Q[k].control_points();
-          if (face.axis == 0) ls.push_back({c(0, face.blend, x), &q(y, z0).x});
-          if (face.axis == 1) ls.push_back({c(1, face.blend, y), &q(x, z0).x});
-        }
-        for (std::size_t k = 0; k < T.edges.size(); ++k)
-          if (const auto& e = T.edges[k]; e.axis == 2)
-            ls.push_back({e.scale * c(0, e.blends[0], x) * c(1, e.blends[1], y), &E[k][z0].x});
-        std::erase_if(ls, [](const detail::LineTerm& t) { return t.s == 0.0; });
+        for (const auto& t : line_terms)
+          if (const double f = factor(t); f != 0.0) ls.push_back({f, &t.base[x * t.sx + y * t.sy + z0].x});
         for (std::size_t b = 0; b < nh; ++b)
           if (h[b] != Vec3{} && coef[2][b].lo < z1 && coef[2][b].hi > z0) ps.emplace_back(coef[2][b].c.data() + 3 * z0, h[b]);
       });
