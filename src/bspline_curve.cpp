@@ -35,6 +35,57 @@ BSplineCurve from_homogeneous(KnotVector k, const std::vector<H>& h, bool ration
   return BSplineCurve(std::move(k), std::move(cp), std::move(w));
 }
 
+// q ← α q + (1 − α) q1, coordinate by coordinate.
+void mix(Vec3& q, const Vec3& q1, double alpha) { q = alpha * q + (1.0 - alpha) * q1; }
+void mix(H& q, const H& q1, double alpha) {
+  for (std::size_t c = 0; c < 4; ++c) q[c] = alpha * q[c] + (1.0 - alpha) * q1[c];
+}
+
+template <class T>
+struct Refined {
+  std::vector<double> knots;
+  std::vector<T> points;
+};
+
+// Every knot of X (sorted, inside the open domain, multiplicities within the degree)
+// inserted in one pass (The NURBS Book A5.4, with the erratum U[i-p+l] for
+// U[i-l+1]): from the last new knot down, each old point is moved once and p new
+// ones are formed per new knot, so the cost is O(n + p·r), not the O(n·r) of r
+// single insertions. Points are Vec3 (non-rational curves) or homogeneous.
+template <class T>
+Refined<T> refine(const KnotVector& knots, const std::vector<T>& P, const std::vector<double>& X) {
+  const auto& U = knots.values();
+  const int p = knots.degree();
+  const int n = knots.count() - 1, m = n + p + 1, r = static_cast<int>(X.size()) - 1;
+  const int a = knots.find_span(X.front()), b = knots.find_span(X.back()) + 1;
+  Refined<T> out{std::vector<double>(U.size() + X.size()), std::vector<T>(P.size() + X.size())};
+  auto& Q = out.points;
+  auto& V = out.knots;
+  auto at = [](auto& v, int i) -> auto& { return v[static_cast<std::size_t>(i)]; };
+  for (int j = 0; j <= a - p; ++j) at(Q, j) = at(P, j);
+  for (int j = b - 1; j <= n; ++j) at(Q, j + r + 1) = at(P, j);
+  for (int j = 0; j <= a; ++j) at(V, j) = at(U, j);
+  for (int j = b + p; j <= m; ++j) at(V, j + r + 1) = at(U, j);
+  int i = b + p - 1, k = b + p + r;
+  for (int j = r; j >= 0; --j) {
+    const double x = at(X, j);
+    for (; x <= at(U, i) && i > a; --k, --i) {
+      at(Q, k - p - 1) = at(P, i - p - 1);
+      at(V, k) = at(U, i);
+    }
+    at(Q, k - p - 1) = at(Q, k - p);
+    for (int l = 1; l <= p; ++l) {
+      const int ind = k - p + l;
+      const double num = at(V, k + l) - x;
+      if (num == 0.0) at(Q, ind - 1) = at(Q, ind);
+      else mix(at(Q, ind - 1), at(Q, ind), num / (at(V, k + l) - at(U, i - p + l)));
+    }
+    at(V, k) = x;
+    --k;
+  }
+  return out;
+}
+
 void check_domain(const KnotVector& k, double t) {
   // A parameter a few ulps outside the domain is rounding from the caller's mapping.
   const double a = k.front(), b = k.back();
@@ -171,7 +222,7 @@ BSplineCurve BSplineCurve::refined(std::span<const double> knots) const {
       fail(errc::out_of_domain, "knot ", t, " to insert is not inside the open domain (", knots_.front(), ", ",
            knots_.back(), ")");
   std::vector<double> X(knots.begin(), knots.end());
-  std::sort(X.begin(), X.end());
+  if (!std::is_sorted(X.begin(), X.end())) std::sort(X.begin(), X.end());
   const int p = degree();
   for (std::size_t i = 0; i < X.size();) {
     std::size_t j = i;
@@ -182,44 +233,12 @@ BSplineCurve BSplineCurve::refined(std::span<const double> knots) const {
            ", more than degree ", p);
     i = j;
   }
-  // All knots in one pass (The NURBS Book A5.4): from the last new knot down, each
-  // old control point is moved once and p new ones are formed per new knot, so the
-  // cost is O(n + p·r), not the O(n·r) of r single insertions.
-  const auto& U = knots_.values();
-  const auto P = homogeneous(cp_, w_);
-  const int n = knots_.count() - 1, m = n + p + 1, r = static_cast<int>(X.size()) - 1;
-  const int a = knots_.find_span(X.front()), b = knots_.find_span(X.back()) + 1;
-  std::vector<H> Q(P.size() + X.size());
-  std::vector<double> V(U.size() + X.size());
-  auto at = [](auto& v, int i) -> auto& { return v[static_cast<std::size_t>(i)]; };
-  for (int j = 0; j <= a - p; ++j) at(Q, j) = at(P, j);
-  for (int j = b - 1; j <= n; ++j) at(Q, j + r + 1) = at(P, j);
-  for (int j = 0; j <= a; ++j) at(V, j) = at(U, j);
-  for (int j = b + p; j <= m; ++j) at(V, j + r + 1) = at(U, j);
-  int i = b + p - 1, k = b + p + r;
-  for (int j = r; j >= 0; --j) {
-    const double x = at(X, j);
-    for (; x <= at(U, i) && i > a; --k, --i) {
-      at(Q, k - p - 1) = at(P, i - p - 1);
-      at(V, k) = at(U, i);
-    }
-    at(Q, k - p - 1) = at(Q, k - p);
-    for (int l = 1; l <= p; ++l) {
-      const int ind = k - p + l;
-      const double num = at(V, k + l) - x;
-      if (num == 0.0) {
-        at(Q, ind - 1) = at(Q, ind);
-        continue;
-      }
-      const double alpha = num / (at(V, k + l) - at(U, i - p + l));
-      H& q = at(Q, ind - 1);
-      const H& q1 = at(Q, ind);
-      for (std::size_t c = 0; c < 4; ++c) q[c] = alpha * q[c] + (1.0 - alpha) * q1[c];
-    }
-    at(V, k) = x;
-    --k;
+  if (!rational()) {
+    auto r = refine(knots_, cp_, X);
+    return BSplineCurve(KnotVector(p, std::move(r.knots)), std::move(r.points));
   }
-  return from_homogeneous(KnotVector(p, std::move(V)), Q, rational());
+  auto r = refine(knots_, homogeneous(cp_, w_), X);
+  return from_homogeneous(KnotVector(p, std::move(r.knots)), r.points, true);
 }
 
 BSplineCurve BSplineCurve::elevated(int times) const {
