@@ -1,17 +1,12 @@
 #include "interpatch/blended_surface.hpp"
 
-#include <cstring>
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 #include "detail/parallel.hpp"
 #include "interpatch/coons.hpp"
 #include "interpatch/interpolate.hpp"
 #include "interpatch/network.hpp"
 #include "interpatch/patches.hpp"
 #include "surface_util.hpp"
+#include "thread_util.hpp"
 
 namespace interpatch {
 namespace {
@@ -173,23 +168,8 @@ TEST(BlendedSurface, LargeExactFormsEqualTheFormula) {
 }
 
 #ifdef _OPENMP
-// Each control point is summed by one thread in one order: 1, 2 and 3 threads give
-// the same bits (tests/determinism_test.cpp for the other threaded loops).
-TEST(BlendedSurface, LargeExactFormsDoNotDependOnTheThreadCount) {
-  const int before = omp_get_max_threads();
-  omp_set_dynamic(0);
-  for (const auto& [s, terms] : large_blended_surfaces()) {
-    omp_set_num_threads(1);
-    const PointGrid one = s.to_bspline().control_points();
-    for (const int threads : {2, 3}) {
-      omp_set_num_threads(threads);
-      const PointGrid many = s.to_bspline().control_points();
-      ASSERT_EQ(many.shape(), one.shape());
-      EXPECT_EQ(std::memcmp(many.data(), one.data(), one.size() * sizeof(Vec3)), 0) << threads << " threads";
-    }
-  }
-  omp_set_num_threads(before);
-}
+// Each control point is summed by one thread in one order.
+TEST(BlendedSurface, LargeExactFormsDoNotDependOnTheThreadCount) { test::expect_exact_forms_independent_of_threads(large_blended_surfaces()); }
 #endif
 
 TEST(BlendedSurface, BatchEvaluationRefusesParametersOutsideTheDomain) {

@@ -1,14 +1,9 @@
 #include "interpatch/blended_volume.hpp"
 
-#include <cstring>
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 #include "detail/parallel.hpp"
 #include "interpatch/coons_volume.hpp"
 #include "interpatch/volume_patches.hpp"
+#include "thread_util.hpp"
 #include "volume_util.hpp"
 
 namespace interpatch {
@@ -101,23 +96,8 @@ TEST(BlendedVolume, LargeExactFormsEqualTheFormula) {
 }
 
 #ifdef _OPENMP
-// Each control point is summed by one thread in one order: 1, 2 and 3 threads give
-// the same bits.
-TEST(BlendedVolume, LargeExactFormsDoNotDependOnTheThreadCount) {
-  const int before = omp_get_max_threads();
-  omp_set_dynamic(0);
-  for (const auto& [s, terms] : large_blended_volumes()) {
-    omp_set_num_threads(1);
-    const PointGrid3 one = s.to_bspline().control_points();
-    for (const int threads : {2, 3}) {
-      omp_set_num_threads(threads);
-      const PointGrid3 many = s.to_bspline().control_points();
-      ASSERT_EQ(many.shape(), one.shape());
-      EXPECT_EQ(std::memcmp(many.data(), one.data(), one.size() * sizeof(Vec3)), 0) << threads << " threads";
-    }
-  }
-  omp_set_num_threads(before);
-}
+// Each control point is summed by one thread in one order.
+TEST(BlendedVolume, LargeExactFormsDoNotDependOnTheThreadCount) { test::expect_exact_forms_independent_of_threads(large_blended_volumes()); }
 #endif
 
 TEST(BlendedVolume, OutOfDomain) {

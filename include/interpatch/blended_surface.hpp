@@ -40,6 +40,11 @@ class BlendedSurface final : public Surface {
   /// count. @throws error out_of_domain, size_mismatch.
   void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
                      const progress_callback& progress = {}) const override;
+  /// Every function of u made compatible (common degree and knots, by degree
+  /// elevation and knot insertion), likewise v, then the control points of the
+  /// tensor-product terms summed: each control point once, in one pass over the
+  /// net, the rows shared by both cores; the result does not depend on the thread
+  /// count.
   /// @throws error no_exact_form (rational boundary curves, Gregory's twists).
   [[nodiscard]] BSplineSurface to_bspline() const override;
   /// Whether to_bspline() succeeds.
