@@ -88,7 +88,8 @@ struct PointTerm {
 void sum_terms(double* o, std::size_t n, const std::vector<LineTerm>& lines, const std::vector<PointTerm>& points);
 
 /// Fills the row o[0..n) (three doubles a point) a stretch of at most 256 points at a
-/// time: terms(y0, y1, lines, points) lists, in the empty vectors, the terms over
+/// time, so that a term of local support is left out of the stretches where it is
+/// zero: terms(y0, y1, lines, points) lists, in the empty vectors, the terms over
 /// [y0, y1), their lines and numbers starting at y0.
 template <class Terms>
 void fill_row(double* o, std::size_t n, std::vector<LineTerm>& lines, std::vector<PointTerm>& points, Terms terms) {

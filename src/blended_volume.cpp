@@ -289,10 +289,12 @@ BSplineVolume BlendedVolume::to_bspline() const {
     const KnotVector& ku = target[static_cast<std::size_t>(o[0])];
     const KnotVector& kv = target[static_cast<std::size_t>(o[1])];
     const bool fits = face.surface.knots_u().values() == ku.values() && face.surface.knots_v().values() == kv.values();
-    Q.push_back(fits ? &face.surface.control_points() : &refit.emplace_back(fitted(face.surface, ku, kv)).control_points());
+    Q.push_back(fits ? &face.surface.control_points()
+                     : &refit.emplace_back(fitted(face.surface, ku, kv)).control_points());
   }
   std::vector<std::vector<Vec3>> E;
-  for (const auto& e : T.edges) E.push_back(fitted(e.line.curve(), target[static_cast<std::size_t>(e.axis)]).control_points());
+  for (const auto& e : T.edges)
+    E.push_back(fitted(e.line.curve(), target[static_cast<std::size_t>(e.axis)]).control_points());
   const std::array<std::size_t, 3> n{static_cast<std::size_t>(target[0].count()),
                                      static_cast<std::size_t>(target[1].count()),
                                      static_cast<std::size_t>(target[2].count())};
@@ -365,7 +367,8 @@ BSplineVolume BlendedVolume::to_bspline() const {
         for (const auto& t : line_terms)
           if (const double f = factor(t); f != 0.0) ls.push_back({f, &t.base[x * t.sx + y * t.sy + z0].x});
         for (std::size_t b = 0; b < nh; ++b)
-          if (h[b] != Vec3{} && coef[2][b].lo < z1 && coef[2][b].hi > z0) ps.emplace_back(coef[2][b].c.data() + 3 * z0, h[b]);
+          if (h[b] != Vec3{} && coef[2][b].lo < z1 && coef[2][b].hi > z0)
+            ps.emplace_back(coef[2][b].c.data() + 3 * z0, h[b]);
       });
     }
   }

@@ -169,7 +169,9 @@ TEST(BlendedSurface, LargeExactFormsEqualTheFormula) {
 
 #ifdef _OPENMP
 // Each control point is summed by one thread in one order.
-TEST(BlendedSurface, LargeExactFormsDoNotDependOnTheThreadCount) { test::expect_exact_forms_independent_of_threads(large_blended_surfaces()); }
+TEST(BlendedSurface, LargeExactFormsDoNotDependOnTheThreadCount) {
+  test::expect_exact_forms_independent_of_threads(large_blended_surfaces());
+}
 #endif
 
 TEST(BlendedSurface, BatchEvaluationRefusesParametersOutsideTheDomain) {

@@ -90,14 +90,17 @@ TEST(BlendedVolume, LargeExactFormsEqualTheFormula) {
     const double scale = test::scale_of(b);
     for (int k = 0; k < 200; ++k) {
       const double u = test::uniform(g, 0, 1), v = test::uniform(g, 0, 1), w = test::uniform(g, 0, 1);
-      EXPECT_LT(distance(b.point(u, v, w), s.point(u, v, w)), 1e-12 * scale) << "at (" << u << ", " << v << ", " << w << ")";
+      EXPECT_LT(distance(b.point(u, v, w), s.point(u, v, w)), 1e-12 * scale)
+          << "at (" << u << ", " << v << ", " << w << ")";
     }
   }
 }
 
 #ifdef _OPENMP
 // Each control point is summed by one thread in one order.
-TEST(BlendedVolume, LargeExactFormsDoNotDependOnTheThreadCount) { test::expect_exact_forms_independent_of_threads(large_blended_volumes()); }
+TEST(BlendedVolume, LargeExactFormsDoNotDependOnTheThreadCount) {
+  test::expect_exact_forms_independent_of_threads(large_blended_volumes());
+}
 #endif
 
 TEST(BlendedVolume, OutOfDomain) {
