@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -27,8 +28,11 @@
 #endif
 
 #include "interpatch/bspline_surface.hpp"
+#include "interpatch/coons.hpp"
+#include "interpatch/coons_volume.hpp"
 #include "interpatch/evaluate.hpp"
 #include "interpatch/interpolate.hpp"
+#include "interpatch/network.hpp"
 #include "terrain.hpp"
 
 namespace {
@@ -213,6 +217,136 @@ void evaluate_derivatives(benchmark::State& state) {
                points * sizeof(interpatch::SurfaceDerivatives) + s.control_points().size() * sizeof(Vec3));
 }
 
+// ---------------------------------------------------------------- exact conversion
+
+// A curve through `points` at equally spaced parameters: curves through the rows and
+// columns of one grid then cross at the grid's points, at the same parameters.
+interpatch::BSplineCurve uniform_curve(const std::vector<Vec3>& points) {
+  interpatch::CurveInterpolationOptions o;
+  o.param = interpatch::Parametrization::uniform;
+  return interpatch::interpolate_curve(points, o).curve;
+}
+
+std::vector<Vec3> terrain_row(const PointGrid& g, std::size_t j) {
+  std::vector<Vec3> r(g.extent(0));
+  for (std::size_t i = 0; i < r.size(); ++i) r[i] = g(i, j);
+  return r;
+}
+
+std::vector<Vec3> terrain_column(const PointGrid& g, std::size_t i) {
+  return {g.data() + i * g.extent(1), g.data() + (i + 1) * g.extent(1)};
+}
+
+// The linear Coons patch of the N x N terrain's four boundary rows, each a cubic
+// through N points at chord-length parameters (bench/compare's "coons" job): four
+// different knot vectors, merged to about 2N control points a direction.
+const interpatch::BlendedSurface& coons_patch(std::size_t n) {
+  static std::map<std::size_t, interpatch::BlendedSurface> cache;
+  auto it = cache.find(n);
+  if (it == cache.end()) {
+    const PointGrid& g = terrain(n);
+    auto c = [](const std::vector<Vec3>& p) { return interpatch::interpolate_curve(p).curve; };
+    const interpatch::CoonsBoundary b{c(terrain_row(g, 0)), c(terrain_row(g, n - 1)), c(terrain_column(g, 0)),
+                                      c(terrain_column(g, n - 1))};
+    it = cache.emplace(n, interpatch::coons(b)).first;
+  }
+  return it->second;
+}
+
+// The network of 9 curves each way through the N x N terrain's rows and columns at
+// every (N − 1)/8-th point, each curve through N points: Gordon (spline cardinal
+// blends) or C1 Coons cells (Hermite blends, many terms).
+const interpatch::BlendedSurface& terrain_network(std::size_t n, interpatch::NetworkMethod method) {
+  static std::map<std::pair<std::size_t, int>, interpatch::BlendedSurface> cache;
+  const std::pair key{n, static_cast<int>(method)};
+  auto it = cache.find(key);
+  if (it == cache.end()) {
+    const PointGrid& g = terrain(n);
+    interpatch::CurveNetwork net;
+    for (std::size_t c = 0; c <= 8; ++c) {
+      const std::size_t i = c * (n - 1) / 8;
+      net.u_curves.push_back(uniform_curve(terrain_row(g, i)));
+      net.v_curves.push_back(uniform_curve(terrain_column(g, i)));
+      net.u_params.push_back(static_cast<double>(i) / static_cast<double>(n - 1));
+    }
+    net.v_params = net.u_params;
+    it = cache.emplace(key, interpatch::curve_network(net, {method, {}})).first;
+  }
+  return it->second;
+}
+
+// The linear Coons volume of six faces, each a bicubic through an N x N grid of a
+// smooth map of the unit cube at equally spaced parameters: faces that share an edge
+// share its samples and its parameters, hence its curve.
+const interpatch::BlendedVolume& coons_volume_of(std::size_t n) {
+  static std::map<std::size_t, interpatch::BlendedVolume> cache;
+  auto it = cache.find(n);
+  if (it == cache.end()) {
+    auto map = [](double u, double v, double w) {
+      return Vec3{u + 0.1 * std::sin(3 * v + w), v + 0.1 * std::cos(2 * u * w), w + 0.1 * std::sin(u + 4 * v)};
+    };
+    auto face = [&](int axis, double t) {
+      PointGrid q({n, n});
+      for (std::size_t a = 0; a < n; ++a)
+        for (std::size_t b = 0; b < n; ++b) {
+          const double s = static_cast<double>(a) / static_cast<double>(n - 1);
+          const double r = static_cast<double>(b) / static_cast<double>(n - 1);
+          q(a, b) = axis == 0 ? map(t, s, r) : (axis == 1 ? map(s, t, r) : map(s, r, t));
+        }
+      interpatch::SurfaceInterpolationOptions o;
+      o.param = interpatch::Parametrization::uniform;
+      return interpatch::interpolate_surface(std::move(q), o).surface;
+    };
+    it = cache.emplace(n, interpatch::coons_volume({face(0, 0), face(0, 1), face(1, 0), face(1, 1), face(2, 0),
+                                                    face(2, 1)})).first;
+  }
+  return it->second;
+}
+
+// One to_bspline per iteration, next to a two-thread memcpy of its control net's
+// bytes timed right after it (counter memcpy_ms, and the ratio x_memcpy): the
+// conversion writes every control point once, so a memcpy of the net is its floor.
+template <class Blended>
+void time_to_bspline(benchmark::State& state, const Blended& blended) {
+  std::size_t points = 0;
+  double call = 0, copy = 0;
+  std::vector<std::byte> src, dst;
+  for (auto _ : state) {
+    const auto t0 = clock_type::now();
+    auto b = blended.to_bspline();
+    const auto t1 = clock_type::now();
+    benchmark::DoNotOptimize(b.control_points().data());
+    state.SetIterationTime(seconds(t0, t1));
+    state.PauseTiming();
+    points = b.control_points().size();
+    const std::size_t bytes = points * sizeof(Vec3);
+    if (src.size() != bytes) {
+      src.assign(bytes, std::byte{1});
+      dst.assign(bytes, std::byte{0});
+    }
+    { const auto gone(std::move(b)); }
+    const auto t2 = clock_type::now();
+    interpatch::bench::copy_bytes(dst.data(), src.data(), bytes, true);
+    benchmark::ClobberMemory();
+    const auto t3 = clock_type::now();
+    call += seconds(t0, t1);
+    copy += seconds(t2, t3);
+    state.ResumeTiming();
+  }
+  set_counters(state, points, points * sizeof(Vec3));
+  state.counters["memcpy_ms"] = 1e3 * copy / static_cast<double>(state.iterations());
+  state.counters["x_memcpy"] = call / copy;
+}
+
+void to_bspline_coons(benchmark::State& state) { time_to_bspline(state, coons_patch(arg(state))); }
+void to_bspline_gordon(benchmark::State& state) {
+  time_to_bspline(state, terrain_network(arg(state), interpatch::NetworkMethod::gordon));
+}
+void to_bspline_network_c1(benchmark::State& state) {
+  time_to_bspline(state, terrain_network(arg(state), interpatch::NetworkMethod::coons_hermite));
+}
+void to_bspline_coons_volume(benchmark::State& state) { time_to_bspline(state, coons_volume_of(arg(state))); }
+
 // ---------------------------------------------------------------- registration
 
 // The fastest repetition next to mean/median/stddev: on a shared machine noise only
@@ -249,6 +383,10 @@ BENCHMARK(memcpy_eval_mt)
     ->Apply(common)
     ->Arg(static_cast<std::int64_t>(sizeof(Vec3)))
     ->Arg(static_cast<std::int64_t>(sizeof(interpatch::SurfaceDerivatives)));
+BENCHMARK(to_bspline_coons)->Apply(common)->Arg(1024);
+BENCHMARK(to_bspline_gordon)->Apply(common)->Arg(1024);
+BENCHMARK(to_bspline_network_c1)->Apply(common)->Arg(1024);
+BENCHMARK(to_bspline_coons_volume)->Apply(common)->Arg(128);
 
 }  // namespace
 

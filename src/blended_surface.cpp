@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 
 #include "blended_terms.hpp"
+#include "detail/kernel.hpp"
 #include "detail/parallel.hpp"
 #include "detail/text.hpp"
 #include "interpatch/hermite.hpp"
@@ -54,6 +56,64 @@ std::vector<Scalar> hermite_scalars() {
 
 BSplineCurve unit(const BSplineCurve& c) {
   return c.domain() == std::pair<double, double>{0.0, 1.0} ? c : c.mapped(0.0, 1.0);
+}
+
+INTERPATCH_KERNEL void sum_terms(double* o, std::size_t n, const std::vector<LineTerm>& lines,
+                                 const std::vector<PointTerm>& points) {
+  std::size_t i = 0;
+#if defined(__GNUC__)
+  using v4 = double __attribute__((vector_size(32)));
+  for (; i + 4 <= n; i += 4) {
+    // Twelve doubles, three vectors, each loaded and stored by a memcpy of its own:
+    // one of the whole array goes through the stack in halves.
+    v4 s0 = {}, s1 = {}, s2 = {}, a0, a1, a2, p0, p1, p2;
+    for (const auto& t : lines) {
+      const double* a = t.a + 3 * i;
+      std::memcpy(&a0, a, sizeof a0);
+      std::memcpy(&a1, a + 4, sizeof a1);
+      std::memcpy(&a2, a + 8, sizeof a2);
+      s0 += t.s * a0;
+      s1 += t.s * a1;
+      s2 += t.s * a2;
+    }
+    for (const auto& t : points) {
+      const double* g = t.g + 3 * i;
+      std::memcpy(&a0, g, sizeof a0);
+      std::memcpy(&a1, g + 4, sizeof a1);
+      std::memcpy(&a2, g + 8, sizeof a2);
+      std::memcpy(&p0, t.p4, sizeof p0);
+      std::memcpy(&p1, t.p4 + 4, sizeof p1);
+      std::memcpy(&p2, t.p4 + 8, sizeof p2);
+      s0 += a0 * p0;
+      s1 += a1 * p1;
+      s2 += a2 * p2;
+    }
+    std::memcpy(o + 3 * i, &s0, sizeof s0);
+    std::memcpy(o + 3 * i + 4, &s1, sizeof s1);
+    std::memcpy(o + 3 * i + 8, &s2, sizeof s2);
+  }
+#endif
+  for (; i < n; ++i) {  // the same operations, one point at a time
+    double acc[3] = {};
+    for (const auto& t : lines)
+      for (std::size_t c = 0; c < 3; ++c) acc[c] += t.s * t.a[3 * i + c];
+    for (const auto& t : points)
+      for (std::size_t c = 0; c < 3; ++c) acc[c] += t.g[3 * i + c] * t.p4[c];
+    for (std::size_t c = 0; c < 3; ++c) o[3 * i + c] = acc[c];
+  }
+}
+
+Coefficients coefficients(const BSplineCurve& f) {
+  const auto& cp = f.control_points();
+  Coefficients r;
+  r.c.resize(3 * cp.size());
+  for (std::size_t i = 0; i < cp.size(); ++i) r.c[3 * i] = r.c[3 * i + 1] = r.c[3 * i + 2] = cp[i].x;
+  const auto nz = [](const Vec3& p) { return p.x != 0.0; };
+  const auto first = std::find_if(cp.begin(), cp.end(), nz);
+  if (first == cp.end()) return r;
+  r.lo = static_cast<std::size_t>(first - cp.begin());
+  r.hi = cp.size() - static_cast<std::size_t>(std::find_if(cp.rbegin(), cp.rend(), nz) - cp.rbegin());
+  return r;
 }
 
 }  // namespace detail
@@ -311,35 +371,48 @@ BSplineSurface BlendedSurface::to_bspline() const {
   us.insert(us.end(), T.b.begin(), T.b.end());
   vs.insert(vs.end(), T.a.begin(), T.a.end());
   const auto cu = make_compatible(us), cv = make_compatible(vs);
-  const std::size_t nf = T.f.size(), ng = T.g.size();
+  const std::size_t nf = T.f.size(), ng = T.g.size(), na = T.a.size();
   const KnotVector& ku = cu.front().knots();
   const KnotVector& kv = cv.front().knots();
   const auto nu = static_cast<std::size_t>(ku.count()), nv = static_cast<std::size_t>(kv.count());
-  PointGrid P({nu, nv});
-  auto coef = [](const BSplineCurve& c, std::size_t i) { return c.control_points()[i].x; };
-  for (std::size_t k = 0; k < T.a.size(); ++k)  // f_k ⊗ a_k
-    for (std::size_t x = 0; x < nu; ++x) {
-      const double fk = coef(cu[k], x);
-      if (fk == 0.0) continue;
-      for (std::size_t y = 0; y < nv; ++y) P(x, y) += fk * cv[ng + k].control_points()[y];
+  // With f_k = Σ_x F[x][k] N_x(u) and g_l = Σ_y G[y][l] N_y(v), control point (x, y) is
+  //   Σ_k F[x][k] a_k[y] + Σ_l G[y][l] B[x][l],  B[x][l] = b_l[x] + Σ_k c_kl F[x][k],
+  // B being the factor of g_l. Per u index: F and B; per v index: the curves a_k and
+  // the coefficients of g_l, each over the range where they are not zero.
+  std::vector<double> F(nu * nf);
+  for (std::size_t k = 0; k < nf; ++k)
+    for (std::size_t x = 0; x < nu; ++x) F[x * nf + k] = cu[k].control_points()[x].x;
+  const std::size_t nb = T.b.empty() && T.c.empty() ? 0 : ng;
+  std::vector<Vec3> B(nu * nb);
+  for (std::size_t x = 0; x < nu; ++x)
+    for (std::size_t l = 0; l < nb; ++l) {
+      Vec3 p = l < T.b.size() ? cu[nf + l].control_points()[x] : Vec3{};
+      if (!T.c.empty())
+        for (std::size_t k = 0; k < nf; ++k) p += F[x * nf + k] * T.c(k, l);
+      B[x * nb + l] = p;
     }
-  for (std::size_t l = 0; l < T.b.size(); ++l)  // b_l ⊗ g_l
-    for (std::size_t y = 0; y < nv; ++y) {
-      const double gl = coef(cv[l], y);
-      if (gl == 0.0) continue;
-      for (std::size_t x = 0; x < nu; ++x) P(x, y) += gl * cu[nf + l].control_points()[x];
+  std::vector<detail::Coefficients> G;
+  for (std::size_t l = 0; l < nb; ++l) G.push_back(detail::coefficients(cv[l]));
+  // One pass over the net: each control point written once, by one thread, with the
+  // a_k of the nonzero F[x][k] and the g_l that are not zero over each stretch.
+  PointGrid P({nu, nv}, for_overwrite);
+  const auto rows = static_cast<long long>(nu);
+#pragma omp parallel if (nu * nv * (na + nb) >= detail::parallel_min_work)
+  {
+    std::vector<detail::LineTerm> lines;
+    std::vector<detail::PointTerm> points;
+#pragma omp for schedule(static)
+    for (long long r = 0; r < rows; ++r) {
+      const auto x = static_cast<std::size_t>(r);
+      detail::fill_row(&P(x, 0).x, nv, lines, points, [&](std::size_t y0, std::size_t y1, auto& ls, auto& ps) {
+        for (std::size_t k = 0; k < na; ++k)
+          if (const double f = F[x * nf + k]; f != 0.0) ls.push_back({f, &cv[ng + k].control_points()[y0].x});
+        for (std::size_t l = 0; l < nb; ++l)
+          if (const Vec3& b = B[x * nb + l]; b != Vec3{} && G[l].lo < y1 && G[l].hi > y0)
+            ps.emplace_back(G[l].c.data() + 3 * y0, b);
+      });
     }
-  if (!T.c.empty())
-    for (std::size_t k = 0; k < nf; ++k)
-      for (std::size_t l = 0; l < ng; ++l) {
-        const Vec3& c = T.c(k, l);
-        if (c == Vec3{}) continue;
-        for (std::size_t x = 0; x < nu; ++x) {
-          const double fk = coef(cu[k], x);
-          if (fk == 0.0) continue;
-          for (std::size_t y = 0; y < nv; ++y) P(x, y) += (fk * coef(cv[l], y)) * c;
-        }
-      }
+  }
   return BSplineSurface(ku, kv, std::move(P));
 }
 

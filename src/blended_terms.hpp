@@ -4,6 +4,7 @@
 // Scalar functions f, g are B-spline curves whose x coordinate is the value; every
 // function and curve is over [0, 1].
 
+#include <algorithm>
 #include <functional>
 #include <optional>
 #include <string>
@@ -57,5 +58,59 @@ Scalar scalar(const Blend& f);
 std::vector<Scalar> hermite_scalars();
 /// The curve over [0, 1].
 BSplineCurve unit(const BSplineCurve& c);
+
+// The row kernel of the exact conversions (to_bspline of BlendedSurface and
+// BlendedVolume): every control point of a row is a short sum of terms of two
+// kinds, a line of points times a number and a point times a line of numbers, and
+// is written once, summed in the order the terms are given, whichever thread fills
+// its row.
+
+/// s · a[i] along a row (a: three doubles a point).
+struct LineTerm {
+  double s;
+  const double* a;
+};
+
+/// g[3i] · p along a row, each number of the line given three times (g[3i] = g[3i+1]
+/// = g[3i+2]) and p four times: four points are then twelve products of equal
+/// numbers with p4, as those of a line term are.
+struct PointTerm {
+  const double* g;
+  double p4[12];
+  PointTerm(const double* g3, const Vec3& p) : g(g3) {
+    for (int c = 0; c < 12; ++c) p4[c] = p[c % 3];
+  }
+};
+
+/// o[i] = Σ line terms + Σ point terms, in that order, i < n (o: three doubles a
+/// point). Four points at a time are summed in registers over all terms, so the
+/// row is read from no memory but the terms' and written once.
+void sum_terms(double* o, std::size_t n, const std::vector<LineTerm>& lines, const std::vector<PointTerm>& points);
+
+/// Fills the row o[0..n) (three doubles a point) a stretch of at most 256 points at a
+/// time, so that a term of local support is left out of the stretches where it is
+/// zero: terms(y0, y1, lines, points) lists, in the empty vectors, the terms over
+/// [y0, y1), their lines and numbers starting at y0.
+template <class Terms>
+void fill_row(double* o, std::size_t n, std::vector<LineTerm>& lines, std::vector<PointTerm>& points, Terms terms) {
+  constexpr std::size_t stretch = 256;
+  for (std::size_t y0 = 0; y0 < n; y0 += stretch) {
+    const std::size_t y1 = std::min(n, y0 + stretch);
+    lines.clear();
+    points.clear();
+    terms(y0, y1, lines, points);
+    sum_terms(o + 3 * y0, y1 - y0, lines, points);
+  }
+}
+
+/// The B-spline coefficients of a scalar function, and the range [lo, hi) outside
+/// which they are all zero: a blend of local support (a Coons network's cardinal
+/// functions) is added only where it is not zero, and knot insertion keeps zero
+/// coefficients exactly zero.
+struct Coefficients {
+  std::vector<double> c;  // each coefficient three times, as PointTerm takes them
+  std::size_t lo = 0, hi = 0;
+};
+Coefficients coefficients(const BSplineCurve& f);
 
 }  // namespace interpatch::detail

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "detail/parallel.hpp"
 #include "detail/text.hpp"
 #include "volume_terms.hpp"
 
@@ -163,22 +164,12 @@ std::vector<double> missing_knots(const KnotVector& k, const KnotVector& target)
   return out;
 }
 
-std::vector<double> fitted_coefficients(const BSplineCurve& f, const KnotVector& target) {
+BSplineCurve fitted(const BSplineCurve& f, const KnotVector& target) {
   BSplineCurve c = f.elevated(target.degree() - f.degree());
   const auto add = missing_knots(f.knots(), target);
   if (!add.empty()) c = c.refined(add);
   INTERPATCH_ASSERT(c.knots().count() == target.count());
-  std::vector<double> x(c.control_points().size());
-  for (std::size_t i = 0; i < x.size(); ++i) x[i] = c.control_points()[i].x;
-  return x;
-}
-
-std::vector<Vec3> fitted_points(const BSplineCurve& f, const KnotVector& target) {
-  BSplineCurve c = f.elevated(target.degree() - f.degree());
-  const auto add = missing_knots(f.knots(), target);
-  if (!add.empty()) c = c.refined(add);
-  INTERPATCH_ASSERT(c.knots().count() == target.count());
-  return c.control_points();
+  return c;
 }
 
 BSplineSurface fitted(const BSplineSurface& s, const KnotVector& ku, const KnotVector& kv) {
@@ -285,54 +276,100 @@ BSplineVolume BlendedVolume::to_bspline() const {
   }
   for (const auto& e : T.edges) ks[static_cast<std::size_t>(e.axis)].push_back(&e.line.knots());
   const std::array<KnotVector, 3> target{common_knots(ks[0]), common_knots(ks[1]), common_knots(ks[2])};
-  std::array<std::vector<std::vector<double>>, 3> coef;
+  // Each blend's coefficients; each face's net and each edge's line on the common knots.
+  std::array<std::vector<detail::Coefficients>, 3> coef;
   for (std::size_t a = 0; a < 3; ++a)
-    for (const auto& b : T.blends[a]) coef[a].push_back(fitted_coefficients(*b.spline, target[a]));
+    for (const auto& b : T.blends[a]) coef[a].push_back(detail::coefficients(fitted(*b.spline, target[a])));
+  // A face on the common knots already is used as it is: no copy of its net.
+  std::vector<BSplineSurface> refit;
+  refit.reserve(T.faces.size());
+  std::vector<const PointGrid*> Q;
+  for (const auto& face : T.faces) {
+    const auto o = detail::other_axes(face.axis);
+    const KnotVector& ku = target[static_cast<std::size_t>(o[0])];
+    const KnotVector& kv = target[static_cast<std::size_t>(o[1])];
+    const bool fits = face.surface.knots_u().values() == ku.values() && face.surface.knots_v().values() == kv.values();
+    Q.push_back(fits ? &face.surface.control_points()
+                     : &refit.emplace_back(fitted(face.surface, ku, kv)).control_points());
+  }
+  std::vector<std::vector<Vec3>> E;
+  for (const auto& e : T.edges)
+    E.push_back(fitted(e.line.curve(), target[static_cast<std::size_t>(e.axis)]).control_points());
   const std::array<std::size_t, 3> n{static_cast<std::size_t>(target[0].count()),
                                      static_cast<std::size_t>(target[1].count()),
                                      static_cast<std::size_t>(target[2].count())};
-  PointGrid3 P(n);
-  auto at = [&P](const std::array<std::size_t, 3>& i) -> Vec3& { return P(i[0], i[1], i[2]); };
-  for (const auto& face : T.faces) {  // f_a ⊗ F
-    const auto a = static_cast<std::size_t>(face.axis);
-    const auto o = detail::other_axes(face.axis);
-    const auto o0 = static_cast<std::size_t>(o[0]), o1 = static_cast<std::size_t>(o[1]);
-    const BSplineSurface Q = fitted(face.surface, target[o0], target[o1]);
-    const auto& c = coef[a][face.blend];
-    std::array<std::size_t, 3> i{};
-    for (i[a] = 0; i[a] < n[a]; ++i[a]) {
-      if (c[i[a]] == 0.0) continue;
-      for (i[o0] = 0; i[o0] < n[o0]; ++i[o0])
-        for (i[o1] = 0; i[o1] < n[o1]; ++i[o1]) at(i) += c[i[a]] * Q.control_points()(i[o0], i[o1]);
-    }
-  }
-  for (const auto& e : T.edges) {  // scale f_a ⊗ g_b ⊗ E
-    const auto c = static_cast<std::size_t>(e.axis);
-    const auto o = detail::other_axes(e.axis);
-    const auto a = static_cast<std::size_t>(o[0]), b = static_cast<std::size_t>(o[1]);
-    const auto E = fitted_points(e.line.curve(), target[c]);
-    const auto& ca = coef[a][e.blends[0]];
-    const auto& cb = coef[b][e.blends[1]];
-    std::array<std::size_t, 3> i{};
-    for (i[a] = 0; i[a] < n[a]; ++i[a])
-      for (i[b] = 0; i[b] < n[b]; ++i[b]) {
-        const double g = e.scale * ca[i[a]] * cb[i[b]];
-        if (g == 0.0) continue;
-        for (i[c] = 0; i[c] < n[c]; ++i[c]) at(i) += g * E[i[c]];
+  // Control point (x, y, z) is a sum over the terms of rows along w: a line along w
+  // times a number of (x, y) (faces of u and v, edges along w), or a point of (x, y)
+  // times a blend of w (faces of w, edges along u and v, corners), the points of one
+  // blend of w added first. Each control point is written once, by one thread, each
+  // point's terms added in one order.
+  struct RowTerm {  // scale · fu[x] · fv[y] (a missing blend is 1) times the line or point at base + x sx + y sy
+    double scale;
+    const detail::Coefficients *fu, *fv;
+    const Vec3* base;
+    std::size_t sx, sy, blend;  // blend: of w, for points
+  };
+  std::vector<RowTerm> line_terms, point_terms;
+  auto blend = [&coef](std::size_t axis, std::size_t k) { return &coef[axis][k]; };
+  // The faces of u and the edges along w of one blend of u first make one grid of
+  // (v, w), R_i = Σ faces + Σ scale g_b(v) E(w), so rows take one term for them.
+  std::vector<PointGrid> R;
+  R.reserve(T.blends[0].size());
+  for (std::size_t i = 0; i < T.blends[0].size(); ++i) {
+    std::vector<std::size_t> faces, edges;
+    for (std::size_t k = 0; k < T.faces.size(); ++k)
+      if (T.faces[k].axis == 0 && T.faces[k].blend == i) faces.push_back(k);
+    for (std::size_t k = 0; k < T.edges.size(); ++k)
+      if (T.edges[k].axis == 2 && T.edges[k].blends[0] == i) edges.push_back(k);
+    if (faces.empty() && edges.empty()) continue;
+    PointGrid& g = R.emplace_back(PointGrid::shape_type{n[1], n[2]}, for_overwrite);
+    for (std::size_t y = 0; y < n[1]; ++y)
+      for (std::size_t z = 0; z < n[2]; ++z) {
+        Vec3 p{};
+        for (std::size_t k : faces) p += (*Q[k])(y, z);
+        for (std::size_t k : edges) p += (T.edges[k].scale * coef[1][T.edges[k].blends[1]].c[3 * y]) * E[k][z];
+        g(y, z) = p;
       }
+    line_terms.push_back({1.0, blend(0, i), nullptr, g.data(), 0, n[2], 0});
   }
-  for (const auto& k : T.corners) {  // f ⊗ g ⊗ h P
-    if (k.point == Vec3{}) continue;
-    const auto& cu = coef[0][k.blends[0]];
-    const auto& cv = coef[1][k.blends[1]];
-    const auto& cw = coef[2][k.blends[2]];
-    for (std::size_t x = 0; x < n[0]; ++x) {
-      if (cu[x] == 0.0) continue;
-      for (std::size_t y = 0; y < n[1]; ++y) {
-        const double g = cu[x] * cv[y];
-        if (g == 0.0) continue;
-        for (std::size_t z = 0; z < n[2]; ++z) P(x, y, z) += (g * cw[z]) * k.point;
-      }
+  for (std::size_t k = 0; k < T.faces.size(); ++k) {
+    const auto& f = T.faces[k];
+    const Vec3* q = Q[k]->data();
+    if (f.axis == 1) line_terms.push_back({1.0, nullptr, blend(1, f.blend), q, n[2], 0, 0});
+    if (f.axis == 2) point_terms.push_back({1.0, nullptr, nullptr, q, n[1], 1, f.blend});
+  }
+  for (std::size_t k = 0; k < T.edges.size(); ++k) {
+    const auto& e = T.edges[k];
+    const Vec3* l = E[k].data();
+    if (e.axis == 0) point_terms.push_back({e.scale, nullptr, blend(1, e.blends[0]), l, 1, 0, e.blends[1]});
+    if (e.axis == 1) point_terms.push_back({e.scale, blend(0, e.blends[0]), nullptr, l, 0, 1, e.blends[1]});
+  }
+  for (const auto& k : T.corners)
+    point_terms.push_back({1.0, blend(0, k.blends[0]), blend(1, k.blends[1]), &k.point, 0, 0, k.blends[2]});
+  const std::size_t nh = T.blends[2].size();
+  PointGrid3 P(n, for_overwrite);
+  const auto rows = static_cast<long long>(n[0] * n[1]);
+#pragma omp parallel if (n[0] * n[1] * n[2] * (line_terms.size() + nh) >= detail::parallel_min_work)
+  {
+    std::vector<detail::LineTerm> lines;
+    std::vector<detail::PointTerm> points;
+    std::array<Vec3, detail::max_volume_blends> h;  // the point of each blend of w
+#pragma omp for schedule(static)
+    for (long long r = 0; r < rows; ++r) {
+      const std::size_t x = static_cast<std::size_t>(r) / n[1], y = static_cast<std::size_t>(r) % n[1];
+      auto factor = [x, y](const RowTerm& t) {
+        const double a = t.fu ? t.scale * t.fu->c[3 * x] : t.scale;
+        return t.fv ? a * t.fv->c[3 * y] : a;
+      };
+      h.fill(Vec3{});
+      for (const auto& t : point_terms) h[t.blend] += factor(t) * t.base[x * t.sx + y * t.sy];
+      detail::fill_row(&P(x, y, 0).x, n[2], lines, points, [&](std::size_t z0, std::size_t z1, auto& ls, auto& ps) {
+        for (const auto& t : line_terms)
+          if (const double f = factor(t); f != 0.0) ls.push_back({f, &t.base[x * t.sx + y * t.sy + z0].x});
+        for (std::size_t b = 0; b < nh; ++b)
+          if (h[b] != Vec3{} && coef[2][b].lo < z1 && coef[2][b].hi > z0)
+            ps.emplace_back(coef[2][b].c.data() + 3 * z0, h[b]);
+      });
     }
   }
   return BSplineVolume(target[0], target[1], target[2], std::move(P));

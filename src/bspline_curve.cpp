@@ -35,6 +35,57 @@ BSplineCurve from_homogeneous(KnotVector k, const std::vector<H>& h, bool ration
   return BSplineCurve(std::move(k), std::move(cp), std::move(w));
 }
 
+// q ← α q + (1 − α) q1, coordinate by coordinate.
+void mix(Vec3& q, const Vec3& q1, double alpha) { q = alpha * q + (1.0 - alpha) * q1; }
+void mix(H& q, const H& q1, double alpha) {
+  for (std::size_t c = 0; c < 4; ++c) q[c] = alpha * q[c] + (1.0 - alpha) * q1[c];
+}
+
+template <class T>
+struct Refined {
+  std::vector<double> knots;
+  std::vector<T> points;
+};
+
+// Every knot of X (sorted, inside the open domain, multiplicities within the degree)
+// inserted in one pass (The NURBS Book A5.4, with the erratum U[i-p+l] for
+// U[i-l+1]): from the last new knot down, each old point is moved once and p new
+// ones are formed per new knot, so the cost is O(n + p·r), not the O(n·r) of r
+// single insertions. Points are Vec3 (non-rational curves) or homogeneous.
+template <class T>
+Refined<T> refine(const KnotVector& knots, const std::vector<T>& P, const std::vector<double>& X) {
+  const auto& U = knots.values();
+  const int p = knots.degree();
+  const int n = knots.count() - 1, m = n + p + 1, r = static_cast<int>(X.size()) - 1;
+  const int a = knots.find_span(X.front()), b = knots.find_span(X.back()) + 1;
+  Refined<T> out{std::vector<double>(U.size() + X.size()), std::vector<T>(P.size() + X.size())};
+  auto& Q = out.points;
+  auto& V = out.knots;
+  auto at = [](auto& v, int i) -> auto& { return v[static_cast<std::size_t>(i)]; };
+  for (int j = 0; j <= a - p; ++j) at(Q, j) = at(P, j);
+  for (int j = b - 1; j <= n; ++j) at(Q, j + r + 1) = at(P, j);
+  for (int j = 0; j <= a; ++j) at(V, j) = at(U, j);
+  for (int j = b + p; j <= m; ++j) at(V, j + r + 1) = at(U, j);
+  int i = b + p - 1, k = b + p + r;
+  for (int j = r; j >= 0; --j) {
+    const double x = at(X, j);
+    for (; x <= at(U, i) && i > a; --k, --i) {
+      at(Q, k - p - 1) = at(P, i - p - 1);
+      at(V, k) = at(U, i);
+    }
+    at(Q, k - p - 1) = at(Q, k - p);
+    for (int l = 1; l <= p; ++l) {
+      const int ind = k - p + l;
+      const double num = at(V, k + l) - x;
+      if (num == 0.0) at(Q, ind - 1) = at(Q, ind);
+      else mix(at(Q, ind - 1), at(Q, ind), num / (at(V, k + l) - at(U, i - p + l)));
+    }
+    at(V, k) = x;
+    --k;
+  }
+  return out;
+}
+
 void check_domain(const KnotVector& k, double t) {
   // A parameter a few ulps outside the domain is rounding from the caller's mapping.
   const double a = k.front(), b = k.back();
@@ -165,9 +216,29 @@ BSplineCurve BSplineCurve::inserted(double t, int times) const {
 }
 
 BSplineCurve BSplineCurve::refined(std::span<const double> knots) const {
-  BSplineCurve c = *this;
-  for (double t : knots) c = c.inserted(t, 1);
-  return c;
+  if (knots.empty()) return *this;
+  for (double t : knots)
+    if (!(t > knots_.front() && t < knots_.back()))
+      fail(errc::out_of_domain, "knot ", t, " to insert is not inside the open domain (", knots_.front(), ", ",
+           knots_.back(), ")");
+  std::vector<double> X(knots.begin(), knots.end());
+  if (!std::is_sorted(X.begin(), X.end())) std::sort(X.begin(), X.end());
+  const int p = degree();
+  for (std::size_t i = 0; i < X.size();) {
+    std::size_t j = i;
+    while (j < X.size() && X[j] == X[i]) ++j;
+    const int s = knots_.multiplicity(X[i]), times = static_cast<int>(j - i);
+    if (s + times > p)
+      fail(errc::invalid_knots, "inserting ", X[i], " ", times, " times gives multiplicity ", s + times,
+           ", more than degree ", p);
+    i = j;
+  }
+  if (!rational()) {
+    auto r = refine(knots_, cp_, X);
+    return BSplineCurve(KnotVector(p, std::move(r.knots)), std::move(r.points));
+  }
+  auto r = refine(knots_, homogeneous(cp_, w_), X);
+  return from_homogeneous(KnotVector(p, std::move(r.knots)), r.points, true);
 }
 
 BSplineCurve BSplineCurve::elevated(int times) const {
@@ -228,19 +299,40 @@ std::vector<BSplineCurve> make_compatible(std::span<const BSplineCurve> curves) 
   std::vector<BSplineCurve> out;
   out.reserve(curves.size());
   for (const auto& c : curves) out.push_back(c.elevated(p - c.degree()));
-  // The merged interior knots: every value with its highest multiplicity.
-  std::vector<std::pair<double, int>> merged;
-  for (const auto& c : out)
-    for (const auto& [t, m] : c.knots().interior_breaks()) {
-      auto it = std::lower_bound(merged.begin(), merged.end(), t,
-                                 [](const std::pair<double, int>& a, double x) { return a.first < x; });
-      if (it != merged.end() && it->first == t) it->second = std::max(it->second, m);
-      else merged.insert(it, {t, m});
+  // The merged interior knots: every value with its highest multiplicity, each
+  // curve's breaks merged in one pass (both lists are sorted); knot vectors met
+  // before add nothing.
+  std::vector<std::pair<double, int>> merged, next;
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    const KnotVector& kv = out[k].knots();
+    if (std::any_of(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(k),
+                    [&](const BSplineCurve& c) { return c.knots().values() == kv.values(); }))
+      continue;
+    const auto breaks = kv.interior_breaks();
+    next.clear();
+    std::size_t i = 0, j = 0;
+    while (i < merged.size() || j < breaks.size()) {
+      if (j == breaks.size() || (i < merged.size() && merged[i].first < breaks[j].first)) {
+        next.push_back(merged[i++]);
+      } else if (i == merged.size() || breaks[j].first < merged[i].first) {
+        next.push_back(breaks[j++]);
+      } else {
+        next.emplace_back(breaks[j].first, std::max(merged[i].second, breaks[j].second));
+        ++i;
+        ++j;
+      }
     }
+    merged.swap(next);
+  }
   for (auto& c : out) {
     std::vector<double> missing;
-    for (const auto& [t, m] : merged)
-      missing.insert(missing.end(), static_cast<std::size_t>(m - c.knots().multiplicity(t)), t);
+    const auto have = c.knots().interior_breaks();
+    std::size_t j = 0;
+    for (const auto& [t, m] : merged) {
+      while (j < have.size() && have[j].first < t) ++j;
+      const int h = j < have.size() && have[j].first == t ? have[j].second : 0;
+      missing.insert(missing.end(), static_cast<std::size_t>(m - h), t);
+    }
     if (!missing.empty()) c = c.refined(missing);
   }
   return out;

@@ -155,7 +155,9 @@ void KnotVector::basis_derivatives(int span, double t, int nd, double* ders) con
 }
 
 int KnotVector::multiplicity(double t) const noexcept {
-  return static_cast<int>(std::count(u_.begin(), u_.end(), t));
+  if (std::isnan(t)) return 0;  // equal to no knot, and unordered for the search below
+  const auto [lo, hi] = std::equal_range(u_.begin(), u_.end(), t);  // the knots are sorted
+  return static_cast<int>(hi - lo);
 }
 
 std::vector<std::pair<double, int>> KnotVector::interior_breaks() const {

@@ -1,10 +1,12 @@
 #include "interpatch/blended_surface.hpp"
 
+#include "detail/parallel.hpp"
 #include "interpatch/coons.hpp"
 #include "interpatch/interpolate.hpp"
 #include "interpatch/network.hpp"
 #include "interpatch/patches.hpp"
 #include "surface_util.hpp"
+#include "thread_util.hpp"
 
 namespace interpatch {
 namespace {
@@ -127,6 +129,50 @@ TEST(BlendedSurface, BatchEvaluationMatchesPointwise) {
     }
   }
 }
+
+// Constructions whose control nets are large enough to be filled by every thread
+// (net size times terms a point above detail::parallel_min_work; the terms are 2 + 2
+// for the Coons patch, 7 + 5 for the networks): boundary curves on different knots
+// and degrees so that the conversion merges and elevates, and a C1 network whose
+// blends of v vanish over most of each row, rows of 700 points, so that their
+// supports begin and end inside the stretches rows are summed by.
+std::vector<std::pair<BlendedSurface, std::size_t>> large_blended_surfaces() {
+  auto g = test::rng(92);
+  const auto src = test::random_bspline_surface(g, 3, 3, 200, 700);
+  auto b = test::boundary_of(src);
+  std::vector<double> extra(200);
+  for (auto& t : extra) t = test::uniform(g, 0.01, 0.99);
+  b.v1 = b.v1.refined(extra);
+  b.u0 = b.u0.elevated(1);
+  const auto net = test::network_on(src, linspace(0, 1, 7), {0, 0.2, 0.45, 0.7, 1});
+  return {{coons(b), 4},
+          {curve_network(net, {NetworkMethod::gordon, {}}), 12},
+          {curve_network(net, {NetworkMethod::coons_hermite, {}}), 12}};
+}
+
+TEST(BlendedSurface, LargeExactFormsEqualTheFormula) {
+  auto g = test::rng(93);
+  for (const auto& [s, terms] : large_blended_surfaces()) {
+    const BSplineSurface b = s.to_bspline();
+    ASSERT_GE(b.control_points().size() * terms, detail::parallel_min_work);
+    // The data are of size ~700 (random_bspline_surface puts control point (i, j) near
+    // (i, j, 0)). The net sums its terms in another order than the formula, after knot
+    // insertions (convex combinations) and an elevation (a collocation solve): a few
+    // ulps of the data, far below 1e-12 of them.
+    const double scale = test::bbox_diagonal(b.control_points().values());
+    for (int k = 0; k < 300; ++k) {
+      const double u = test::uniform(g, 0, 1), v = test::uniform(g, 0, 1);
+      EXPECT_LT(distance(b.point(u, v), s.point(u, v)), 1e-12 * scale) << "at (" << u << ", " << v << ")";
+    }
+  }
+}
+
+#ifdef _OPENMP
+// Each control point is summed by one thread in one order.
+TEST(BlendedSurface, LargeExactFormsDoNotDependOnTheThreadCount) {
+  test::expect_exact_forms_independent_of_threads(large_blended_surfaces());
+}
+#endif
 
 TEST(BlendedSurface, BatchEvaluationRefusesParametersOutsideTheDomain) {
   const auto s = coons(CoonsBoundary{line({0, 0, 0}, {1, 0, 0}), line({0, 1, 0}, {1, 1, 1}), line({0, 0, 0}, {0, 1, 0}),

@@ -45,6 +45,11 @@ class BlendedSurface final : public Surface {
   /// point (Gregory-corrected patches point by point). @throws error out_of_domain, too_large.
   [[nodiscard]] Grid<SurfaceDerivatives, 2> evaluate_derivatives(std::span<const double> us,
                                                                  std::span<const double> vs) const override;
+  /// Every function of u made compatible (common degree and knots, by degree
+  /// elevation and knot insertion), likewise v, then the control points of the
+  /// tensor-product terms summed: each control point once, in one pass over the
+  /// net, the rows shared by both cores; the result does not depend on the thread
+  /// count.
   /// @throws error no_exact_form (rational boundary curves, Gregory's twists).
   [[nodiscard]] BSplineSurface to_bspline() const override;
   /// Whether to_bspline() succeeds.
