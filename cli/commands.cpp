@@ -322,10 +322,10 @@ void write_build(const io::Construction& c, const fs::path& out) {
   io::write_exact_json(out, *c.exact);
 }
 
-void write_mesh(const io::Construction& c, const fs::path& out, const Resolution& res) {
+void write_mesh(io::Construction& c, const fs::path& out, const Resolution& res) {
   check_mesh_kind(c, out, res);
   if (io::is_volume(c)) return mesh_volume(c, out, res);
-  const Surface& s = io::evaluator(c);
+  const Surface& s = io::evaluator(c, res.nu * res.nv, io::Sample::derivatives);
   constexpr double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  // every construction is over the unit square
   const std::vector<double> us = linspace(u0, u1, res.nu), vs = linspace(v0, v1, res.nv);
   io::SurfaceMesh mesh{PointGrid({res.nu, res.nv}), PointGrid({res.nu, res.nv})};
@@ -347,10 +347,10 @@ void write_mesh(const io::Construction& c, const fs::path& out, const Resolution
   io::write_surface_mesh(out, mesh);
 }
 
-void write_eval(const io::Construction& c, const fs::path& out, const Resolution& grid) {
+void write_eval(io::Construction& c, const fs::path& out, const Resolution& grid) {
   check_counts_kind(c, grid_option, grid);
   if (io::is_volume(c)) return eval_volume(c, out, grid);
-  const Surface& s = io::evaluator(c);
+  const Surface& s = io::evaluator(c, grid.nu * grid.nv, io::Sample::points);
   constexpr double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  // every construction is over the unit square
   std::vector<std::vector<double>> params{linspace(u0, u1, grid.nu), linspace(v0, v1, grid.nv)};
   ProgressLine progress("evaluating");
@@ -403,8 +403,8 @@ int mesh_command(const Input& in, const fs::path& out, std::string_view res_text
   check_mesh_output(out);
   io::check_writable(out);
   if (given) require_mesh_memory(*given);
-  // Meshes evaluate the construction; its exact form is built only if that is cheaper.
-  const io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = true});
+  // A mesh samples the construction; its exact form is made only if that costs less.
+  io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = true});
   const Resolution res = given ? *given : (io::is_volume(c) ? default_volume_resolution : default_surface_resolution);
   check_mesh_kind(c, out, res);
   if (!given) require_mesh_memory(res);
@@ -420,8 +420,8 @@ int eval_command(const Input& in, const fs::path& out, std::string_view grid_tex
   // Before the build, the grid as given (K: KxK, the least it can be); after it, the
   // grid of the construction's kind (K of a volume: KxKxK).
   require_eval_room({counts[0], counts.size() > 1 ? counts[1] : counts[0], counts.size() > 2 ? counts[2] : 0}, out);
-  // Evaluation goes through the construction's formula; its exact form is not built.
-  const io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = true});
+  // Evaluation samples the construction; its exact form is made only if that costs less.
+  io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = true});
   const Resolution grid = grid_resolution(counts, c);
   require_eval_room(grid, out);
   write_eval(c, out, grid);

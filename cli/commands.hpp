@@ -112,9 +112,11 @@ void check_mesh_kind(const io::Construction& c, const std::filesystem::path& out
 
 /// The outputs, from a built construction.
 void write_build(const io::Construction& c, const std::filesystem::path& out);
-void write_mesh(const io::Construction& c, const std::filesystem::path& out, const Resolution& res);
+/// Meshes and evaluations sample through the cheaper exact evaluator
+/// (io::evaluator), which may make the exact form of `c`.
+void write_mesh(io::Construction& c, const std::filesystem::path& out, const Resolution& res);
 /// `grid`: the points along u and v (and w, for a volume).
-void write_eval(const io::Construction& c, const std::filesystem::path& out, const Resolution& grid);
+void write_eval(io::Construction& c, const std::filesystem::path& out, const Resolution& grid);
 nlohmann::ordered_json info(const io::Construction& c);
 
 /// Builds a spec file, showing progress on a terminal (the progress callback of

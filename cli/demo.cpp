@@ -499,7 +499,7 @@ int demo_command(const fs::path& requested) {
       spec_path = dir / ex.spec_file;
     }
 
-    const io::Construction c = build_spec(spec_path);
+    io::Construction c = build_spec(spec_path);
     const auto out = [&](const std::string& suffix) {
       written.push_back(ex.name + suffix);
       return dir / (ex.name + suffix);

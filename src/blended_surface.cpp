@@ -348,8 +348,10 @@ bool BlendedSurface::has_exact_form() const noexcept {
   return true;
 }
 
-BSplineSurface BlendedSurface::to_bspline() const {
-  const auto& T = *t_;
+namespace {
+
+// Refuses, saying why, a blended surface without an exact form.
+void require_exact_form(const detail::BlendedTerms& T) {
   if (!T.gregory.empty())
     fail(errc::no_exact_form, "Gregory's twist correction is a rational blend of u and v with a singular point at "
                               "each corrected corner; the patch has no exact B-spline form");
@@ -364,6 +366,26 @@ BSplineSurface BlendedSurface::to_bspline() const {
       if (!s.spline)
         fail(errc::no_exact_form, "a blending function given as a callable has no B-spline form; give it as a "
                                   "B-spline (knots and coefficients) for an exact conversion");
+}
+
+}  // namespace
+
+std::size_t BlendedSurface::terms() const noexcept { return t_->a.size() + t_->g.size(); }
+
+std::array<KnotVector, 2> BlendedSurface::exact_knots() const {
+  const auto& T = *t_;
+  require_exact_form(T);
+  std::vector<KnotVector> ku, kv;
+  for (const auto& s : T.f) ku.push_back(s.spline->knots());
+  for (const auto& c : T.b) ku.push_back(c.knots());
+  for (const auto& s : T.g) kv.push_back(s.spline->knots());
+  for (const auto& c : T.a) kv.push_back(c.knots());
+  return {merged_knots(ku), merged_knots(kv)};
+}
+
+BSplineSurface BlendedSurface::to_bspline() const {
+  const auto& T = *t_;
+  require_exact_form(T);
   // Every function of u on one knot vector and degree, every function of v likewise.
   std::vector<BSplineCurve> us, vs;
   for (const auto& s : T.f) us.push_back(*s.spline);

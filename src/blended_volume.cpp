@@ -130,27 +130,19 @@ BSplineSurface unit(const BSplineSurface& s) {
 
 namespace {
 
-// The degree and knots every ingredient of one direction is brought to: the highest
-// degree, and every interior break with the highest multiplicity it has after its
-// ingredient is elevated to that degree (elevation raises every multiplicity by as
-// much as the degree). All knot vectors are over [0, 1].
-KnotVector common_knots(const std::vector<const KnotVector*>& ks) {
-  int p = 1;
-  for (const auto* k : ks) p = std::max(p, k->degree());
-  std::vector<std::pair<double, int>> merged;
-  for (const auto* k : ks) {
-    const int t = p - k->degree();
-    for (const auto& [x, m] : k->interior_breaks()) {
-      auto it = std::lower_bound(merged.begin(), merged.end(), x,
-                                 [](const std::pair<double, int>& a, double y) { return a.first < y; });
-      if (it != merged.end() && it->first == x) it->second = std::max(it->second, m + t);
-      else merged.insert(it, {x, m + t});
-    }
+// The knots of the exact form along u, v and w: every function of one direction
+// on one knot vector and degree (merged_knots), blends, faces and edges alike.
+std::array<KnotVector, 3> exact_knots(const detail::VolumeTerms& T) {
+  std::array<std::vector<KnotVector>, 3> ks;
+  for (std::size_t a = 0; a < 3; ++a)
+    for (const auto& b : T.blends[a]) ks[a].push_back(b.spline->knots());
+  for (const auto& face : T.faces) {
+    const auto o = detail::other_axes(face.axis);
+    ks[static_cast<std::size_t>(o[0])].push_back(face.surface.knots_u());
+    ks[static_cast<std::size_t>(o[1])].push_back(face.surface.knots_v());
   }
-  std::vector<double> u(static_cast<std::size_t>(p) + 1, 0.0);
-  for (const auto& [x, m] : merged) u.insert(u.end(), static_cast<std::size_t>(m), x);
-  u.insert(u.end(), static_cast<std::size_t>(p) + 1, 1.0);
-  return KnotVector(p, std::move(u));
+  for (const auto& e : T.edges) ks[static_cast<std::size_t>(e.axis)].push_back(e.line.knots());
+  return {merged_knots(ks[0]), merged_knots(ks[1]), merged_knots(ks[2])};
 }
 
 // Knots to insert into `k`, once elevated to the target's degree, to reach the target.
@@ -266,16 +258,7 @@ BSplineVolume BlendedVolume::to_bspline() const {
       fail(errc::no_exact_form, "edge line ", k, " along ", detail::axis_letter(T.edges[k].axis),
            " lies on a rational surface; blends of rational data have no B-spline form of the same kind");
   // Every function of u on one knot vector and degree, likewise v and w.
-  std::array<std::vector<const KnotVector*>, 3> ks;
-  for (std::size_t a = 0; a < 3; ++a)
-    for (const auto& b : T.blends[a]) ks[a].push_back(&b.spline->knots());
-  for (const auto& face : T.faces) {
-    const auto o = detail::other_axes(face.axis);
-    ks[static_cast<std::size_t>(o[0])].push_back(&face.surface.knots_u());
-    ks[static_cast<std::size_t>(o[1])].push_back(&face.surface.knots_v());
-  }
-  for (const auto& e : T.edges) ks[static_cast<std::size_t>(e.axis)].push_back(&e.line.knots());
-  const std::array<KnotVector, 3> target{common_knots(ks[0]), common_knots(ks[1]), common_knots(ks[2])};
+  const std::array<KnotVector, 3> target = exact_knots(T);
   // Each blend's coefficients; each face's net and each edge's line on the common knots.
   std::array<std::vector<detail::Coefficients>, 3> coef;
   for (std::size_t a = 0; a < 3; ++a)

@@ -296,34 +296,13 @@ std::vector<BSplineCurve> make_compatible(std::span<const BSplineCurve> curves) 
       fail(errc::out_of_domain, "curve ", k, " has domain [", curves[k].domain().first, ", ",
            curves[k].domain().second, "], curve 0 has [", dom.first, ", ", dom.second, "]");
   }
+  std::vector<KnotVector> knots;
+  knots.reserve(curves.size());
+  for (const auto& c : curves) knots.push_back(c.knots());
+  const auto merged = merged_knots(knots).interior_breaks();
   std::vector<BSplineCurve> out;
   out.reserve(curves.size());
   for (const auto& c : curves) out.push_back(c.elevated(p - c.degree()));
-  // The merged interior knots: every value with its highest multiplicity, each
-  // curve's breaks merged in one pass (both lists are sorted); knot vectors met
-  // before add nothing.
-  std::vector<std::pair<double, int>> merged, next;
-  for (std::size_t k = 0; k < out.size(); ++k) {
-    const KnotVector& kv = out[k].knots();
-    if (std::any_of(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(k),
-                    [&](const BSplineCurve& c) { return c.knots().values() == kv.values(); }))
-      continue;
-    const auto breaks = kv.interior_breaks();
-    next.clear();
-    std::size_t i = 0, j = 0;
-    while (i < merged.size() || j < breaks.size()) {
-      if (j == breaks.size() || (i < merged.size() && merged[i].first < breaks[j].first)) {
-        next.push_back(merged[i++]);
-      } else if (i == merged.size() || breaks[j].first < merged[i].first) {
-        next.push_back(breaks[j++]);
-      } else {
-        next.emplace_back(breaks[j].first, std::max(merged[i].second, breaks[j].second));
-        ++i;
-        ++j;
-      }
-    }
-    merged.swap(next);
-  }
   for (auto& c : out) {
     std::vector<double> missing;
     const auto have = c.knots().interior_breaks();

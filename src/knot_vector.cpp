@@ -198,4 +198,40 @@ int KnotVector::continuity() const noexcept {
   return p_ - maxm;
 }
 
+KnotVector merged_knots(std::span<const KnotVector> knots) {
+  if (knots.empty()) detail::fail(errc::too_few_points, "no knot vectors to merge");
+  int p = 0;
+  for (const KnotVector& k : knots) p = std::max(p, k.degree());
+  // Each vector's breaks merged in one pass (both lists are sorted); vectors met
+  // before add nothing.
+  std::vector<std::pair<double, int>> merged, next;
+  for (std::size_t k = 0; k < knots.size(); ++k) {
+    const KnotVector& kv = knots[k];
+    if (std::any_of(knots.begin(), knots.begin() + static_cast<std::ptrdiff_t>(k),
+                    [&](const KnotVector& o) { return o.degree() == kv.degree() && o.values() == kv.values(); }))
+      continue;
+    const int raise = p - kv.degree();
+    auto breaks = kv.interior_breaks();
+    for (auto& b : breaks) b.second += raise;
+    next.clear();
+    std::size_t i = 0, j = 0;
+    while (i < merged.size() || j < breaks.size()) {
+      if (j == breaks.size() || (i < merged.size() && merged[i].first < breaks[j].first)) {
+        next.push_back(merged[i++]);
+      } else if (i == merged.size() || breaks[j].first < merged[i].first) {
+        next.push_back(breaks[j++]);
+      } else {
+        next.emplace_back(breaks[j].first, std::max(merged[i].second, breaks[j].second));
+        ++i;
+        ++j;
+      }
+    }
+    merged.swap(next);
+  }
+  std::vector<double> u(static_cast<std::size_t>(p) + 1, knots.front().front());
+  for (const auto& [x, m] : merged) u.insert(u.end(), static_cast<std::size_t>(m), x);
+  u.insert(u.end(), static_cast<std::size_t>(p) + 1, knots.front().back());
+  return KnotVector(p, std::move(u));
+}
+
 }  // namespace interpatch

@@ -220,9 +220,13 @@ std::size_t first_difference(std::span<const double> got, std::span<const double
   return got.size();
 }
 
+// How eval builds a construction: without its exact form, until the evaluation asks.
+const io::BuildOptions evaluation_options{.progress = {}, .keep_data = false, .defer_exact = true};
+
 // What evaluate() gives for construction c on linspace(0, 1, n) along each direction
 // (two counts for a surface, three for a volume): the doubles of a C-order array.
-std::vector<double> library_evaluation(const io::Construction& c, const std::vector<std::size_t>& counts) {
+// A surface is evaluated by what eval chooses (io::evaluator for the grid's points).
+std::vector<double> library_evaluation(io::Construction c, const std::vector<std::size_t>& counts) {
   std::vector<std::vector<double>> t;
   for (const std::size_t n : counts) t.push_back(linspace(0, 1, n));
   const auto doubles = [](const Vec3* p, std::size_t n) { return std::vector<double>(&p->x, &p->x + 3 * n); };
@@ -230,7 +234,7 @@ std::vector<double> library_evaluation(const io::Construction& c, const std::vec
     const PointGrid3 g = io::volume_evaluator(c).evaluate(t[0], t[1], t[2]);
     return doubles(g.data(), g.size());
   }
-  const PointGrid g = io::evaluator(c).evaluate(t.at(0), t.at(1));
+  const PointGrid g = io::evaluator(c, counts.at(0) * counts.at(1), io::Sample::points).evaluate(t.at(0), t.at(1));
   return doubles(g.data(), g.size());
 }
 
@@ -245,9 +249,6 @@ void expect_npy_is_evaluation(const std::string& bytes, const io::Construction& 
   const std::size_t i = first_difference(n.data, expected);
   EXPECT_EQ(i, expected.size()) << "value " << i << " is " << n.data[i] << ", evaluate() gives " << expected[i];
 }
-
-// How eval builds a construction: without its exact form.
-const io::BuildOptions evaluation_options{.progress = {}, .keep_data = false, .defer_exact = true};
 
 TEST_F(CliTest, EvalToNpyInBlocksIsTheLibrarysEvaluateBitForBit) {
   // eval evaluates and writes .npy about 2^17 points at a time along u
@@ -327,7 +328,7 @@ TEST_F(CliTest, EvalGridOfCountsPerDirectionToCsvIsOneRowPerPointInCOrder) {
     ASSERT_EQ(run_result.status, 0) << run_result.err;
     const auto [header, rows] = read_csv(read_file(at("g.csv")));
     EXPECT_EQ(header, k.header);
-    const std::vector<double> expected = library_evaluation(io::build_file(at(k.spec)), k.counts);
+    const std::vector<double> expected = library_evaluation(io::build_file(at(k.spec), evaluation_options), k.counts);
     const std::size_t dims = k.counts.size();
     ASSERT_EQ(rows.size(), expected.size() / 3);
     for (std::size_t r = 0; r < rows.size(); ++r) {

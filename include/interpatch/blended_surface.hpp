@@ -9,6 +9,7 @@
 /// spline cardinal functions), curves a_k(v), b_l(u) and corner data c_kl. Because
 /// every ingredient is a B-spline, the sum converts exactly to one B-spline surface.
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
@@ -52,6 +53,13 @@ class BlendedSurface final : public Surface {
   /// count.
   /// @throws error no_exact_form (rational boundary curves, Gregory's twists).
   [[nodiscard]] BSplineSurface to_bspline() const override;
+  /// The knot vectors (u, v) of the exact form, without making its control net:
+  /// what to_bspline() gives, count() control points along each. Cheap: the knots
+  /// of the curves and blending functions merged. @throws error no_exact_form.
+  [[nodiscard]] std::array<KnotVector, 2> exact_knots() const;
+  /// The products evaluate_into() sums per point: the curve terms of the formula,
+  /// what a point costs by formula against a point of the exact form.
+  [[nodiscard]] std::size_t terms() const noexcept;
   /// Whether to_bspline() succeeds.
   [[nodiscard]] bool has_exact_form() const noexcept;
   /// Notes on how the data were used (e.g. twists taken from the cross-derivative

@@ -87,4 +87,13 @@ class KnotVector {
   std::vector<double> u_;
 };
 
+/// The one knot vector of B-splines made compatible (make_compatible in
+/// bspline_curve.hpp): the highest degree p among them, every interior knot value
+/// with the highest multiplicity it has in any of them once raised to degree p
+/// (raising the degree by t raises each multiplicity by t). It tells the size of an
+/// exact form before any control point is made: count() control points along it.
+/// The knot vectors are taken to share their domain (make_compatible checks).
+/// @throws error too_few_points (no knot vectors).
+[[nodiscard]] KnotVector merged_knots(std::span<const KnotVector> knots);
+
 }  // namespace interpatch

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "interpatch/evaluate.hpp"
 #include "interpatch/io/json_out.hpp"
 #include "interpatch/io/npy.hpp"
 #include "temp_dir.hpp"
@@ -694,6 +695,101 @@ TEST(SpecVolume, KnownTypesListTheVolumes) {
   const auto t = known_types();
   for (const char* name : {"trilinear", "coons_volume", "hermite_volume", "interpolate_volume", "bspline_volume"})
     EXPECT_NE(std::find(t.begin(), t.end(), name), t.end()) << name;
+}
+
+}  // namespace
+}  // namespace interpatch::io
+
+namespace interpatch::io {
+namespace {
+
+// A spec of a network of n × n curves on z = sin(3u) cos(2v) / 5, each curve m points
+// interpolated at uniform parameters (so every curve has the same knots).
+json network_spec(std::size_t n, std::size_t m, const char* method) {
+  const auto S = [](double u, double v) { return json::array({u, v, 0.2 * std::sin(3 * u) * std::cos(2 * v)}); };
+  json uc = json::array(), vc = json::array(), p = json::array();
+  for (std::size_t j = 0; j < n; ++j) {
+    const double c = static_cast<double>(j) / static_cast<double>(n - 1);
+    json a = json::array(), b = json::array();
+    for (std::size_t i = 0; i < m; ++i) {
+      const double t = static_cast<double>(i) / static_cast<double>(m - 1);
+      a.push_back(S(t, c));
+      b.push_back(S(c, t));
+    }
+    uc.push_back({{"interpolate", a}, {"param", "uniform"}});
+    vc.push_back({{"interpolate", b}, {"param", "uniform"}});
+    p.push_back(c);
+  }
+  return {{"type", "network"}, {"u_curves", uc}, {"v_curves", vc}, {"u_params", p}, {"v_params", p}, {"method", method}};
+}
+
+// A Coons patch of four m-point curves at chord parameters (their knots differ).
+json coons_spec(std::size_t m) {
+  json side[4];
+  for (std::size_t i = 0; i < m; ++i) {
+    const double t = static_cast<double>(i) / static_cast<double>(m - 1);
+    side[0].push_back({t, 0, 0.1 * std::sin(6 * t)});
+    side[1].push_back({t, 1, 0.1 * std::sin(5 * t) + 0.2 * t});
+    side[2].push_back({0, t, 0.05 * std::sin(3 * t) * (1 - t)});
+    side[3].push_back({1, t, 0.1 * std::sin(6) * (1 - t) + t * (0.1 * std::sin(5) + 0.2) + 0.05 * std::sin(7 * t) * (1 - t) * t});
+  }
+  return {{"type", "coons"},
+          {"boundary", {{"v0", {{"interpolate", side[0]}}}, {"v1", {{"interpolate", side[1]}}},
+                        {"u0", {{"interpolate", side[2]}}}, {"u1", {{"interpolate", side[3]}}}}}};
+}
+
+const BuildOptions deferred{.progress = {}, .keep_data = false, .defer_exact = true};
+
+TEST(SpecExact, DeferredUntilAskedThenTheSameAsBuiltAtOnce) {
+  const json spec = coons_spec(40);
+  Construction c = build(spec, {}, deferred);
+  EXPECT_FALSE(c.exact.has_value());
+  EXPECT_TRUE(has_exact_form(c));
+  EXPECT_FALSE(is_volume(c));
+  EXPECT_EQ(&evaluator(c), c.formula.get());  // nothing built: the formula evaluates
+  const auto& made = std::get<BSplineSurface>(exact_form(c));
+  EXPECT_TRUE(c.exact.has_value());
+  EXPECT_FALSE(c.convert);
+  EXPECT_EQ(&evaluator(c), &made);
+  const Construction at_once = build(spec);
+  EXPECT_EQ(made.control_points().values(), std::get<BSplineSurface>(*at_once.exact).control_points().values());
+  // A construction without one says why, deferred or not: a rational side (weights
+  // 1, 2, 1) blended with polynomial ones.
+  json rational = spec;
+  rational["boundary"]["v0"] = {{"bspline",
+                                 {{"degree", 2},
+                                  {"knots", {0, 0, 0, 1, 1, 1}},
+                                  {"control_points", {{0, 0, 0}, {0.5, 0, 0.1}, {1, 0, 0.1 * std::sin(6)}}},
+                                  {"weights", {1, 2, 1}}}}};
+  Construction r = build(rational, {}, deferred);
+  EXPECT_FALSE(has_exact_form(r));
+  EXPECT_FALSE(r.convert);
+  EXPECT_ERRC((void)exact_form(r), no_exact_form, "coons: curve 0 of the u-direction terms is rational");
+  EXPECT_EQ(&evaluator(r, 1000, Sample::points), r.formula.get());
+}
+
+TEST(SpecExact, TheEvaluatorIsTheCheaperOfFormulaAndExactForm) {
+  // A Coons patch of four 600-point curves: 4 terms per point against a ~1200² net.
+  Construction coons = build(coons_spec(600), {}, deferred);
+  (void)evaluator(coons, 1000 * 1000, Sample::points);
+  EXPECT_FALSE(coons.exact.has_value()) << "a million points by formula";
+  (void)evaluator(coons, 1000 * 1000, Sample::derivatives);
+  EXPECT_FALSE(coons.exact.has_value()) << "a mesh of a million points by formula";
+  // A Gordon surface of 8 × 8 curves on shared knots: 16 terms against a 60² net.
+  Construction gordon = build(network_spec(8, 60, "gordon"), {}, deferred);
+  (void)evaluator(gordon, 10, Sample::points);
+  EXPECT_FALSE(gordon.exact.has_value()) << "ten points: not worth a net";
+  const Surface& s = evaluator(gordon, 1000 * 1000, Sample::points);
+  ASSERT_TRUE(gordon.exact.has_value()) << "a million points: the exact form";
+  EXPECT_EQ(&s, &std::get<BSplineSurface>(*gordon.exact));
+  // Both exact: the grid of each agrees with the other to rounding.
+  const auto t = linspace(0, 1, 57);
+  const PointGrid a = s.evaluate(t, t), b = gordon.formula->evaluate(t, t);
+  double worst = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) worst = std::max(worst, distance(a.values()[k], b.values()[k]));
+  // Curves of unit size, ~20 terms each rounded at 1.1e-16, and the exact form's
+  // sums after knot insertion: well under 1e-12.
+  EXPECT_LT(worst, 1e-12);
 }
 
 }  // namespace

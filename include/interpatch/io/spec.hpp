@@ -115,6 +115,22 @@ struct BuildOptions {
 /// The same for a volume construction. @throws error wrong_type (a surface construction).
 [[nodiscard]] const Volume& volume_evaluator(const Construction& c);
 
+/// What a sampling of a construction needs at each point.
+enum class Sample {
+  points,       ///< the points (eval)
+  derivatives,  ///< the points and their derivatives (a mesh's normals)
+};
+
+/// What evaluates a surface construction on `points` parameter pairs at the least
+/// cost: its exact form when that is built, or when making it (about its control
+/// points times the formula's terms) and evaluating it (about the two degrees plus 2
+/// per point) costs less than the formula (its terms per point), in which case it
+/// is made now; otherwise the formula. Both are exact and agree to rounding. A
+/// Coons patch of four 1024-point curves (4 terms, 2044 × 2044 control points) is
+/// evaluated by formula; a Gordon surface of 24 curves on shared knots (24 terms,
+/// 200 × 200 control points) by its exact form. @throws error wrong_type (a volume).
+[[nodiscard]] const Surface& evaluator(Construction& c, std::size_t points, Sample what);
+
 /// The construction types a spec's "type" may name, in the order they are documented.
 [[nodiscard]] std::vector<std::string_view> known_types();
 

@@ -13,6 +13,7 @@
 #include <iterator>
 
 #include "detail/excerpt.hpp"
+#include "interpatch/blended_surface.hpp"
 #include "interpatch/memory.hpp"
 #include "io/spec/forms.hpp"
 #include "io/spec/reader.hpp"
@@ -187,6 +188,24 @@ const Surface& evaluator(const Construction& c) {
   if (c.exact) return std::get<BSplineSurface>(*c.exact);
   if (!c.formula) fail(errc::internal, c.type, ": the construction has neither an exact form nor a formula");
   return *c.formula;
+}
+
+const Surface& evaluator(Construction& c, std::size_t points, Sample what) {
+  if (c.exact || !c.convert) return evaluator(c);
+  const auto* blended = dynamic_cast<const BlendedSurface*>(c.formula.get());
+  if (blended == nullptr) return evaluator(c);
+  // Operations per point, up to a common factor: a term of the formula is one
+  // product (six with derivatives); the exact form's batch evaluation is about
+  // (p + 1) + (q + 1) products per point (six times that with derivatives), after
+  // one sum of the terms per control point to make it.
+  const auto knots = blended->exact_knots();
+  const double w = what == Sample::derivatives ? 6 : 1, n = static_cast<double>(points);
+  const double terms = static_cast<double>(blended->terms());
+  const double net = static_cast<double>(knots[0].count()) * static_cast<double>(knots[1].count());
+  const double by_formula = n * terms * w;
+  const double by_exact = net * terms + n * (knots[0].degree() + knots[1].degree() + 2) * w;
+  if (by_exact < by_formula) (void)exact_form(c);
+  return evaluator(c);
 }
 
 const Volume& volume_evaluator(const Construction& c) {
