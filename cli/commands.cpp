@@ -328,21 +328,8 @@ void write_mesh(io::Construction& c, const fs::path& out, const Resolution& res)
   const Surface& s = io::evaluator(c, res.nu * res.nv, io::Sample::derivatives);
   constexpr double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  // every construction is over the unit square
   const std::vector<double> us = linspace(u0, u1, res.nu), vs = linspace(v0, v1, res.nv);
-  io::SurfaceMesh mesh{PointGrid({res.nu, res.nv}), PointGrid({res.nu, res.nv})};
   ProgressLine progress("meshing");
-  // Derivatives a block of rows at a time: the full grid of them would be six
-  // times the size of the mesh.
-  const std::size_t block = std::max<std::size_t>(1, (std::size_t{1} << 15) / res.nv);
-  for (std::size_t i0 = 0; i0 < res.nu; i0 += block) {
-    const std::size_t nb = std::min(block, res.nu - i0);
-    const auto d = s.evaluate_derivatives(std::span<const double>(us).subspan(i0, nb), vs);
-    for (std::size_t i = 0; i < nb; ++i)
-      for (std::size_t j = 0; j < res.nv; ++j) {
-        mesh.points(i0 + i, j) = d(i, j).s;
-        mesh.normals(i0 + i, j) = unit_normal(d(i, j));
-      }
-    progress.update(static_cast<double>(i0 + nb) / static_cast<double>(res.nu));
-  }
+  const io::SurfaceMesh mesh = io::sample_mesh(s, us, vs, progress.callback());
   progress.clear();
   io::write_surface_mesh(out, mesh);
 }

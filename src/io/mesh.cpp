@@ -11,7 +11,9 @@
 #include <ostream>
 #include <string>
 
+#include "detail/parallel.hpp"
 #include "detail/text.hpp"
+#include "interpatch/evaluate.hpp"
 #include "interpatch/io/atomic_file.hpp"
 
 namespace interpatch::io {
@@ -520,6 +522,26 @@ void write_volume_mesh(const fs::path& path, const PointGrid3& points, const Gri
   s.scalars = jacobian.empty() ? nullptr : jacobian.data();
   s.kind = "volume";
   write_structured(path, ext, s);
+}
+
+SurfaceMesh sample_mesh(const Surface& surface, std::span<const double> us, std::span<const double> vs,
+                        const progress_callback& progress) {
+  const std::size_t nu = us.size(), nv = vs.size();
+  SurfaceMesh mesh{PointGrid({nu, nv}, for_overwrite), PointGrid({nu, nv}, for_overwrite)};
+  const std::size_t block = std::max<std::size_t>(1, (std::size_t{1} << 15) / std::max<std::size_t>(1, nv));
+  for (std::size_t i0 = 0; i0 < nu; i0 += block) {
+    const std::size_t nb = std::min(block, nu - i0);
+    const auto d = surface.evaluate_derivatives(us.subspan(i0, nb), vs);
+    const auto cells = static_cast<long long>(nb * nv);
+#pragma omp parallel for schedule(static) if (nb * nv >= interpatch::detail::parallel_min_work / 16)
+    for (long long c = 0; c < cells; ++c) {
+      const std::size_t i = static_cast<std::size_t>(c) / nv, j = static_cast<std::size_t>(c) % nv;
+      mesh.points(i0 + i, j) = d(i, j).s;
+      mesh.normals(i0 + i, j) = unit_normal(d(i, j));
+    }
+    if (progress) progress(static_cast<double>(i0 + nb) / static_cast<double>(nu));
+  }
+  return mesh;
 }
 
 }  // namespace interpatch::io

@@ -4,9 +4,12 @@
 /// CFD-meshing tools read.
 
 #include <filesystem>
+#include <span>
 #include <string_view>
 
 #include "interpatch/grid.hpp"
+#include "interpatch/progress.hpp"
+#include "interpatch/surface.hpp"
 
 namespace interpatch::io {
 
@@ -16,6 +19,13 @@ struct SurfaceMesh {
   /// Unit normals per vertex (same shape as points), or empty.
   PointGrid normals;
 };
+
+/// The mesh of a surface on the grid us × vs: points and unit normals
+/// (unit_normal()). Derivatives are taken a block of rows at a time (the whole grid
+/// of them would be six times the mesh); both cores share every block.
+/// @throws error out_of_domain, too_large, and what the surface's evaluation throws.
+[[nodiscard]] SurfaceMesh sample_mesh(const Surface& surface, std::span<const double> us, std::span<const double> vs,
+                                      const progress_callback& progress = {});
 
 /// The mesh formats a surface can be written to, chosen by extension:
 /// .obj (Wavefront, quads with normals and uv), .stl (binary, triangles),
