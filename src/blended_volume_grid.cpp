@@ -215,7 +215,7 @@ Folded fold_slab(const detail::VolumeTerms& T, std::span<const double> us, std::
 }
 
 // Calls at(i, j, k, S, S_u, S_v, S_w) for every grid point (the partials zero
-// without derivatives), u rows split over the threads; each point is a sum in a
+// without derivatives), lines along w split over the threads; each point is a sum in a
 // fixed order, so the result does not depend on the thread count.
 template <bool derivatives, class At>
 void for_each_point(const Folded& F, const progress_callback& progress, const At& at) {
@@ -299,8 +299,12 @@ template <class At>
 void fold_and_evaluate(const detail::VolumeTerms& T, PlaneCache& cache, std::span<const double> us,
                        std::span<const double> vs, std::span<const double> ws, bool derivatives,
                        const progress_callback& progress, const At& at) {
-  const auto u = u_planes(T, vs, ws, derivatives, cache);
   const std::size_t nu = us.size();
+  if (nu == 0) {  // no point: no planes to make
+    if (progress) progress(1.0);
+    return;
+  }
+  const auto u = u_planes(T, vs, ws, derivatives, cache);
   const std::size_t per_row = (T.blends[1].size() * ws.size() + T.blends[2].size() * vs.size()) * (derivatives ? 3 : 1);
   const std::size_t rows = std::max<std::size_t>(1, max_slab_plane_points / std::max<std::size_t>(1, per_row));
   for (std::size_t i0 = 0; i0 < nu; i0 += rows) {
@@ -314,7 +318,6 @@ void fold_and_evaluate(const detail::VolumeTerms& T, PlaneCache& cache, std::spa
     if (derivatives) for_each_point<true>(F, slab_progress, slab_at);
     else for_each_point<false>(F, slab_progress, slab_at);
   }
-  if (progress && nu == 0) progress(1.0);
 }
 
 // Whether the grid's point count, times the bytes of a point, can be addressed; the

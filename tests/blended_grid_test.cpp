@@ -163,6 +163,14 @@ TEST(BlendedGrid, VolumeGridReportsProgressAndRefusesBadInput) {
   EXPECT_ERRC(v.evaluate_into(ok, bad, ok, std::span<Vec3>(out)), out_of_domain, "parameter v = 1.5");
   EXPECT_ERRC(v.evaluate_into(ok, ok, ok, std::span<Vec3>(out)), size_mismatch, "the output holds 4 points");
   EXPECT_ERRC((void)v.evaluate_derivatives(ok, ok, bad), out_of_domain, "parameter w = 1.5");
+  // One u value over 10⁵ × 10⁵ (v, w): the planes of u (two blends, 480 GB) are
+  // refused before anything is made or written (the caller's memory is never touched).
+  const std::vector<double> many = linspace(0, 1, 100000), one{0.5};
+  const std::span<Vec3> huge(out.data(), many.size() * many.size());
+  EXPECT_ERRC(v.evaluate_into(one, many, many, huge), too_large,
+              "the planes of a blended volume over 100000x100000 (v, w) parameters");
+  // No u value: nothing to make, whatever vs and ws.
+  EXPECT_NO_THROW(v.evaluate_into({}, many, many, std::span<Vec3>()));
 }
 
 TEST(BlendedGrid, SurfaceDerivativeGridsAgreeWithThePointwiseFormula) {

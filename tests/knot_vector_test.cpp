@@ -1,6 +1,11 @@
 #include "interpatch/knot_vector.hpp"
 
+#include <algorithm>
+#include <map>
 #include <numeric>
+#include <vector>
+
+#include "interpatch/bspline_curve.hpp"
 
 #include "test_util.hpp"
 
@@ -105,6 +110,57 @@ TEST(KnotVector, InvalidInput) {
   EXPECT_ERRC(KnotVector(1, {0, 0, std::nan(""), 1, 1}), not_finite, "knot 2");
   EXPECT_ERRC(KnotVector(1, {1, 1, 1, 1}), invalid_knots, "empty domain");
   EXPECT_ERRC(KnotVector::uniform(3, 3), too_few_points, "at least 4");
+}
+
+TEST(KnotVector, MergedKnotsAreTheKnotsOfCurvesMadeCompatible) {
+  auto g = test::rng(31);
+  for (int trial = 0; trial < 50; ++trial) {
+    // Random degrees and knots, some shared (repeated vectors add nothing), some
+    // with a break of multiplicity above 1.
+    std::vector<KnotVector> ks;
+    const int n = 1 + static_cast<int>(test::uniform(g, 0, 4));
+    for (int k = 0; k < n; ++k) {
+      const int p = 1 + static_cast<int>(test::uniform(g, 0, 3));
+      if (k > 0 && test::uniform(g, 0, 1) < 0.3) {
+        ks.push_back(ks.back());
+        continue;
+      }
+      KnotVector kv = random_knots(g, p, p + 1 + static_cast<int>(test::uniform(g, 0, 6)));
+      if (test::uniform(g, 0, 1) < 0.3 && p > 1) {
+        std::vector<double> u = kv.values();
+        u.insert(u.begin() + p + 1, 2, 0.5);  // a break at 0.5 of multiplicity 2 (or more)
+        std::sort(u.begin(), u.end());
+        kv = KnotVector(p, u);
+      }
+      ks.push_back(kv);
+    }
+    std::vector<BSplineCurve> curves;
+    for (const KnotVector& kv : ks) {
+      std::vector<Vec3> cp(static_cast<std::size_t>(kv.count()));
+      for (Vec3& x : cp) x = test::random_point(g);
+      curves.emplace_back(kv, cp);
+    }
+    const KnotVector merged = merged_knots(ks);
+    // Counted here on their own: the highest degree, each break with its highest
+    // multiplicity once raised to that degree.
+    int p = 0;
+    for (const KnotVector& kv : ks) p = std::max(p, kv.degree());
+    std::map<double, int> want;
+    for (const KnotVector& kv : ks)
+      for (const auto& [x, m] : kv.interior_breaks()) want[x] = std::max(want[x], m + p - kv.degree());
+    EXPECT_EQ(merged.degree(), p) << "trial " << trial;
+    const auto got = merged.interior_breaks();
+    const std::map<double, int> have(got.begin(), got.end());
+    EXPECT_EQ(have, want) << "trial " << trial;
+    // Every curve made compatible has exactly these knots, and its shape.
+    const auto compatible = make_compatible(curves);
+    for (std::size_t k = 0; k < curves.size(); ++k) {
+      EXPECT_EQ(compatible[k].knots(), merged) << "trial " << trial << ", curve " << k;
+      for (double t : {0.0, 0.13, 0.5, 0.77, 1.0})  // knot insertion and elevation: rounding only
+        EXPECT_LT(distance(compatible[k].point(t), curves[k].point(t)), 1e-12) << "trial " << trial;
+    }
+  }
+  EXPECT_ERRC((void)merged_knots({}), too_few_points, "no knot vectors to merge");
 }
 
 }  // namespace

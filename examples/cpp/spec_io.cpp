@@ -56,6 +56,24 @@ void building() {
                   "info_json: the surface passes through its data");
 }
 
+void sampling() {
+  auto spec = interpatch::io::parse_json(R"({"type": "coons", "boundary": {
+      "v0": {"line": [[0,0,0], [1,0,0]]}, "v1": {"line": [[0,1,0], [1,1,1]]},
+      "u0": {"line": [[0,0,0], [0,1,0]]}, "u1": {"line": [[1,0,0], [1,1,1]]}}})");
+  interpatch::io::BuildOptions lazy;
+  lazy.defer_exact = true;
+  interpatch::io::Construction c = interpatch::io::build(spec, {}, lazy);  // c.exact is empty
+  const interpatch::Surface& s = interpatch::io::evaluator(c, 10000, interpatch::io::Sample::points);
+  interpatch::Vec3 p = s.point(0.5, 0.5);  // (0.5, 0.5, 0.25), by the formula
+  const auto& e = std::get<interpatch::BSplineSurface>(interpatch::io::exact_form(c));  // made now: 2 × 2
+  // The evaluator was the formula: the exact form did not exist until exact_form().
+  example::expect(&s == c.formula.get(), "evaluated by the formula");
+  example::expect_near(p, {0.5, 0.5, 0.25}, "(0.5, 0.5, 0.25)");
+  example::expect(c.exact.has_value() && &e == &std::get<interpatch::BSplineSurface>(*c.exact), "made now");
+  example::expect(e.control_points().shape() == interpatch::PointGrid::shape_type{2, 2}, "2 × 2 control points");
+  example::expect_near(e.point(0.5, 0.5), p, "the exact form gives the same point");
+}
+
 void point_arrays() {
   auto a = interpatch::io::points_from_json(nlohmann::json::parse("[[0,0,0],[1,0,0]]"), 1);
   // a.shape == {2}
@@ -89,6 +107,7 @@ int main() {
   return example::run("spec_io", [] {
     parsing();
     building();
+    sampling();
     point_arrays();
     curves();
   });

@@ -81,6 +81,19 @@ struct Construction {
 };
 
 /// How build() builds a construction.
+///
+/// Example: a Coons patch sampled by its formula, its exact form made when asked.
+/// @code
+///   auto spec = interpatch::io::parse_json(R"({"type": "coons", "boundary": {
+///       "v0": {"line": [[0,0,0], [1,0,0]]}, "v1": {"line": [[0,1,0], [1,1,1]]},
+///       "u0": {"line": [[0,0,0], [0,1,0]]}, "u1": {"line": [[1,0,0], [1,1,1]]}}})");
+///   interpatch::io::BuildOptions lazy;
+///   lazy.defer_exact = true;
+///   interpatch::io::Construction c = interpatch::io::build(spec, {}, lazy);  // c.exact is empty
+///   const interpatch::Surface& s = interpatch::io::evaluator(c, 10000, interpatch::io::Sample::points);
+///   interpatch::Vec3 p = s.point(0.5, 0.5);  // (0.5, 0.5, 0.25), by the formula
+///   const auto& e = std::get<interpatch::BSplineSurface>(interpatch::io::exact_form(c));  // made now: 2 × 2
+/// @endcode
 struct BuildOptions {
   /// Gets the fraction done of long constructions.
   progress_callback progress;
