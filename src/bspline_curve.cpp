@@ -86,7 +86,42 @@ Refined<T> refine(const KnotVector& knots, const std::vector<T>& P, const std::v
   return out;
 }
 
+// The homogeneous point of a curve at t (inside its domain, or wrapped).
+H homogeneous_at(const KnotVector& k, const std::vector<Vec3>& cp, const std::vector<double>& w, double t) {
+  t = k.wrap(t);
+  const int p = k.degree(), span = k.find_span(t);
+  double N[max_degree + 1];
+  k.basis(span, t, N);
+  H h{0, 0, 0, 0};
+  for (int j = 0; j <= p; ++j) {
+    const auto idx = static_cast<std::size_t>(k.wrap_index(span - p + j));
+    const double c = N[j] * (w.empty() ? 1.0 : w[idx]);
+    h[0] += c * cp[idx].x;
+    h[1] += c * cp[idx].y;
+    h[2] += c * cp[idx].z;
+    h[3] += c;
+  }
+  return h;
+}
+
+// The curve in a spline space that contains it (a refinement, an elevation, the
+// clamped form of a closed curve): interpolation at the space's Greville abscissae
+// recovers its control points exactly, up to rounding of a well-conditioned banded
+// (or cyclic banded) solve.
+BSplineCurve in_space(KnotVector target, const KnotVector& k, const std::vector<Vec3>& cp, const std::vector<double>& w) {
+  const auto g = target.greville();
+  std::vector<H> rhs(g.size());
+  for (std::size_t i = 0; i < g.size(); ++i) rhs[i] = homogeneous_at(k, cp, w, g[i]);
+  if (target.periodic()) detail::factor_periodic_collocation(target, g).solve(rhs.data()->data(), 4, 4);
+  else detail::factor_collocation(target, g).solve(rhs.data()->data(), 4, 4);
+  return from_homogeneous(std::move(target), rhs, !w.empty());
+}
+
 void check_domain(const KnotVector& k, double t) {
+  if (k.periodic()) {
+    if (!std::isfinite(t)) fail(errc::out_of_domain, "parameter ", t, " is not a number on the closed curve");
+    return;
+  }
   // A parameter a few ulps outside the domain is rounding from the caller's mapping.
   const double a = k.front(), b = k.back();
   const double slack = 1e-12 * (b - a);
@@ -135,6 +170,7 @@ std::vector<Vec3> BSplineCurve::derivatives(double t, int n) const {
 
 void BSplineCurve::derivatives(double t, int n, Vec3* out) const {
   check_domain(knots_, t);
+  t = knots_.wrap(t);
   const int p = degree();
   const int nb = std::min(n, p);
   const int s = knots_.find_span(t);
@@ -144,7 +180,7 @@ void BSplineCurve::derivatives(double t, int n, Vec3* out) const {
   if (!rational()) {
     for (int k = 0; k <= nb; ++k) {
       Vec3 d{};
-      for (int j = 0; j <= p; ++j) d += ders[k * (p + 1) + j] * cp_[static_cast<std::size_t>(s - p + j)];
+      for (int j = 0; j <= p; ++j) d += ders[k * (p + 1) + j] * cp_[static_cast<std::size_t>(knots_.wrap_index(s - p + j))];
       out[k] = d;
     }
     return;
@@ -157,7 +193,7 @@ void BSplineCurve::derivatives(double t, int n, Vec3* out) const {
     Vec3 a{};
     double w = 0;
     for (int j = 0; j <= p; ++j) {
-      const auto idx = static_cast<std::size_t>(s - p + j);
+      const auto idx = static_cast<std::size_t>(knots_.wrap_index(s - p + j));
       const double c = ders[k * (p + 1) + j] * w_[idx];
       a += c * cp_[idx];
       w += c;
@@ -177,6 +213,7 @@ void BSplineCurve::derivatives(double t, int n, Vec3* out) const {
 }
 
 BSplineCurve BSplineCurve::inserted(double t, int times) const {
+  if (periodic()) return refined(std::vector<double>(static_cast<std::size_t>(std::max(times, 0)), t));
   const int p = degree();
   const auto& U = knots_.values();
   if (!(t > knots_.front() && t < knots_.back()))
@@ -217,11 +254,18 @@ BSplineCurve BSplineCurve::inserted(double t, int times) const {
 
 BSplineCurve BSplineCurve::refined(std::span<const double> knots) const {
   if (knots.empty()) return *this;
-  for (double t : knots)
-    if (!(t > knots_.front() && t < knots_.back()))
+  for (double t : knots) {
+    if (periodic() && !std::isfinite(t)) fail(errc::out_of_domain, "knot ", t, " to insert is not a number");
+    if (!periodic() && !(t > knots_.front() && t < knots_.back()))
       fail(errc::out_of_domain, "knot ", t, " to insert is not inside the open domain (", knots_.front(), ", ",
            knots_.back(), ")");
+  }
   std::vector<double> X(knots.begin(), knots.end());
+  if (periodic())
+    for (double& t : X) {
+      t = knots_.wrap(t);
+      if (t == knots_.back()) t = knots_.front();  // the seam
+    }
   if (!std::is_sorted(X.begin(), X.end())) std::sort(X.begin(), X.end());
   const int p = degree();
   for (std::size_t i = 0; i < X.size();) {
@@ -232,6 +276,12 @@ BSplineCurve BSplineCurve::refined(std::span<const double> knots) const {
       fail(errc::invalid_knots, "inserting ", X[i], " ", times, " times gives multiplicity ", s + times,
            ", more than degree ", p);
     i = j;
+  }
+  if (periodic()) {
+    std::vector<double> k = knots_.period_knots();
+    k.insert(k.end(), X.begin(), X.end());
+    std::sort(k.begin(), k.end());
+    return in_space(KnotVector::periodic_from(p, std::move(k), knots_.back()), knots_, cp_, w_);
   }
   if (!rational()) {
     auto r = refine(knots_, cp_, X);
@@ -248,8 +298,12 @@ BSplineCurve BSplineCurve::elevated(int times) const {
   const int q = p + times;
   if (q > max_degree) fail(errc::invalid_degree, "elevated degree ", q, " exceeds ", max_degree);
   // The elevated space has every knot's multiplicity raised by `times`; the curve
-  // lies in it, so interpolation at that space's Greville abscissae recovers its
-  // control points exactly (up to rounding of a well-conditioned banded solve).
+  // lies in it (in_space).
+  if (periodic()) {
+    std::vector<double> V;
+    for (const auto& [x, m] : knots_.interior_breaks()) V.insert(V.end(), static_cast<std::size_t>(m + times), x);
+    return in_space(KnotVector::periodic_from(q, std::move(V), knots_.back()), knots_, cp_, w_);
+  }
   std::vector<double> V;
   const auto& U = knots_.values();
   for (std::size_t i = 0; i < U.size();) {
@@ -258,28 +312,12 @@ BSplineCurve BSplineCurve::elevated(int times) const {
     V.insert(V.end(), j - i + static_cast<std::size_t>(times), U[i]);
     i = j;
   }
-  KnotVector kv(q, std::move(V));
-  const auto g = kv.greville();
-  const auto lu = detail::factor_collocation(kv, g);
-  std::vector<H> rhs(g.size());
-  const int s = p;
-  double N[max_degree + 1];
-  for (std::size_t i = 0; i < g.size(); ++i) {
-    const int span = knots_.find_span(g[i]);
-    knots_.basis(span, g[i], N);
-    H h{0, 0, 0, 0};
-    for (int j = 0; j <= s; ++j) {
-      const auto idx = static_cast<std::size_t>(span - p + j);
-      const double w = rational() ? w_[idx] : 1.0;
-      h[0] += N[j] * w * cp_[idx].x;
-      h[1] += N[j] * w * cp_[idx].y;
-      h[2] += N[j] * w * cp_[idx].z;
-      h[3] += N[j] * w;
-    }
-    rhs[i] = h;
-  }
-  lu.solve(rhs.data()->data(), 4, 4);
-  return from_homogeneous(std::move(kv), rhs, rational());
+  return in_space(KnotVector(q, std::move(V)), knots_, cp_, w_);
+}
+
+BSplineCurve BSplineCurve::clamped() const {
+  if (!periodic()) return *this;
+  return in_space(knots_.clamped(), knots_, cp_, w_);
 }
 
 BSplineCurve BSplineCurve::mapped(double a, double b) const {

@@ -28,20 +28,19 @@ std::vector<Basis> bases(const KnotVector& k, std::span<const double> ts, int nd
   return detail::basis_table<3>(k, ts, nd, dir);
 }
 
-// out[x] = Σ_a w[a] first[a·stride + x] for x < n: rows of the control net
-// (3 doubles a point) weighted by the basis functions of one u. Cubics (4 rows) in
-// one sweep; other degrees row by row.
-INTERPATCH_KERNEL void weighted_rows(const double* w, int count, const double* first, std::size_t stride,
-                                     std::size_t n, double* out) {
+// out[x] = Σ_a w[a] rows[a][x] for x < n: rows of the control net (3 doubles a
+// point) weighted by the basis functions of one u. Cubics (4 rows) in one sweep;
+// other degrees row by row.
+INTERPATCH_KERNEL void weighted_rows(const double* w, int count, const double* const* rows, std::size_t n, double* out) {
   if (count == 4) {
-    const double *r0 = first, *r1 = first + stride, *r2 = first + 2 * stride, *r3 = first + 3 * stride;
+    const double *r0 = rows[0], *r1 = rows[1], *r2 = rows[2], *r3 = rows[3];
     for (std::size_t x = 0; x < n; ++x) out[x] = w[0] * r0[x] + w[1] * r1[x] + w[2] * r2[x] + w[3] * r3[x];
     return;
   }
-  for (std::size_t x = 0; x < n; ++x) out[x] = w[0] * first[x];
+  for (std::size_t x = 0; x < n; ++x) out[x] = w[0] * rows[0][x];
   for (int a = 1; a < count; ++a) {
     const double c = w[a];
-    const double* r = first + static_cast<std::size_t>(a) * stride;
+    const double* r = rows[a];
     for (std::size_t x = 0; x < n; ++x) out[x] += c * r[x];
   }
 }
@@ -151,8 +150,8 @@ Vec3 BSplineSurface::derivative(double u, double v, int du, int dv) const {
   check_parameter(kv_, v, "v");
   if (du < 0 || dv < 0 || du > max_degree || dv > max_degree)
     fail(errc::invalid_degree, "derivative order (", du, ", ", dv, ") is outside 0..", max_degree);
-  u = std::clamp(u, ku_.front(), ku_.back());
-  v = std::clamp(v, kv_.front(), kv_.back());
+  u = ku_.periodic() ? ku_.wrap(u) : std::clamp(u, ku_.front(), ku_.back());
+  v = kv_.periodic() ? kv_.wrap(v) : std::clamp(v, kv_.front(), kv_.back());
   const int p = degree_u(), q = degree_v();
   const int su = ku_.find_span(u), sv = kv_.find_span(v);
   double Nu[W * W], Nv[W * W];
@@ -168,9 +167,9 @@ Vec3 BSplineSurface::derivative(double u, double v, int du, int dv) const {
       for (int i = 0; i <= p; ++i) {
         const double nu_ = Nu[k * (p + 1) + i];
         if (nu_ == 0.0) continue;
-        const auto ii = static_cast<std::size_t>(su - p + i);
+        const auto ii = static_cast<std::size_t>(ku_.wrap_index(su - p + i));
         for (int j = 0; j <= q; ++j) {
-          const auto jj = static_cast<std::size_t>(sv - q + j);
+          const auto jj = static_cast<std::size_t>(kv_.wrap_index(sv - q + j));
           const double c = nu_ * Nv[l * (q + 1) + j] * (w_.empty() ? 1.0 : w_(ii, jj));
           a += c * cp_(ii, jj);
           wsum += c;
@@ -230,15 +229,21 @@ void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const d
       std::copy_n(bv[j].d, q + 1, weights.data() + j * static_cast<std::size_t>(q + 1));
     }
     const std::size_t row_doubles = 3 * ncv;
+    // A periodic v: the row's first q points repeated after it, so that spans past
+    // the last control point read on (sample_row never wraps).
+    const std::size_t wrap_doubles = kv_.periodic() ? 3 * static_cast<std::size_t>(q) : 0;
 #pragma omp parallel if (threads)
     {
-      std::vector<double> row(row_doubles + 1);  // one double of slack for sample_row
+      std::vector<double> row(row_doubles + wrap_doubles + 1);  // one double of slack for sample_row
+      const double* rows[W];
       const bool reporter = detail::thread_index() == 0;
 #pragma omp for schedule(static, 16)
       for (long long ri = 0; ri < nu; ++ri) {
         const auto i = static_cast<std::size_t>(ri);
         const Basis& b = bu[i];
-        weighted_rows(b.d, p + 1, &cp_(static_cast<std::size_t>(b.span - p), 0).x, row_doubles, row_doubles, row.data());
+        for (int a = 0; a <= p; ++a) rows[a] = &cp_(static_cast<std::size_t>(ku_.wrap_index(b.span - p + a)), 0).x;
+        weighted_rows(b.d, p + 1, rows, row_doubles, row.data());
+        std::copy_n(row.data(), wrap_doubles, row.data() + row_doubles);
         // Not &out[i * nv].x: with no v values there is no element to index.
         sample_row(spans.data(), weights.data(), q, nv, row.data(), reinterpret_cast<double*>(out.data() + i * nv));
         const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
@@ -252,6 +257,7 @@ void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const d
   {
     // One contracted row of homogeneous points per thread, reused for every u.
     std::vector<std::array<double, 4>> row(ncv);
+    const KnotVector& kv = kv_;
     const bool reporter = detail::thread_index() == 0;
 #pragma omp for schedule(static, 16)
     for (long long ri = 0; ri < nu; ++ri) {
@@ -260,7 +266,7 @@ void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const d
       for (std::size_t l = 0; l < ncv; ++l) {
         double x = 0, y = 0, z = 0, w = 0;
         for (int a = 0; a <= p; ++a) {
-          const auto ii = static_cast<std::size_t>(b.span - p + a);
+          const auto ii = static_cast<std::size_t>(ku_.wrap_index(b.span - p + a));
           const double c = b.d[a] * (rat ? w_(ii, l) : 1.0);
           const Vec3& P = cp_(ii, l);
           x += c * P.x;
@@ -275,7 +281,7 @@ void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const d
         const Basis& c = bv[j];
         double x = 0, y = 0, z = 0, w = 0;
         for (int k = 0; k <= q; ++k) {
-          const auto& h = row[static_cast<std::size_t>(c.span - q + k)];
+          const auto& h = row[static_cast<std::size_t>(kv.wrap_index(c.span - q + k))];
           x += c.d[k] * h[0];
           y += c.d[k] * h[1];
           z += c.d[k] * h[2];
@@ -314,7 +320,7 @@ Grid<SurfaceDerivatives, 2> BSplineSurface::evaluate_derivatives(std::span<const
         for (std::size_t l = 0; l < ncv; ++l) {
           std::array<double, 4> h{0, 0, 0, 0};
           for (int a = 0; a <= p; ++a) {
-            const auto ii = static_cast<std::size_t>(b.span - p + a);
+            const auto ii = static_cast<std::size_t>(ku_.wrap_index(b.span - p + a));
             const double c = b.d[k * (p + 1) + a] * (rat ? w_(ii, l) : 1.0);
             const Vec3& P = cp_(ii, l);
             h[0] += c * P.x;
@@ -333,7 +339,7 @@ Grid<SurfaceDerivatives, 2> BSplineSurface::evaluate_derivatives(std::span<const
             std::array<double, 4> h{0, 0, 0, 0};
             for (int m = 0; m <= q; ++m) {
               const double f = c.d[l * (q + 1) + m];
-              const auto& r = rows[k][static_cast<std::size_t>(c.span - q + m)];
+              const auto& r = rows[k][static_cast<std::size_t>(kv_.wrap_index(c.span - q + m))];
               for (int e = 0; e < 4; ++e) h[static_cast<std::size_t>(e)] += f * r[static_cast<std::size_t>(e)];
             }
             A[k][l] = h;
@@ -370,6 +376,13 @@ BSplineSurface BSplineSurface::elevated(int tu, int tv) const {
   BSplineSurface s = *this;
   if (tu > 0) s = along(s, 0, [&](const BSplineCurve& c) { return c.elevated(tu); });
   if (tv > 0) s = along(s, 1, [&](const BSplineCurve& c) { return c.elevated(tv); });
+  return s;
+}
+
+BSplineSurface BSplineSurface::clamped() const {
+  BSplineSurface s = *this;
+  if (ku_.periodic()) s = along(s, 0, [](const BSplineCurve& c) { return c.clamped(); });
+  if (kv_.periodic()) s = along(s, 1, [](const BSplineCurve& c) { return c.clamped(); });
   return s;
 }
 

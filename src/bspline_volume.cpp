@@ -22,6 +22,9 @@ constexpr int D = max_volume_derivative + 1;
 using H = std::array<double, 4>;  // homogeneous point (w x, w y, w z, w)
 
 using detail::check_parameter;
+double into_domain(const KnotVector& k, double t) {
+  return k.periodic() ? k.wrap(t) : std::clamp(t, k.front(), k.back());
+}
 // Rows of basis functions with first derivatives, computed once per batch.
 using Basis = detail::BasisRow<2>;
 std::vector<Basis> bases(const KnotVector& k, std::span<const double> ts, int nd, const char* dir) {
@@ -72,7 +75,7 @@ void contract(const BSplineVolume& b, const std::vector<Basis>& bu, const std::v
         std::fill(out, out + plane, H{0, 0, 0, 0});
         for (int e = 0; e <= p; ++e) {
           const double c = a.d[k * (p + 1) + e];
-          const auto ii = static_cast<std::size_t>(a.span - p + e);
+          const auto ii = static_cast<std::size_t>(b.knots_u().wrap_index(a.span - p + e));
           const Vec3* P = &cp(ii, 0, 0);
           if (rat) {
             const double* wp = &wt(ii, 0, 0);
@@ -100,19 +103,18 @@ void contract(const BSplineVolume& b, const std::vector<Basis>& bu, const std::v
           std::fill(out, out + ncw, H{0, 0, 0, 0});
           for (int e = 0; e <= q; ++e) {
             const double c = bj.d[ll[t] * (q + 1) + e];
-            const H* in = U[kk[t]].data() + static_cast<std::size_t>(bj.span - q + e) * ncw;
+            const H* in = U[kk[t]].data() + static_cast<std::size_t>(b.knots_v().wrap_index(bj.span - q + e)) * ncw;
             for (std::size_t x = 0; x < ncw; ++x)
               for (std::size_t y = 0; y < 4; ++y) out[x][y] += c * in[x][y];
           }
         }
         for (std::size_t m = 0; m < nw; ++m) {
           const Basis& bm = bw[m];
-          const auto s0 = static_cast<std::size_t>(bm.span - r);
           // h[0] = S, h[1] = S_u, h[2] = S_v, h[3] = S_w, homogeneous.
           H h[4]{};
           for (int e = 0; e <= r; ++e) {
             const double c0 = bm.d[e];
-            const auto x = s0 + static_cast<std::size_t>(e);
+            const auto x = static_cast<std::size_t>(b.knots_w().wrap_index(bm.span - r + e));
             for (std::size_t y = 0; y < 4; ++y) h[0][y] += c0 * V[0][x][y];
             if constexpr (Partials) {
               const double c1 = bm.d[(r + 1) + e];
@@ -254,9 +256,9 @@ Vec3 BSplineVolume::derivative(double u, double v, double w, int du, int dv, int
     if (k < 0 || k > max_volume_derivative)
       fail(errc::invalid_degree, "derivative order (", du, ", ", dv, ", ", dw, ") is outside 0..",
            max_volume_derivative, " in some direction");
-  u = std::clamp(u, ku_.front(), ku_.back());
-  v = std::clamp(v, kv_.front(), kv_.back());
-  w = std::clamp(w, kw_.front(), kw_.back());
+  u = into_domain(ku_, u);
+  v = into_domain(kv_, v);
+  w = into_domain(kw_, w);
   const int p = degree_u(), q = degree_v(), r = degree_w();
   const int su = ku_.find_span(u), sv = kv_.find_span(v), sw = kw_.find_span(w);
   double Nu[D * W], Nv[D * W], Nw[D * W];
@@ -276,13 +278,13 @@ Vec3 BSplineVolume::derivative(double u, double v, double w, int du, int dv, int
         for (int a = 0; a <= p; ++a) {
           const double fa = Nu[k * (p + 1) + a];
           if (fa == 0.0) continue;
-          const auto ii = static_cast<std::size_t>(su - p + a);
+          const auto ii = static_cast<std::size_t>(ku_.wrap_index(su - p + a));
           for (int b = 0; b <= q; ++b) {
             const double fb = fa * Nv[l * (q + 1) + b];
             if (fb == 0.0) continue;
-            const auto jj = static_cast<std::size_t>(sv - q + b);
+            const auto jj = static_cast<std::size_t>(kv_.wrap_index(sv - q + b));
             for (int c = 0; c <= r; ++c) {
-              const auto kk = static_cast<std::size_t>(sw - r + c);
+              const auto kk = static_cast<std::size_t>(kw_.wrap_index(sw - r + c));
               const double f = fb * Nw[m * (r + 1) + c] * (rat ? w_(ii, jj, kk) : 1.0);
               acc += f * cp_(ii, jj, kk);
               wsum += f;
@@ -320,9 +322,9 @@ VolumeDerivatives BSplineVolume::derivatives(double u, double v, double w) const
   check_parameter(ku_, u, "u");
   check_parameter(kv_, v, "v");
   check_parameter(kw_, w, "w");
-  u = std::clamp(u, ku_.front(), ku_.back());
-  v = std::clamp(v, kv_.front(), kv_.back());
-  w = std::clamp(w, kw_.front(), kw_.back());
+  u = into_domain(ku_, u);
+  v = into_domain(kv_, v);
+  w = into_domain(kw_, w);
   const int p = degree_u(), q = degree_v(), r = degree_w();
   const int su = ku_.find_span(u), sv = kv_.find_span(v), sw = kw_.find_span(w);
   double Nu[2 * W], Nv[2 * W], Nw[2 * W];
@@ -333,11 +335,11 @@ VolumeDerivatives BSplineVolume::derivatives(double u, double v, double w) const
   const bool rat = rational();
   H h[4]{};
   for (int a = 0; a <= p; ++a) {
-    const auto ii = static_cast<std::size_t>(su - p + a);
+    const auto ii = static_cast<std::size_t>(ku_.wrap_index(su - p + a));
     for (int b = 0; b <= q; ++b) {
-      const auto jj = static_cast<std::size_t>(sv - q + b);
+      const auto jj = static_cast<std::size_t>(kv_.wrap_index(sv - q + b));
       for (int c = 0; c <= r; ++c) {
-        const auto kk = static_cast<std::size_t>(sw - r + c);
+        const auto kk = static_cast<std::size_t>(kw_.wrap_index(sw - r + c));
         const double wt = rat ? w_(ii, jj, kk) : 1.0;
         const Vec3& P = cp_(ii, jj, kk);
         const H x{wt * P.x, wt * P.y, wt * P.z, wt};
@@ -402,6 +404,13 @@ BSplineVolume BSplineVolume::elevated(int tu, int tv, int tw) const {
   if (tu > 0) b = along(b, 0, [&](const BSplineCurve& c) { return c.elevated(tu); });
   if (tv > 0) b = along(b, 1, [&](const BSplineCurve& c) { return c.elevated(tv); });
   if (tw > 0) b = along(b, 2, [&](const BSplineCurve& c) { return c.elevated(tw); });
+  return b;
+}
+
+BSplineVolume BSplineVolume::clamped() const {
+  BSplineVolume b = *this;
+  for (int a = 0; a < 3; ++a)
+    if ((a == 0 ? ku_ : a == 1 ? kv_ : kw_).periodic()) b = along(b, a, [](const BSplineCurve& c) { return c.clamped(); });
   return b;
 }
 

@@ -26,6 +26,7 @@ std::string_view to_string(errc code) noexcept {
     case errc::invalid_blend: return "invalid_blend";
     case errc::no_exact_form: return "no_exact_form";
     case errc::malformed_file: return "malformed_file";
+    case errc::closing_gap: return "closing_gap";
     case errc::file_unreadable: return "file_unreadable";
     case errc::file_unwritable: return "file_unwritable";
     case errc::too_large: return "too_large";

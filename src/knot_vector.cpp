@@ -9,7 +9,12 @@ namespace interpatch {
 
 using detail::fail;
 
+KnotVector::KnotVector(int degree, std::vector<double> knots, int count, bool periodic)
+    : p_(degree), u_(std::move(knots)), count_(count), end_(periodic ? count + degree : count), periodic_(periodic) {}
+
 KnotVector::KnotVector(int degree, std::vector<double> knots) : p_(degree), u_(std::move(knots)) {
+  count_ = static_cast<int>(u_.size()) - p_ - 1;
+  end_ = count_;
   if (p_ < 1 || p_ > max_degree)
     fail(errc::invalid_degree, "degree ", p_, " is outside 1..", max_degree);
   const auto p = static_cast<std::size_t>(p_);
@@ -47,6 +52,86 @@ KnotVector::KnotVector(int degree, std::vector<double> knots) : p_(degree), u_(s
   }
 }
 
+KnotVector KnotVector::periodic_from(int degree, std::vector<double> knots, double end) {
+  if (degree < 1 || degree > max_degree) fail(errc::invalid_degree, "degree ", degree, " is outside 1..", max_degree);
+  const std::size_t n = knots.size(), p = static_cast<std::size_t>(degree);
+  // Fewer control points than p + 1 would make one span use a control point twice.
+  if (n < p + 1)
+    fail(errc::too_few_points, "a periodic knot vector of degree ", degree, " needs at least ", p + 1,
+         " knots in its period, got ", n);
+  for (std::size_t i = 0; i < n; ++i)
+    if (!std::isfinite(knots[i])) fail(errc::not_finite, "knot ", i, " is ", knots[i]);
+  if (!std::isfinite(end)) fail(errc::not_finite, "the end of the period is ", end);
+  for (std::size_t i = 1; i < n; ++i)
+    if (knots[i] < knots[i - 1])
+      fail(errc::non_increasing, "knot ", i, " = ", knots[i], " is smaller than knot ", i - 1, " = ", knots[i - 1]);
+  const double a = knots.front();
+  if (!(end > a)) fail(errc::invalid_knots, "the period [", a, ", ", end, ") is empty");
+  if (!(knots.back() < end))
+    fail(errc::invalid_knots, "knot ", n - 1, " = ", knots.back(), " is not inside the period [", a, ", ", end, ")");
+  for (std::size_t i = 0; i < n;) {
+    std::size_t j = i;
+    while (j + 1 < n && knots[j + 1] == knots[i]) ++j;
+    if (j - i + 1 > p)
+      fail(errc::invalid_knots, "knot ", knots[i], " at index ", i, " has multiplicity ", j - i + 1, ", more than degree ",
+           degree, " allows");
+    i = j + 1;
+  }
+  // Extended knots: p images of the period's last knots before it, the period, its
+  // end, and p images of its first knots after it.
+  const double T = end - a;
+  std::vector<double> u(n + 2 * p + 1);
+  for (std::size_t i = 0; i < p; ++i) u[i] = knots[n - p + i] - T;
+  std::copy(knots.begin(), knots.end(), u.begin() + static_cast<std::ptrdiff_t>(p));
+  u[n + p] = end;
+  for (std::size_t i = 1; i <= p; ++i) u[n + p + i] = knots[i] + T;
+  return KnotVector(degree, std::move(u), static_cast<int>(n), true);
+}
+
+KnotVector KnotVector::periodic_from_extended(int degree, const std::vector<double>& knots) {
+  if (degree < 1 || degree > max_degree) fail(errc::invalid_degree, "degree ", degree, " is outside 1..", max_degree);
+  const auto p = static_cast<std::size_t>(degree);
+  if (knots.size() < 3 * p + 2)
+    fail(errc::invalid_knots, "a periodic knot vector of degree ", degree, " needs at least ", 3 * p + 2,
+         " extended knots (degree + 1 control points), got ", knots.size());
+  const std::size_t n = knots.size() - 2 * p - 1;
+  KnotVector k = periodic_from(degree, std::vector<double>(knots.begin() + static_cast<std::ptrdiff_t>(p),
+                                                           knots.begin() + static_cast<std::ptrdiff_t>(p + n)),
+                               knots[p + n]);
+  // Other programs compute the images by their own additions: 1e-12 of the period
+  // covers their rounding and nothing more.
+  const double tol = 1e-12 * (k.back() - k.front());
+  for (std::size_t i = 0; i < knots.size(); ++i)
+    if (!(std::abs(knots[i] - k.u_[i]) <= tol))
+      fail(errc::invalid_knots, "knot ", i, " = ", knots[i], " does not repeat the period: a periodic knot vector has ",
+           k.u_[i], " there (the period ", k.back() - k.front(), " on from knot ", i < p ? i + n : i - n, ")");
+  return k;
+}
+
+double KnotVector::wrap(double t) const noexcept {
+  const double a = front(), b = back();
+  if (!periodic_ || (t >= a && t <= b) || !std::isfinite(t)) return t;
+  const double T = b - a;
+  double r = a + (t - a - T * std::floor((t - a) / T));
+  if (r >= b) r = a;  // rounding of the last step
+  if (r < a) r = a;
+  return r;
+}
+
+std::vector<double> KnotVector::period_knots() const {
+  if (!periodic_) return {};
+  return {u_.begin() + p_, u_.begin() + p_ + count_};
+}
+
+KnotVector KnotVector::clamped() const {
+  if (!periodic_) return *this;
+  std::vector<double> u(static_cast<std::size_t>(p_) + 1, front());
+  for (int i = p_; i < p_ + count_; ++i)
+    if (u_[static_cast<std::size_t>(i)] != front()) u.push_back(u_[static_cast<std::size_t>(i)]);
+  u.insert(u.end(), static_cast<std::size_t>(p_) + 1, back());
+  return KnotVector(p_, std::move(u));
+}
+
 KnotVector KnotVector::bezier(int degree) {
   if (degree < 1 || degree > max_degree)
     detail::fail(errc::invalid_degree, "degree ", degree, " is outside 1..", max_degree);
@@ -68,7 +153,7 @@ KnotVector KnotVector::uniform(int degree, int count, double a, double b) {
 }
 
 int KnotVector::find_span(double t) const noexcept {
-  const int n = count() - 1;
+  const int n = end_ - 1;
   if (t >= u_[static_cast<std::size_t>(n + 1)]) return n;
   if (t <= u_[static_cast<std::size_t>(p_)]) return p_;
   // upper_bound over [p, n+1]: first knot > t, the span is the one before it.
@@ -162,7 +247,8 @@ int KnotVector::multiplicity(double t) const noexcept {
 
 std::vector<std::pair<double, int>> KnotVector::interior_breaks() const {
   std::vector<std::pair<double, int>> out;
-  for (std::size_t i = static_cast<std::size_t>(p_) + 1; i < static_cast<std::size_t>(count()); ++i) {
+  const std::size_t first = periodic_ ? static_cast<std::size_t>(p_) : static_cast<std::size_t>(p_) + 1;
+  for (std::size_t i = first; i < static_cast<std::size_t>(end_); ++i) {
     if (!out.empty() && out.back().first == u_[i]) ++out.back().second;
     else out.emplace_back(u_[i], 1);
   }
@@ -180,6 +266,14 @@ std::vector<double> KnotVector::greville() const {
 }
 
 KnotVector KnotVector::mapped(double a, double b) const {
+  if (periodic_) {
+    const double u0 = front(), u1 = back();
+    std::vector<double> k = period_knots();
+    for (double& x : k) x = a + (x - u0) * ((b - a) / (u1 - u0));
+    k.front() = a;
+    for (std::size_t i = 1; i < k.size() && u_[static_cast<std::size_t>(p_) + i] == u0; ++i) k[i] = a;
+    return periodic_from(p_, std::move(k), b);
+  }
   const double u0 = u_.front(), u1 = u_.back();
   std::vector<double> v(u_.size());
   for (std::size_t i = 0; i < v.size(); ++i) v[i] = a + (u_[i] - u0) * ((b - a) / (u1 - u0));
@@ -202,6 +296,11 @@ KnotVector merged_knots(std::span<const KnotVector> knots) {
   if (knots.empty()) detail::fail(errc::too_few_points, "no knot vectors to merge");
   int p = 0;
   for (const KnotVector& k : knots) p = std::max(p, k.degree());
+  const bool periodic = knots.front().periodic();
+  for (std::size_t k = 1; k < knots.size(); ++k)
+    if (knots[k].periodic() != periodic)
+      detail::fail(errc::invalid_knots, "knot vector ", k, " is ", knots[k].periodic() ? "periodic" : "clamped",
+                   " and knot vector 0 is not: closed and open splines do not merge");
   // Each vector's breaks merged in one pass (both lists are sorted); vectors met
   // before add nothing.
   std::vector<std::pair<double, int>> merged, next;
@@ -227,6 +326,14 @@ KnotVector merged_knots(std::span<const KnotVector> knots) {
       }
     }
     merged.swap(next);
+  }
+  if (periodic) {
+    std::vector<double> u;
+    // The seam: a break only where some vector has a knot there; the merged period
+    // starts with it either way.
+    if (merged.empty() || merged.front().first != knots.front().front()) u.push_back(knots.front().front());
+    for (const auto& [x, m] : merged) u.insert(u.end(), static_cast<std::size_t>(m), x);
+    return KnotVector::periodic_from(p, std::move(u), knots.front().back());
   }
   std::vector<double> u(static_cast<std::size_t>(p) + 1, knots.front().front());
   for (const auto& [x, m] : merged) u.insert(u.end(), static_cast<std::size_t>(m), x);

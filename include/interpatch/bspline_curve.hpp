@@ -12,7 +12,10 @@
 namespace interpatch {
 
 /// C(t) = Σ N_{i,p}(t) w_i P_i / Σ N_{i,p}(t) w_i over the domain [knots[p], knots[n+1]];
-/// without weights all w_i = 1 and the curve is polynomial on each span.
+/// without weights all w_i = 1 and the curve is polynomial on each span. Over a
+/// periodic knot vector the curve is closed: its control points are the distinct
+/// ones (basis function i + n + 1 belongs to P_i), it is as smooth across the seam
+/// as at any knot, and parameters outside the domain wrap around.
 /// Valid by construction: n+1 control points for n+p+2 knots, finite coordinates,
 /// positive weights.
 ///
@@ -35,9 +38,11 @@ class BSplineCurve {
   /// Empty for a polynomial (non-rational) curve.
   [[nodiscard]] const std::vector<double>& weights() const noexcept { return w_; }
   [[nodiscard]] bool rational() const noexcept { return !w_.empty(); }
+  /// True for a closed curve over a periodic knot vector.
+  [[nodiscard]] bool periodic() const noexcept { return knots_.periodic(); }
   [[nodiscard]] std::pair<double, double> domain() const noexcept { return {knots_.front(), knots_.back()}; }
 
-  /// C(t). @throws error out_of_domain.
+  /// C(t). @throws error out_of_domain (never for a periodic curve: t wraps).
   [[nodiscard]] Vec3 point(double t) const;
   /// d^k C / dt^k at t, any k >= 0. @throws error out_of_domain.
   [[nodiscard]] Vec3 derivative(double t, int k) const;
@@ -47,7 +52,8 @@ class BSplineCurve {
   [[nodiscard]] std::vector<Vec3> derivatives(double t, int n) const;
 
   /// The same curve with t inserted `times` more times (Boehm's algorithm on
-  /// homogeneous points). Geometry unchanged.
+  /// homogeneous points; a periodic curve is re-solved in the refined space, exact
+  /// up to rounding, and takes any t, the seam included). Geometry unchanged.
   /// @throws error out_of_domain (t outside the open domain), invalid_knots (the
   ///   multiplicity would exceed the degree).
   [[nodiscard]] BSplineCurve inserted(double t, int times = 1) const;
@@ -58,6 +64,12 @@ class BSplineCurve {
   [[nodiscard]] BSplineCurve elevated(int times = 1) const;
   /// The same curve over [a, b] instead of its own domain (a linear change of parameter).
   [[nodiscard]] BSplineCurve mapped(double a = 0.0, double b = 1.0) const;
+  /// The same curve over a clamped knot vector: a periodic curve as the open curve
+  /// of its domain (knots front() and back() p+1 times, the period's other knots in
+  /// between; its first and last control points are the seam point), found by
+  /// interpolation at the Greville abscissae of that space, exact up to rounding. A
+  /// clamped curve is returned as it is.
+  [[nodiscard]] BSplineCurve clamped() const;
 
  private:
   KnotVector knots_;

@@ -2,6 +2,7 @@
 /// @file bspline_surface.hpp
 /// Tensor-product B-spline and rational B-spline surfaces, with batch grid evaluation.
 
+#include <array>
 #include <span>
 #include <utility>
 #include <vector>
@@ -16,7 +17,9 @@ namespace interpatch {
 
 /// S(u,v) = Σ_i Σ_j N_i(u) N_j(v) w_ij P_ij / Σ_i Σ_j N_i(u) N_j(v) w_ij.
 /// Control points are an (n+1) × (m+1) grid, first index along u. Valid by
-/// construction; evaluation never allocates per point.
+/// construction; evaluation never allocates per point. A direction whose knot vector
+/// is periodic is closed (a pipe, a torus): its control points are the distinct ones
+/// and its parameters wrap around (see KnotVector::periodic_from).
 ///
 /// Example:
 /// @code
@@ -39,6 +42,8 @@ class BSplineSurface final : public Surface {
   [[nodiscard]] const PointGrid& control_points() const noexcept { return cp_; }
   [[nodiscard]] const Grid<double, 2>& weights() const noexcept { return w_; }
   [[nodiscard]] bool rational() const noexcept { return !w_.empty(); }
+  /// Which directions are closed (periodic knot vectors), u then v.
+  [[nodiscard]] std::array<bool, 2> periodic() const noexcept { return {ku_.periodic(), kv_.periodic()}; }
   [[nodiscard]] std::pair<double, double> domain_u() const noexcept { return {ku_.front(), ku_.back()}; }
   [[nodiscard]] std::pair<double, double> domain_v() const noexcept { return {kv_.front(), kv_.back()}; }
   /// The knot domains [knots[p], knots[n+1]] in u and v.
@@ -69,6 +74,10 @@ class BSplineSurface final : public Surface {
   [[nodiscard]] BSplineSurface elevated(int tu, int tv) const;
   /// The same surface over [u0,u1] × [v0,v1].
   [[nodiscard]] BSplineSurface mapped(double u0, double u1, double v0, double v1) const;
+  /// The same surface over clamped knot vectors: each periodic direction as the open
+  /// surface of its domain, its first and last control lines on the seam
+  /// (BSplineCurve::clamped on every line). Open surfaces are returned as they are.
+  [[nodiscard]] BSplineSurface clamped() const;
 
  private:
   KnotVector ku_, kv_;

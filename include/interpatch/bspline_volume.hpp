@@ -3,6 +3,7 @@
 /// Trivariate tensor-product B-spline and rational B-spline volumes, with batch
 /// evaluation of points and Jacobians over parameter grids.
 
+#include <array>
 #include <span>
 #include <utility>
 
@@ -19,7 +20,8 @@ inline constexpr int max_volume_derivative = 3;
 
 /// S(u,v,w) = Σ_ijk N_i(u) N_j(v) N_k(w) w_ijk P_ijk / Σ_ijk N_i(u) N_j(v) N_k(w) w_ijk.
 /// Control points are an (n+1) × (m+1) × (l+1) grid, indices along u, v, w. Valid by
-/// construction; evaluation never allocates per point.
+/// construction; evaluation never allocates per point. Directions over periodic knot
+/// vectors are closed, as for BSplineSurface.
 ///
 /// Example:
 /// @code
@@ -51,6 +53,8 @@ class BSplineVolume final : public Volume {
   /// Empty for a polynomial (non-rational) volume.
   [[nodiscard]] const Grid<double, 3>& weights() const noexcept { return w_; }
   [[nodiscard]] bool rational() const noexcept { return !w_.empty(); }
+  /// Which directions are closed (periodic knot vectors), u, v, w.
+  [[nodiscard]] std::array<bool, 3> periodic() const noexcept { return {ku_.periodic(), kv_.periodic(), kw_.periodic()}; }
   /// The knot domains [knots[p], knots[n+1]] in u, v and w.
   [[nodiscard]] std::array<std::pair<double, double>, 3> domain() const override;
 
@@ -90,6 +94,10 @@ class BSplineVolume final : public Volume {
   /// The same volume with the degrees raised by tu, tv, tw (each line elevated as a
   /// curve, which keeps the continuity at every knot). @throws error invalid_degree.
   [[nodiscard]] BSplineVolume elevated(int tu, int tv, int tw) const;
+  /// The same volume over clamped knot vectors: each periodic direction open over its
+  /// domain, first and last control planes on the seam (BSplineCurve::clamped on every
+  /// line). Open volumes are returned as they are.
+  [[nodiscard]] BSplineVolume clamped() const;
   /// The same volume over [u0,u1] × [v0,v1] × [w0,w1] (a linear change of parameters).
   [[nodiscard]] BSplineVolume mapped(double u0, double u1, double v0, double v1, double w0, double w1) const;
 

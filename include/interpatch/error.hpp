@@ -33,6 +33,7 @@ enum class errc {
   invalid_blend,           ///< a blending function that is not 0 at 0, 1 at 1 and monotone
   no_exact_form,           ///< the construction has no exact B-spline form (e.g. Gregory's rational twists)
   malformed_file,          ///< a data file is readable but not well formed (NPY header, CSV field)
+  closing_gap,             ///< a closed shape's last point nearly, but not quite, repeats the first
   // --- files; the command line exits with 4 ---
   file_unreadable,         ///< a file cannot be opened or read
   file_unwritable,         ///< an output file cannot be written

@@ -72,6 +72,147 @@ INTERPATCH_KERNEL void BandedLU::solve(double* b, std::size_t width, std::size_t
 }
 
 namespace {
+int modulo(int a, int n) { return ((a % n) + n) % n; }
+}  // namespace
+
+CyclicLU::CyclicLU(int n, const std::vector<std::vector<Entry>>& rows) : n_(n), rows_(rows) {}
+
+bool CyclicLU::factor() {
+  const int n = n_;
+  if (n == 0) return true;
+  double scale = 0;
+  std::size_t best = 0;
+  for (std::size_t j = 0; j < rows_[0].size(); ++j)
+    if (std::abs(rows_[0][j].value) > std::abs(rows_[0][best].value)) best = j;
+  h_ = rows_[0].empty() ? 0 : modulo(rows_[0][best].col, n);
+  // Offsets of the entries from the shifted diagonal, taken the short way round.
+  int kl = 0, ku = 0;
+  for (int i = 0; i < n; ++i)
+    for (const Entry& e : rows_[static_cast<std::size_t>(i)]) {
+      int d = modulo(e.col - h_ - i, n);
+      if (d > n / 2) d -= n;
+      kl = std::max(kl, -d);
+      ku = std::max(ku, d);
+      scale = std::max(scale, std::abs(e.value));
+    }
+  // A border of m rows and columns keeps the wrapped corners out of B, and a shift
+  // of at most m (either way round) lets solve() undo it in its last pass.
+  int m = std::max({kl, ku, std::min(h_, n - h_)});
+  if (n <= 2 * m + 1) m = n;  // too small to have a band: all border, solved dense
+  m_ = m;
+  nb_ = n - m;
+  const auto M = static_cast<std::size_t>(m), NB = static_cast<std::size_t>(nb_);
+  b_ = BandedLU(nb_, nb_ > 0 ? kl : 0, nb_ > 0 ? ku : 0);
+  y_.assign(NB * M, 0.0);
+  d_.assign(M, {});
+  s_.assign(M * M, 0.0);
+  for (int i = 0; i < n; ++i)
+    for (const Entry& e : rows_[static_cast<std::size_t>(i)]) {
+      const int c = modulo(e.col - h_, n);
+      if (i < nb_ && c < nb_) b_.at(i, c) += e.value;
+      else if (i < nb_) y_[static_cast<std::size_t>(i) * M + static_cast<std::size_t>(c - nb_)] += e.value;
+      else if (c < nb_) d_[static_cast<std::size_t>(i - nb_)].push_back({c, e.value});
+      else s_[static_cast<std::size_t>(i - nb_) * M + static_cast<std::size_t>(c - nb_)] += e.value;
+    }
+  if (nb_ > 0) {
+    if (!b_.factor()) {
+      failed_row_ = modulo(b_.failed_row(), n);
+      return false;
+    }
+    if (M > 0) b_.solve(y_.data(), M, M);
+  }
+  for (std::size_t r = 0; r < M; ++r)
+    for (const Entry& e : d_[r])
+      for (std::size_t j = 0; j < M; ++j) s_[r * M + j] -= e.value * y_[static_cast<std::size_t>(e.col) * M + j];
+  // Dense LU of S with partial pivoting.
+  piv_.assign(M, 0);
+  const double tiny = 1e-14 * scale;
+  for (std::size_t k = 0; k < M; ++k) {
+    std::size_t p = k;
+    for (std::size_t i = k + 1; i < M; ++i)
+      if (std::abs(s_[i * M + k]) > std::abs(s_[p * M + k])) p = i;
+    piv_[k] = static_cast<int>(p);
+    if (!(std::abs(s_[p * M + k]) > tiny)) {
+      failed_row_ = nb_ + static_cast<int>(k);
+      return false;
+    }
+    if (p != k)
+      for (std::size_t j = 0; j < M; ++j) std::swap(s_[k * M + j], s_[p * M + j]);
+    const double inv = 1.0 / s_[k * M + k];
+    for (std::size_t i = k + 1; i < M; ++i) {
+      const double l = s_[i * M + k] * inv;
+      s_[i * M + k] = l;
+      if (l != 0.0)
+        for (std::size_t j = k + 1; j < M; ++j) s_[i * M + j] -= l * s_[k * M + j];
+    }
+  }
+  return true;
+}
+
+INTERPATCH_KERNEL void CyclicLU::solve(double* b, std::size_t width, std::size_t stride) const {
+  if (n_ == 0) return;
+  const auto M = static_cast<std::size_t>(m_);
+  auto row = [&](int i) { return b + static_cast<std::size_t>(i) * stride; };
+  if (nb_ > 0) b_.solve(b, width, stride);
+  // Border right-hand sides less D z, then the Schur complement's solve.
+  for (std::size_t r = 0; r < M; ++r) {
+    double* br = row(nb_ + static_cast<int>(r));
+    for (const Entry& e : d_[r]) {
+      const double* z = row(e.col);
+      for (std::size_t c = 0; c < width; ++c) br[c] -= e.value * z[c];
+    }
+  }
+  for (std::size_t k = 0; k < M; ++k) {
+    double* bk = row(nb_ + static_cast<int>(k));
+    if (const auto p = static_cast<std::size_t>(piv_[k]); p != k) std::swap_ranges(bk, bk + width, row(nb_ + static_cast<int>(p)));
+    for (std::size_t i = k + 1; i < M; ++i) {
+      const double l = s_[i * M + k];
+      if (l == 0.0) continue;
+      double* bi = row(nb_ + static_cast<int>(i));
+      for (std::size_t c = 0; c < width; ++c) bi[c] -= l * bk[c];
+    }
+  }
+  for (std::size_t k = M; k-- > 0;) {
+    double* bk = row(nb_ + static_cast<int>(k));
+    for (std::size_t j = k + 1; j < M; ++j) {
+      const double u = s_[k * M + j];
+      const double* bj = row(nb_ + static_cast<int>(j));
+      for (std::size_t c = 0; c < width; ++c) bk[c] -= u * bj[c];
+    }
+    const double inv = 1.0 / s_[k * M + k];
+    for (std::size_t c = 0; c < width; ++c) bk[c] *= inv;
+  }
+  // x_c = z_c − Σ_j Y[c][j] x_border[j], each moved to its control point: unknown c
+  // is control point (c + h) mod n. The border is copied aside first; B's rows then
+  // move in the order that reads every row before it is overwritten.
+  std::vector<double> border(M * width);
+  for (std::size_t j = 0; j < M; ++j) std::copy_n(row(nb_ + static_cast<int>(j)), width, border.data() + j * width);
+  auto update = [&](int c, double* dst) {
+    const double* src = row(c);
+    const double* yc = y_.data() + static_cast<std::size_t>(c) * M;
+    if (M == 1) {
+      const double y0 = yc[0];
+      for (std::size_t k = 0; k < width; ++k) dst[k] = src[k] - y0 * border[k];
+      return;
+    }
+    for (std::size_t k = 0; k < width; ++k) dst[k] = src[k];
+    for (std::size_t j = 0; j < M; ++j) {
+      const double y = yc[j];
+      const double* x = border.data() + j * width;
+      for (std::size_t k = 0; k < width; ++k) dst[k] -= y * x[k];
+    }
+  };
+  const int n = n_;
+  if (h_ <= n - h_) {  // right by h (descending: row c + h was read already)
+    for (int c = nb_ - 1; c >= 0; --c) update(c, row(c + h_));
+  } else {  // left by n − h (ascending)
+    for (int c = 0; c < nb_; ++c) update(c, row(modulo(c + h_, n)));
+  }
+  for (std::size_t j = 0; j < M; ++j)
+    std::copy_n(border.data() + j * width, width, row(modulo(nb_ + static_cast<int>(j) + h_, n)));
+}
+
+namespace {
 
 // Columns of wide lines solved together, a slice of them at a time. The forward and
 // the back sweep each stream through the slice's n rows (the rows of the band stay
@@ -121,7 +262,8 @@ INTERPATCH_KERNEL void shuffle_lines(double* data, std::size_t n, std::size_t in
   }
 }
 
-void solve_narrow_group(const BandedLU& lu, double* data, std::size_t n, std::size_t inner, std::size_t block,
+template <class Solver>
+void solve_narrow_group(const Solver& lu, double* data, std::size_t n, std::size_t inner, std::size_t block,
                         std::size_t m, double* buf) {
   shuffle_lines<true>(data, n, inner, block, m, buf);
   lu.solve(buf, m * inner, m * inner);
@@ -130,8 +272,9 @@ void solve_narrow_group(const BandedLU& lu, double* data, std::size_t n, std::si
 
 }  // namespace
 
-void solve_along_axis(const BandedLU& lu, double* data, const std::size_t* shape, std::size_t rank,
-                      std::size_t axis, std::size_t components, bool parallel) {
+template <class Solver>
+void solve_along_axis(const Solver& lu, double* data, const std::size_t* shape, std::size_t rank, std::size_t axis,
+                      std::size_t components, bool parallel) {
   std::size_t outer = 1, inner = components;
   for (std::size_t a = 0; a < axis; ++a) outer *= shape[a];
   for (std::size_t a = axis + 1; a < rank; ++a) inner *= shape[a];
@@ -163,5 +306,10 @@ void solve_along_axis(const BandedLU& lu, double* data, const std::size_t* shape
     lu.solve(data + o * block + c0, width, inner);
   }
 }
+
+template void solve_along_axis<BandedLU>(const BandedLU&, double*, const std::size_t*, std::size_t, std::size_t,
+                                        std::size_t, bool);
+template void solve_along_axis<CyclicLU>(const CyclicLU&, double*, const std::size_t*, std::size_t, std::size_t,
+                                        std::size_t, bool);
 
 }  // namespace interpatch::detail

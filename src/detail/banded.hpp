@@ -39,13 +39,50 @@ class BandedLU {
   int failed_row_ = -1;
 };
 
+/// A cyclic banded matrix: row i has its entries near column i + h modulo n, for
+/// one shift h — the collocation matrix of a periodic spline. Solved as a bordered
+/// system: the leading (n − m) block B, banded and without the wrapped corners, is
+/// factored with BandedLU; the m border unknowns come from the small dense Schur
+/// complement S = E − D B⁻¹ C; Y = B⁻¹ C is kept. A right-hand side costs one banded
+/// solve, m·n more multiply-adds and one move of every row (the shift h undone),
+/// fused into one pass. Factored once, applied to any number of right-hand sides
+/// in place, like BandedLU.
+class CyclicLU {
+ public:
+  struct Entry {
+    int col;  ///< taken modulo n
+    double value;
+  };
+  /// The n × n matrix whose row i holds rows[i]. Entries sharing a place add up.
+  CyclicLU(int n, const std::vector<std::vector<Entry>>& rows);
+
+  [[nodiscard]] int size() const noexcept { return n_; }
+  /// False when a pivot is zero or below 1e-14 × the largest entry; `failed_row`
+  /// tells where.
+  bool factor();
+  [[nodiscard]] int failed_row() const noexcept { return failed_row_; }
+  /// Solves A X = B in place, laid out as for BandedLU::solve.
+  void solve(double* b, std::size_t width, std::size_t stride) const;
+
+ private:
+  int n_, h_ = 0, m_ = 0, nb_ = 0;  // shift, border size, size of B
+  std::vector<std::vector<Entry>> rows_;
+  BandedLU b_{0, 0, 0};
+  std::vector<double> y_;                   // nb × m, row-major: B⁻¹ C
+  std::vector<std::vector<Entry>> d_;       // border rows' entries in columns < nb
+  std::vector<double> s_;                   // m × m: the factored Schur complement
+  std::vector<int> piv_;
+  int failed_row_ = -1;
+};
+
 /// Solves along one axis of a C-order array of `shape` (doubles, last axis the
 /// `components` of each value) in place: every line along `axis` is a right-hand
 /// side of `lu`. With `parallel`, threads split independent lines and column
 /// slices; without, the calling thread does all (for callers already inside a
 /// parallel region). Every number is computed by the same operations whatever the
 /// thread count.
-void solve_along_axis(const BandedLU& lu, double* data, const std::size_t* shape, std::size_t rank,
-                      std::size_t axis, std::size_t components, bool parallel = true);
+template <class Solver>
+void solve_along_axis(const Solver& lu, double* data, const std::size_t* shape, std::size_t rank, std::size_t axis,
+                      std::size_t components, bool parallel = true);
 
 }  // namespace interpatch::detail

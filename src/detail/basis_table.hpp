@@ -3,6 +3,7 @@
 // shared by every point that uses them (surfaces and volumes alike).
 
 #include <algorithm>
+#include <cmath>
 #include <span>
 #include <vector>
 
@@ -12,8 +13,13 @@
 namespace interpatch::detail {
 
 /// Refuses a parameter outside the knot domain; 1e-12 of the domain's length of
-/// slack absorbs rounding in the caller's parameter mapping.
+/// slack absorbs rounding in the caller's parameter mapping. A periodic direction
+/// takes every finite parameter (it wraps).
 inline void check_parameter(const KnotVector& k, double t, const char* dir) {
+  if (k.periodic()) {
+    if (!std::isfinite(t)) fail(errc::out_of_domain, "parameter ", dir, " = ", t, " is not a number");
+    return;
+  }
   const double a = k.front(), b = k.back();
   const double slack = 1e-12 * (b - a);
   if (!(t >= a - slack && t <= b + slack))
@@ -37,7 +43,7 @@ std::vector<BasisRow<Orders>> basis_table(const KnotVector& k, std::span<const d
   const int p = k.degree();
   for (std::size_t i = 0; i < ts.size(); ++i) {
     check_parameter(k, ts[i], dir);
-    const double t = std::clamp(ts[i], k.front(), k.back());
+    const double t = k.periodic() ? k.wrap(ts[i]) : std::clamp(ts[i], k.front(), k.back());
     rows[i].span = k.find_span(t);
     if (nd == 0) {
       k.basis(rows[i].span, t, rows[i].d);

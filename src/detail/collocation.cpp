@@ -40,4 +40,25 @@ BandedLU factor_collocation(const KnotVector& knots, std::span<const double> par
   return factor_collocation(knots, rows);
 }
 
+CyclicLU factor_periodic_collocation(const KnotVector& knots, std::span<const double> params) {
+  const int n = knots.count(), p = knots.degree();
+  INTERPATCH_ASSERT(knots.periodic() && static_cast<int>(params.size()) == n);
+  std::vector<std::vector<CyclicLU::Entry>> rows(params.size());
+  double N[max_degree + 1];
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    const double t = knots.wrap(params[i]);
+    const int s = knots.find_span(t);
+    knots.basis(s, t, N);
+    for (int j = 0; j <= p; ++j)
+      if (N[j] != 0.0) rows[i].push_back({knots.wrap_index(s - p + j), N[j]});
+  }
+  CyclicLU lu(n, rows);
+  if (!lu.factor()) {
+    const auto r = static_cast<std::size_t>(lu.failed_row());
+    fail(errc::singular, "periodic collocation matrix is singular at row ", r, " (parameter ", params[r],
+         "): the parameters do not fit the knots (Schoenberg-Whitney condition fails)");
+  }
+  return lu;
+}
+
 }  // namespace interpatch::detail

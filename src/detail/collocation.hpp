@@ -24,4 +24,10 @@ BandedLU factor_collocation(const KnotVector& knots, std::span<const Condition> 
 /// The same for plain point conditions.
 BandedLU factor_collocation(const KnotVector& knots, std::span<const double> params);
 
+/// The factored cyclic collocation matrix of a periodic knot vector: row i holds the
+/// basis functions at params[i] (wrapped into the domain), column j the control
+/// point j; params.size() must equal knots.count().
+/// @throws error singular, naming the row and the parameter there.
+CyclicLU factor_periodic_collocation(const KnotVector& knots, std::span<const double> params);
+
 }  // namespace interpatch::detail
