@@ -113,6 +113,25 @@ PointGrid twisted_strip() {
   return g;
 }
 
+// A pipe bent through a quarter turn of radius 3 about the y axis, its circular
+// cross-section swelling from radius 0.5 at the ends to 0.8 in the middle: u along
+// the pipe (nu sections), v around it (nv points, the last repeating the first, as
+// a scanner that closes each section writes it).
+PointGrid bent_pipe(std::size_t nu, std::size_t nv) {
+  PointGrid g({nu, nv});
+  for (std::size_t i = 0; i < nu; ++i) {
+    const double s = static_cast<double>(i) / static_cast<double>(nu - 1), a = 0.5 * pi * s;
+    const double r = 0.5 + 0.3 * std::sin(pi * s);
+    const Vec3 centre{3 * std::sin(a), 0, 3 * (1 - std::cos(a))}, normal{-std::sin(a), 0, std::cos(a)}, binormal{0, 1, 0};
+    for (std::size_t j = 0; j + 1 < nv; ++j) {
+      const double phi = 2 * pi * static_cast<double>(j) / static_cast<double>(nv - 1);
+      g(i, j) = centre + r * std::cos(phi) * normal + r * std::sin(phi) * binormal;
+    }
+    g(i, nv - 1) = g(i, 0);
+  }
+  return g;
+}
+
 ojson grid_json(const PointGrid& g) {
   ojson rows = ojson::array();
   for (std::size_t i = 0; i < g.extent(0); ++i) {
@@ -424,6 +443,13 @@ std::vector<Example> examples() {
                 {{"type", "hermite_patch"},
                  {"comment", "Positions, tangents and twists at the corners of a bicubic dome."},
                  {"corners", hermite_corners()}},
+                nullptr, "", false});
+  ex.push_back({"pipe", "closed around v (\"periodic\": [false, true]), C2 across the seam, through 20x33 points",
+                {{"type", "interpolate"},
+                 {"comment", "A bent pipe whose cross-section swells in the middle: u along the pipe (20 sections), v around "
+                             "it (33 points, the last repeating the first and left out)."},
+                 {"periodic", {false, true}},
+                 {"points", grid_json(bent_pipe(20, 33))}},
                 nullptr, "", false});
   ex.push_back({"half_cylinder", "11x5 grid read from half_cylinder.npy",
                 {{"type", "interpolate"},

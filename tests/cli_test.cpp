@@ -421,7 +421,7 @@ TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
   const Result r = run({"demo", "-o", "out"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("outputs in out"), std::string::npos) << r.out;
-  for (const char* name : {"hemisphere", "terrain", "wave", "saddle", "half_cylinder", "twisted_strip"}) {
+  for (const char* name : {"hemisphere", "terrain", "wave", "saddle", "pipe", "half_cylinder", "twisted_strip"}) {
     for (const char* suffix :
          {".spec.json", ".bspline.json", ".bspline.npz", ".step", ".igs", ".eval.npy", ".eval.csv", ".obj", ".vtk",
           ".info.json"})
@@ -432,6 +432,16 @@ TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
   EXPECT_TRUE(fs::exists(at("out") / "half_cylinder.npy"));
   EXPECT_TRUE(fs::exists(at("out") / "twisted_strip.csv"));
   EXPECT_TRUE(fs::exists(at("out") / "hemisphere.stl"));
+  // The pipe: closed around v, C2 across the seam, its spec the checked-in example.
+  const json pipe = json::parse(read_file(at("out") / "pipe.info.json"));
+  EXPECT_EQ(pipe["periodic"], json({false, true}));
+  EXPECT_EQ(pipe["seam_continuity"], json({{"v", "C2"}}));
+  EXPECT_EQ(pipe["control_points"], json({20, 32}));
+  EXPECT_TRUE(pipe["warnings"].empty());
+  EXPECT_EQ(read_file(at("out") / "pipe.spec.json"), read_file(fs::path(INTERPATCH_EXAMPLES) / "pipe.json"));
+  EXPECT_EQ(json::parse(read_file(at("out") / "pipe.bspline.json"))["periodic"], json({false, true}));
+  // The hemisphere's data close around v, undeclared: the demo shows the warning.
+  EXPECT_NE(r.err.find("warning: /points: the data close along v"), std::string::npos) << r.err;
   for (const char* name : {"trilinear", "coons_volume", "hermite_volume", "annular_sector"}) {
     for (const char* suffix : {".spec.json", ".bspline.json", ".bspline.npz", ".step", ".igs", ".eval.npy", ".eval.csv", ".vts",
                                ".vtk", ".xyz", ".info.json"})
@@ -473,6 +483,83 @@ TEST_F(CliTest, CheckedInExamplesBuild) {
     }
   }
   EXPECT_GE(count, 3u);
+}
+
+// --- closed (periodic) shapes ------------------------------------------------------------
+
+TEST_F(CliTest, ClosedPipeFromTheCommandLine) {
+  write_file(at("pipe.json"), test::pipe_spec(12, 16, true).dump());
+  // info: closed around v, C2 across the seam, the closing column checked as data.
+  const Result i = run({"info", "pipe.json"});
+  ASSERT_EQ(i.status, 0) << i.err;
+  EXPECT_TRUE(i.err.empty()) << i.err;
+  const json info = json::parse(i.out);
+  EXPECT_EQ(info["periodic"], json({false, true}));
+  EXPECT_EQ(info["seam_continuity"], json({{"v", "C2"}}));
+  EXPECT_EQ(info["continuity"]["v"], "C2");
+  EXPECT_EQ(info["control_points"], json({12, 16}));
+  EXPECT_EQ(info["max_data_error"]["points"], 12 * 17);
+  EXPECT_LT(info["max_data_error"]["relative"].get<double>(), 1e-13);  // rounding of the banded solves
+  // eval samples [0, 1] in v too: its first and last columns are one seam, and every
+  // value is the library's.
+  ASSERT_EQ(run({"eval", "pipe.json", "--grid", "9x21", "-o", "g.npy"}).status, 0);
+  const std::string npy = read_file(at("g.npy"));
+  expect_npy_is_evaluation(npy, io::build_file(at("pipe.json"), evaluation_options), {9, 21});
+  const Npy n = parse_npy(npy);
+  for (std::size_t row = 0; row < 9; ++row)
+    for (std::size_t k = 0; k < 3; ++k)  // v = 1 wraps to v = 0: the same point to rounding of the pipe's size (~5)
+      EXPECT_NEAR(n.data[(row * 21 + 20) * 3 + k], n.data[(row * 21) * 3 + k], 1e-14) << row;
+  // build: the exact form as .json and .npz, each read back and written again
+  // byte for byte, and both the same form.
+  for (const char* ext : {".json", ".npz"}) {
+    ASSERT_EQ(run({"build", "pipe.json", "-o", std::string("e") + ext}).status, 0) << ext;
+    const std::string again = std::string(ext) == ".json" ? "e.json" : "from_npz.json";
+    if (std::string(ext) == ".npz") write_file(at(again), R"({"type": "bspline_surface", "npz": "e.npz"})");
+    ASSERT_EQ(run({"build", again, "-o", std::string("again") + ext}).status, 0) << ext;
+    EXPECT_EQ(read_file(at(std::string("again") + ext)), read_file(at(std::string("e") + ext))) << ext;
+  }
+  EXPECT_EQ(json::parse(read_file(at("e.json")))["periodic"], json({false, true}));
+  ASSERT_EQ(run({"build", "from_npz.json", "-o", "npz_as.json"}).status, 0);
+  EXPECT_EQ(read_file(at("npz_as.json")), read_file(at("e.json")));
+  ASSERT_EQ(run({"mesh", "pipe.json", "-o", "m.obj", "--res", "8x8"}).status, 0);
+}
+
+TEST_F(CliTest, ClosedDataNotDeclaredPeriodicAreWarnedAboutByEveryCommand) {
+  write_file(at("closed.json"), test::pipe_spec(6, 8, true, false).dump());
+  write_file(at("declared.json"), test::pipe_spec(6, 8, true).dump());
+  write_file(at("open.json"), test::pipe_spec(6, 8, false, false).dump());
+  const std::vector<std::vector<std::string>> commands{{"build", "X", "-o", "b.json"},
+                                                       {"mesh", "X", "-o", "m.obj", "--res", "6x6"},
+                                                       {"eval", "X", "--grid", "5", "-o", "e.npy"},
+                                                       {"info", "X"}};
+  for (std::vector<std::string> args : commands) {
+    SCOPED_TRACE(args[0]);
+    args[1] = "closed.json";
+    const Result closed = run(args);
+    ASSERT_EQ(closed.status, 0) << closed.err;
+    EXPECT_EQ(closed.err,
+              "interpatch: warning: /points: the data close along v (the last line of points repeats the first), but v is "
+              "not periodic: the surface meets itself there with a crease; \"periodic\": [false, true] makes it smooth "
+              "across the seam\n");
+    for (const char* quiet : {"declared.json", "open.json"}) {
+      args[1] = quiet;
+      const Result r = run(args);
+      ASSERT_EQ(r.status, 0) << r.err;
+      EXPECT_TRUE(r.err.empty()) << quiet << ": " << r.err;
+    }
+  }
+  const json info = json::parse(run({"info", "closed.json"}).out);
+  ASSERT_EQ(info["warnings"].size(), 1u);
+  EXPECT_EQ(info["parameters"]["notes"], json::array({info["warnings"][0].get<std::string>().substr(std::string("/points: ").size())}));
+  // A data file in place of the spec is warned about the same way.
+  const io::PointArray a = io::points_from_json(test::pipe_points(6, 8, true), 2);
+  std::vector<double> flat;
+  for (const Vec3& p : a.points) flat.insert(flat.end(), {p.x, p.y, p.z});
+  const std::size_t shape[3] = {6, 9, 3};
+  io::write_npy(at("closed.npy"), shape, flat);
+  const Result npy = run({"info", "closed.npy"});
+  ASSERT_EQ(npy.status, 0) << npy.err;
+  EXPECT_NE(npy.err.find("warning: /points: the data close along v"), std::string::npos) << npy.err;
 }
 
 // --- failures: one table in cli_bad_input_test.cpp; here what it does not cover ----------

@@ -6,15 +6,15 @@ bit for bit, with the .json exact form of the same construction.
     check_npz.py --pairs DIR            compare every DIR/X.npz with DIR/X.json
 
 The first form runs `interpatch build SPEC -o X.npz` and `-o X.json` for checked-in
-examples (surfaces, a volume, a grid from a .npy file) and for rational surface and
+examples (surfaces, a closed one among them, a volume, a grid from a .npy file) and for rational surface and
 volume specs it writes into WORKDIR, then `interpatch build` of
 {"type": ..., "npz": "X.npz"}, whose .json must equal the first byte for byte. The
 second compares archives written by the library itself (with and without ZIP64
 records) with their .json. Checked for each archive: zipfile finds every member
 stored (not compressed) with a correct CRC-32; numpy.load finds exactly the arrays
 degree (int64), knots_u, knots_v[, knots_w], control_points, weights (float64,
-only when the .json has weights) and periodic (bool, all False), in the shapes of
-the .json, holding the same doubles. Exits non-zero naming the file and the array.
+only when the .json has weights) and periodic (bool: the .json's "periodic", all
+False when it has none), in the shapes of the .json, holding the same doubles. Exits non-zero naming the file and the array.
 Needs python3-numpy.
 """
 import json
@@ -90,8 +90,9 @@ def compare(npz_path, json_path):
                 fail(npz_path, f"{name} has dtype {a[name].dtype}, expected {np.dtype(want)}")
         if a["degree"].tolist() != [int(d) for d in exact["degree"]]:
             fail(npz_path, f"degree {a['degree'].tolist()}, the .json has {exact['degree']}")
-        if a["periodic"].shape != (len(axes),) or a["periodic"].any():
-            fail(npz_path, f"periodic is {a['periodic'].tolist()}, expected {len(axes)} times False")
+        periodic = [bool(p) for p in exact.get("periodic", [False] * len(axes))]
+        if a["periodic"].shape != (len(axes),) or a["periodic"].tolist() != periodic:
+            fail(npz_path, f"periodic is {a['periodic'].tolist()}, the .json says {periodic}")
         for x in axes:
             if not same_doubles(a[f"knots_{x}"], exact["knots"][x]):
                 fail(npz_path, f"knots_{x} differ from the .json's")
@@ -104,7 +105,7 @@ def compare(npz_path, json_path):
 
 def from_specs(exe, work):
     os.makedirs(work, exist_ok=True)
-    specs = [os.path.join(EXAMPLES, f"{n}.json") for n in ("terrain", "hemisphere", "half_cylinder", "annular_sector")]
+    specs = [os.path.join(EXAMPLES, f"{n}.json") for n in ("terrain", "hemisphere", "half_cylinder", "annular_sector", "pipe")]
     for name, spec in (("rational_surface", RATIONAL_SURFACE), ("rational_volume", RATIONAL_VOLUME)):
         path = os.path.join(work, f"{name}.json")
         with open(path, "w") as f:

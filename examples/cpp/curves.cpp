@@ -28,6 +28,18 @@ void knot_vectors() {
   std::printf("cubic basis at t = 0.25 (span %d): %g %g %g %g\n", span, N[0], N[1], N[2], N[3]);
 }
 
+void periodic_knot_vectors() {
+  // A closed cubic with 6 control points and uniform knots over [0, 1].
+  auto k = interpatch::KnotVector::periodic_from(3, {0, 1 / 6., 2 / 6., 3 / 6., 4 / 6., 5 / 6.}, 1.0);
+  int n = k.count();          // 6 control points
+  double t = k.wrap(1.25);    // 0.25: one period on
+  example::expect(k.periodic() && n == 6, "6 control points");
+  example::expect_near(t, 0.25, "k.wrap(1.25) == 0.25");
+  example::expect(k.size() == 6 + 2 * 3 + 1, "6 + 2p + 1 extended knots");
+  example::expect(k.front() == 0.0 && k.back() == 1.0, "the domain [0, 1]");
+  std::printf("closed cubic knots: %d control points, wrap(1.25) = %g\n", n, t);
+}
+
 void bspline_curves() {
   using namespace interpatch;
   BSplineCurve c(KnotVector::bezier(2), {{0, 0, 0}, {1, 2, 0}, {2, 0, 0}});  // a parabola
@@ -94,6 +106,7 @@ int main() {
   return example::run("curves", [] {
     vectors();
     knot_vectors();
+    periodic_knot_vectors();
     bspline_curves();
     lines();
     hermite_functions();

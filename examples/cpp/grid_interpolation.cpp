@@ -1,8 +1,9 @@
 // Interpolating grids of points: the README's first example (section "The
-// library"), then the examples of interpolate.hpp for a curve and a surface,
-// grid.hpp, and threads.hpp's main(). Every comment that states a value is checked.
+// library") and its closed pipe, then the examples of interpolate.hpp for a curve
+// and a surface, open and closed, grid.hpp, and threads.hpp's main(). Every comment that states a value is checked.
 // Links interpatch::core only.
 
+#include <array>
 #include <cstdio>
 #include <span>
 #include <vector>
@@ -73,6 +74,70 @@ void curve() {
               r.params[3]);
 }
 
+void closed_curve() {
+  using namespace interpatch;
+  CurveInterpolationOptions closed;
+  closed.periodic = true;
+  std::vector<Vec3> ring{{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {1, 0, 0}};  // last repeats the first
+  auto c = interpolate_curve(ring, closed);  // 4 control points, C2 at the seam too
+  Vec3 same = c.curve.point(1.25);           // == c.curve.point(0.25): parameters wrap
+  example::expect(c.curve.periodic() && c.curve.control_points().size() == 4, "4 control points, closed");
+  example::expect_near(same, c.curve.point(0.25), "c.curve.point(1.25) == c.curve.point(0.25)");
+  for (int k = 0; k <= 2; ++k)
+    example::expect_near(c.curve.derivative(1.0, k), c.curve.derivative(0.0, k), "C2 at the seam");
+  for (std::size_t i = 0; i < ring.size(); ++i)
+    example::expect_near(c.curve.point(c.params[i]), ring[i], "the closed curve passes through every point");
+  example::expect(c.params.back() == 1.0, "the closing point's parameter is 1");
+  std::printf("closed curve through 4 points: %zu control points, C(0.25) = %s\n", c.curve.control_points().size(),
+              example::str(c.curve.point(0.25)).c_str());
+}
+
+void closed_surface() {
+  using namespace interpatch;
+  SurfaceInterpolationOptions pipe;
+  pipe.periodic = {false, true};
+  PointGrid ring({5, 12});
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 12; ++j) ring(i, j) = {std::cos(j * M_PI / 6), std::sin(j * M_PI / 6), double(i)};
+  auto tube = interpolate_surface(ring, pipe);  // 5 x 12 control points, C2 around
+  example::expect(tube.surface.control_points().shape() == PointGrid::shape_type{5, 12}, "5 x 12 control points");
+  example::expect(tube.surface.periodic() == std::array<bool, 2>{false, true}, "closed around v");
+  example::expect(tube.surface.knots_v().continuity() == 2, "C2 around, the seam included");
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 12; ++j)
+      example::expect_near(tube.surface.point(tube.params_u[i], tube.params_v[j]), ring(i, j), "the tube passes through ring");
+  example::expect_near(tube.surface.derivative(0.5, 1.0, 0, 2), tube.surface.derivative(0.5, 0.0, 0, 2),
+                       "S_vv across the seam");
+  std::printf("tube closed around v: %zu x %zu control points\n", tube.surface.control_points().extent(0),
+              tube.surface.control_points().extent(1));
+}
+
+void readme_closed() {
+  // A pipe closed around v: 20 sections of 32 distinct points (a 33rd repeating the first would be left out)
+  PointGrid ring({20, 32});
+  for (std::size_t i = 0; i < 20; ++i)
+    for (std::size_t j = 0; j < 32; ++j) {
+      const double a = 2 * M_PI * double(j) / 32, r = 1 + 0.2 * std::sin(0.3 * double(i));
+      ring(i, j) = {r * std::cos(a), r * std::sin(a), 0.5 * double(i)};
+    }
+  SurfaceInterpolationOptions closed;
+  closed.periodic = {false, true};                // u open, v closed
+  auto pipe = interpolate_surface(ring, closed);  // 20 × 32 control points, C2 across the seam
+  Vec3 seam = pipe.surface.point(0.5, 1.0);       // == pipe.surface.point(0.5, 0.0)
+  BSplineSurface open = pipe.surface.clamped();   // the same surface over clamped knots, for programs that want them
+
+  example::expect(pipe.surface.control_points().shape() == PointGrid::shape_type{20, 32}, "20 × 32 control points");
+  example::expect(pipe.surface.periodic() == std::array<bool, 2>{false, true}, "u open, v closed");
+  example::expect_near(seam, pipe.surface.point(0.5, 0.0), "pipe.surface.point(0.5, 1.0) == pipe.surface.point(0.5, 0.0)");
+  example::expect(pipe.surface.knots_v().continuity() == 2, "C2 across the seam");
+  example::expect(open.periodic() == std::array<bool, 2>{false, false}, "clamped() is open in both directions");
+  for (double u : {0.0, 0.3, 1.0})
+    for (double v : {0.0, 0.1, 0.55, 1.0})
+      example::expect_near(open.point(u, v), pipe.surface.point(u, v), "clamped() is the same surface");
+  std::printf("pipe: %zu x %zu control points closed around v, %zu x %zu clamped\n", pipe.surface.control_points().extent(0),
+              pipe.surface.control_points().extent(1), open.control_points().extent(0), open.control_points().extent(1));
+}
+
 void surface() {
   using namespace interpatch;
   PointGrid q({7, 13});
@@ -97,8 +162,11 @@ void grids() {
 int run() {
   return example::run("grid_interpolation", [] {
     readme_library();
+    readme_closed();
     curve();
+    closed_curve();
     surface();
+    closed_surface();
     grids();
   });
 }

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <span>
 #include <type_traits>
@@ -71,9 +72,18 @@ void put_grid(std::ostream& os, const Grid<T, 2>& g) {
   os << "  ]";
 }
 
+// The "periodic" line of a form closed in some direction, after its degrees:
+// "  \"periodic\": [false, true],\n"; nothing for an open form.
+std::string periodic_line(std::span<const bool> periodic) {
+  if (std::none_of(periodic.begin(), periodic.end(), [](bool p) { return p; })) return "";
+  std::string line = "  \"periodic\": [";
+  for (std::size_t a = 0; a < periodic.size(); ++a) line += cat(a ? ", " : "", periodic[a] ? "true" : "false");
+  return line + "],\n";
+}
+
 void write_surface(std::ostream& os, const BSplineSurface& s) {
-  std::string head = cat("{\n  \"type\": \"bspline_surface\",\n  \"degree\": [", s.degree_u(), ", ", s.degree_v(),
-                         "],\n  \"knots\": {\n    \"u\": ");
+  std::string head = cat("{\n  \"type\": \"bspline_surface\",\n  \"degree\": [", s.degree_u(), ", ", s.degree_v(), "],\n",
+                         periodic_line(s.periodic()), "  \"knots\": {\n    \"u\": ");
   put(head, s.knots_u().values());
   head += ",\n    \"v\": ";
   put(head, s.knots_v().values());
@@ -110,7 +120,7 @@ void put_grid(std::ostream& os, const Grid<T, 3>& g) {
 
 void write_volume(std::ostream& os, const BSplineVolume& v) {
   std::string head = cat("{\n  \"type\": \"bspline_volume\",\n  \"degree\": [", v.degree_u(), ", ", v.degree_v(), ", ",
-                         v.degree_w(), "],\n  \"knots\": {\n    \"u\": ");
+                         v.degree_w(), "],\n", periodic_line(v.periodic()), "  \"knots\": {\n    \"u\": ");
   put(head, v.knots_u().values());
   head += ",\n    \"v\": ";
   put(head, v.knots_v().values());
@@ -203,6 +213,21 @@ void volume_data_error(const Volume& s, const DataSet& d, DataError& e, std::siz
   }
 }
 
+// "continuity" per direction (a closed direction's seam counts as one of its knots),
+// and "seam_continuity" of the closed directions alone.
+void continuity_info(ojson& j, std::initializer_list<const KnotVector*> knots) {
+  ojson all = ojson::object(), seams = ojson::object();
+  std::size_t a = 0;
+  for (const KnotVector* k : knots) {
+    const char* name = a == 0 ? "u" : (a == 1 ? "v" : "w");
+    all[name] = continuity_name(*k);
+    if (k->periodic()) seams[name] = cat("C", k->degree() - k->multiplicity(k->front()));
+    ++a;
+  }
+  j["continuity"] = std::move(all);
+  j["seam_continuity"] = std::move(seams);
+}
+
 ojson volume_info(const BSplineVolume& v) {
   ojson j;
   j["kind"] = "volume";
@@ -211,10 +236,9 @@ ojson volume_info(const BSplineVolume& v) {
   const auto& cp = v.control_points();
   j["control_points"] = {cp.extent(0), cp.extent(1), cp.extent(2)};
   j["rational"] = v.rational();
+  j["periodic"] = v.periodic();
   j["knots"] = {{"u", v.knots_u().values()}, {"v", v.knots_v().values()}, {"w", v.knots_w().values()}};
-  j["continuity"] = {{"u", continuity_name(v.knots_u())},
-                     {"v", continuity_name(v.knots_v())},
-                     {"w", continuity_name(v.knots_w())}};
+  continuity_info(j, {&v.knots_u(), &v.knots_v(), &v.knots_w()});
   const auto d = v.domain();
   j["domain"] = {{"u", {d[0].first, d[0].second}}, {"v", {d[1].first, d[1].second}}, {"w", {d[2].first, d[2].second}}};
   Box box;
@@ -248,8 +272,9 @@ ojson surface_info(const BSplineSurface& s) {
   j["degree"] = {s.degree_u(), s.degree_v()};
   j["control_points"] = {s.control_points().extent(0), s.control_points().extent(1)};
   j["rational"] = s.rational();
+  j["periodic"] = s.periodic();
   j["knots"] = {{"u", s.knots_u().values()}, {"v", s.knots_v().values()}};
-  j["continuity"] = {{"u", continuity_name(s.knots_u())}, {"v", continuity_name(s.knots_v())}};
+  continuity_info(j, {&s.knots_u(), &s.knots_v()});
   const auto [u0, u1] = s.domain_u();
   const auto [v0, v1] = s.domain_v();
   j["domain"] = {{"u", {u0, u1}}, {"v", {v0, v1}}};

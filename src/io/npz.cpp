@@ -146,7 +146,9 @@ std::vector<OutMember> members_of(const FormView& f) {
   points_shape.push_back(3);
   m.push_back({member_names[4], internal::npy_header("<f8", points_shape), {}, {&f.points->x, 3 * count}});
   if (f.weights) m.push_back({member_names[5], internal::npy_header("<f8", f.shape), {}, {f.weights, count}});
-  m.push_back({member_names[6], internal::npy_header("|b1", axes), std::string(dims, '\0'), {}});  // all False
+  std::string periodic;
+  for (const KnotVector* k : f.knots) periodic += k->periodic() ? '\1' : '\0';
+  m.push_back({member_names[6], internal::npy_header("|b1", axes), std::move(periodic), {}});
   return m;
 }
 
@@ -417,9 +419,9 @@ class Reader {
              " is outside 1..", max_degree);
       degrees.push_back(static_cast<int>(deg[a]));
     }
-    check_not_periodic(dims);
-    if (dims == 2) return read_form<2>(degrees);
-    return read_form<3>(degrees);
+    const std::vector<bool> periodic = read_periodic(dims);
+    if (dims == 2) return read_form<2>(degrees, periodic);
+    return read_form<3>(degrees, periodic);
   }
 
  private:
@@ -635,18 +637,19 @@ class Reader {
 
   std::vector<double> read_degrees() const { return read_vector(require("degree.npy"), 'i', 0); }
 
-  void check_not_periodic(std::size_t dims) const {
-    const Entry* e = find("periodic.npy");
-    if (!e) return;  // an archive of numpy.savez without it: not periodic
-    const std::vector<double> periodic = read_vector(*e, 'b', dims);
-    for (std::size_t a = 0; a < dims; ++a)
-      if (periodic[a] != 0)
-        fail(errc::invalid_knots, name_, ": periodic.npy: the form is periodic along ", axis_name(a),
-             "; periodic B-splines are not supported yet (only clamped knot vectors are)");
+  // Which directions are closed; none without the member (an archive of numpy.savez).
+  std::vector<bool> read_periodic(std::size_t dims) const {
+    std::vector<bool> periodic(dims, false);
+    if (const Entry* e = find("periodic.npy")) {
+      const std::vector<double> flags = read_vector(*e, 'b', dims);
+      for (std::size_t a = 0; a < dims; ++a) periodic[a] = flags[a] != 0;
+    }
+    return periodic;
   }
 
+  // The knots of a closed direction are the extended ones (KnotVector::values()).
   template <std::size_t D>
-  ExactForm read_form(const std::vector<int>& degrees) const {
+  ExactForm read_form(const std::vector<int>& degrees, const std::vector<bool>& periodic) const {
     std::vector<KnotVector> knots;
     for (std::size_t a = 0; a < D; ++a) {
       const Entry& e = require(knots_member(a));
@@ -658,7 +661,9 @@ class Reader {
         values.resize(count);
         return values.data();
       });
-      knots.push_back(detail::prefixed(cat(name_, ": ", e.name), [&] { return KnotVector(degrees[a], std::move(values)); }));
+      knots.push_back(detail::prefixed(cat(name_, ": ", e.name), [&] {
+        return periodic[a] ? KnotVector::periodic_from_extended(degrees[a], values) : KnotVector(degrees[a], std::move(values));
+      }));
     }
 
     using Shape = typename Grid<Vec3, D>::shape_type;
@@ -678,7 +683,8 @@ class Reader {
       for (std::size_t a = 0; a < D; ++a)
         if (s[a] != shape[a])
           fail(errc::size_mismatch, name_, ": control_points.npy has shape ", internal::npy_shape_text(s), ", but the ",
-               knots[a].size(), " knots of degree ", knots[a].degree(), " in ", knots_member(a), " need ", shape[a],
+               knots[a].size(), knots[a].periodic() ? " periodic knots" : " knots", " of degree ", knots[a].degree(), " in ",
+               knots_member(a), " need ", shape[a],
                " control points along ", axis_name(a), ", ", expected(), "3)");
       points = Grid<Vec3, D>(shape, for_overwrite);
       static_assert(sizeof(Vec3) == 3 * sizeof(double), "control points are read as triples of doubles");

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "cli_specs.hpp"
 #include "test_util.hpp"
 
 namespace interpatch::io {
@@ -121,6 +122,45 @@ TEST(JsonOut, InfoHasTheFieldsOtherProgramsRead) {
   EXPECT_EQ(j["bounding_box"]["min"].size(), 3u);
   for (const char* t : {"parse_ms", "build_ms", "check_ms", "total_ms"}) EXPECT_GE(j["timings"][t].get<double>(), 0.0) << t;
   EXPECT_EQ(j.begin().key(), "type");  // the order people read it in
+}
+
+TEST(JsonOut, InfoReportsTheClosedDirectionsAndTheContinuityAcrossTheSeam) {
+  // The bicubic pipe closed around v: C2 everywhere, across the seam too.
+  const auto pipe = info_json(build(test::pipe_spec(8, 12, true)));
+  EXPECT_EQ(pipe["periodic"], nlohmann::ordered_json({false, true}));
+  EXPECT_EQ(pipe["continuity"], nlohmann::ordered_json({{"u", "C2"}, {"v", "C2"}}));
+  EXPECT_EQ(pipe["seam_continuity"], nlohmann::ordered_json({{"v", "C2"}}));
+  EXPECT_EQ(pipe["control_points"], nlohmann::ordered_json({8, 12}));
+  EXPECT_EQ(pipe["knots"]["v"].size(), 12u + 2 * 3 + 1);  // the extended knots
+  EXPECT_EQ(pipe["domain"]["v"], nlohmann::ordered_json({0.0, 1.0}));
+  // The closing column is data too, checked at v = 1: the first column, one turn on.
+  EXPECT_EQ(pipe["max_data_error"]["points"], 8 * 13);
+  EXPECT_LT(pipe["max_data_error"]["relative"].get<double>(), 1e-13);  // rounding of two banded solves
+  EXPECT_EQ(pipe["parameters"]["periodic"], nlohmann::ordered_json({false, true}));
+  EXPECT_NE(pipe["parameters"]["notes"][0].get<std::string>().find("repeats the first and is left out: 12 distinct"),
+            std::string::npos);
+  // Quadratic around: C1 across the seam as at every knot.
+  json quadratic = test::pipe_spec(8, 12, true);
+  quadratic["degree"] = {3, 2};
+  const auto q = info_json(build(quadratic));
+  EXPECT_EQ(q["seam_continuity"], nlohmann::ordered_json({{"v", "C1"}}));
+  EXPECT_EQ(q["continuity"]["v"], "C1");
+  // A knot of multiplicity 2 at the seam of a cubic: C1 there, and so in the whole direction.
+  const Construction kinked = build(json::parse(R"({"type": "bspline_surface", "degree": [1, 3], "periodic": [false, true],
+      "knots": {"u": [0, 0, 1, 1], "v": [-0.75, -0.5, -0.25, 0, 0, 0.25, 0.5, 0.75, 1, 1, 1.25, 1.5]},
+      "control_points": [[[1,0,0],[1,1,0],[-1,1,0],[-1,0,0],[0,-1,0]], [[1,0,1],[1,1,1],[-1,1,1],[-1,0,1],[0,-1,1]]]})"));
+  const auto k = info_json(kinked);
+  EXPECT_EQ(k["seam_continuity"], nlohmann::ordered_json({{"v", "C1"}}));
+  EXPECT_EQ(k["continuity"]["v"], "C1");
+  // Open: no seam.
+  const auto open = info_json(interpolated(6, 7, 13));
+  EXPECT_EQ(open["periodic"], nlohmann::ordered_json({false, false}));
+  EXPECT_EQ(open["seam_continuity"], nlohmann::ordered_json::object());
+  // A volume closed around v.
+  const auto tube = info_json(build(test::tube_spec(3, 8, 5, true)));
+  EXPECT_EQ(tube["periodic"], nlohmann::ordered_json({false, true, false}));
+  EXPECT_EQ(tube["seam_continuity"], nlohmann::ordered_json({{"v", "C2"}}));
+  EXPECT_EQ(tube["continuity"]["v"], "C2");
 }
 
 TEST(JsonOut, PrettyJsonKeepsPlainArraysOnOneLineAndParsesBack) {

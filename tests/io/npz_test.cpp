@@ -20,6 +20,7 @@
 #include "interpatch/io/npy.hpp"
 #include "io/crc32.hpp"
 #include "io/npz_internal.hpp"
+#include "cli_specs.hpp"
 #include "npy_util.hpp"
 #include "temp_dir.hpp"
 #include "test_util.hpp"
@@ -289,6 +290,45 @@ TEST(Npz, MembersAreStoredNpyFilesInOrderWithTheirChecksums) {
   }
 }
 
+// Closed forms: a pipe (closed around v, odd and even degrees), a tube's wall as a
+// volume, and a surface closed around u and v.
+std::vector<ExactForm> closed_forms() {
+  std::vector<ExactForm> f;
+  for (const int q : {2, 3}) {
+    nlohmann::json s = test::pipe_spec(6, 9, true);
+    s["degree"] = {3, q};
+    f.push_back(*build(s).exact);
+  }
+  nlohmann::json both = test::pipe_spec(5, 7, false);
+  both["periodic"] = {true, true};
+  f.push_back(*build(both).exact);
+  f.push_back(*build(test::tube_spec(3, 7, 4, true)).exact);
+  return f;
+}
+
+TEST(Npz, ClosedFormsRoundTripBitIdentically) {
+  TempDir dir;
+  for (const ExactForm& f : closed_forms()) {
+    write_exact_npz(dir / "f.npz", f);
+    const ExactForm back = read_exact_npz(dir / "f.npz");
+    expect_identical(back, f);
+    // The periodic member says which directions are closed.
+    const std::vector<LocalMember> m = local_members(read_bytes(dir / "f.npz"));
+    const std::string flags = m.back().data.substr(m.back().data.size() - (f.index() == 0 ? 2 : 3));
+    std::string expected;
+    if (const auto* s = std::get_if<BSplineSurface>(&f))
+      for (const bool p : s->periodic()) expected += p ? '\1' : '\0';
+    else
+      for (const bool p : std::get<BSplineVolume>(f).periodic()) expected += p ? '\1' : '\0';
+    EXPECT_EQ(m.back().name, "periodic.npy");
+    EXPECT_EQ(flags, expected);
+    // The same form as the .json exact form reads back to.
+    std::ostringstream text;
+    write_exact_json(text, f);
+    expect_identical(*build(parse_json(text.str())).exact, back);
+  }
+}
+
 TEST(Npz, TheSameFormGivesTheSameBytes) {
   TempDir dir;
   const ExactForm s = random_surface(12, true);
@@ -486,8 +526,8 @@ std::vector<Case> cases() {
        R"(^x\.npz: knots_v\.npy: knot 2 is nan)"},
       {"KnotsOfRankTwo", bilinear_npz_with("knots_u.npy", npy_bytes("<f8", "(2, 2)", f8(four))), errc::size_mismatch,
        R"(^x\.npz: knots_u\.npy has shape \(2, 2\); expected a 1-D array of knots)"},
-      {"Periodic", bilinear_npz_with("periodic.npy", npy_bytes("|b1", "(2,)", std::string("\0\1", 2))), errc::invalid_knots,
-       R"(^x\.npz: periodic\.npy: the form is periodic along v; periodic B-splines are not supported yet)"},
+      {"PeriodicWithClampedKnots", bilinear_npz_with("periodic.npy", npy_bytes("|b1", "(2,)", std::string("\0\1", 2))),
+       errc::invalid_knots, R"(^x\.npz: knots_v\.npy: a periodic knot vector of degree 1 needs at least 5 extended knots)"},
       {"PeriodicOfThree", bilinear_npz_with("periodic.npy", npy_bytes("|b1", "(3,)", std::string(3, '\0'))), errc::size_mismatch,
        R"(^x\.npz: periodic\.npy has shape \(3,\); expected \(2,\), one entry per direction)"},
       {"KnotsWInASurface",
@@ -581,7 +621,9 @@ TEST(NpzForNumpy, WritesSamples) {
   const std::vector<std::pair<std::string, ExactForm>> forms = {{"surface", random_surface(31, false)},
                                                                 {"rational_surface", random_surface(32, true)},
                                                                 {"volume", random_volume(33, false)},
-                                                                {"rational_volume", random_volume(34, true)}};
+                                                                {"rational_volume", random_volume(34, true)},
+                                                                {"closed_surface", closed_forms()[1]},
+                                                                {"closed_volume", closed_forms()[3]}};
   for (const auto& [name, form] : forms)
     for (const bool zip64 : {false, true}) {
       const std::string base = (fs::path(out) / (name + (zip64 ? "_zip64" : ""))).string();

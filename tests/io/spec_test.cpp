@@ -7,12 +7,15 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "cli_specs.hpp"
 #include "interpatch/evaluate.hpp"
+#include "interpatch/interpolate.hpp"
 #include "interpatch/io/json_out.hpp"
 #include "interpatch/io/npy.hpp"
 #include "temp_dir.hpp"
@@ -790,6 +793,309 @@ TEST(SpecExact, TheEvaluatorIsTheCheaperOfFormulaAndExactForm) {
   // Curves of unit size, ~20 terms each rounded at 1.1e-16, and the exact form's
   // sums after knot insertion: well under 1e-12.
   EXPECT_LT(worst, 1e-12);
+}
+
+// --- closed (periodic) shapes ---------------------------------------------------------
+
+PointGrid point_grid(const json& points) {
+  const PointArray a = points_from_json(points, 2);
+  return PointGrid({a.shape[0], a.shape[1]}, std::vector<Vec3>(a.points.begin(), a.points.end()));
+}
+
+PointGrid3 point_grid3(const json& points) {
+  const PointArray a = points_from_json(points, 3);
+  return PointGrid3({a.shape[0], a.shape[1], a.shape[2]}, std::vector<Vec3>(a.points.begin(), a.points.end()));
+}
+
+TEST(SpecPeriodic, ClosedSurfaceIsTheLibrarysBitForBit) {
+  // Odd and even degrees around (the even ones re-anchor their period at the first
+  // parameter), with and without a closing column, every parametrization.
+  for (const int q : {1, 2, 3, 4}) {
+    for (const bool closing : {false, true}) {
+      for (const char* param : {"chord", "centripetal", "uniform"}) {
+        SCOPED_TRACE(std::to_string(q) + (closing ? " closing " : " ") + param);
+        json spec = test::pipe_spec(6, 9, closing);
+        spec["degree"] = {3, q};
+        spec["param"] = param;
+        const Construction c = build(spec);
+        SurfaceInterpolationOptions o;
+        o.degree_u = 3;
+        o.degree_v = q;
+        o.param = param == std::string("chord") ? Parametrization::chord
+                  : param == std::string("uniform") ? Parametrization::uniform
+                                                    : Parametrization::centripetal;
+        o.periodic = {false, true};
+        const SurfaceInterpolation r = interpolate_surface(point_grid(spec["points"]), o);
+        const auto& s = std::get<BSplineSurface>(*c.exact);
+        EXPECT_EQ(s.periodic(), (std::array<bool, 2>{false, true}));
+        EXPECT_EQ(s.knots_u(), r.surface.knots_u());
+        EXPECT_EQ(s.knots_v(), r.surface.knots_v());
+        EXPECT_EQ(s.control_points().values(), r.surface.control_points().values());  // bit for bit
+        EXPECT_EQ(s.control_points().extent(1), q % 2 == 0 ? 10u : 9u);  // the distinct points; even: one more
+        ASSERT_EQ(c.data.size(), 1u);
+        EXPECT_EQ(c.data[0].params[1], r.params_v);
+        if (closing) {
+          EXPECT_EQ(c.data[0].params[1].back(), 1.0);  // the closing column: the first, one turn on
+        }
+        EXPECT_EQ(c.parameters["periodic"], nlohmann::ordered_json({false, true}));
+        EXPECT_TRUE(c.warnings.empty()) << c.warnings[0];
+        // The data, the closing column included, to rounding of the pipe's size (~5).
+        EXPECT_LT(max_error_at_data(c), 1e-13);
+      }
+    }
+  }
+}
+
+TEST(SpecPeriodic, ClosedVolumeIsTheLibrarysBitForBit) {
+  for (const bool closing : {false, true}) {
+    SCOPED_TRACE(closing);
+    const json spec = test::tube_spec(3, 8, 5, closing);
+    const Construction c = build(spec);
+    VolumeInterpolationOptions o;
+    o.periodic = {false, true, false};
+    const VolumeInterpolation r = interpolate_volume(point_grid3(spec["points"]), o);
+    const auto& v = std::get<BSplineVolume>(*c.exact);
+    EXPECT_EQ(v.periodic(), (std::array<bool, 3>{false, true, false}));
+    EXPECT_EQ(v.knots_u(), r.volume.knots_u());
+    EXPECT_EQ(v.knots_v(), r.volume.knots_v());
+    EXPECT_EQ(v.knots_w(), r.volume.knots_w());
+    EXPECT_EQ(v.control_points().values(), r.volume.control_points().values());
+    EXPECT_EQ(v.control_points().extent(1), 8u);
+    const auto e = max_data_error(c);
+    ASSERT_TRUE(e.has_value());
+    EXPECT_EQ(e->count, 3u * (closing ? 9u : 8u) * 5u);
+    EXPECT_LT(e->relative, 1e-13);  // rounding of a few solves
+  }
+}
+
+TEST(SpecPeriodic, ClosedCurveIsTheLibrarysAndAsSmoothAtTheSeamAsAnywhere) {
+  std::vector<Vec3> pts;
+  json list = json::array();
+  for (std::size_t k = 0; k < 7; ++k) {
+    const json p = test::pipe_point(0.3, k, 7);
+    pts.push_back({p[0].get<double>(), p[1].get<double>(), p[2].get<double>()});
+    list.push_back(p);
+  }
+  list.push_back(list[0]);  // the closing point
+  for (const int p : {2, 3, 5}) {
+    SCOPED_TRACE(p);
+    const BSplineCurve c = curve_from_json(json{{"interpolate", list}, {"periodic", true}, {"degree", p}});
+    CurveInterpolationOptions o;
+    o.degree = p;
+    o.periodic = true;
+    const BSplineCurve r = interpolate_curve(pts, o).curve;
+    EXPECT_TRUE(c.periodic());
+    EXPECT_EQ(c.knots(), r.knots());
+    EXPECT_EQ(c.control_points(), r.control_points());
+    EXPECT_EQ(c.domain(), std::make_pair(0.0, 1.0));
+    // C^(p−1) across the seam: derivatives 0..p−1 at the end and at the start agree
+    // to rounding relative to their size (a derivative of order k grows like the
+    // curve's size, ~1, times the number of spans to the k).
+    for (int k = 0; k < p; ++k) {
+      const Vec3 a = c.derivative(0.0, k), b = c.derivative(1.0, k);
+      EXPECT_LT(distance(a, b), 1e-11 * std::max(1.0, norm(a))) << "order " << k;
+    }
+  }
+  // An open curve through the same points is not closed, nor smooth where it ends.
+  const BSplineCurve open = curve_from_json(json{{"interpolate", list}});
+  EXPECT_FALSE(open.periodic());
+  EXPECT_GT(distance(open.derivative(0.0, 1), open.derivative(1.0, 1)), 1e-3);
+}
+
+TEST(SpecPeriodic, ClosedBsplineCurveAndSurfaceFromTheirKnots) {
+  // The closed uniform cubic of four control points, and the cylinder of the docs.
+  const auto c = curve_from_json(json::parse(R"({"bspline": {"degree": 3, "periodic": true,
+      "knots": [-0.75, -0.5, -0.25, 0, 0.25, 0.5, 0.75, 1, 1.25, 1.5, 1.75],
+      "control_points": [[1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]]}})"));
+  EXPECT_TRUE(c.periodic());
+  EXPECT_EQ(c.knots().count(), 4);
+  // A uniform cubic: at a knot, (P[i-1] + 4 P[i] + P[i+1]) / 6; at 0 (knot 3) the
+  // point of control point 1's neighbours 0 and 2: (1, 0, 0)/6 + 4 (0, 1, 0)/6 + (-1, 0, 0)/6.
+  EXPECT_LT(distance(c.point(0.0), Vec3{0, 4.0 / 6, 0}), 1e-15);
+  EXPECT_LT(distance(c.point(1.0), c.point(0.0)), 1e-15);
+  const Construction s = build(json::parse(R"({"type": "bspline_surface", "degree": [1, 3], "periodic": [false, true],
+      "knots": {"u": [0, 0, 1, 1], "v": [-0.75, -0.5, -0.25, 0, 0.25, 0.5, 0.75, 1, 1.25, 1.5, 1.75]},
+      "control_points": [[[1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]], [[1, 0, 2], [0, 1, 2], [-1, 0, 2], [0, -1, 2]]]})"));
+  const auto& b = std::get<BSplineSurface>(*s.exact);
+  EXPECT_EQ(b.periodic(), (std::array<bool, 2>{false, true}));
+  for (const double u : {0.0, 0.4, 1.0}) {
+    EXPECT_LT(distance(b.point(u, 0.0), b.point(u, 1.0)), 1e-15);
+    EXPECT_LT(distance(b.point(u, 0.25), c.point(0.25) + Vec3{0, 0, 2 * u}), 1e-15);
+  }
+  EXPECT_TRUE(s.warnings.empty());
+}
+
+TEST(SpecPeriodic, ClosedFormsReadBackBitForBit) {
+  // What build writes for closed surfaces and volumes (odd and even degrees,
+  // closed in one and in two directions) reads back to the same form.
+  std::vector<json> specs;
+  for (const int q : {2, 3}) {
+    json s = test::pipe_spec(5, 7, true);
+    s["degree"] = {2, q};
+    specs.push_back(s);
+  }
+  json torus = test::pipe_spec(6, 8, false);
+  torus["periodic"] = {true, true};  // closed both ways: the pipe's last section joined back to its first
+  specs.push_back(torus);
+  specs.push_back(test::tube_spec(3, 6, 4, true));
+  for (const json& spec : specs) {
+    const Construction a = build(spec);
+    std::ostringstream text;
+    write_exact_json(text, *a.exact);
+    EXPECT_NE(text.str().find("\"periodic\": ["), std::string::npos);
+    const Construction b = build(parse_json(text.str()));
+    ASSERT_EQ(a.exact->index(), b.exact->index());
+    if (const auto* sa = std::get_if<BSplineSurface>(&*a.exact)) {
+      const auto& sb = std::get<BSplineSurface>(*b.exact);
+      EXPECT_EQ(sa->knots_u(), sb.knots_u());
+      EXPECT_EQ(sa->knots_v(), sb.knots_v());
+      EXPECT_EQ(sa->control_points().values(), sb.control_points().values());
+    } else {
+      const auto& va = std::get<BSplineVolume>(*a.exact);
+      const auto& vb = std::get<BSplineVolume>(*b.exact);
+      EXPECT_EQ(va.knots_u(), vb.knots_u());
+      EXPECT_EQ(va.knots_v(), vb.knots_v());
+      EXPECT_EQ(va.knots_w(), vb.knots_w());
+      EXPECT_EQ(va.control_points().values(), vb.control_points().values());
+    }
+    EXPECT_TRUE(b.warnings.empty());
+  }
+  // An open form is written as before: without "periodic".
+  std::ostringstream open;
+  write_exact_json(open, *build(small_spec()).exact);
+  EXPECT_EQ(open.str().find("periodic"), std::string::npos);
+}
+
+TEST(SpecPeriodic, DataClosedInADirectionNotDeclaredPeriodicAreReported) {
+  // A pipe whose sections repeat their first point, without "periodic".
+  const Construction c = build(test::pipe_spec(5, 8, true, false));
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("/points: the data close along v"), std::string::npos) << c.warnings[0];
+  EXPECT_NE(c.warnings[0].find("\"periodic\": [false, true]"), std::string::npos) << c.warnings[0];
+  ASSERT_TRUE(c.parameters.contains("notes"));
+  EXPECT_NE(c.parameters["notes"][0].get<std::string>().find("close along v"), std::string::npos);
+  EXPECT_EQ(c.parameters["periodic"], nlohmann::ordered_json({false, false}));
+  // Closing points off by rounding (within 1e-12 of the diagonal) close the data too.
+  json rounded = test::pipe_spec(5, 8, true, false);
+  for (auto& row : rounded["points"]) row[8][2] = row[8][2].get<double>() * (1 + 1e-15);
+  const Construction r = build(rounded);
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("close along v"), std::string::npos);
+  // Declared periodic, or open data: nothing to say.
+  for (const json& quiet : {test::pipe_spec(5, 8, true), test::pipe_spec(5, 8, false, false), small_spec()}) {
+    const Construction q = build(quiet);
+    EXPECT_TRUE(q.warnings.empty()) << q.warnings[0];
+    EXPECT_FALSE(q.parameters.contains("notes") &&
+                 q.parameters["notes"].dump().find("is not periodic") != std::string::npos);
+  }
+  // Closed in one direction declared and one not: the suggestion keeps the first.
+  json both = test::pipe_spec(5, 8, true);
+  both["points"].push_back(both["points"][0]);  // the first section again at the end: closed along u too
+  const Construction b = build(both);
+  ASSERT_EQ(b.warnings.size(), 1u);
+  EXPECT_NE(b.warnings[0].find("close along u"), std::string::npos) << b.warnings[0];
+  EXPECT_NE(b.warnings[0].find("\"periodic\": [true, true]"), std::string::npos) << b.warnings[0];
+  // A volume closed along v, not declared: named with its three directions.
+  const Construction v = build(test::tube_spec(3, 6, 4, true, false));
+  ASSERT_EQ(v.warnings.size(), 1u);
+  EXPECT_NE(v.warnings[0].find("close along v"), std::string::npos) << v.warnings[0];
+  EXPECT_NE(v.warnings[0].find("the volume meets itself"), std::string::npos) << v.warnings[0];
+  EXPECT_NE(v.warnings[0].find("\"periodic\": [false, true, false]"), std::string::npos) << v.warnings[0];
+}
+
+TEST(SpecPeriodic, ErrorsNameThePlace) {
+  const json pipe = test::pipe_spec(5, 6, true);
+  const auto with_periodic = [](json s, const json& periodic) {
+    s["periodic"] = periodic;
+    return s;
+  };
+  const auto with = [&](const std::function<void(json&)>& change) {
+    json s = pipe;
+    change(s);
+    return s;
+  };
+  EXPECT_ERRC((void)build(with([](json& s) { s["periodic"] = {true}; })), wrong_type,
+              "/periodic: expected 2 booleans [u, v], one per direction, got 1");
+  EXPECT_ERRC((void)build(with([](json& s) { s["periodic"] = true; })), wrong_type,
+              "/periodic: expected an array of 2 booleans [u, v], one per direction, got a boolean");
+  EXPECT_ERRC((void)build(with([](json& s) { s["periodic"] = {false, 1}; })), wrong_type,
+              "/periodic/1: expected true or false (is v closed?), got a number");
+  EXPECT_ERRC((void)build(with_periodic(test::tube_spec(3, 4, 3, false), {false, true})), wrong_type,
+              "/periodic: expected 3 booleans [u, v, w], one per direction, got 2");
+  // Too few distinct points around for the degree: 3 after the closing one is left out.
+  EXPECT_ERRC((void)build(with([](json& s) { s["points"] = test::pipe_points(5, 3, true); s["degree"] = 3; })), too_few_points,
+              "/degree: degree 3 around v (closed) needs at least 4 distinct points, /points has 4 (shape 5x4), the last "
+              "repeating the first");
+  // A closing column off by more than rounding, less than a chord: a kink at the seam.
+  EXPECT_ERRC((void)build(with([](json& s) { s["points"][2][6][1] = s["points"][2][6][1].get<double>() + 1e-9; })),
+              closing_gap, "/points: point [2][6], the last along v,");
+  EXPECT_ERRC((void)build(json::parse(R"({"type": "bspline_surface", "npz": "x.npz", "periodic": [false, true]})")), wrong_type,
+              "/npz: give either \"npz\" or \"periodic\"");
+  // A periodic direction whose knots are clamped.
+  EXPECT_ERRC((void)build(json::parse(R"({"type": "bspline_surface", "degree": 1, "periodic": [false, true],
+      "knots": {"u": [0, 0, 1, 1], "v": [0, 0, 1, 1]}, "control_points": [[[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]]]})")),
+              invalid_knots, "/knots/v:");
+
+  // Curves: the same rules, and no end derivatives on a closed curve.
+  const json ring = json::parse(R"([[1,0,0], [0,1,0], [-1,0,0], [0,-1,0], [1,0,0]])");
+  EXPECT_ERRC((void)curve_from_json(json{{"interpolate", ring}, {"periodic", "yes"}}, {}, "/c"), wrong_type,
+              "/c/periodic: expected true or false, got a string");
+  EXPECT_ERRC((void)curve_from_json(json{{"interpolate", ring}, {"periodic", true}, {"degree", 4}}, {}, "/c"), too_few_points,
+              "/c/degree: degree 4 of a closed curve needs at least 5 distinct points, /c/interpolate has 4 (its last point "
+              "repeats the first and is left out)");
+  json near = ring;
+  near[4][1] = 1e-9;
+  EXPECT_ERRC((void)curve_from_json(json{{"interpolate", near}, {"periodic", true}}, {}, "/c"), closing_gap,
+              "/c/interpolate: point 4 = ");
+  json twice = ring;
+  twice.push_back(ring[0]);
+  EXPECT_ERRC((void)curve_from_json(json{{"interpolate", twice}, {"periodic", true}}, {}, "/c"), zero_chord,
+              "/c/interpolate/4: point 4 (1, 0, 0) coincides with point 0 (the closing chord of a closed curve has zero length)");
+  EXPECT_ERRC((void)curve_from_json(json{{"interpolate", ring}, {"periodic", true}, {"end_derivative", {0, 1, 0}}}, {}, "/c"),
+              wrong_type, "/c/end_derivative: a closed curve (\"periodic\": true) has no ends");
+  EXPECT_ERRC((void)curve_from_json(json::parse(R"({"bspline": {"degree": 1, "periodic": true, "knots": [-0.5, 0, 0.5, 1, 1.5],
+      "control_points": [[0,0,0], [1,0,0], [2,0,0]]}})"), {}, "/c"),
+              size_mismatch, "/c/bspline/control_points: 5 periodic knots of degree 1 need 2 control points, got 3");
+}
+
+TEST(SpecPeriodic, RuledBetweenClosedCurvesIsATube) {
+  const json c0 = json::parse(R"({"interpolate": [[1,0,0], [0,1,0], [-1,0,0], [0,-1,0], [1,0,0]], "periodic": true})");
+  const json c1 = json::parse(R"({"interpolate": [[2,0,1], [0,2,1], [-2,0,1], [0,-2,1]], "periodic": true})");
+  const Construction c = build(json{{"type", "ruled"}, {"curves", {c0, c1}}});
+  const auto& s = std::get<BSplineSurface>(*c.exact);
+  EXPECT_EQ(s.periodic(), (std::array<bool, 2>{true, false}));
+  const BSplineCurve a = curve_from_json(c0), b = curve_from_json(c1);
+  for (const double u : {0.0, 0.3, 0.75, 1.0}) {
+    // Straight lines between the curves' points at u, closed across u = 0 and 1;
+    // to rounding of the unit-sized curves.
+    EXPECT_LT(distance(s.point(u, 0.0), a.point(u)), 1e-14);
+    EXPECT_LT(distance(s.point(u, 0.4), 0.6 * a.point(u) + 0.4 * b.point(u)), 1e-14);
+  }
+  EXPECT_LT(distance(s.derivative(0.0, 0.5, 2, 0), s.derivative(1.0, 0.5, 2, 0)), 1e-12);  // C2 across the seam
+  // A closed and an open curve make no ruled surface; a closed curve no side of a Coons patch.
+  EXPECT_ERRC((void)build(json{{"type", "ruled"}, {"curves", {c0, test::line_curve({0, 0, 1}, {1, 0, 1})}}}), invalid_knots,
+              "/curves/1: the curve is open and /curves/0 is closed");
+  json coons = test::square_coons();
+  coons["boundary"]["v1"] = c1;
+  EXPECT_ERRC((void)build(coons), invalid_knots, "/boundary/v1: a closed curve (\"periodic\": true) cannot be a side");
+}
+
+TEST(SpecCurve, EndDerivativesAreTakenByTheInterpolation) {
+  const json pts = json::parse(R"([[0,0,0], [1,1,0], [2,0,0]])");
+  const BSplineCurve c = curve_from_json(json{{"interpolate", pts}, {"start_derivative", {0, 4, 0}}, {"end_derivative", {4, 0, 0}}});
+  // Two conditions more: cubic (min(3, points + derivatives − 1)), five control points.
+  EXPECT_EQ(c.degree(), 3);
+  EXPECT_EQ(c.control_points().size(), 5u);
+  EXPECT_LT(distance(c.derivative(0.0, 1), Vec3{0, 4, 0}), 1e-13);
+  EXPECT_LT(distance(c.derivative(1.0, 1), Vec3{4, 0, 0}), 1e-13);
+  EXPECT_LT(distance(c.point(1.0), Vec3{2, 0, 0}), 1e-15);
+  // A degree the points alone could not carry, with the derivatives they can.
+  EXPECT_EQ(curve_from_json(json{{"interpolate", pts}, {"degree", 4}, {"start_derivative", {0, 4, 0}},
+                                 {"end_derivative", {4, 0, 0}}}).degree(), 4);
+  EXPECT_ERRC((void)curve_from_json(json{{"interpolate", pts}, {"degree", 4}, {"start_derivative", {0, 4, 0}}}, {}, "/c"),
+              too_few_points, "/c/degree: degree 4 needs at least 4 points besides its 1 end derivative, /c/interpolate has 3");
+  EXPECT_ERRC((void)curve_from_json(json{{"interpolate", pts}, {"start_derivative", {0, 4}}}, {}, "/c"), wrong_type,
+              "/c/start_derivative: expected a point [x, y, z], got 2 numbers");
 }
 
 }  // namespace

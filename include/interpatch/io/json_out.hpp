@@ -26,8 +26,11 @@ namespace interpatch::io {
 /// control_points (n+1) × (m+1) × 3 (first index along u) and weights only when
 /// rational. A volume is the same with three directions:
 /// `{"type": "bspline_volume", "degree": [p, q, r], "knots": {"u", "v", "w"},
-/// "control_points": (n+1) × (m+1) × (l+1) × 3, "weights"}`. Numbers are written in
-/// the shortest form that reads back to the same double.
+/// "control_points": (n+1) × (m+1) × (l+1) × 3, "weights"}`. A form closed in some
+/// direction also has `"periodic": [false, true]` (one entry per direction, after
+/// "degree"); the knots of a closed direction are then its extended knots
+/// (KnotVector::values()) and its control points the distinct ones. Numbers are
+/// written in the shortest form that reads back to the same double.
 ///
 /// Example:
 /// @code
@@ -63,14 +66,16 @@ struct DataError {
 /// The description `interpatch info` prints, computing the data error (its time is
 /// timings.check_ms):
 /// `{"type", "kind": "surface", "exact_form": "bspline_surface", "degree": [p, q],
-/// "control_points": [n+1, m+1], "rational", "knots": {"u", "v"},
-/// "continuity": {"u": "C2", "v": "C2"}, "domain", "bounding_box": {"min", "max",
+/// "control_points": [n+1, m+1], "rational", "periodic": [false, true], "knots":
+/// {"u", "v"}, "continuity": {"u": "C2", "v": "C2"} (a closed direction's seam
+/// counted as one of its knots), "seam_continuity": {"v": "C2"} (the closed
+/// directions only), "domain", "bounding_box": {"min", "max",
 /// "diagonal"} (of the control net, which contains the surface),
 /// "max_data_error": {"absolute", "relative", "diagonal", "points", "at", "params"} or
 /// null, "data": [{"pointer", "shape", "params": {"u", "v"}}], "parameters",
 /// "warnings", "timings": {"parse_ms", "build_ms", "check_ms", "total_ms"}}`.
 /// A volume has "kind": "volume", "exact_form": "bspline_volume", three entries in
-/// degree, control_points, knots, continuity and domain (u, v, w), and
+/// degree, control_points, periodic, knots, continuity and domain (u, v, w), and
 /// "jacobian": {"samples_per_direction": 17, "samples", "inverted_points", "cells",
 /// "inverted_cells", "min_determinant", "max_determinant", "min_at", "inverted_at"}
 /// from inverted_cells() on a 17 × 17 × 17 grid (its time counts into check_ms).

@@ -9,13 +9,16 @@
 /// | member | dtype | shape (surface) | shape (volume) |
 /// |---|---|---|---|
 /// | `degree` | int64 | (2,) | (3,) |
-/// | `knots_u`, `knots_v`, `knots_w` (volumes) | float64 | (n + p + 1,) ... | ... |
+/// | `knots_u`, `knots_v`, `knots_w` (volumes) | float64 | (n + p + 1,) ...; closed: (n + 2p + 1,) | ... |
 /// | `control_points` | float64 | (n, m, 3) | (n, m, l, 3) |
 /// | `weights` (only when rational) | float64 | (n, m) | (n, m, l) |
 /// | `periodic` | bool | (2,) | (3,) |
 ///
-/// C order, first index along u; `periodic` is all False (periodic B-splines are
-/// not supported yet; an archive that says True is refused). Members the
+/// C order, first index along u. `periodic` says which directions are closed: the
+/// knots of such a direction are the extended knots of a periodic vector
+/// (KnotVector::values(), n + 2p + 1 of them for n distinct control points) and its
+/// control points the distinct ones, as BSplineSurface and BSplineVolume hold them;
+/// an archive without it is open in every direction. Members the
 /// format does not define are refused rather than ignored: a misspelled `weights`
 /// would otherwise read as a polynomial form.
 
@@ -64,7 +67,8 @@ void write_exact_npz(const std::filesystem::path& path, const ExactForm& exact);
 ///   size_mismatch (a shape that does not fit: control_points not (..., 3), knots
 ///   that need another number of control points, weights of another shape);
 ///   invalid_degree (a degree outside 1..30); invalid_knots, non_increasing (the
-///   knot vectors, as KnotVector checks them; periodic True); not_finite (NaN or
+///   knot vectors, as KnotVector and, for a closed direction,
+///   KnotVector::periodic_from_extended check them); not_finite (NaN or
 ///   Inf in knots, control points or weights); invalid_weight (a weight <= 0);
 ///   too_large (the net needs more memory than available; refused before reading).
 [[nodiscard]] ExactForm read_exact_npz(const std::filesystem::path& path);

@@ -66,7 +66,8 @@ struct Construction {
   std::vector<DataSet> data;  ///< what it interpolates (empty when given exactly)
   /// The options in effect, defaults filled in (degree, param, grid shape, ...).
   nlohmann::ordered_json parameters = nlohmann::ordered_json::object();
-  /// Fields that were ignored (unknown names), each "pointer: reason".
+  /// What the reader warns about, each "pointer: reason": fields that were ignored
+  /// (unknown names), data closed in a direction not declared periodic.
   std::vector<std::string> warnings;
   Timings timings;
   /// The construction's own formula, when it is not a B-spline itself (Coons
@@ -192,7 +193,7 @@ struct SpecForm {
 ///   (naming the pointer and the expected type), ragged_grid, not_finite, size_mismatch,
 ///   file_unreadable and malformed_file (data files), too_large, and whatever the
 ///   construction raises (too_few_points, invalid_degree, zero_chord, non_increasing,
-///   invalid_knots, invalid_weight, singular, ...), prefixed with the pointer.
+///   invalid_knots, invalid_weight, singular, closing_gap, ...), prefixed with the pointer.
 [[nodiscard]] Construction build(const nlohmann::json& spec, const std::filesystem::path& base_dir,
                                  const BuildOptions& options);
 
@@ -235,18 +236,20 @@ struct PointArray {
                                           const std::filesystem::path& base_dir = {}, std::string_view pointer = "");
 
 /// Reads a curve in any of its forms (docs/spec-format.md) — `{"interpolate": points,
-/// "degree": p, "param": "chord"}`, `{"bspline": {"degree", "knots",
-/// "control_points", "weights"}}`, `{"hermite": {"points", "tangents", "params"}}`,
+/// "degree": p, "param": "chord", "periodic": false, "start_derivative": [x, y, z],
+/// "end_derivative": [x, y, z]}`, `{"bspline": {"degree", "knots", "control_points",
+/// "weights", "periodic"}}`, `{"hermite": {"points", "tangents", "params"}}`,
 /// `{"line": [A, B]}` — as a B-spline curve over [0, 1] (its own domain mapped
-/// linearly).
+/// linearly). `"periodic": true` makes a closed curve (BSplineCurve::periodic()).
 ///
 /// Example:
 /// @code
 ///   auto c = interpatch::io::curve_from_json(nlohmann::json::parse(R"({"line": [[0,0,0], [2,0,0]]})"));
 ///   // c.point(0.5) == (1, 0, 0)
 /// @endcode
-/// @throws error missing_field, wrong_type, and the codes of points_from_json and of
-///   the curve constructions, each naming its place under `pointer`.
+/// @throws error missing_field, wrong_type (also end derivatives of a closed curve),
+///   and the codes of points_from_json and of the curve constructions (closing_gap
+///   among them), each naming its place under `pointer`.
 [[nodiscard]] BSplineCurve curve_from_json(const nlohmann::json& j, const std::filesystem::path& base_dir = {},
                                            std::string_view pointer = "");
 

@@ -24,23 +24,43 @@ std::vector<Vec3> curve_points(const json& j, std::string_view ptr, Context& ctx
   return {a.points.begin(), a.points.end()};
 }
 
+// {"interpolate": points, ...}: open, or closed ("periodic": true) through the
+// distinct points, a last point repeating the first left out.
 BSplineCurve interpolated_curve(const json& obj, std::string_view ptr, Context& ctx) {
   check_fields(obj, ptr, forms::interpolate_curve, ctx);
   const std::string pts_at = child(ptr, "interpolate");
   const std::vector<Vec3> pts = curve_points(obj.at("interpolate"), pts_at, ctx);
-  const auto degree = degrees(obj, ptr, 1)[0];
-  if (degree && static_cast<std::size_t>(*degree) >= pts.size())
-    fail(errc::too_few_points, degree_pointer(obj, ptr, 0), ": degree ", *degree, " needs at least ", *degree + 1,
-         " points, ", pts_at, " has ", pts.size());
-  const Parametrization param = parametrization(obj, ptr);
-  if (param != Parametrization::uniform)
-    for (std::size_t i = 1; i < pts.size(); ++i)
+  CurveInterpolationOptions options;
+  options.periodic = periodic_flags(obj, ptr, 1)[0];
+  for (const char* end : {"start_derivative", "end_derivative"}) {
+    const json* d = find_member(obj, end);
+    if (!d) continue;
+    const std::string dptr = child(ptr, end);
+    if (options.periodic)
+      fail(errc::wrong_type, place(dptr), ": a closed curve (\"periodic\": true) has no ends; give either \"periodic\" or ",
+           "end derivatives, not both");
+    (end[0] == 's' ? options.start_derivative : options.end_derivative) = point_value(*d, dptr);
+  }
+  const Closing closing = options.periodic ? at(pts_at, [&] { return closing_point(pts); }) : Closing{pts.size(), false};
+  const std::size_t n = closing.count;  // the points the curve is made of
+  const std::size_t ends = (options.start_derivative ? 1u : 0u) + (options.end_derivative ? 1u : 0u);
+  options.degree = degrees(obj, ptr, 1)[0];
+  if (const auto p = options.degree; p && static_cast<std::size_t>(*p) >= n + ends)
+    fail(errc::too_few_points, degree_pointer(obj, ptr, 0), ": degree ", *p, options.periodic ? " of a closed curve" : "",
+         " needs at least ", static_cast<std::size_t>(*p) + 1 - ends, options.periodic ? " distinct points" : " points",
+         ends == 0 ? "" : cat(" besides its ", ends, " end derivative", ends == 1 ? "" : "s"), ", ", pts_at, " has ", n,
+         closing.dropped ? " (its last point repeats the first and is left out)" : "");
+  options.param = parametrization(obj, ptr);
+  if (options.param != Parametrization::uniform) {
+    for (std::size_t i = 1; i < n; ++i)
       if (pts[i] == pts[i - 1])
         fail(errc::zero_chord, child(pts_at, i), ": point ", i, " ", pts[i], " coincides with point ", i - 1,
-             " (a zero chord); ", param_name(param), " parameters need distinct consecutive points");
-  CurveInterpolationOptions options;
-  options.degree = degree;
-  options.param = param;
+             " (a zero chord); ", param_name(options.param), " parameters need distinct consecutive points");
+    if (options.periodic && n >= 2 && pts[n - 1] == pts[0])
+      fail(errc::zero_chord, child(pts_at, n - 1), ": point ", n - 1, " ", pts[n - 1],
+           " coincides with point 0 (the closing chord of a closed curve has zero length); ", param_name(options.param),
+           " parameters need distinct consecutive points, the last and the first included");
+  }
   return at(ptr, [&] { return on_unit_domain(interpolate_curve(pts, options).curve); });
 }
 
@@ -50,14 +70,14 @@ BSplineCurve bspline_curve(const json& b, std::string_view ptr, Context& ctx) {
   const int p = degree_value(member(b, "degree", ptr, "an integer degree"), child(ptr, "degree"));
   const std::string kptr = child(ptr, "knots"), cptr = child(ptr, "control_points"), wptr = child(ptr, "weights");
   std::vector<double> knots = numbers(member(b, "knots", ptr, "an array of knots"), kptr);
+  const bool closed = periodic_flags(b, ptr, 1)[0];
   const PointStorage cps = points_impl(member(b, "control_points", ptr, "a list of points"), 1, cptr, ctx).points;
   std::vector<Vec3> cp(cps.begin(), cps.end());
   std::vector<double> w;
   if (const json* wj = find_member(b, "weights")) w = numbers(*wj, wptr);
-  KnotVector k = at(kptr, [&] { return KnotVector(p, std::move(knots)); });
+  KnotVector k = at(kptr, [&] { return knot_vector(p, std::move(knots), closed); });
   if (static_cast<std::size_t>(k.count()) != cp.size())
-    fail(errc::size_mismatch, cptr, ": ", k.size(), " knots of degree ", p, " need ", k.count(), " control points, got ",
-         cp.size());
+    fail(errc::size_mismatch, cptr, ": ", knots_text(k), " need ", k.count(), " control points, got ", cp.size());
   if (!w.empty() && w.size() != cp.size())
     fail(errc::size_mismatch, wptr, ": ", cp.size(), " control points need ", cp.size(), " weights, got ", w.size());
   for (std::size_t i = 0; i < w.size(); ++i)

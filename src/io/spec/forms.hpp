@@ -16,8 +16,10 @@ inline constexpr auto csv = std::to_array({"csv"sv, "shape"sv});
 
 // Curves: the fields of the curve object ("interpolate", "line"), or of the object
 // under its key ("bspline": {...}, "hermite": {...}).
-inline constexpr auto interpolate_curve = std::to_array({"interpolate"sv, "degree"sv, "param"sv});
-inline constexpr auto bspline_curve = std::to_array({"degree"sv, "knots"sv, "control_points"sv, "weights"sv});
+inline constexpr auto interpolate_curve = std::to_array(
+    {"interpolate"sv, "degree"sv, "param"sv, "periodic"sv, "start_derivative"sv, "end_derivative"sv});
+inline constexpr auto bspline_curve =
+    std::to_array({"degree"sv, "knots"sv, "control_points"sv, "weights"sv, "periodic"sv});
 inline constexpr auto hermite_curve = std::to_array({"points"sv, "tangents"sv, "params"sv});
 inline constexpr auto line_curve = std::to_array({"line"sv});
 
@@ -28,12 +30,12 @@ inline constexpr auto coons = std::to_array(
     {"type"sv, "boundary"sv, "blending"sv, "cross_derivatives"sv, "twists"sv, "twist_correction"sv, "tolerance"sv});
 inline constexpr auto network =
     std::to_array({"type"sv, "u_curves"sv, "v_curves"sv, "u_params"sv, "v_params"sv, "method"sv, "tolerance"sv});
-inline constexpr auto interpolate = std::to_array({"type"sv, "points"sv, "degree"sv, "param"sv});
+inline constexpr auto interpolate = std::to_array({"type"sv, "points"sv, "degree"sv, "param"sv, "periodic"sv});
 inline constexpr auto hermite_patch = std::to_array({"type"sv, "corners"sv});
 // bspline_surface and bspline_volume: the form by its fields, or "npz", an archive
 // that holds them all (and excludes the others).
 inline constexpr auto bspline =
-    std::to_array({"type"sv, "degree"sv, "knots"sv, "control_points"sv, "weights"sv, "npz"sv});
+    std::to_array({"type"sv, "degree"sv, "knots"sv, "control_points"sv, "weights"sv, "periodic"sv, "npz"sv});
 inline constexpr auto trilinear = std::to_array(
     {"type"sv, "p000"sv, "p001"sv, "p010"sv, "p011"sv, "p100"sv, "p101"sv, "p110"sv, "p111"sv});
 inline constexpr auto coons_volume = std::to_array({"type"sv, "faces"sv, "blending"sv, "cross_derivatives"sv, "tolerance"sv});

@@ -3,7 +3,9 @@
 // build writes (bspline_surface, bspline_volume). One builder of each serves both
 // dimensions; Tensor<D> says what differs.
 
+#include <algorithm>
 #include <array>
+#include <limits>
 #include <utility>
 
 #include "interpatch/bspline_surface.hpp"
@@ -24,6 +26,7 @@ template <>
 struct Tensor<2> {
   using Exact = BSplineSurface;
   using Points = PointGrid;
+  static constexpr const char* kind = "surface";
   static constexpr const char* interpolate_type = "interpolate";
   static constexpr const char* bspline_type = "bspline_surface";
   static constexpr const char* grid_form = "(n+1) x (m+1) x 3";
@@ -31,12 +34,14 @@ struct Tensor<2> {
   static constexpr const char* knots_form = "an object {\"u\": [...], \"v\": [...]}";
 
   static std::pair<Exact, std::vector<std::vector<double>>> interpolate(Points grid, const std::vector<std::optional<int>>& d,
-                                                                        Parametrization param, const progress_callback& progress) {
+                                                                        Parametrization param, const std::array<bool, 3>& periodic,
+                                                                        const progress_callback& progress) {
     SurfaceInterpolationOptions o;
     o.degree_u = d[0];
     o.degree_v = d[1];
     o.param = param;
     o.progress = progress;
+    o.periodic = {periodic[0], periodic[1]};
     SurfaceInterpolation r = interpolate_surface(std::move(grid), o);
     return {std::move(r.surface), {std::move(r.params_u), std::move(r.params_v)}};
   }
@@ -51,6 +56,7 @@ template <>
 struct Tensor<3> {
   using Exact = BSplineVolume;
   using Points = PointGrid3;
+  static constexpr const char* kind = "volume";
   static constexpr const char* interpolate_type = "interpolate_volume";
   static constexpr const char* bspline_type = "bspline_volume";
   static constexpr const char* grid_form = "(n+1) x (m+1) x (l+1) x 3";
@@ -58,13 +64,15 @@ struct Tensor<3> {
   static constexpr const char* knots_form = "an object {\"u\": [...], \"v\": [...], \"w\": [...]}";
 
   static std::pair<Exact, std::vector<std::vector<double>>> interpolate(Points grid, const std::vector<std::optional<int>>& d,
-                                                                        Parametrization param, const progress_callback& progress) {
+                                                                        Parametrization param, const std::array<bool, 3>& periodic,
+                                                                        const progress_callback& progress) {
     VolumeInterpolationOptions o;
     o.degree_u = d[0];
     o.degree_v = d[1];
     o.degree_w = d[2];
     o.param = param;
     o.progress = progress;
+    o.periodic = periodic;
     VolumeInterpolation r = interpolate_volume(std::move(grid), o);
     return {std::move(r.volume), {std::move(r.params_u), std::move(r.params_v), std::move(r.params_w)}};
   }
@@ -88,6 +96,42 @@ typename Grid<Vec3, D>::shape_type grid_shape(const std::vector<std::size_t>& sh
   typename Grid<Vec3, D>::shape_type s{};
   for (std::size_t a = 0; a < D; ++a) s[a] = shape[a];
   return s;
+}
+
+// How a grid of data ends along an axis, by the rule interpolation follows in a
+// closed direction (closing_point, for every line along the axis at once): its last
+// line repeats the first (every point of it equal to the first line's, or within
+// 1e-12 of the bounding-box diagonal when some last point is nearer its first than
+// 1e-3 of the chords next to it), nearly does (such a near point, but a gap above
+// that tolerance: a closed direction refuses it as closing_gap), or does not.
+enum class Ending { open, closes, nearly };
+
+Ending ending_along(const PointStorage& q, const std::vector<std::size_t>& shape, std::size_t axis) {
+  const std::size_t n = shape[axis];
+  if (n < 3) return Ending::open;  // two lines are the closing chord and its way back, never a closing line
+  std::size_t inner = 1;
+  for (std::size_t a = axis + 1; a < shape.size(); ++a) inner *= shape[a];
+  const std::size_t lines = q.size() / n;
+  const auto at = [&](std::size_t l, std::size_t k) -> const Vec3& { return q[(l / inner) * n * inner + k * inner + l % inner]; };
+  bool all_equal = true, near = false;
+  double largest = 0;
+  for (std::size_t l = 0; l < lines; ++l) {
+    const double gap = distance(at(l, n - 1), at(l, 0));
+    if (gap == 0.0) continue;
+    all_equal = false;
+    largest = std::max(largest, gap);
+    near = near || gap < 1e-3 * std::min(distance(at(l, 1), at(l, 0)), distance(at(l, n - 1), at(l, n - 2)));
+  }
+  if (all_equal) return Ending::closes;
+  if (!near) return Ending::open;
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
+  for (const Vec3& p : q)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]);
+      hi[k] = std::max(hi[k], p[k]);
+    }
+  return largest <= 1e-12 * norm(hi - lo) ? Ending::closes : Ending::nearly;
 }
 
 // "domain": {"u": [a, b], ...}, as the exact form had it before it was mapped onto [0, 1].
@@ -115,7 +159,7 @@ Construction exact_construction(typename Tensor<D>::Exact s) {
 template <std::size_t D>
 Construction bspline_from_npz(const json& spec, Context& ctx) {
   using T = Tensor<D>;
-  for (const char* field : {"degree", "knots", "control_points", "weights"})
+  for (const char* field : {"degree", "knots", "control_points", "weights", "periodic"})
     if (find_member(spec, field))
       fail(errc::wrong_type, "/npz: give either \"npz\" or \"", field, "\" (with the other fields of ", T::bspline_type,
            "), not both: the archive holds the whole form");
@@ -134,15 +178,37 @@ Construction build_interpolate(const json& spec, Context& ctx) {
   PointArray pts = points_impl(member(spec, "points", "", cat("a grid of points, ", T::grid_form)), D, "/points", ctx);
   const auto degree = degrees(spec, "", D);
   const Parametrization param = parametrization(spec, "");
+  const std::array<bool, 3> periodic = periodic_flags(spec, "", D);
   const std::string shape = extents_text(pts.shape);
+  nlohmann::ordered_json notes = nlohmann::ordered_json::array();
   for (std::size_t a = 0; a < D; ++a) {
     const std::size_t count = pts.shape[a];
     if (count < 2)
       fail(errc::too_few_points, "/points: the grid has ", count, " point", count == 1 ? "" : "s", " along ", axis_name(a),
            " (shape ", shape, "); interpolation needs at least 2");
-    if (degree[a] && static_cast<std::size_t>(*degree[a]) >= count)
-      fail(errc::too_few_points, degree_pointer(spec, "", a), ": degree ", *degree[a], " along ", axis_name(a),
-           " needs at least ", *degree[a] + 1, " points, /points has ", count, " (shape ", shape, ")");
+    const Ending ending = ending_along(pts.points, pts.shape, a);
+    // A closed direction is made of its distinct lines: a closing line is left out.
+    const bool dropped = periodic[a] && ending == Ending::closes;
+    const std::size_t lines = dropped ? count - 1 : count;
+    // A closing line nearly equal to the first: interpolation refuses it (closing_gap) before any degree.
+    const bool refused = periodic[a] && ending == Ending::nearly;
+    if (degree[a] && static_cast<std::size_t>(*degree[a]) >= lines && !refused)
+      fail(errc::too_few_points, degree_pointer(spec, "", a), ": degree ", *degree[a], periodic[a] ? " around " : " along ",
+           axis_name(a), periodic[a] ? " (closed)" : "", " needs at least ", *degree[a] + 1,
+           periodic[a] ? " distinct points" : " points", ", /points has ", count, " (shape ", shape, ")",
+           dropped ? ", the last repeating the first" : "");
+    if (dropped)
+      notes.push_back(cat("the last line of points along ", axis_name(a), " repeats the first and is left out: ", lines,
+                          " distinct lines around ", axis_name(a)));
+    if (!periodic[a] && ending == Ending::closes) {
+      std::array<bool, 3> suggested = periodic;
+      suggested[a] = true;
+      const std::string what = cat("the data close along ", axis_name(a), " (the last line of points repeats the first), but ",
+                                   axis_name(a), " is not periodic: the ", T::kind, " meets itself there with a crease; \"periodic\": ",
+                                   periodic_text(suggested, D), " makes it smooth across the seam");
+      ctx.warn(cat("/points: ", what));
+      notes.push_back(what);
+    }
   }
   typename T::Points grid(grid_shape<D>(pts.shape), std::move(pts.points));
   DataSet data;
@@ -152,14 +218,18 @@ Construction build_interpolate(const json& spec, Context& ctx) {
     data.points.assign(grid.values().begin(), grid.values().end());
   }
   ctx.parsed();
-  auto [exact, params] = at("/points", [&] { return T::interpolate(std::move(grid), degree, param, ctx.progress); });
+  auto [exact, params] = at("/points", [&] { return T::interpolate(std::move(grid), degree, param, periodic, ctx.progress); });
   const auto dom = exact.domain();
   for (std::size_t a = 0; a < D; ++a) data.params.push_back(to_unit(std::move(params[a]), dom[a]));
   if (!on_unit_domain<D>(exact)) exact = T::on_unit_domain(std::move(exact));
 
   Construction c;
   c.type = T::interpolate_type;
-  c.parameters = {{"grid", pts.shape}, {"degree", T::degrees(exact)}, {"param", param_name(param)}};
+  c.parameters = {{"grid", pts.shape},
+                  {"degree", T::degrees(exact)},
+                  {"param", param_name(param)},
+                  {"periodic", std::vector<bool>(periodic.begin(), periodic.begin() + D)}};
+  if (!notes.empty()) c.parameters["notes"] = std::move(notes);
   c.exact = std::move(exact);
   if (ctx.keep_data) c.data.push_back(std::move(data));
   return c;
@@ -194,18 +264,18 @@ Construction build_bspline(const json& spec, Context& ctx) {
         fail(errc::invalid_weight, index_pointer("/weights", idx, D), ": weight ", weights.values()[i], " is not positive");
       }
   }
-  auto knot_vector = [&](std::size_t a) {
-    return at(child("/knots", axis_name(a)), [&] { return KnotVector(*degree[a], std::move(kv[a])); });
+  const std::array<bool, 3> periodic = periodic_flags(spec, "", D);
+  auto knots_of = [&](std::size_t a) {
+    return at(child("/knots", axis_name(a)), [&] { return knot_vector(*degree[a], std::move(kv[a]), periodic[a]); });
   };
   // Braced lists evaluate in order: the u knots are checked first.
   std::array<KnotVector, D> k = [&]<std::size_t... A>(std::index_sequence<A...>) {
-    return std::array<KnotVector, D>{knot_vector(A)...};
+    return std::array<KnotVector, D>{knots_of(A)...};
   }(std::make_index_sequence<D>{});
   for (std::size_t a = 0; a < D; ++a)
     if (static_cast<std::size_t>(k[a].count()) != cp.shape[a])
       fail(errc::size_mismatch, "/control_points: ", cp.shape[a], " control points along ", axis_name(a), " (shape ",
-           shape, "), but the ", k[a].size(), " knots of degree ", k[a].degree(), " in /knots/", axis_name(a), " need ",
-           k[a].count());
+           shape, "), but the ", knots_text(k[a]), " in /knots/", axis_name(a), " need ", k[a].count());
   ctx.parsed();
   typename T::Exact s = at("/control_points", [&] {
     return T::make(std::move(k), typename T::Points(grid_shape<D>(cp.shape), std::move(cp.points)), std::move(weights));

@@ -210,6 +210,41 @@ Parametrization parametrization(const json& obj, std::string_view ptr) {
        "\"; expected uniform, chord or centripetal");
 }
 
+std::array<bool, 3> periodic_flags(const json& obj, std::string_view ptr, std::size_t dims) {
+  std::array<bool, 3> flags{};
+  const json* j = find_member(obj, "periodic");
+  if (!j) return flags;
+  const std::string at_ = child(ptr, "periodic");
+  if (dims == 1) {
+    if (!j->is_boolean()) wrong_type(at_, "true or false", *j);
+    flags[0] = j->get<bool>();
+    return flags;
+  }
+  const std::string form = cat(dims, " booleans [", dims == 3 ? "u, v, w" : "u, v", "], one per direction");
+  if (!j->is_array()) wrong_type(at_, cat("an array of ", form), *j);
+  if (j->size() != dims) fail(errc::wrong_type, place(at_), ": expected ", form, ", got ", j->size());
+  for (std::size_t a = 0; a < dims; ++a) {
+    const json& e = (*j)[a];
+    if (!e.is_boolean()) wrong_type(child(at_, a), cat("true or false (is ", axis_name(a), " closed?)"), e);
+    flags[a] = e.get<bool>();
+  }
+  return flags;
+}
+
+std::string periodic_text(const std::array<bool, 3>& flags, std::size_t dims) {
+  std::string s = "[";
+  for (std::size_t a = 0; a < dims; ++a) s += cat(a ? ", " : "", flags[a] ? "true" : "false");
+  return s + "]";
+}
+
+KnotVector knot_vector(int degree, std::vector<double> knots, bool periodic) {
+  return periodic ? KnotVector::periodic_from_extended(degree, knots) : KnotVector(degree, std::move(knots));
+}
+
+std::string knots_text(const KnotVector& k) {
+  return cat(k.size(), k.periodic() ? " periodic knots" : " knots", " of degree ", k.degree());
+}
+
 std::optional<double> tolerance_of(const json& spec) {
   const json* t = find_member(spec, "tolerance");
   if (!t) return std::nullopt;

@@ -118,6 +118,17 @@ std::string degree_pointer(const json& obj, std::string_view ptr, std::size_t ax
 const char* param_name(Parametrization p);
 /// "param": uniform, chord (default) or centripetal.
 Parametrization parametrization(const json& obj, std::string_view ptr);
+/// "periodic": which directions are closed. A curve (dims 1) takes true or false; a
+/// grid or an exact form an array of `dims` booleans, one per direction u, v(, w).
+/// Absent: none. Entries past `dims` are false.
+std::array<bool, 3> periodic_flags(const json& obj, std::string_view ptr, std::size_t dims);
+/// "[false, true]": the flags of `dims` directions as a spec writes them.
+std::string periodic_text(const std::array<bool, 3>& flags, std::size_t dims);
+/// A knot vector as a spec gives it: clamped, or the extended knots of a periodic one
+/// (KnotVector::periodic_from_extended), as build writes them.
+KnotVector knot_vector(int degree, std::vector<double> knots, bool periodic);
+/// "6 knots of degree 2", "13 periodic knots of degree 3": knots in a message.
+std::string knots_text(const KnotVector& k);
 /// "tolerance": a non-negative number, or nothing.
 std::optional<double> tolerance_of(const json& spec);
 /// A string member that must be one of `allowed`; `fallback` when absent.

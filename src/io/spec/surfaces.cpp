@@ -85,6 +85,10 @@ Construction build_ruled(const json& spec, Context& ctx) {
   const json& cs = member(spec, "curves", "", "an array of two curves [c0, c1]");
   if (!cs.is_array() || cs.size() != 2) wrong_type("/curves", "an array of two curves [c0, c1]", cs);
   const BSplineCurve c0 = curve_impl(cs[0], "/curves/0", ctx), c1 = curve_impl(cs[1], "/curves/1", ctx);
+  // Two closed curves make a closed surface (a tube); a closed and an open one nothing.
+  if (c0.periodic() != c1.periodic())
+    fail(errc::invalid_knots, "/curves/1: the curve is ", c1.periodic() ? "closed" : "open", " and /curves/0 is ",
+         c0.periodic() ? "closed" : "open", "; a ruled surface joins two closed curves (\"periodic\": true, a tube) or two open ones");
   ctx.parsed();
   return blended("ruled", ruled(c0, c1), {curve_data(c0, 0, 0.0, "/curves/0"), curve_data(c1, 0, 1.0, "/curves/1")},
                  nlohmann::ordered_json::object());
@@ -96,7 +100,12 @@ Construction build_coons(const json& spec, Context& ctx) {
     expect_object(obj, ptr, "an object {\"v0\", \"v1\", \"u0\", \"u1\"} of curves");
     check_fields(obj, ptr, {"v0", "v1", "u0", "u1"}, ctx);
     std::vector<BSplineCurve> c;
-    for (const char* side : sides) c.push_back(curve_impl(member(obj, side, ptr, "a curve"), child(ptr, side), ctx));
+    for (const char* side : sides) {
+      c.push_back(curve_impl(member(obj, side, ptr, "a curve"), child(ptr, side), ctx));
+      if (c.back().periodic())
+        fail(errc::invalid_knots, place(child(ptr, side)), ": a closed curve (\"periodic\": true) cannot be a side of a ",
+             "Coons patch, whose sides run from corner to corner");
+    }
     return c;
   };
   const auto b = four_curves(member(spec, "boundary", "", "an object {\"v0\", \"v1\", \"u0\", \"u1\"} of curves"), "/boundary");
