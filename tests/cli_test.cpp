@@ -132,6 +132,9 @@ TEST_F(CliTest, InfoPrintsOneObjectWithTheContractFields) {
   EXPECT_EQ(j["knots"]["v"].size(), 13u);
   EXPECT_LT(j["max_data_error"]["relative"].get<double>(), 1e-12);
   EXPECT_EQ(j["continuity"], json({{"u", "C2"}, {"v", "C2"}}));
+  EXPECT_EQ(j["periodic"], json({false, false}));
+  EXPECT_EQ(j["seam_continuity"], json::object());
+  EXPECT_EQ(j["parameters"]["periodic"], json({false, false}));
   for (const char* t : {"parse_ms", "build_ms", "check_ms"}) EXPECT_TRUE(j["timings"][t].is_number()) << t;
 }
 

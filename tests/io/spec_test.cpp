@@ -911,6 +911,7 @@ TEST(SpecPeriodic, ClosedBsplineCurveAndSurfaceFromTheirKnots) {
   EXPECT_EQ(c.knots().count(), 4);
   // A uniform cubic: at a knot, (P[i-1] + 4 P[i] + P[i+1]) / 6; at 0 (knot 3) the
   // point of control point 1's neighbours 0 and 2: (1, 0, 0)/6 + 4 (0, 1, 0)/6 + (-1, 0, 0)/6.
+  // Unit-sized values through a few products: 1e-15 is rounding.
   EXPECT_LT(distance(c.point(0.0), Vec3{0, 4.0 / 6, 0}), 1e-15);
   EXPECT_LT(distance(c.point(1.0), c.point(0.0)), 1e-15);
   const Construction s = build(json::parse(R"({"type": "bspline_surface", "degree": [1, 3], "periodic": [false, true],
@@ -918,7 +919,7 @@ TEST(SpecPeriodic, ClosedBsplineCurveAndSurfaceFromTheirKnots) {
       "control_points": [[[1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]], [[1, 0, 2], [0, 1, 2], [-1, 0, 2], [0, -1, 2]]]})"));
   const auto& b = std::get<BSplineSurface>(*s.exact);
   EXPECT_EQ(b.periodic(), (std::array<bool, 2>{false, true}));
-  for (const double u : {0.0, 0.4, 1.0}) {
+  for (const double u : {0.0, 0.4, 1.0}) {  // closed around v, the straight lines of a cylinder along u; rounding as above
     EXPECT_LT(distance(b.point(u, 0.0), b.point(u, 1.0)), 1e-15);
     EXPECT_LT(distance(b.point(u, 0.25), c.point(0.25) + Vec3{0, 0, 2 * u}), 1e-15);
   }
@@ -1084,6 +1085,8 @@ TEST(SpecCurve, EndDerivativesAreTakenByTheInterpolation) {
   const json pts = json::parse(R"([[0,0,0], [1,1,0], [2,0,0]])");
   const BSplineCurve c = curve_from_json(json{{"interpolate", pts}, {"start_derivative", {0, 4, 0}}, {"end_derivative", {4, 0, 0}}});
   // Two conditions more: cubic (min(3, points + derivatives − 1)), five control points.
+  // The derivatives and the end point to rounding: derivatives of size 4 come out of
+  // one small solve, the end point is the last control point.
   EXPECT_EQ(c.degree(), 3);
   EXPECT_EQ(c.control_points().size(), 5u);
   EXPECT_LT(distance(c.derivative(0.0, 1), Vec3{0, 4, 0}), 1e-13);

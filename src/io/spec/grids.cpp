@@ -108,7 +108,7 @@ enum class Ending { open, closes, nearly };
 
 Ending ending_along(const PointStorage& q, const std::vector<std::size_t>& shape, std::size_t axis) {
   const std::size_t n = shape[axis];
-  if (n < 3) return Ending::open;  // two lines are the closing chord and its way back, never a closing line
+  if (n < 3) return Ending::open;  // as in interpolation: of two lines, the last is never a closing line
   std::size_t inner = 1;
   for (std::size_t a = axis + 1; a < shape.size(); ++a) inner *= shape[a];
   const std::size_t lines = q.size() / n;
