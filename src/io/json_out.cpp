@@ -15,6 +15,7 @@
 #include "interpatch/bspline_volume.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/memory.hpp"
+#include "io/box.hpp"
 
 namespace interpatch::io {
 
@@ -140,18 +141,7 @@ ojson vec(const Vec3& p) { return ojson::array({p.x, p.y, p.z}); }
 
 double round_ms(double ms) { return std::round(ms * 1000.0) / 1000.0; }
 
-struct Box {
-  Vec3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
-          std::numeric_limits<double>::infinity()};
-  Vec3 hi = -lo;
-  void add(const Vec3& p) {
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], p[k]);
-      hi[k] = std::max(hi[k], p[k]);
-    }
-  }
-  [[nodiscard]] double diagonal() const { return lo.x <= hi.x ? norm(hi - lo) : 0.0; }
-};
+using internal::Box;
 
 // The surface at the data parameters, a block of rows at a time.
 void surface_data_error(const Surface& s, const DataSet& d, DataError& e, std::size_t& done, std::size_t total,

@@ -5,13 +5,13 @@
 
 #include <algorithm>
 #include <array>
-#include <limits>
 #include <utility>
 
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/bspline_volume.hpp"
 #include "interpatch/interpolate.hpp"
 #include "interpatch/memory.hpp"
+#include "io/box.hpp"
 #include "io/npz_internal.hpp"
 #include "io/spec/reader.hpp"
 
@@ -124,14 +124,9 @@ Ending ending_along(const PointStorage& q, const std::vector<std::size_t>& shape
   }
   if (all_equal) return Ending::closes;
   if (!near) return Ending::open;
-  constexpr double inf = std::numeric_limits<double>::infinity();
-  Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
-  for (const Vec3& p : q)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], p[k]);
-      hi[k] = std::max(hi[k], p[k]);
-    }
-  return largest <= 1e-12 * norm(hi - lo) ? Ending::closes : Ending::nearly;
+  internal::Box box;
+  for (const Vec3& p : q) box.add(p);
+  return largest <= 1e-12 * box.diagonal() ? Ending::closes : Ending::nearly;
 }
 
 // "domain": {"u": [a, b], ...}, as the exact form had it before it was mapped onto [0, 1].
