@@ -722,15 +722,19 @@ std::vector<std::pair<std::string, SurfaceMesh>> closed_meshes() {
   return out;
 }
 
-TEST(Mesh, ClosedSurfaceObjSharesTheSeamVertices) {
+TEST(Mesh, ClosedSurfaceObjAndPlyShareTheSeamVertices) {
   TempDir dir;
   for (const auto& [what, m] : closed_meshes()) {
-    write_surface_mesh(dir / "closed.obj", m);
+    for (const char* name : {"closed.obj", "closed.ply"}) {
+      write_surface_mesh(dir / name, m);
+      const std::string bytes = read_bytes(dir / name);
+      const MeshRead r = fs::path(name).extension() == ".obj" ? read_obj(bytes) : read_ply(bytes);
+      expect_closed_mesh(r, m, 1, what + " " + name);
+      expect_vertex_normals(r, m, what + " " + name);
+    }
+    // OBJ's texture coordinates stay one per sample: no face spans more than one
+    // cell of them, those across the seam included.
     const MeshRead r = read_obj(read_bytes(dir / "closed.obj"));
-    expect_closed_mesh(r, m, 1, what);
-    expect_vertex_normals(r, m, what);
-    // Texture coordinates stay one per sample: no face spans more than one cell of
-    // them, those across the seam included.
     const double du = 1.0 / static_cast<double>(m.points.extent(0) - 1);
     const double dv = 1.0 / static_cast<double>(m.points.extent(1) - 1);
     for (const auto& uv : r.uv)
@@ -739,16 +743,6 @@ TEST(Mesh, ClosedSurfaceObjSharesTheSeamVertices) {
           EXPECT_LE(std::abs(a[0] - b[0]), du * (1 + 1e-12)) << what;  // 1e-12: the quotient's rounding
           EXPECT_LE(std::abs(a[1] - b[1]), dv * (1 + 1e-12)) << what;
         }
-  }
-}
-
-TEST(Mesh, ClosedSurfacePlySharesTheSeamVertices) {
-  TempDir dir;
-  for (const auto& [what, m] : closed_meshes()) {
-    write_surface_mesh(dir / "closed.ply", m);
-    const MeshRead r = read_ply(read_bytes(dir / "closed.ply"));
-    expect_closed_mesh(r, m, 1, what);
-    expect_vertex_normals(r, m, what);
   }
 }
 

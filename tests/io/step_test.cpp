@@ -104,6 +104,18 @@ void expect_counts(const std::map<int, std::string>& e, const std::map<std::stri
   for (const auto& [prefix, n] : expected) EXPECT_EQ(count_of(e, prefix), n) << prefix;
 }
 
+// How each edge is used by the loops: edge "#n" -> its ORIENTED_EDGEs' .T./.F.
+std::map<std::string, std::multiset<std::string>> edge_orientations(const std::map<int, std::string>& e) {
+  std::map<std::string, std::multiset<std::string>> uses;
+  const std::string head = "ORIENTED_EDGE('',*,*,";
+  for (const auto& [n, body] : e) {
+    if (body.rfind(head, 0) != 0) continue;
+    const auto comma = body.find(',', head.size());
+    uses[body.substr(head.size(), comma - head.size())].insert(body.substr(comma + 1, 3));
+  }
+  return uses;
+}
+
 BSplineSurface bilinear_patch() {
   PointGrid cp({2, 2});
   cp(0, 0) = {0, 0, 0};
@@ -187,13 +199,7 @@ TEST(Step, VolumeIsAClosedShellWithEveryEdgeRunBothWays) {
   const auto e = entities(step_text(unit_cube()));
   expect_counts(e, {{"ADVANCED_FACE(", 6}, {"EDGE_CURVE(", 12}, {"VERTEX_POINT(", 8}, {"CLOSED_SHELL(", 1},
                     {"MANIFOLD_SOLID_BREP(", 1}, {"ADVANCED_BREP_SHAPE_REPRESENTATION(", 1}});
-  std::map<std::string, std::multiset<std::string>> uses;  // edge -> orientations
-  const std::string head = "ORIENTED_EDGE('',*,*,";
-  for (const auto& [n, body] : e) {
-    if (body.rfind(head, 0) != 0) continue;
-    const auto comma = body.find(',', head.size());
-    uses[body.substr(head.size(), comma - head.size())].insert(body.substr(comma + 1, 3));
-  }
+  const auto uses = edge_orientations(e);
   ASSERT_EQ(uses.size(), 12u);
   for (const auto& [edge, o] : uses) EXPECT_EQ(o, (std::multiset<std::string>{".F.", ".T."})) << edge;
 }
@@ -458,14 +464,7 @@ TEST(Step, ClosedVolumeHasNoFacesAcrossItsSeam) {
   const auto ring = entities(step_text(test::closed_volume({true, false}, 1)));
   expect_counts(ring, {{"ADVANCED_FACE(", 4}, {"SEAM_CURVE(", 4}, {"CLOSED_SHELL(", 1}, {"MANIFOLD_SOLID_BREP(", 1},
                        {"OPEN_SHELL(", 0}});
-  std::map<std::string, std::multiset<std::string>> uses;  // edge -> orientations
-  const std::string head = "ORIENTED_EDGE('',*,*,";
-  for (const auto& [n, body] : ring) {
-    if (body.rfind(head, 0) != 0) continue;
-    const auto comma = body.find(',', head.size());
-    uses[body.substr(head.size(), comma - head.size())].insert(body.substr(comma + 1, 3));
-  }
-  for (const auto& [edge, o] : uses) EXPECT_EQ(o, (std::multiset<std::string>{".F.", ".T."})) << edge;
+  for (const auto& [edge, o] : edge_orientations(ring)) EXPECT_EQ(o, (std::multiset<std::string>{".F.", ".T."})) << edge;
 
   const auto shell = entities(step_text(test::closed_volume({true, true}, 2)));
   expect_counts(shell, {{"ADVANCED_FACE(", 2}, {"CLOSED_SHELL(", 2}, {"MANIFOLD_SOLID_BREP(", 0},
