@@ -242,6 +242,18 @@ void expect_exact_numbers(const std::vector<TopoDS_Face>& faces, const io::Exact
   }
 }
 
+// The shape is one solid, oriented outward (positive volume), with `centre` (the
+// volume's own centre) classified inside it.
+void expect_solid_around(const TopoDS_Shape& shape, const Vec3& centre, const std::string& what) {
+  ASSERT_EQ(count(shape, TopAbs_SOLID), 1u) << what;
+  GProp_GProps props;
+  BRepGProp::VolumeProperties(shape, props);
+  EXPECT_GT(props.Mass(), 0) << what << ": faces oriented inward";
+  // 1e-7: the files' uncertainty (confusion accuracy, mm); the centre lies far deeper inside.
+  BRepClass3d_SolidClassifier inside(shape, gp_Pnt(centre.x, centre.y, centre.z), 1e-7);
+  EXPECT_EQ(inside.State(), TopAbs_IN) << what;
+}
+
 // The figures docs/interop.md quotes: printed, one line per file.
 void report(const std::string& what, double rel) {
   std::printf("[ readback ] %-34s max |OCCT - interpatch| / diagonal = %.2e\n", what.c_str(), rel);
@@ -322,15 +334,8 @@ TEST_P(OcctReadback, StepFacesMatchTheExactFormAndAreValid) {
   for (const auto& f : faces) EXPECT_TRUE(BRepCheck_Analyzer(f).IsValid()) << name << ".step: a face is invalid";
 
   if (io::is_volume(built_)) {
-    // The six faces close into one solid, oriented outward: positive volume, and
-    // the volume's own centre classified inside it.
-    ASSERT_EQ(count(shape, TopAbs_SOLID), 1u) << name;
-    GProp_GProps props;
-    BRepGProp::VolumeProperties(shape, props);
-    EXPECT_GT(props.Mass(), 0) << name << ": faces oriented inward";
-    const Vec3 centre = io::volume_evaluator(built_).point(0.5, 0.5, 0.5);
-    BRepClass3d_SolidClassifier inside(shape, gp_Pnt(centre.x, centre.y, centre.z), 1e-7);
-    EXPECT_EQ(inside.State(), TopAbs_IN) << name;
+    // The six faces close into one solid.
+    expect_solid_around(shape, io::volume_evaluator(built_).point(0.5, 0.5, 0.5), name);
   }
 }
 
@@ -517,17 +522,11 @@ TEST_P(OcctReadbackClosed, StepIsTheSameClosedShapeAndValid) {
   }
   const auto& vol = std::get<BSplineVolume>(c.form);
   if (closed_directions == 1) {
-    // A ring: its four faces close into one solid, oriented outward, the volume's
-    // own centre inside it.
-    ASSERT_EQ(count(shape, TopAbs_SOLID), 1u) << c.name;
-    GProp_GProps props;
-    BRepGProp::VolumeProperties(shape, props);
-    EXPECT_GT(props.Mass(), 0) << c.name << ": faces oriented inward";
+    // A ring: its four faces close into one solid.
     const auto d = vol.domain();
-    const Vec3 centre = vol.point(0.5 * (d[0].first + d[0].second), 0.5 * (d[1].first + d[1].second),
-                                  0.5 * (d[2].first + d[2].second));
-    BRepClass3d_SolidClassifier inside(shape, gp_Pnt(centre.x, centre.y, centre.z), 1e-7);
-    EXPECT_EQ(inside.State(), TopAbs_IN) << c.name;
+    expect_solid_around(shape, vol.point(0.5 * (d[0].first + d[0].second), 0.5 * (d[1].first + d[1].second),
+                                         0.5 * (d[2].first + d[2].second)),
+                        c.name);
   } else {
     // A thick torus shell: its inner and outer skins, two closed shells apart.
     EXPECT_EQ(count(shape, TopAbs_SOLID), 0u) << c.name;
