@@ -80,9 +80,9 @@ struct NetworkParameters {
 ///   interpatch::CurveNetwork net{u_curves, v_curves, {}, {}};
 ///   auto s = interpatch::curve_network(net);  // Gordon
 ///   auto b = s.to_bspline();                  // one B-spline surface through every curve
-///   interpatch::CurveNetwork tube{sections, lines, {}, {}, {true, false}};  // closed sections
-///   auto t = interpatch::curve_network(tube).to_bspline();  // periodic in u
 /// @endcode
+/// A tube from closed sections is the same with `periodic = {true, false}`: its exact
+/// form is periodic in u.
 /// @throws error too_few_points, size_mismatch (params and curve counts), non_increasing,
 ///   out_of_domain (params not from 0 to 1; a closing curve's not 1), network_gap
 ///   (naming both curves, the node and the gap; an open curve of a closed direction
