@@ -34,7 +34,8 @@ TEST(BlendedSurface, BlendValues) {
 TEST(BlendedSurface, NetworkCardinalFunctionsAreDeltas) {
   // Every curve zero except v_curves[k], a bump that vanishes at the node parameters:
   // the surface is that bump along u = u_k and zero along every other network line.
-  const std::vector<double> tu{0, 0.3, 0.65, 1}, tv{0, 0.4, 1};
+  // Closed in u, the same with periodic cardinal functions over 0 = u_0 < ... < u_n <
+  // 1, and u = 1 is u_0 again; the zero u_curves' ends meet: closed with a C0 seam.
   const BSplineCurve zero(KnotVector::bezier(1), {{0, 0, 0}, {0, 0, 0}});
   // Cubic through (0,0), (0.4, 0) and (1, 0) with a non-zero middle: t (t − 0.4)(t − 1) · (1,2,3).
   auto bump_at = [](double t) { return (t * (t - 0.4) * (t - 1)) * Vec3{1, 2, 3}; };
@@ -43,17 +44,24 @@ TEST(BlendedSurface, NetworkCardinalFunctionsAreDeltas) {
   CurveInterpolationOptions o;
   o.params = {0, 1.0 / 3, 2.0 / 3, 1};
   const BSplineCurve bump = interpolate_curve(samples, o).curve;  // the cubic itself
-  for (auto method : {NetworkMethod::coons_linear, NetworkMethod::coons_hermite, NetworkMethod::gordon})
-    for (std::size_t k = 0; k < tu.size(); ++k) {
-      CurveNetwork n{std::vector<BSplineCurve>(tv.size(), zero), std::vector<BSplineCurve>(tu.size(), zero), tu, tv};
-      n.v_curves[k] = bump;
-      const auto s = curve_network(n, {method, {}});
-      for (double t : linspace(0, 1, 11)) {
-        for (std::size_t i = 0; i < tu.size(); ++i)
-          EXPECT_LT(distance(s.point(tu[i], t), i == k ? bump_at(t) : Vec3{}), 1e-15 * 16);
-        for (double v : tv) EXPECT_LT(norm(s.point(t, v)), 1e-15 * 16);
+  for (const bool closed : {false, true}) {
+    const std::vector<double> tu{0, 0.3, 0.65, closed ? 0.8 : 1.0}, tv{0, 0.4, 1};
+    for (auto method : {NetworkMethod::coons_linear, NetworkMethod::coons_hermite, NetworkMethod::gordon})
+      for (std::size_t k = 0; k < tu.size(); ++k) {
+        CurveNetwork n{std::vector<BSplineCurve>(tv.size(), zero), std::vector<BSplineCurve>(tu.size(), zero), tu, tv,
+                       {closed, false}};
+        n.v_curves[k] = bump;
+        const auto s = curve_network(n, {method, {}});
+        for (double t : linspace(0, 1, 11)) {
+          for (std::size_t i = 0; i < tu.size(); ++i)
+            EXPECT_LT(distance(s.point(tu[i], t), i == k ? bump_at(t) : Vec3{}), 1e-15 * 16);
+          if (closed) {
+            EXPECT_LT(distance(s.point(1.0, t), k == 0 ? bump_at(t) : Vec3{}), 1e-15 * 16);
+          }
+          for (double v : tv) EXPECT_LT(norm(s.point(t, v)), 1e-15 * 16);
+        }
       }
-    }
+  }
 }
 
 TEST(BlendedSurface, TranslatingTheDataTranslatesTheSurface) {
@@ -184,34 +192,6 @@ TEST(BlendedSurface, BatchEvaluationRefusesParametersOutsideTheDomain) {
   EXPECT_ERRC((void)s.evaluate(good, bad), out_of_domain, "parameter v = 1.5");
 }
 
-// Closed in u: the cardinal functions are periodic deltas over the nodes 0 = u_0 < ...
-// < u_n < 1 (no node at 1: u = 1 is u_0 again), for every method.
-TEST(BlendedSurface, ClosedNetworkCardinalFunctionsAreDeltas) {
-  const std::vector<double> tu{0, 0.3, 0.65, 0.8}, tv{0, 0.4, 1};
-  // Zero sections: closed curves (their ends meet), taken as closed with a C0 seam.
-  const BSplineCurve zero(KnotVector::bezier(1), {{0, 0, 0}, {0, 0, 0}});
-  auto bump_at = [](double t) { return (t * (t - 0.4) * (t - 1)) * Vec3{1, 2, 3}; };
-  std::vector<Vec3> samples;
-  for (int k = 0; k < 4; ++k) samples.push_back(bump_at(k / 3.0));
-  CurveInterpolationOptions o;
-  o.params = {0, 1.0 / 3, 2.0 / 3, 1};
-  const BSplineCurve bump = interpolate_curve(samples, o).curve;
-  for (auto method : {NetworkMethod::coons_linear, NetworkMethod::coons_hermite, NetworkMethod::gordon})
-    for (std::size_t k = 0; k < tu.size(); ++k) {
-      CurveNetwork n{std::vector<BSplineCurve>(tv.size(), zero), std::vector<BSplineCurve>(tu.size(), zero), tu, tv,
-                     {true, false}};
-      n.v_curves[k] = bump;
-      const auto s = curve_network(n, {method, {}});
-      for (double t : linspace(0, 1, 11)) {
-        for (std::size_t i = 0; i < tu.size(); ++i)
-          EXPECT_LT(distance(s.point(tu[i], t), i == k ? bump_at(t) : Vec3{}), 1e-15 * 16);
-        // u = 1 is the first node again.
-        EXPECT_LT(distance(s.point(1.0, t), k == 0 ? bump_at(t) : Vec3{}), 1e-15 * 16);
-        for (double v : tv) EXPECT_LT(norm(s.point(t, v)), 1e-15 * 16);
-      }
-    }
-}
-
 // Sections collapsed to points on one curve C(v), every line that curve: S(u, v) =
 // C(v) Σ φ_i(u) + Σ_j C(v_j) ψ_j(v) (1 − Σ φ_i(u)), which is C(v) exactly when the
 // periodic cardinal functions sum to 1 everywhere, between the nodes and across the seam.
@@ -233,9 +213,10 @@ TEST(BlendedSurface, ClosedNetworkCardinalFunctionsSumToOne) {
     n.periodic = {true, false};
     for (auto method : {NetworkMethod::coons_linear, NetworkMethod::coons_hermite, NetworkMethod::gordon}) {
       const auto s = curve_network(n, {method, {}});
-      // A sum of a few cardinal functions of size ~1 times points of size ~1: rounding.
+      // Sums of up to 6 cardinal functions (up to ~2 between the nodes) times points of
+      // size ~1, twice: rounding, up to 1e-14 in these trials.
       for (double u : linspace(0, 1, 23))
-        for (double v : linspace(0, 1, 9)) EXPECT_LT(distance(s.point(u, v), C.point(v)), 1e-14) << trial;
+        for (double v : linspace(0, 1, 9)) EXPECT_LT(distance(s.point(u, v), C.point(v)), 1e-13) << trial;
     }
   }
 }
@@ -295,8 +276,9 @@ TEST(BlendedSurface, ClosedNetworkBatchEvaluationMatchesPointwise) {
           worst = std::max({worst, distance(grid(i, j), p.s), distance(d(i, j).s, p.s), distance(d(i, j).su, p.su),
                             distance(d(i, j).svv, p.svv), distance(d(i, j).suv, p.suv)});
         }
-      // The same products summed in another order; values and derivatives of size
-      // ~10 at most (second derivatives of a unit tube over unit parameters): a few ulps.
+      // The same products summed in another order; second derivatives up to ~100 (a
+      // unit ring over a unit parameter: (2π)² ≈ 40, and the random wobble): a few ulps
+      // of them, 2e-13 in these trials.
       EXPECT_LT(worst, 1e-12) << "trial " << trial;
     }
   }
@@ -324,7 +306,8 @@ TEST(BlendedSurface, ClosedAndOpenCurvesConvertExactly) {
       const BSplineSurface e = s.to_bspline();
       EXPECT_EQ(e.periodic()[0], periodic);
       EXPECT_EQ(s.exact_knots()[0], e.knots_u());
-      // The open form of a closed curve is re-solved by collocation: rounding of data ~2.
+      // The open form of a closed curve is re-solved by collocation: rounding of data of
+      // size ~2, 1.5e-15 in these trials.
       EXPECT_LT(test::max_distance(e, s), 1e-13) << trial;
     }
   }

@@ -231,20 +231,22 @@ TEST(Network, ClosedNetworksInterpolateEveryCurveAndConvertExactly) {
   }
 }
 
-// |a − b| against the larger of |a| and |b| (the size of that derivative), or 1 when
-// both vanish.
+// |a − b| against the larger of |a| and |b|, the size of that derivative (0 when both
+// vanish).
 double relative(const Vec3& a, const Vec3& b) { return distance(a, b) / std::max({norm(a), norm(b), 1e-300}); }
 
 // The largest relative jump across the seam u = 0 ≡ 1 (axis 0) or v = 0 ≡ 1 (axis 1)
-// of the value (order 0) or the derivatives of order 1 or 2 across it.
+// of the value (order 0), the first derivatives (order 1) or the second (order 2).
 double seam_jump(const Surface& s, int axis, int order) {
   double e = 0;
   for (double t : linspace(0, 1, 13)) {
     const auto a = axis == 0 ? s.derivatives(0, t) : s.derivatives(t, 0);
     const auto b = axis == 0 ? s.derivatives(1, t) : s.derivatives(t, 1);
-    if (order == 0) e = std::max(e, relative(a.s, b.s));
-    if (order == 1) e = std::max({e, relative(axis == 0 ? a.su : a.sv, axis == 0 ? b.su : b.sv)});
-    if (order == 2) e = std::max(e, relative(axis == 0 ? a.suu : a.svv, axis == 0 ? b.suu : b.svv));
+    const std::vector<Vec3 SurfaceDerivatives::*> parts =
+        order == 0 ? std::vector{&SurfaceDerivatives::s}
+        : order == 1 ? std::vector{&SurfaceDerivatives::su, &SurfaceDerivatives::sv}
+                     : std::vector{&SurfaceDerivatives::suu, &SurfaceDerivatives::suv, &SurfaceDerivatives::svv};
+    for (auto part : parts) e = std::max(e, relative(a.*part, b.*part));
   }
   return e;
 }
@@ -441,11 +443,11 @@ TEST(Network, SpecPeriodicBuildsTheSameSurface) {
                         {"u_curves", {{{"line", {{0, 0, 0}, {1, 0, 0}}}}, {{"line", {{0, 1, 0}, {1, 1, 0}}}}}},
                         {"v_curves", {{{"line", {{0, 0, 0}, {0, 1, 0}}}}, {{"line", {{1, 0, 0}, {1, 1, 0}}}}}}};
   bad["periodic"] = true;
-  EXPECT_ERRC((void)io::build(bad), wrong_type, "/periodic: expected an array of two booleans");
+  EXPECT_ERRC((void)io::build(bad), wrong_type, "/periodic: expected an array of 2 booleans [u, v]");
   bad["periodic"] = {true};
-  EXPECT_ERRC((void)io::build(bad), size_mismatch, "/periodic: expected 2 booleans");
+  EXPECT_ERRC((void)io::build(bad), wrong_type, "/periodic: expected 2 booleans [u, v], one per direction, got 1");
   bad["periodic"] = {true, 1};
-  EXPECT_ERRC((void)io::build(bad), wrong_type, "/periodic/1: expected a boolean");
+  EXPECT_ERRC((void)io::build(bad), wrong_type, "/periodic/1: expected true or false (is v closed?), got a number");
   bad["periodic"] = {true, false};  // the u_curves are open and far from closed
   EXPECT_ERRC((void)io::build(bad), network_gap, "u_curves[0] is not closed");
 }

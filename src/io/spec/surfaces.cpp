@@ -143,11 +143,11 @@ std::array<bool, 2> periodic_of(const json& spec) {
   std::array<bool, 2> r{false, false};
   const json* p = find_member(spec, "periodic");
   if (!p) return r;
-  if (!p->is_array()) wrong_type("/periodic", "an array of two booleans [u, v]", *p);
-  if (p->size() != 2)
-    fail(errc::size_mismatch, place("/periodic"), ": expected 2 booleans (one per direction u, v), got ", p->size());
+  constexpr std::string_view form = "2 booleans [u, v], one per direction";
+  if (!p->is_array()) wrong_type("/periodic", cat("an array of ", form), *p);
+  if (p->size() != 2) fail(errc::wrong_type, place("/periodic"), ": expected ", form, ", got ", p->size());
   for (std::size_t a = 0; a < 2; ++a) {
-    if (!(*p)[a].is_boolean()) wrong_type(child("/periodic", a), "a boolean", (*p)[a]);
+    if (!(*p)[a].is_boolean()) wrong_type(child("/periodic", a), cat("true or false (is ", axis_name(a), " closed?)"), (*p)[a]);
     r[a] = (*p)[a].get<bool>();
   }
   return r;
