@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <variant>
 
 #include "detail/banded.hpp"
 #include "detail/collocation.hpp"
@@ -116,7 +117,205 @@ KnotVector averaged_knots(std::span<const double> params, int degree, bool extra
   return KnotVector(p, std::move(u));
 }
 
+std::vector<double> closed_curve_parameters(std::span<const Vec3> points, Parametrization param) {
+  const std::size_t n = points.size();
+  if (n < 2) fail(errc::too_few_points, "parameters of a closed curve need at least 2 points, got ", n);
+  for (std::size_t i = 0; i < n; ++i)
+    if (!is_finite(points[i])) fail(errc::not_finite, "point ", i, " is ", points[i]);
+  std::vector<double> t(n, 0.0);
+  if (param == Parametrization::uniform) {
+    for (std::size_t i = 0; i < n; ++i) t[i] = static_cast<double>(i) / static_cast<double>(n);
+    return t;
+  }
+  double total = distance(points[0], points[n - 1]);
+  for (std::size_t i = 1; i < n; ++i) total += distance(points[i], points[i - 1]);
+  if (!std::isfinite(total))
+    fail(errc::not_finite, "the closed polygon's length overflows (", total, "): the points span more than ",
+         std::numeric_limits<double>::max());
+  const double root = root_scale(point_exponent(points));
+  for (std::size_t i = 1; i <= n; ++i) {
+    const std::size_t j = i % n;
+    const double d = distance(points[j], points[i - 1]);
+    // Chords below 1e-14 of the polygon's length are rounding noise: the two points coincide.
+    if (!(d > 1e-14 * total))
+      fail(errc::zero_chord, "points ", i - 1, " and ", j, j == 0 ? " (the closing chord)" : "", " coincide (chord ", d,
+           ", closed polygon length ", total, "): parameters must increase");
+    const double st = step(points[i - 1], points[j], param, root);
+    if (i < n) t[i] = t[i - 1] + st;
+    else total = t[i - 1] + st;
+  }
+  for (std::size_t i = 1; i < n; ++i) t[i] /= total;
+  return t;
+}
+
+KnotVector periodic_knots(std::span<const double> params, int degree) {
+  const std::size_t n = params.size();
+  const int p = degree;
+  if (p < 1 || p > max_degree) fail(errc::invalid_degree, "degree ", p, " is outside 1..", max_degree);
+  if (n < static_cast<std::size_t>(p) + 1)
+    fail(errc::too_few_points, "a closed spline of degree ", p, " needs at least ", p + 1, " distinct points, got ", n);
+  check_params(params, "parameter");
+  const double a = params.front(), b = a + 1.0;
+  if (!(params.back() < b))
+    fail(errc::out_of_domain, "parameter ", n - 1, " = ", params.back(), " is not inside the period [", a, ", ", b, ")");
+  if (p % 2 == 1) return KnotVector::periodic_from(p, {params.begin(), params.end()}, b);
+  // Even degree: midpoints; the period starts at the last one, one period back.
+  std::vector<double> k(n);
+  const double last = 0.5 * (params.back() + b);
+  k[0] = last - 1.0;
+  for (std::size_t i = 0; i + 1 < n; ++i) k[i + 1] = 0.5 * (params[i] + params[i + 1]);
+  return KnotVector::periodic_from(p, std::move(k), last);
+}
+
+namespace {
+
+// The largest coordinate extent of points: the bounding-box diagonal.
+template <class PointAt>
+double box_diagonal(std::size_t count, const PointAt& point) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
+  for (std::size_t i = 0; i < count; ++i) {
+    const Vec3& q = point(i);
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], q[k]);
+      hi[k] = std::max(hi[k], q[k]);
+    }
+  }
+  return norm(hi - lo);
+}
+
+// Whether the last point of each of `lines` closed lines of n points repeats the
+// first (closing_point; the rule is the same for every line of a grid, and all must
+// repeat for the last line to be left out). point(l, k) is point k of line l;
+// diagonal() the data's bounding-box diagonal, computed only when a gap is small;
+// where(l) names line l's last point in a message.
+template <class PointAt, class Diagonal, class Where>
+Closing find_closing(std::size_t lines, std::size_t n, const PointAt& point, const Diagonal& diagonal,
+                     const Where& where) {
+  if (n < 3) return {n, false};
+  bool all_zero = true, near = false;
+  for (std::size_t l = 0; l < lines; ++l) {
+    const double gap = distance(point(l, n - 1), point(l, 0));
+    if (gap == 0.0) continue;
+    all_zero = false;
+    const double adjacent = std::min(distance(point(l, 1), point(l, 0)), distance(point(l, n - 1), point(l, n - 2)));
+    near = near || gap < 1e-3 * adjacent;
+  }
+  if (all_zero) return {n - 1, true};
+  if (!near) return {n, false};
+  const double tol = 1e-12 * diagonal();
+  bool all_close = true;
+  for (std::size_t l = 0; l < lines && all_close; ++l) all_close = distance(point(l, n - 1), point(l, 0)) <= tol;
+  if (all_close) return {n - 1, true};
+  for (std::size_t l = 0; l < lines; ++l) {
+    const Vec3 &last = point(l, n - 1), &first = point(l, 0);
+    const double gap = distance(last, first);
+    const double adjacent = std::min(distance(point(l, 1), first), distance(last, point(l, n - 2)));
+    if (gap > tol && gap < 1e-3 * adjacent)
+      fail(errc::closing_gap, where(l), " = ", last, " nearly repeats the first point ", first, ": gap ", gap,
+           ", more than the ", tol, " (1e-12 of the bounding-box diagonal) that makes it the closing point and less than ",
+           "1e-3 of the chords next to it (", adjacent, "), which would leave a kink at the seam; repeat the first point "
+           "exactly, or leave the last one out");
+  }
+  return {n, false};
+}
+
+}  // namespace
+
+Closing closing_point(std::span<const Vec3> points) {
+  return find_closing(
+      1, points.size(), [&](std::size_t, std::size_t k) -> const Vec3& { return points[k]; },
+      [&] { return box_diagonal(points.size(), [&](std::size_t i) -> const Vec3& { return points[i]; }); },
+      [&](std::size_t) { return detail::cat("point ", points.size() - 1); });
+}
+
+namespace {
+
+// Inserting a periodic spline's first parameter a (not a knot) and starting its
+// period there: each new control point j is α P[x] + (1 − α) P[y] of the old ones
+// (Boehm's rule on the periodic sequence of knots; new control point j + 1 of the
+// refined spline becomes j once the period starts at a). With `knots` the refined,
+// re-anchored knot vector.
+struct SeamInsertion {
+  struct Row {
+    std::size_t x, y;
+    double alpha;
+  };
+  std::vector<Row> rows;
+  KnotVector knots;
+};
+
+SeamInsertion seam_insertion(const KnotVector& k, double a) {
+  const int n = k.count(), p = k.degree();
+  const auto& u = k.values();
+  const int span = k.find_span(a);
+  auto mod = [](int i, int m) { return static_cast<std::size_t>(((i % m) + m) % m); };
+  std::vector<SeamInsertion::Row> rows(static_cast<std::size_t>(n) + 1);
+  // New control points of the refined spline, window i = span − n + 1 .. span + 1.
+  for (int i = span - n + 1; i <= span + 1; ++i) {
+    SeamInsertion::Row r{mod(i, n), mod(i - 1, n), 1.0};
+    if (i > span) r.alpha = 0.0;
+    else if (i > span - p)
+      r.alpha = (a - u[static_cast<std::size_t>(i)]) / (u[static_cast<std::size_t>(i + p)] - u[static_cast<std::size_t>(i)]);
+    const std::size_t j = mod(i, n + 1);  // index in the refined spline; a is its knot 1
+    rows[(j + static_cast<std::size_t>(n)) % (static_cast<std::size_t>(n) + 1)] = r;
+  }
+  std::vector<double> pk = k.period_knots();
+  std::vector<double> nk{a};
+  nk.insert(nk.end(), pk.begin() + 1, pk.end());
+  nk.push_back(k.back());
+  return {std::move(rows), KnotVector::periodic_from(p, std::move(nk), a + (k.back() - k.front()))};
+}
+
+}  // namespace
+
+namespace {
+
+CurveInterpolation interpolate_closed_curve(std::span<const Vec3> all, const CurveInterpolationOptions& options) {
+  if (options.start_derivative || options.end_derivative)
+    fail(errc::wrong_type, "a closed curve has no ends: start and end derivatives do not apply to a periodic curve");
+  const std::size_t given = all.size();
+  if (given < 2) fail(errc::too_few_points, "curve interpolation needs at least 2 points, got ", given);
+  for (std::size_t i = 0; i < given; ++i)
+    if (!is_finite(all[i])) fail(errc::not_finite, "point ", i, " is ", all[i]);
+  const Closing closing = closing_point(all);
+  const std::span<const Vec3> points = all.first(closing.count);
+  const std::size_t n = points.size();
+  const int p = options.degree ? *options.degree : std::min<int>(3, static_cast<int>(n) - 1);
+  if (p < 1 || p > max_degree) fail(errc::invalid_degree, "degree ", p, " is outside 1..", max_degree);
+  if (n < static_cast<std::size_t>(p) + 1)
+    fail(errc::too_few_points, "a closed curve of degree ", p, " needs at least ", p + 1, " distinct points, got ", n,
+         closing.dropped ? " (the last point repeats the first and is left out)" : "");
+  std::vector<double> t;
+  if (!options.params.empty()) {
+    if (options.params.size() != given)
+      fail(errc::size_mismatch, given, " points need ", given, " parameters, got ", options.params.size());
+    check_params(options.params, "parameter");
+    t.assign(options.params.begin(), options.params.begin() + static_cast<std::ptrdiff_t>(n));
+  } else {
+    t = closed_curve_parameters(points, options.param);
+  }
+  KnotVector knots = periodic_knots(t, p);
+  std::vector<Vec3> cp(points.begin(), points.end());
+  detail::factor_periodic_collocation(knots, t).solve(&cp.data()->x, 3, 3);
+  if (p % 2 == 0) {  // the domain starts at a midpoint: start it at the first parameter
+    SeamInsertion seam = seam_insertion(knots, t.front());
+    std::vector<Vec3> q(seam.rows.size());
+    for (std::size_t j = 0; j < q.size(); ++j) {
+      const auto& r = seam.rows[j];
+      q[j] = r.alpha * cp[r.x] + (1.0 - r.alpha) * cp[r.y];
+    }
+    cp = std::move(q);
+    knots = std::move(seam.knots);
+  }
+  if (closing.dropped) t.push_back(t.front() + 1.0);
+  return {BSplineCurve(std::move(knots), std::move(cp)), std::move(t)};
+}
+
+}  // namespace
+
 CurveInterpolation interpolate_curve(std::span<const Vec3> points, const CurveInterpolationOptions& options) {
+  if (options.periodic) return interpolate_closed_curve(points, options);
   const std::size_t n1 = points.size();
   if (n1 < 2) fail(errc::too_few_points, "curve interpolation needs at least 2 points, got ", n1);
   for (std::size_t i = 0; i < n1; ++i)
@@ -326,8 +525,8 @@ void scale_points(Vec3* p, std::size_t count, int k) {
 // Pass 1 and what the averaged parameters need from it.
 class GridChords {
  public:
-  GridChords(const Vec3* q, const GridShape& g, Parametrization param)
-      : g_(g), param_(param), root_(root_scale(grid_exponent(q, g))) {
+  GridChords(const Vec3* q, const GridShape& g, Parametrization param, std::array<bool, 3> periodic = {})
+      : g_(g), param_(param), root_(root_scale(grid_exponent(q, g))), periodic_(periodic) {
     const std::size_t n0 = g.n[0], M = g.row, R = g.rank;
     if (param == Parametrization::uniform) {
       check_grid_finite(q, g);
@@ -390,6 +589,11 @@ class GridChords {
       for (std::size_t c = 0; c < chunks; ++c)
         for (std::size_t k = 0; k < sums_[a].size(); ++k) sums_[a][k] += part[c * R + a][k];
     }
+    if (periodic_[0]) {  // the closing chords of the lines along u: last row back to the first
+      std::vector<double> closing(M);
+      chord_lengths(q + (n0 - 1) * M, q, M, closing.data(), param, root_);
+      for (std::size_t m = 0; m < M; ++m) sums_[0][m] += closing[m];
+    }
     check_lengths(sums_[0], 0);
     // Along u: the weight of each line is 1 / its length, 0 for a collapsed line.
     const double cut0 = pole_ratio * *std::max_element(sums_[0].begin(), sums_[0].end());
@@ -403,7 +607,7 @@ class GridChords {
 
   // Averaged parameters along in-row axis a ≥ 1.
   [[nodiscard]] std::vector<double> in_row_parameters(std::size_t a) const {
-    if (param_ == Parametrization::uniform) return uniform(g_.n[a]);
+    if (param_ == Parametrization::uniform) return uniform(g_.n[a], periodic_[a]);
     if (used_[a] == 0) fail_all_collapsed(a);
     std::vector<double> t(g_.n[a], 0.0);
     double s = 0;
@@ -422,7 +626,7 @@ class GridChords {
 
   // Parameters along u from the rows' steps (steps[0] unused).
   [[nodiscard]] std::vector<double> u_parameters(std::span<const double> steps) const {
-    if (param_ == Parametrization::uniform) return uniform(g_.n[0]);
+    if (param_ == Parametrization::uniform) return uniform(g_.n[0], periodic_[0]);
     if (used_[0] == 0) fail_all_collapsed(0);
     std::vector<double> t(g_.n[0], 0.0);
     double s = 0;
@@ -464,19 +668,24 @@ class GridChords {
     fail(errc::zero_chord, "every line of the grid along ", ax, " has zero length: all points coincide along ", ax);
   }
 
-  static std::vector<double> uniform(std::size_t n) {
+  // k / (n − 1), or k / n around a closed direction (1 would be the first line again).
+  static std::vector<double> uniform(std::size_t n, bool closed) {
     std::vector<double> t(n);
-    for (std::size_t i = 0; i < n; ++i) t[i] = static_cast<double>(i) / static_cast<double>(n - 1);
-    t.back() = 1.0;
+    const double d = static_cast<double>(closed ? n : n - 1);
+    for (std::size_t i = 0; i < n; ++i) t[i] = static_cast<double>(i) / d;
+    if (!closed) t.back() = 1.0;
     return t;
   }
 
-  static std::vector<double> finish(std::vector<double> t, std::size_t a) {
-    t.back() = 1.0;
+  [[nodiscard]] std::vector<double> finish(std::vector<double> t, std::size_t a) const {
+    if (!periodic_[a]) t.back() = 1.0;
     for (std::size_t k = 1; k < t.size(); ++k)
       if (!(t[k] > t[k - 1]))
         fail(errc::zero_chord, "grid points ", k - 1, " and ", k, " along ", axis_name(static_cast<int>(a)),
              " coincide on every line (averaged parameters ", t[k - 1], " and ", t[k], ")");
+    if (periodic_[a] && !(t.back() < 1.0))
+      fail(errc::zero_chord, "the last and the first grid points along ", axis_name(static_cast<int>(a)),
+           " coincide on every line: the closing chord has zero length (averaged parameter ", t.back(), ")");
     return t;
   }
 
@@ -487,20 +696,23 @@ class GridChords {
     const std::size_t n = g_.n[a], inner = g_.inner(a), outer = g_.outer(a);
     double* ch = scratch;  // (n − 1) × inner chords
     double* inv = ch + n * inner;
+    const bool closed = periodic_[a];
     for (std::size_t o = 0; o < outer; ++o) {
       const Vec3* base = row + o * n * inner;
       if (inner == 1) {
         chord_lengths(base, base + 1, n - 1, ch, param_, root_);
-        lengths[o] = sum(ch, n - 1);
+        if (closed) chord_lengths(base + n - 1, base, 1, ch + n - 1, param_, root_);
+        lengths[o] = sum(ch, closed ? n : n - 1);
         const double w = line_weight(lengths[o]);
         for (std::size_t k = 1; k < n; ++k) acc[k] += ch[k - 1] * w;
         continue;
       }
       for (std::size_t k = 1; k < n; ++k)
         chord_lengths(base + (k - 1) * inner, base + k * inner, inner, ch + (k - 1) * inner, param_, root_);
+      if (closed) chord_lengths(base + (n - 1) * inner, base, inner, ch + (n - 1) * inner, param_, root_);
       double* len = lengths + o * inner;
       std::fill_n(len, inner, 0.0);
-      for (std::size_t k = 1; k < n; ++k)
+      for (std::size_t k = 1; k < (closed ? n + 1 : n); ++k)
         for (std::size_t i = 0; i < inner; ++i) len[i] += ch[(k - 1) * inner + i];
       for (std::size_t i = 0; i < inner; ++i) inv[i] = line_weight(len[i]);
       for (std::size_t k = 1; k < n; ++k) acc[k] += dot(ch + (k - 1) * inner, inv, inner);
@@ -522,6 +734,7 @@ class GridChords {
   GridShape g_;
   Parametrization param_;
   double root_;                                    // see root_scale
+  std::array<bool, 3> periodic_;                   // closed axes: their lines' lengths take in the closing chord
   std::vector<std::vector<double>> sums_;         // per axis: 0 → line lengths along u; a ≥ 1 → Σ over lines of chord k / line length
   std::vector<std::vector<double>> line_length_;  // per in-row axis: every line's length, row by row
   std::vector<std::size_t> used_;                  // lines averaged per axis
@@ -582,30 +795,123 @@ struct GridSolution {
   std::vector<std::vector<double>> params;  // one per axis
 };
 
-detail::BandedLU factor_axis(const KnotVector& knots, std::span<const double> params, std::size_t a) {
+// The factored system of one axis: banded for an open direction, cyclic banded for
+// a closed one.
+using AxisSolver = std::variant<detail::BandedLU, detail::CyclicLU>;
+
+AxisSolver factor_axis(const KnotVector& knots, std::span<const double> params, std::size_t a) {
   try {
+    if (knots.periodic()) return detail::factor_periodic_collocation(knots, params);
     return detail::factor_collocation(knots, params);
   } catch (const error& e) {
     fail(e.code(), "along ", axis_name(static_cast<int>(a)), ": ", e.what());
   }
 }
 
+void solve_axis(const AxisSolver& lu, double* data, const std::size_t* shape, std::size_t rank, std::size_t axis,
+                std::size_t components, bool parallel = true) {
+  std::visit([&](const auto& s) { detail::solve_along_axis(s, data, shape, rank, axis, components, parallel); }, lu);
+}
+
+KnotVector axis_knots(std::span<const double> params, int degree, bool closed) {
+  return closed ? periodic_knots(params, degree) : averaged_knots(params, degree);
+}
+
+// Leaves out the last line along `axis` of a grid (a closing line equal to the
+// first): along u the storage just ends earlier; along an axis inside the rows every
+// row's later points move down, in place, in order.
+template <std::size_t Rank>
+void drop_last_line(Grid<Vec3, Rank>& points, std::size_t axis) {
+  auto shape = points.shape();
+  std::size_t outer = 1, inner = 1;
+  for (std::size_t a = 0; a < axis; ++a) outer *= shape[a];
+  for (std::size_t a = axis + 1; a < Rank; ++a) inner *= shape[a];
+  const std::size_t n = shape[axis], keep = (n - 1) * inner;
+  auto values = std::move(points.values());
+  if (axis > 0)
+    for (std::size_t o = 1; o < outer; ++o)
+      std::copy_n(values.data() + o * n * inner, keep, values.data() + o * keep);
+  values.resize(outer * keep);
+  shape[axis] = n - 1;
+  points = Grid<Vec3, Rank>(shape, std::move(values));
+}
+
+// The closing line along `axis`, if any (find_closing over the grid's lines).
+template <std::size_t Rank>
+Closing grid_closing(const Grid<Vec3, Rank>& points, std::size_t axis) {
+  const auto& shape = points.shape();
+  std::size_t inner = 1;
+  for (std::size_t a = axis + 1; a < Rank; ++a) inner *= shape[a];
+  const std::size_t n = shape[axis], lines = points.size() / n;
+  const Vec3* q = points.data();
+  auto at = [&](std::size_t l, std::size_t k) -> const Vec3& { return q[(l / inner) * n * inner + k * inner + l % inner]; };
+  auto diagonal = [&] { return box_diagonal(points.size(), [&](std::size_t i) -> const Vec3& { return q[i]; }); };
+  auto where = [&](std::size_t l) {
+    const std::size_t k = (l / inner) * n * inner + (n - 1) * inner + l % inner;
+    std::string idx;
+    for (std::size_t a = Rank, rest = k; a-- > 0; rest /= shape[a]) idx = detail::cat("[", rest % shape[a], "]", idx);
+    return detail::cat("point ", idx, ", the last along ", axis_name(static_cast<int>(axis)), ",");
+  };
+  return find_closing(lines, n, at, diagonal, where);
+}
+
+// Re-anchors a closed axis of even degree at its first parameter (seam_insertion on
+// every line along it): one more control point along the axis.
+template <std::size_t Rank>
+void insert_seam(Grid<Vec3, Rank>& points, std::size_t axis, KnotVector& knots, double first) {
+  SeamInsertion seam = seam_insertion(knots, first);
+  auto shape = points.shape();
+  std::size_t outer = 1, inner = 1;
+  for (std::size_t a = 0; a < axis; ++a) outer *= shape[a];
+  for (std::size_t a = axis + 1; a < Rank; ++a) inner *= shape[a];
+  const std::size_t n = shape[axis], n1 = seam.rows.size();
+  shape[axis] = n1;
+  require_memory(Grid<Vec3, Rank>::count(shape), sizeof(Vec3), "a closed grid's control points");
+  Grid<Vec3, Rank> out(shape, for_overwrite);
+  const Vec3* in = points.data();
+  Vec3* o = out.data();
+  const auto no = static_cast<long long>(outer);
+#pragma omp parallel for schedule(static) if (points.size() >= detail::parallel_min_work)
+  for (long long oi = 0; oi < no; ++oi) {
+    const auto b = static_cast<std::size_t>(oi);
+    for (std::size_t j = 0; j < n1; ++j) {
+      const auto& r = seam.rows[j];
+      const Vec3* x = in + (b * n + r.x) * inner;
+      const Vec3* y = in + (b * n + r.y) * inner;
+      Vec3* d = o + (b * n1 + j) * inner;
+      for (std::size_t i = 0; i < inner; ++i) d[i] = r.alpha * x[i] + (1.0 - r.alpha) * y[i];
+    }
+  }
+  points = std::move(out);
+  knots = std::move(seam.knots);
+}
+
 // The tensor-product interpolation behind surfaces and volumes, in the
 // three passes described above. The data become the control points.
 template <std::size_t Rank>
 GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional<int>, Rank>& degree,
-                        Parametrization param, const progress_callback& progress, const char* what) {
-  const auto& shape = points.shape();
+                        Parametrization param, const progress_callback& progress, const char* what,
+                        const std::array<bool, Rank>& periodic) {
   auto dims = [&](bool wanted) {  // "2 x 2 x 2" or the actual "nu x nv x nw"
     std::string s;
-    for (std::size_t a = 0; a < Rank; ++a) s += detail::cat(a ? " x " : "", wanted ? std::size_t{2} : shape[a]);
+    for (std::size_t a = 0; a < Rank; ++a) s += detail::cat(a ? " x " : "", wanted ? std::size_t{2} : points.shape()[a]);
     return s;
   };
-  if (std::any_of(shape.begin(), shape.end(), [](std::size_t n) { return n < 2; }))
+  if (std::any_of(points.shape().begin(), points.shape().end(), [](std::size_t n) { return n < 2; }))
     fail(errc::too_few_points, what, " interpolation needs at least ", dims(true), " points, got ", dims(false));
+  // Closed directions: a last line repeating the first is left out.
+  std::array<bool, Rank> dropped{};
+  for (std::size_t a = 0; a < Rank; ++a)
+    if (periodic[a])
+      if (const Closing c = grid_closing(points, a); c.dropped) {
+        drop_last_line(points, a);
+        dropped[a] = true;
+      }
+  const auto& shape = points.shape();
   static constexpr const char* in_axis[3] = {" in u", " in v", " in w"};
+  static constexpr const char* around_axis[3] = {" around u (closed)", " around v (closed)", " around w (closed)"};
   std::array<int, Rank> p{};
-  for (std::size_t a = 0; a < Rank; ++a) p[a] = resolve_degree(degree[a], shape[a], 0, in_axis[a]);
+  for (std::size_t a = 0; a < Rank; ++a) p[a] = resolve_degree(degree[a], shape[a], 0, periodic[a] ? around_axis[a] : in_axis[a]);
   if (progress) progress(0.0);
 
   // Pass 1, then the knots and factorizations of the axes inside the rows.
@@ -615,16 +921,20 @@ GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional
     check_grid_finite(points.data(), g);  // before scaling: the message shows the point as given
     scale_points(points.data(), points.size(), -shift);
   }
-  const GridChords chords(points.data(), g, param);
+  std::array<bool, 3> closed{};
+  for (std::size_t a = 0; a < Rank; ++a) closed[a] = periodic[a];
+  const GridChords chords(points.data(), g, param, closed);
   chords.check_lines();
 
   GridSolution r;
   r.params.resize(Rank);
   r.knots.reserve(Rank);
-  std::vector<detail::BandedLU> lu;
+  std::vector<AxisSolver> lu;
+  std::vector<KnotVector> row_knots;
   for (std::size_t a = 1; a < Rank; ++a) {
     r.params[a] = chords.in_row_parameters(a);
-    lu.push_back(factor_axis(averaged_knots(r.params[a], p[a]), r.params[a], a));
+    row_knots.push_back(axis_knots(r.params[a], p[a], periodic[a]));
+    lu.push_back(factor_axis(row_knots.back(), r.params[a], a));
   }
   if (progress) progress(0.2);
 
@@ -654,19 +964,23 @@ GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional
         std::copy_n(data + (r1 - 1) * M, M, prev.data());
       }
       gs[0] = r1 - r0;
-      for (std::size_t a = 1; a < Rank; ++a)
-        detail::solve_along_axis(lu[a - 1], &data[r0 * M].x, gs.data(), Rank + 1, a, 1, false);
+      for (std::size_t a = 1; a < Rank; ++a) solve_axis(lu[a - 1], &data[r0 * M].x, gs.data(), Rank + 1, a, 1, false);
     }
   }
   if (progress) progress(0.6);
 
   // Pass 3: along u.
   r.params[0] = chords.u_parameters(steps);
-  r.knots.push_back(averaged_knots(r.params[0], p[0]));
-  for (std::size_t a = 1; a < Rank; ++a) r.knots.push_back(averaged_knots(r.params[a], p[a]));
-  const detail::BandedLU lu0 = factor_axis(r.knots[0], r.params[0], 0);
-  detail::solve_along_axis(lu0, &data->x, shape.data(), Rank, 0, 3);
+  r.knots.push_back(axis_knots(r.params[0], p[0], periodic[0]));
+  for (auto& k : row_knots) r.knots.push_back(std::move(k));
+  const AxisSolver lu0 = factor_axis(r.knots[0], r.params[0], 0);
+  solve_axis(lu0, &data->x, shape.data(), Rank, 0, 3);
   if (shift != 0) scale_points(data, points.size(), shift);
+  // Closed axes of even degree start their period at their first parameter.
+  for (std::size_t a = 0; a < Rank; ++a)
+    if (periodic[a] && p[a] % 2 == 0) insert_seam(points, a, r.knots[a], r.params[a].front());
+  for (std::size_t a = 0; a < Rank; ++a)
+    if (dropped[a]) r.params[a].push_back(r.params[a].front() + 1.0);
   if (progress) progress(1.0);
   return r;
 }
@@ -674,14 +988,15 @@ GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional
 }  // namespace
 
 SurfaceInterpolation interpolate_surface(PointGrid points, const SurfaceInterpolationOptions& options) {
-  GridSolution s = solve_grid<2>(points, {options.degree_u, options.degree_v}, options.param, options.progress, "surface");
+  GridSolution s = solve_grid<2>(points, {options.degree_u, options.degree_v}, options.param, options.progress, "surface",
+                                 options.periodic);
   return {BSplineSurface(std::move(s.knots[0]), std::move(s.knots[1]), std::move(points)), std::move(s.params[0]),
           std::move(s.params[1])};
 }
 
 VolumeInterpolation interpolate_volume(PointGrid3 points, const VolumeInterpolationOptions& options) {
   GridSolution s = solve_grid<3>(points, {options.degree_u, options.degree_v, options.degree_w}, options.param,
-                                 options.progress, "volume");
+                                 options.progress, "volume", options.periodic);
   return {BSplineVolume(std::move(s.knots[0]), std::move(s.knots[1]), std::move(s.knots[2]), std::move(points)),
           std::move(s.params[0]), std::move(s.params[1]), std::move(s.params[2])};
 }

@@ -155,7 +155,9 @@ KnotVector KnotVector::uniform(int degree, int count, double a, double b) {
 int KnotVector::find_span(double t) const noexcept {
   const int n = end_ - 1;
   if (t >= u_[static_cast<std::size_t>(n + 1)]) return n;
-  if (t <= u_[static_cast<std::size_t>(p_)]) return p_;
+  // A clamped vector's first span is p; a periodic one's domain may start at a knot
+  // of any multiplicity, so t there is searched for like any other.
+  if (t < u_[static_cast<std::size_t>(p_)] || (!periodic_ && t == u_[static_cast<std::size_t>(p_)])) return p_;
   // upper_bound over [p, n+1]: first knot > t, the span is the one before it.
   const auto first = u_.begin() + p_;
   const auto last = u_.begin() + n + 2;

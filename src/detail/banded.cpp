@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -81,10 +82,27 @@ bool CyclicLU::factor() {
   const int n = n_;
   if (n == 0) return true;
   double scale = 0;
-  std::size_t best = 0;
-  for (std::size_t j = 0; j < rows_[0].size(); ++j)
-    if (std::abs(rows_[0][j].value) > std::abs(rows_[0][best].value)) best = j;
-  h_ = rows_[0].empty() ? 0 : modulo(rows_[0][best].col, n);
+  // The shift puts on the diagonal the entry of each row that matches its row (the
+  // basis function whose support has the row's parameter inside): of the columns of
+  // row 0, the one whose diagonal's smallest entry is largest. B, consecutive basis
+  // functions at increasing parameters with a positive diagonal, is then totally
+  // positive and regular (Schoenberg–Whitney).
+  auto entry = [&](int i, int col) {
+    double v = 0;
+    for (const Entry& e : rows_[static_cast<std::size_t>(i)])
+      if (modulo(e.col, n) == col) v += e.value;
+    return std::abs(v);
+  };
+  double best = -1;
+  for (const Entry& cand : rows_[0]) {
+    const int h = modulo(cand.col, n);
+    double low = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < n && low > best; ++i) low = std::min(low, entry(i, modulo(i + h, n)));
+    if (low > best) {
+      best = low;
+      h_ = h;
+    }
+  }
   // Offsets of the entries from the shifted diagonal, taken the short way round.
   int kl = 0, ku = 0;
   for (int i = 0; i < n; ++i)
