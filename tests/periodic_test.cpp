@@ -28,6 +28,10 @@
 #include "interpatch/knot_vector.hpp"
 #include "test_util.hpp"
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 namespace interpatch {
 namespace {
 
@@ -699,6 +703,41 @@ TEST(PeriodicInvariance, ClosingPointOrLineChangesNothing) {
   EXPECT_EQ(a3.volume.knots_w(), b3.volume.knots_w());
   EXPECT_EQ(b3.params_u.size(), 6u);
   EXPECT_EQ(b3.params_w.back(), 1.0);
+}
+
+TEST(PeriodicInvariance, ClosingLineOfALargeGridIsLeftOutInPlace) {
+  // Grids of more than 2^18 points, where the closing line inside the rows is left
+  // out by both cores, each moving its share of rows: the result is the same bits as
+  // the grid without the line, with 1, 2 and 3 threads (uneven shares).
+  auto g = test::rng(721);
+  const PointGrid q = random_closed_grid(g, 181, 1451, {false, true}, 1e-4);
+  const PointGrid3 q3 = random_closed_grid3(g, {37, 61, 119}, {false, true, true});
+  SurfaceInterpolationOptions o;
+  o.periodic = {false, true};
+  VolumeInterpolationOptions o3;
+  o3.periodic = {false, true, true};
+#ifdef _OPENMP
+  const int before = omp_get_max_threads();
+  omp_set_dynamic(0);
+  omp_set_num_threads(1);
+#endif
+  const auto a = interpolate_surface(q, o);
+  const auto a3 = interpolate_volume(q3, o3);
+  for (const int threads : {1, 2, 3}) {
+#ifdef _OPENMP
+    omp_set_num_threads(threads);
+#endif
+    const auto b = interpolate_surface(with_closing_line(q, 1), o);
+    EXPECT_EQ(b.surface.control_points().values(), a.surface.control_points().values()) << threads << " threads";
+    for (int axis : {1, 2}) {
+      const auto b3 = interpolate_volume(with_closing_plane(q3, axis), o3);
+      EXPECT_EQ(b3.volume.control_points().values(), a3.volume.control_points().values())
+          << "closing plane along axis " << axis << ", " << threads << " threads";
+    }
+  }
+#ifdef _OPENMP
+  omp_set_num_threads(before);
+#endif
 }
 
 TEST(PeriodicInvariance, NearlyRepeatedClosingPointIsDropped) {
