@@ -9,6 +9,7 @@ SHELL := /bin/bash
 #   nlohmann-json3-dev               specs and JSON output (the io library only; the core needs none)
 #   libgtest-dev libgmock-dev        the tests;  libbenchmark-dev: make bench
 #   python3 python3-numpy            the reference-data script and the read-back checks
+#   python3-scipy                    the closed-spline reference data (tools/reference/make_periodic_reference.py)
 #   python3-vtk9                     VTK's own readers read back the .vts/.vtk/.xyz files interpatch writes
 #   python3-matplotlib               make bench draws docs/bench_interpolation.png
 #   libocct-*-dev                    OpenCASCADE reads back the STEP and IGES files (tests) and races us (make bench)
@@ -17,7 +18,7 @@ SHELL := /bin/bash
 DEBS := cmake ninja-build g++ pkg-config python3 libcli11-dev nlohmann-json3-dev \
         libgtest-dev libgmock-dev libbenchmark-dev python3-numpy python3-vtk9 python3-matplotlib \
         libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
-        libocct-foundation-dev libsisl-dev clang libclang-rt-14-dev libomp-14-dev
+        libocct-foundation-dev libsisl-dev python3-scipy clang libclang-rt-14-dev libomp-14-dev
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 

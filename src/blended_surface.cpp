@@ -368,6 +368,17 @@ void require_exact_form(const detail::BlendedTerms& T) {
                                   "B-spline (knots and coefficients) for an exact conversion");
 }
 
+// Functions of one parameter (curves or their knot vectors) all closed or all open:
+// a direction that mixes periodic ones with clamped ones (a closed boundary curve
+// blended by open functions, say) merges as the clamped forms of all, the exact form
+// of a surface that is closed only geometrically there.
+template <class T>
+void same_kind(std::vector<T>& xs) {
+  const auto closed = [](const T& x) { return x.periodic(); };
+  if (std::any_of(xs.begin(), xs.end(), closed) && !std::all_of(xs.begin(), xs.end(), closed))
+    for (auto& x : xs) x = x.clamped();
+}
+
 }  // namespace
 
 std::size_t BlendedSurface::terms() const noexcept { return t_->a.size() + t_->g.size(); }
@@ -380,6 +391,8 @@ std::array<KnotVector, 2> BlendedSurface::exact_knots() const {
   for (const auto& c : T.b) ku.push_back(c.knots());
   for (const auto& s : T.g) kv.push_back(s.spline->knots());
   for (const auto& c : T.a) kv.push_back(c.knots());
+  same_kind(ku);
+  same_kind(kv);
   return {merged_knots(ku), merged_knots(kv)};
 }
 
@@ -392,6 +405,8 @@ BSplineSurface BlendedSurface::to_bspline() const {
   for (const auto& s : T.g) vs.push_back(*s.spline);
   us.insert(us.end(), T.b.begin(), T.b.end());
   vs.insert(vs.end(), T.a.begin(), T.a.end());
+  same_kind(us);
+  same_kind(vs);
   const auto cu = make_compatible(us), cv = make_compatible(vs);
   const std::size_t nf = T.f.size(), ng = T.g.size(), na = T.a.size();
   const KnotVector& ku = cu.front().knots();

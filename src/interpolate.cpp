@@ -818,20 +818,34 @@ KnotVector axis_knots(std::span<const double> params, int degree, bool closed) {
 }
 
 // Leaves out the last line along `axis` of a grid (a closing line equal to the
-// first): along u the storage just ends earlier; along an axis inside the rows every
-// row's later points move down, in place, in order.
+// first): along u the storage just ends earlier; along an axis inside the rows each
+// block of lines (one value of the axes before it) moves down to close the gap, in
+// place. Blocks move in order within each thread's run; the first blocks of a run,
+// whose places still hold the run before it, wait in a buffer until every thread
+// has moved its others.
 template <std::size_t Rank>
 void drop_last_line(Grid<Vec3, Rank>& points, std::size_t axis) {
   auto shape = points.shape();
   std::size_t outer = 1, inner = 1;
   for (std::size_t a = 0; a < axis; ++a) outer *= shape[a];
   for (std::size_t a = axis + 1; a < Rank; ++a) inner *= shape[a];
-  const std::size_t n = shape[axis], keep = (n - 1) * inner;
+  const std::size_t n = shape[axis], B = n * inner, K = (n - 1) * inner;
   auto values = std::move(points.values());
-  if (axis > 0)
-    for (std::size_t o = 1; o < outer; ++o)
-      std::copy_n(values.data() + o * n * inner, keep, values.data() + o * keep);
-  values.resize(outer * keep);
+  Vec3* v = values.data();
+  if (axis > 0) {
+#pragma omp parallel if (values.size() >= detail::parallel_min_work)
+    {
+      const std::size_t nt = detail::thread_count(), t = static_cast<std::size_t>(detail::thread_index());
+      const std::size_t a = outer * t / nt, b = outer * (t + 1) / nt;
+      // Blocks r with r·K < a·B land where the runs before this one still are.
+      const std::size_t late = std::min(b, std::max(a, (a * B + K - 1) / K));
+      std::vector<Vec3> held(v + a * B, v + late * B);
+      for (std::size_t r = std::max<std::size_t>(late, 1); r < b; ++r) std::copy_n(v + r * B, K, v + r * K);
+#pragma omp barrier
+      for (std::size_t r = a; r < late; ++r) std::copy_n(held.data() + (r - a) * B, K, v + r * K);
+    }
+  }
+  values.resize(outer * K);
   shape[axis] = n - 1;
   points = Grid<Vec3, Rank>(shape, std::move(values));
 }

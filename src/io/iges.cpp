@@ -106,7 +106,11 @@ class Packer {
 
 // Entity 128's parameters (IGES 5.3, section 4.24): counts, degrees, flags, both
 // knot vectors, weights and control points with the u index fastest, parameter range.
-void put_surface(Packer& p, const BSplineSurface& s, double tol) {
+// The surface is the face's clamped form (IGES lists every knot, the ends p+1
+// times); a direction that was periodic is flagged closed (PROP1/PROP2) and
+// periodic (PROP4/PROP5).
+void put_surface(Packer& p, const detail::Face& f, double tol) {
+  const BSplineSurface& s = f.surface;
   const auto& cp = s.control_points();
   const std::size_t n = cp.extent(0), m = cp.extent(1);
   p.put_int(128);
@@ -114,11 +118,11 @@ void put_surface(Packer& p, const BSplineSurface& s, double tol) {
   p.put_int(static_cast<long long>(m) - 1);
   p.put_int(s.degree_u());
   p.put_int(s.degree_v());
-  p.put_int(detail::closed_in(s, 0, tol) ? 1 : 0);
-  p.put_int(detail::closed_in(s, 1, tol) ? 1 : 0);
+  p.put_int(detail::closed(f, 0, tol) ? 1 : 0);
+  p.put_int(detail::closed(f, 1, tol) ? 1 : 0);
   p.put_int(s.rational() ? 0 : 1);  // PROP3: 1 = polynomial
-  p.put_int(0);                     // not periodic in u
-  p.put_int(0);                     // nor in v
+  p.put_int(f.periodic[0] ? 1 : 0);  // PROP4: periodic in u
+  p.put_int(f.periodic[1] ? 1 : 0);  // PROP5: periodic in v
   for (const double k : s.knots_u().values()) p.put(k);
   for (const double k : s.knots_v().values()) p.put(k);
   for (std::size_t j = 0; j < m; ++j)
@@ -142,7 +146,7 @@ std::string timestamp(const IgesOptions& o) {
 }  // namespace
 
 void write_iges(std::ostream& os, const ExactForm& exact, const IgesOptions& options) {
-  const std::vector<BSplineSurface> faces = detail::faces_of(exact);
+  const std::vector<detail::Face> faces = detail::faces_of(exact);
   const double tol = detail::coincidence_tolerance(faces);
 
   // The directory needs each entity's parameter line count: count them first.
@@ -163,7 +167,7 @@ void write_iges(std::ostream& os, const ExactForm& exact, const IgesOptions& opt
 
   double max_coord = 0;
   for (const auto& f : faces)
-    for (const Vec3& q : f.control_points().values())
+    for (const Vec3& q : f.surface.control_points().values())
       max_coord = std::max({max_coord, std::abs(q.x), std::abs(q.y), std::abs(q.z)});
   const std::string when = timestamp(options);
   Section global(&os, 'G');

@@ -5,6 +5,7 @@
 #include <bit>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -13,6 +14,7 @@
 
 #include "detail/parallel.hpp"
 #include "detail/text.hpp"
+#include "interpatch/bspline_surface.hpp"
 #include "interpatch/evaluate.hpp"
 #include "interpatch/io/atomic_file.hpp"
 
@@ -123,43 +125,81 @@ std::string list(const std::array<std::string_view, N>& formats) {
 std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
 
 // ---------------------------------------------------------------------------
-// Faces of a structured surface grid.
+// Vertices and faces of a structured surface grid.
 
-/// The corners of cell (i, j) as C-order vertex indices, counterclockwise in
-/// (u, v) so that the face normal is S_u x S_v. Corners at the same point as their
-/// predecessor (a pole row or a collapsed edge) are dropped: 4 corners is a quad,
-/// 3 a triangle, 0 a cell with no area left to draw.
-std::size_t cell_corners(const PointGrid& g, std::size_t i, std::size_t j, std::size_t out[4]) {
-  const std::size_t nv = g.extent(1);
-  const std::size_t cand[4] = {i * nv + j, (i + 1) * nv + j, (i + 1) * nv + j + 1, i * nv + j + 1};
-  const Vec3* p = g.data();
-  std::size_t n = 0;
-  for (std::size_t c : cand) {
-    if (n == 0 || !(p[c] == p[out[n - 1]])) out[n++] = c;
+/// The vertices the unstructured formats (.obj, .ply, .stl) write: the grid's
+/// points less the last row (column) in a direction the mesh closes in, which
+/// repeats the first; cells next to it use the first row's vertices instead. Vertex
+/// (i, j) of the rows written is number i * cols + j.
+class Vertices {
+ public:
+  explicit Vertices(const SurfaceMesh& m)
+      : g_(m.points),
+        rows_(g_.extent(0) - (m.closed[0] ? 1 : 0)),
+        cols_(g_.extent(1) - (m.closed[1] ? 1 : 0)) {}
+
+  [[nodiscard]] std::size_t rows() const noexcept { return rows_; }
+  [[nodiscard]] std::size_t cols() const noexcept { return cols_; }
+  [[nodiscard]] std::size_t count() const noexcept { return rows_ * cols_; }
+  [[nodiscard]] const PointGrid& grid() const noexcept { return g_; }
+  /// Visits every vertex written, in order, with its row and column.
+  template <class F>
+  void each(F&& f) const {
+    for (std::size_t i = 0; i < rows_; ++i)
+      for (std::size_t j = 0; j < cols_; ++j) f(i, j);
   }
-  while (n > 1 && p[out[n - 1]] == p[out[0]]) --n;
+  /// The row (column) of vertices grid row (column) i stands for: i itself, or 0 for
+  /// the last one of a closed direction.
+  [[nodiscard]] std::size_t row(std::size_t i) const noexcept { return i == rows_ ? 0 : i; }
+  [[nodiscard]] std::size_t col(std::size_t j) const noexcept { return j == cols_ ? 0 : j; }
+
+ private:
+  const PointGrid& g_;
+  std::size_t rows_, cols_;
+};
+
+/// A corner of a face: its vertex and the vertex's point, and the grid point it
+/// stands for (C order), which differ across a seam.
+struct Corner {
+  std::size_t vertex = 0, grid = 0;
+  const Vec3* point = nullptr;
+};
+
+/// The corners of cell (i, j), counterclockwise in (u, v) so that the face normal
+/// is S_u x S_v. Corners at the same point as their predecessor (a pole row or a
+/// collapsed edge) are dropped: 4 corners is a quad, 3 a triangle, 0 a cell with no
+/// area left to draw.
+std::size_t cell_corners(const Vertices& v, std::size_t i, std::size_t j, Corner out[4]) {
+  const std::size_t nv = v.grid().extent(1);
+  const std::size_t ci[4] = {i, i + 1, i + 1, i}, cj[4] = {j, j, j + 1, j + 1};
+  std::size_t n = 0;
+  for (std::size_t c = 0; c < 4; ++c) {
+    const std::size_t r = v.row(ci[c]), q = v.col(cj[c]);
+    const Corner k{r * v.cols() + q, ci[c] * nv + cj[c], &v.grid()(r, q)};
+    if (n == 0 || !(*k.point == *out[n - 1].point)) out[n++] = k;
+  }
+  while (n > 1 && *out[n - 1].point == *out[0].point) --n;
   return n >= 3 ? n : 0;
 }
 
 template <class F>
-void for_each_face(const PointGrid& g, F&& f) {
-  const std::size_t nu = g.extent(0), nv = g.extent(1);
+void for_each_face(const Vertices& v, F&& f) {
+  const std::size_t nu = v.grid().extent(0), nv = v.grid().extent(1);
   if (nu < 2 || nv < 2) return;
-  std::size_t c[4];
+  Corner c[4];
   for (std::size_t i = 0; i + 1 < nu; ++i)
     for (std::size_t j = 0; j + 1 < nv; ++j)
-      if (const std::size_t n = cell_corners(g, i, j, c); n != 0) f(c, n);
+      if (const std::size_t n = cell_corners(v, i, j, c); n != 0) f(c, n);
 }
 
 /// The triangles of a face (a fan from its first corner), skipping those of zero area.
 template <class F>
-void for_each_triangle(const PointGrid& g, F&& f) {
-  const Vec3* p = g.data();
-  for_each_face(g, [&](const std::size_t* c, std::size_t n) {
+void for_each_triangle(const Vertices& v, F&& f) {
+  for_each_face(v, [&](const Corner* c, std::size_t n) {
     for (std::size_t k = 1; k + 1 < n; ++k) {
-      const Vec3& a = p[c[0]];
-      const Vec3& b = p[c[k]];
-      const Vec3& d = p[c[k + 1]];
+      const Vec3& a = *c[0].point;
+      const Vec3& b = *c[k].point;
+      const Vec3& d = *c[k + 1].point;
       const Vec3 nrm = cross(b - a, d - a);
       if (nrm == Vec3{}) continue;
       f(a, b, d, nrm);
@@ -167,19 +207,31 @@ void for_each_triangle(const PointGrid& g, F&& f) {
   });
 }
 
+/// " (closed in u and v: ...)" for the formats' comment lines, or nothing.
+std::string closed_note(const SurfaceMesh& m) {
+  if (!m.closed[0] && !m.closed[1]) return {};
+  const char* dirs = m.closed[0] && m.closed[1] ? "u and v" : m.closed[0] ? "u" : "v";
+  return std::string(" (closed in ") + dirs + ": the last row of samples is the first, written once)";
+}
+
 // ---------------------------------------------------------------------------
 // Surface-only formats.
 
+// Vertices, normals and faces share numbers; texture coordinates are one per grid
+// point, so that the cells across a seam still run up to u (v) = 1.
 void write_obj(std::ostream& os, const SurfaceMesh& m) {
   const PointGrid& g = m.points;
+  const Vertices vx(m);
   const std::size_t nu = g.extent(0), nv = g.extent(1);
   const bool normals = !m.normals.empty();
   Sink s(os);
-  s.text("# interpatch surface mesh: ").uint(nu).text(" x ").uint(nv).text(" vertices, first index along u\n");
-  for (const Vec3& p : g.values()) {
+  s.text("# interpatch surface mesh: ").uint(vx.rows()).text(" x ").uint(vx.cols()).text(" vertices, first index along u");
+  s.text(closed_note(m)).ch('\n');
+  vx.each([&](std::size_t i, std::size_t j) {
+    const Vec3& p = g(i, j);
     s.text("v ").shortest(p.x).ch(' ').shortest(p.y).ch(' ').shortest(p.z).ch('\n');
     s.end_record();
-  }
+  });
   for (std::size_t i = 0; i < nu; ++i) {
     const double u = nu > 1 ? static_cast<double>(i) / static_cast<double>(nu - 1) : 0.0;
     for (std::size_t j = 0; j < nv; ++j) {
@@ -189,17 +241,18 @@ void write_obj(std::ostream& os, const SurfaceMesh& m) {
     }
   }
   if (normals) {
-    for (const Vec3& n : m.normals.values()) {
+    vx.each([&](std::size_t i, std::size_t j) {
+      const Vec3& n = m.normals(i, j);
       s.text("vn ").shortest(n.x).ch(' ').shortest(n.y).ch(' ').shortest(n.z).ch('\n');
       s.end_record();
-    }
+    });
   }
-  for_each_face(g, [&](const std::size_t* c, std::size_t n) {
+  for_each_face(vx, [&](const Corner* c, std::size_t n) {
     s.ch('f');
     for (std::size_t k = 0; k < n; ++k) {
-      const std::size_t idx = c[k] + 1;  // OBJ counts from 1; v, vt and vn share the index
-      s.ch(' ').uint(idx).ch('/').uint(idx);
-      if (normals) s.ch('/').uint(idx);
+      const std::size_t v = c[k].vertex + 1;  // OBJ counts from 1; v and vn share the index
+      s.ch(' ').uint(v).ch('/').uint(c[k].grid + 1);
+      if (normals) s.ch('/').uint(v);
     }
     s.ch('\n');
     s.end_record();
@@ -207,9 +260,9 @@ void write_obj(std::ostream& os, const SurfaceMesh& m) {
   s.flush();
 }
 
-std::uint32_t stl_triangle_count(const PointGrid& g, const fs::path& path) {
+std::uint32_t stl_triangle_count(const SurfaceMesh& m, const fs::path& path) {
   std::uint64_t count = 0;
-  for_each_triangle(g, [&](const Vec3&, const Vec3&, const Vec3&, const Vec3&) { ++count; });
+  for_each_triangle(Vertices(m), [&](const Vec3&, const Vec3&, const Vec3&, const Vec3&) { ++count; });
   if (count > std::numeric_limits<std::uint32_t>::max()) {
     detail::fail(errc::too_large, "cannot write ", quoted(path), ": ", count,
                  " triangles; binary STL holds at most 4294967295");
@@ -227,7 +280,7 @@ void write_stl(std::ostream& os, const SurfaceMesh& m, std::uint32_t triangles) 
   s.text(std::string_view(header, sizeof header));
   s.little(triangles);
   auto f32 = [](double v) { return static_cast<float>(v); };
-  for_each_triangle(m.points, [&](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n) {
+  for_each_triangle(Vertices(m), [&](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n) {
     const Vec3 unit = n / norm(n);
     s.little(f32(unit.x)).little(f32(unit.y)).little(f32(unit.z));
     for (const Vec3* p : {&a, &b, &c}) s.little(f32(p->x)).little(f32(p->y)).little(f32(p->z));
@@ -238,36 +291,38 @@ void write_stl(std::ostream& os, const SurfaceMesh& m, std::uint32_t triangles) 
 }
 
 void write_ply(std::ostream& os, const SurfaceMesh& m) {
-  const PointGrid& g = m.points;
+  const Vertices vx(m);
   const bool normals = !m.normals.empty();
   std::uint64_t faces = 0;
-  for_each_face(g, [&](const std::size_t*, std::size_t) { ++faces; });
-  const bool fits_int = g.size() <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
+  for_each_face(vx, [&](const Corner*, std::size_t) { ++faces; });
+  const bool fits_int = vx.count() <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
 
   Sink s(os);
   s.text("ply\nformat binary_little_endian 1.0\ncomment interpatch surface mesh ")
-      .uint(g.extent(0))
+      .uint(vx.rows())
       .text(" x ")
-      .uint(g.extent(1))
-      .text(", first index along u\nelement vertex ")
-      .uint(g.size())
+      .uint(vx.cols())
+      .text(", first index along u")
+      .text(closed_note(m))
+      .text("\nelement vertex ")
+      .uint(vx.count())
       .text("\nproperty double x\nproperty double y\nproperty double z\n");
   if (normals) s.text("property double nx\nproperty double ny\nproperty double nz\n");
   s.text("element face ").uint(faces).text("\nproperty list uchar ").text(fits_int ? "int" : "uint").text(" vertex_indices\nend_header\n");
-  for (std::size_t k = 0; k < g.size(); ++k) {
-    const Vec3& p = g.data()[k];
+  vx.each([&](std::size_t i, std::size_t j) {
+    const Vec3& p = m.points(i, j);
     s.little(p.x).little(p.y).little(p.z);
     if (normals) {
-      const Vec3& n = m.normals.data()[k];
+      const Vec3& n = m.normals(i, j);
       s.little(n.x).little(n.y).little(n.z);
     }
     s.end_record();
-  }
-  for_each_face(g, [&](const std::size_t* c, std::size_t n) {
+  });
+  for_each_face(vx, [&](const Corner* c, std::size_t n) {
     s.little(static_cast<std::uint8_t>(n));
     for (std::size_t k = 0; k < n; ++k) {
-      if (fits_int) s.little(static_cast<std::int32_t>(c[k]));
-      else s.little(static_cast<std::uint32_t>(c[k]));
+      if (fits_int) s.little(static_cast<std::int32_t>(c[k].vertex));
+      else s.little(static_cast<std::uint32_t>(c[k].vertex));
     }
     s.end_record();
   });
@@ -460,6 +515,44 @@ void write_structured(const fs::path& path, const std::string& ext, const Struct
   }
 }
 
+/// A mesh closed in u (v) needs two rows (columns) or more, its last one repeating
+/// the first.
+void check_closed(const fs::path& path, const SurfaceMesh& m) {
+  const PointGrid& g = m.points;
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
+  if (m.closed[0] || m.closed[1])
+    for (const Vec3& p : g.values())
+      for (int d = 0; d < 3; ++d) {
+        lo[d] = std::min(lo[d], p[d]);
+        hi[d] = std::max(hi[d], p[d]);
+      }
+  // sample_mesh copies the first row exactly; a surface evaluated at both ends of
+  // its period agrees to rounding (~1e-15 of its size). 1e-9 of the bounding-box
+  // diagonal takes that and refuses any real gap.
+  const double tol = 1e-9 * norm(hi - lo);
+  for (const std::size_t a : {0u, 1u}) {
+    if (!m.closed[a]) continue;
+    const char* dir = a == 0 ? "u" : "v";
+    const char* line = a == 0 ? "row" : "column";
+    const std::size_t n = g.extent(a), across = g.extent(1 - a);
+    if (n < 2) {
+      detail::fail(errc::size_mismatch, "cannot write ", quoted(path), ": a mesh closed in ", dir, " needs 2 ", line,
+                   "s or more, the last repeating the first; it has ", n);
+    }
+    for (std::size_t t = 0; t < across; ++t) {
+      const Vec3& first = a == 0 ? g(0, t) : g(t, 0);
+      const Vec3& last = a == 0 ? g(n - 1, t) : g(t, n - 1);
+      if (const double gap = norm(last - first); gap > tol) {
+        const std::size_t i = a == 0 ? n - 1 : t, j = a == 0 ? t : n - 1;
+        detail::fail(errc::closing_gap, "cannot write ", quoted(path), ": the mesh is closed in ", dir,
+                     " but its last ", line, " does not repeat the first: point [", i, "][", j, "] is ", gap,
+                     " away from point [", a == 0 ? 0 : i, "][", a == 0 ? j : 0, "] (allowed: ", tol, ")");
+      }
+    }
+  }
+}
+
 }  // namespace
 
 bool is_mesh_format(std::string_view extension) noexcept {
@@ -483,11 +576,12 @@ void write_surface_mesh(const fs::path& path, const SurfaceMesh& mesh) {
     detail::fail(errc::size_mismatch, "cannot write ", quoted(path), ": ", mesh.normals.extent(0), " x ",
                  mesh.normals.extent(1), " normals for ", g.extent(0), " x ", g.extent(1), " points");
   }
+  check_closed(path, mesh);
 
   if (ext == ".obj") {
     write_atomically(path, [&](std::ostream& os) { write_obj(os, mesh); });
   } else if (ext == ".stl") {
-    const std::uint32_t triangles = stl_triangle_count(g, path);
+    const std::uint32_t triangles = stl_triangle_count(mesh, path);
     write_atomically(path, [&](std::ostream& os) { write_stl(os, mesh, triangles); });
   } else if (ext == ".ply") {
     write_atomically(path, [&](std::ostream& os) { write_ply(os, mesh); });
@@ -527,7 +621,7 @@ void write_volume_mesh(const fs::path& path, const PointGrid3& points, const Gri
 SurfaceMesh sample_mesh(const Surface& surface, std::span<const double> us, std::span<const double> vs,
                         const progress_callback& progress) {
   const std::size_t nu = us.size(), nv = vs.size();
-  SurfaceMesh mesh{PointGrid({nu, nv}, for_overwrite), PointGrid({nu, nv}, for_overwrite)};
+  SurfaceMesh mesh{PointGrid({nu, nv}, for_overwrite), PointGrid({nu, nv}, for_overwrite), {false, false}};
   const std::size_t block = std::max<std::size_t>(1, (std::size_t{1} << 15) / std::max<std::size_t>(1, nv));
   for (std::size_t i0 = 0; i0 < nu; i0 += block) {
     const std::size_t nb = std::min(block, nu - i0);
@@ -540,6 +634,27 @@ SurfaceMesh sample_mesh(const Surface& surface, std::span<const double> us, std:
       mesh.normals(i0 + i, j) = unit_normal(d(i, j));
     }
     if (progress) progress(static_cast<double>(i0 + nb) / static_cast<double>(nu));
+  }
+  // A direction in which a B-spline surface is periodic and the samples span one
+  // whole period closes: its last row (column) is its first again, points and
+  // normals copied so that every format sees one seam.
+  if (const auto* b = dynamic_cast<const BSplineSurface*>(&surface)) {
+    const auto domain = b->domain();
+    for (const std::size_t a : {0u, 1u}) {
+      const std::span<const double> t = a == 0 ? us : vs;
+      const double period = domain[a].second - domain[a].first;
+      // Parameters made by linspace over a period end on its ends to an ulp or so.
+      mesh.closed[a] = b->periodic()[a] && t.size() >= 2 &&
+                       std::abs(std::abs(t.back() - t.front()) - period) <= 1e-12 * period;
+    }
+    for (std::size_t j = 0; mesh.closed[0] && j < nv; ++j) {
+      mesh.points(nu - 1, j) = mesh.points(0, j);
+      mesh.normals(nu - 1, j) = mesh.normals(0, j);
+    }
+    for (std::size_t i = 0; mesh.closed[1] && i < nu; ++i) {
+      mesh.points(i, nv - 1) = mesh.points(i, 0);
+      mesh.normals(i, nv - 1) = mesh.normals(i, 0);
+    }
   }
   return mesh;
 }

@@ -117,9 +117,11 @@ struct Side {
   // The parameter line of the side: (base + t * dir) for the curve parameter t.
   std::array<double, 2> base{}, dir{};
   bool forward_in_loop = true;
+  bool periodic = false;  // the face was periodic along the side: its curve is closed
 };
 
-Side side_of(const BSplineSurface& s, int side) {
+Side side_of(const detail::Face& f, int side) {
+  const BSplineSurface& s = f.surface;
   const std::size_t n = s.control_points().extent(0), m = s.control_points().extent(1);
   const auto [u0, u1] = s.domain_u();
   const auto [v0, v1] = s.domain_v();
@@ -138,6 +140,7 @@ Side side_of(const BSplineSurface& s, int side) {
   r.base = side == 0 ? std::array{0.0, v0} : side == 1 ? std::array{u1, 0.0} : side == 2 ? std::array{0.0, v1} : std::array{u0, 0.0};
   r.dir = along_u ? std::array{1.0, 0.0} : std::array{0.0, 1.0};
   r.forward_in_loop = side < 2;
+  r.periodic = f.periodic[along_u ? 0 : 1];
   return r;
 }
 
@@ -163,11 +166,14 @@ struct Topology {
   std::vector<std::vector<LoopEntry>> loops;  // per face, counterclockwise about the face normal
   std::vector<bool> same_sense;               // per face: face normal along S_u x S_v
   bool closed = false;                        // every edge used twice, in opposite directions
+  // The faces joined through shared edges, each set a shell; more than one when the
+  // faces fall apart (a volume closed in two directions: its inner and outer skin).
+  std::vector<std::vector<int>> shells;
 };
 
 class TopologyBuilder {
  public:
-  TopologyBuilder(const std::vector<BSplineSurface>& faces, double tol) : faces_(faces), tol_(tol) {}
+  TopologyBuilder(const std::vector<detail::Face>& faces, double tol) : faces_(faces), tol_(tol) {}
 
   Topology build(const std::vector<bool>& same_sense) {
     t_.same_sense = same_sense;
@@ -191,13 +197,41 @@ class TopologyBuilder {
       for (const auto& e : loop) ++(e.forward ? forward : backward)[e.edge];
     for (std::size_t e = 0; e < t_.edges.size(); ++e)
       t_.closed = t_.closed && forward[e] == 1 && backward[e] == 1;
+    t_.shells = shells();
     return std::move(t_);
   }
 
  private:
-  const Vec3& point(int f, std::size_t i) const { return faces_[f].control_points().data()[i]; }
+  const Vec3& point(int f, std::size_t i) const { return faces_[f].surface.control_points().data()[i]; }
   double weight(int f, std::size_t i) const {
-    return faces_[f].rational() ? faces_[f].weights().data()[i] : 1.0;
+    const BSplineSurface& s = faces_[f].surface;
+    return s.rational() ? s.weights().data()[i] : 1.0;
+  }
+
+  // Faces sharing an edge in one shell (union-find), shells in the order of their first face.
+  std::vector<std::vector<int>> shells() const {
+    std::vector<int> root(faces_.size());
+    for (std::size_t f = 0; f < root.size(); ++f) root[f] = static_cast<int>(f);
+    const auto find = [&](int f) {
+      while (root[f] != f) f = root[f] = root[root[f]];
+      return f;
+    };
+    for (const Edge& e : t_.edges)
+      for (const Use& u : e.uses) {
+        const int a = find(e.first.face), b = find(u.face);
+        root[std::max(a, b)] = std::min(a, b);
+      }
+    std::vector<std::vector<int>> out;
+    std::vector<int> shell_of(faces_.size(), -1);
+    for (int f = 0; f < static_cast<int>(faces_.size()); ++f) {
+      int& s = shell_of[find(f)];
+      if (s < 0) {
+        s = static_cast<int>(out.size());
+        out.emplace_back();
+      }
+      out[s].push_back(f);
+    }
+    return out;
   }
 
   bool degenerate(int f, const Side& s) const {
@@ -256,7 +290,7 @@ class TopologyBuilder {
     return t_.edges.back().first;
   }
 
-  const std::vector<BSplineSurface>& faces_;
+  const std::vector<detail::Face>& faces_;
   double tol_;
   Topology t_;
   int edge_of_last_ = 0;
@@ -289,10 +323,13 @@ std::vector<int> write_points(Entities& out, const PointGrid& cp) {
   return ids;
 }
 
-int write_surface(Entities& out, const BSplineSurface& s, const std::vector<int>& ids, double tol) {
+// The face's surface, its clamped form: u_closed/v_closed .T. in a direction that
+// was periodic or whose net closes on itself (detail::closed).
+int write_surface(Entities& out, const detail::Face& f, const std::vector<int>& ids, double tol) {
+  const BSplineSurface& s = f.surface;
   const std::size_t n = s.control_points().extent(0), m = s.control_points().extent(1);
-  const std::string flags = std::string(",.UNSPECIFIED.,") + logical(detail::closed_in(s, 0, tol)) + "," +
-                            logical(detail::closed_in(s, 1, tol)) + ",.F.";
+  const std::string flags = std::string(",.UNSPECIFIED.,") + logical(detail::closed(f, 0, tol)) + "," +
+                            logical(detail::closed(f, 1, tol)) + ",.F.";
   const auto net = [&] {
     out.text("(");
     for (std::size_t i = 0; i < n; ++i) {
@@ -337,7 +374,8 @@ int write_curve(Entities& out, const BSplineSurface& s, const Side& side, const 
     pts.push_back(ids[i]);
     if (s.rational()) w.push_back(s.weights().data()[i]);
   }
-  const bool closed = norm(s.control_points().data()[side.index.front()] - s.control_points().data()[side.index.back()]) <= tol;
+  const bool closed =
+      side.periodic || norm(s.control_points().data()[side.index.front()] - s.control_points().data()[side.index.back()]) <= tol;
   const std::string head = std::to_string(side.knots->degree()) + "," + refs(pts) + ",.UNSPECIFIED.," + logical(closed) + ",.F.";
   const std::string with_knots = knot_lists(*side.knots) + ",.UNSPECIFIED.";
   if (w.empty()) return out.add("B_SPLINE_CURVE_WITH_KNOTS(''," + head + "," + with_knots + ")");
@@ -371,11 +409,14 @@ std::string iso_time(const StepOptions& o) {
 }  // namespace
 
 void write_step(std::ostream& os, const ExactForm& exact, const StepOptions& options) {
-  const std::vector<BSplineSurface> faces = detail::faces_of(exact);
+  const std::vector<detail::Face> faces = detail::faces_of(exact);
   const double tol = detail::coincidence_tolerance(faces);
-  const auto* volume = std::get_if<BSplineVolume>(&exact);
-  const Topology topo =
-      TopologyBuilder(faces, tol).build(volume ? outward_senses(*volume) : std::vector<bool>(faces.size(), true));
+  std::vector<bool> same_sense(faces.size(), true);
+  if (const auto* volume = std::get_if<BSplineVolume>(&exact)) {
+    const std::vector<bool> outward = outward_senses(*volume);
+    for (std::size_t f = 0; f < faces.size(); ++f) same_sense[f] = outward[static_cast<std::size_t>(faces[f].side)];
+  }
+  const Topology topo = TopologyBuilder(faces, tol).build(same_sense);
   const std::string name = step_string(options.name);
   const auto r = [](int id) { return "#" + std::to_string(id); };
 
@@ -411,7 +452,7 @@ void write_step(std::ostream& os, const ExactForm& exact, const StepOptions& opt
   std::vector<std::vector<int>> point_ids;
   std::vector<int> surfaces;
   for (const auto& f : faces) {
-    point_ids.push_back(write_points(out, f.control_points()));
+    point_ids.push_back(write_points(out, f.surface.control_points()));
     surfaces.push_back(write_surface(out, f, point_ids.back(), tol));
   }
 
@@ -423,7 +464,7 @@ void write_step(std::ostream& os, const ExactForm& exact, const StepOptions& opt
     const auto& ids = point_ids[e.first.face];
     for (const auto& [v, corner] : {std::pair{e.start, side.index.front()}, std::pair{e.end, side.index.back()}})
       if (!vertex_ids[v]) vertex_ids[v] = out.add("VERTEX_POINT(''," + r(ids[corner]) + ")");
-    const int curve = write_curve(out, faces[e.first.face], side, ids, tol);
+    const int curve = write_curve(out, faces[e.first.face].surface, side, ids, tol);
     std::vector<int> pcurves;
     bool seam = false;
     for (const Use& u : e.uses) {
@@ -452,14 +493,21 @@ void write_step(std::ostream& os, const ExactForm& exact, const StepOptions& opt
   const int xdir = out.add("DIRECTION('',(1.,0.,0.))");
   const int placement = out.add("AXIS2_PLACEMENT_3D(''," + r(origin) + "," + r(zdir) + "," + r(xdir) + ")");
   int representation = 0;
-  if (topo.closed) {
+  if (topo.closed && topo.shells.size() == 1) {
     const int shell = out.add("CLOSED_SHELL(''," + refs(face_ids) + ")");
     const int solid = out.add("MANIFOLD_SOLID_BREP(" + name + "," + r(shell) + ")");
     representation = out.add("ADVANCED_BREP_SHAPE_REPRESENTATION(" + name + ",(" + r(placement) + "," + r(solid) +
                              ")," + r(ctx3) + ")");
   } else {
-    const int shell = out.add("OPEN_SHELL(''," + refs(face_ids) + ")");
-    const int model = out.add("SHELL_BASED_SURFACE_MODEL(" + name + ",(" + r(shell) + "))");
+    // One shell per set of connected faces; closed ones (a volume's inner and outer
+    // skin when it is closed in two directions) say so.
+    std::vector<int> shells;
+    for (const std::vector<int>& members : topo.shells) {
+      std::vector<int> ids;
+      for (const int f : members) ids.push_back(face_ids[static_cast<std::size_t>(f)]);
+      shells.push_back(out.add(std::string(topo.closed ? "CLOSED_SHELL" : "OPEN_SHELL") + "(''," + refs(ids) + ")"));
+    }
+    const int model = out.add("SHELL_BASED_SURFACE_MODEL(" + name + "," + refs(shells) + ")");
     representation = out.add("MANIFOLD_SURFACE_SHAPE_REPRESENTATION(" + name + ",(" + r(placement) + "," +
                              r(model) + ")," + r(ctx3) + ")");
   }

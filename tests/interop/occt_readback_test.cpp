@@ -48,6 +48,7 @@
 #include "interpatch/io/iges.hpp"
 #include "interpatch/io/spec.hpp"
 #include "interpatch/io/step.hpp"
+#include "io/closed_shapes.hpp"
 #include "temp_dir.hpp"
 
 namespace interpatch {
@@ -136,24 +137,30 @@ FaceGrid occt_grid(const TopoDS_Face& face) {
   return g;
 }
 
-// interpatch's exact form on the same grids: the surface, or a volume's six faces
-// evaluated through the volume itself (u0: S(0, v, w), v0: S(u, 0, w), w0: S(u, v, 0), ...).
+// interpatch's exact form on the same grids over its own domain: the surface, or a
+// volume's boundary faces evaluated through the volume itself (u0: S(u_0, v, w),
+// v0: S(u, v_0, w), w0: S(u, v, w_0), ...). A periodic direction of a volume has no
+// faces: its two sides meet inside it.
 std::vector<FaceGrid> reference_grids(const io::ExactForm& exact) {
-  const std::vector<double> t = linspace(0, 1, samples);
+  const auto grid = [](std::pair<double, double> d) { return linspace(d.first, d.second, samples); };
   if (const auto* s = std::get_if<BSplineSurface>(&exact)) {
-    const PointGrid g = s->evaluate(t, t);
+    const PointGrid g = s->evaluate(grid(s->domain_u()), grid(s->domain_v()));
     return {FaceGrid(g.values().begin(), g.values().end())};
   }
   const auto& vol = std::get<BSplineVolume>(exact);
+  const auto domain = vol.domain();
   std::vector<FaceGrid> faces;
-  for (int axis = 0; axis < 3; ++axis)
-    for (const double at : {0.0, 1.0}) {
+  for (std::size_t axis = 0; axis < 3; ++axis) {
+    if (vol.periodic()[axis]) continue;
+    const std::vector<double> ta = grid(domain[axis == 0 ? 1 : 0]), tb = grid(domain[axis == 2 ? 1 : 2]);
+    for (const double at : {domain[axis].first, domain[axis].second}) {
       FaceGrid g;
-      for (const double a : t)
-        for (const double b : t)
+      for (const double a : ta)
+        for (const double b : tb)
           g.push_back(axis == 0 ? vol.point(at, a, b) : axis == 1 ? vol.point(a, at, b) : vol.point(a, b, at));
       faces.push_back(std::move(g));
     }
+  }
   return faces;
 }
 
@@ -201,9 +208,10 @@ double compare(const std::vector<TopoDS_Face>& faces, const std::vector<FaceGrid
 }
 
 // The numbers themselves survive the text: every pole, weight and knot of a face
-// read back is, bit for bit, a control point, weight or knot of the exact form
-// (a volume's faces carry the boundary layers of its net). Text with fewer digits
-// than round-trip needs fails here even where the 1e-9 comparison would not.
+// read back is, bit for bit, a control point, weight or knot of the exact form's
+// clamped form, the one written (a volume's faces carry the boundary layers of its
+// net). Text with fewer digits than round-trip needs fails here even where the 1e-9
+// comparison would not.
 void expect_exact_numbers(const std::vector<TopoDS_Face>& faces, const io::ExactForm& exact, const std::string& what) {
   std::set<std::array<double, 3>> points;
   std::set<double> weights{1.0}, knots;
@@ -211,11 +219,12 @@ void expect_exact_numbers(const std::vector<TopoDS_Face>& faces, const io::Exact
     for (const Vec3& p : b.control_points().values()) points.insert({p.x, p.y, p.z});
     for (const double w : b.weights().values()) weights.insert(w);
   };
-  if (const auto* s = std::get_if<BSplineSurface>(&exact)) {
-    add(*s);
-    for (const auto* k : {&s->knots_u(), &s->knots_v()}) knots.insert(k->values().begin(), k->values().end());
+  if (const auto* surface = std::get_if<BSplineSurface>(&exact)) {
+    const BSplineSurface s = surface->clamped();
+    add(s);
+    for (const auto* k : {&s.knots_u(), &s.knots_v()}) knots.insert(k->values().begin(), k->values().end());
   } else {
-    const auto& v = std::get<BSplineVolume>(exact);
+    const BSplineVolume v = std::get<BSplineVolume>(exact).clamped();
     add(v);
     for (const auto* k : {&v.knots_u(), &v.knots_v(), &v.knots_w()}) knots.insert(k->values().begin(), k->values().end());
   }
@@ -231,6 +240,18 @@ void expect_exact_numbers(const std::vector<TopoDS_Face>& faces, const io::Exact
     for (Standard_Integer i = 1; i <= b->NbUKnots(); ++i) EXPECT_TRUE(knots.count(b->UKnot(i))) << what << ": u knot " << i;
     for (Standard_Integer i = 1; i <= b->NbVKnots(); ++i) EXPECT_TRUE(knots.count(b->VKnot(i))) << what << ": v knot " << i;
   }
+}
+
+// The shape is one solid, oriented outward (positive volume), with `centre` (the
+// volume's own centre) classified inside it.
+void expect_solid_around(const TopoDS_Shape& shape, const Vec3& centre, const std::string& what) {
+  ASSERT_EQ(count(shape, TopAbs_SOLID), 1u) << what;
+  GProp_GProps props;
+  BRepGProp::VolumeProperties(shape, props);
+  EXPECT_GT(props.Mass(), 0) << what << ": faces oriented inward";
+  // 1e-7: the files' uncertainty (confusion accuracy, mm); the centre lies far deeper inside.
+  BRepClass3d_SolidClassifier inside(shape, gp_Pnt(centre.x, centre.y, centre.z), 1e-7);
+  EXPECT_EQ(inside.State(), TopAbs_IN) << what;
 }
 
 // The figures docs/interop.md quotes: printed, one line per file.
@@ -313,15 +334,8 @@ TEST_P(OcctReadback, StepFacesMatchTheExactFormAndAreValid) {
   for (const auto& f : faces) EXPECT_TRUE(BRepCheck_Analyzer(f).IsValid()) << name << ".step: a face is invalid";
 
   if (io::is_volume(built_)) {
-    // The six faces close into one solid, oriented outward: positive volume, and
-    // the volume's own centre classified inside it.
-    ASSERT_EQ(count(shape, TopAbs_SOLID), 1u) << name;
-    GProp_GProps props;
-    BRepGProp::VolumeProperties(shape, props);
-    EXPECT_GT(props.Mass(), 0) << name << ": faces oriented inward";
-    const Vec3 centre = io::volume_evaluator(built_).point(0.5, 0.5, 0.5);
-    BRepClass3d_SolidClassifier inside(shape, gp_Pnt(centre.x, centre.y, centre.z), 1e-7);
-    EXPECT_EQ(inside.State(), TopAbs_IN) << name;
+    // The six faces close into one solid.
+    expect_solid_around(shape, io::volume_evaluator(built_).point(0.5, 0.5, 0.5), name);
   }
 }
 
@@ -397,6 +411,153 @@ TEST(OcctReadbackTopology, HemispherePoleAndSeam) {
   EXPECT_EQ(seams, 2u);  // the seam edge, met once in each direction
   EXPECT_TRUE(BRepCheck_Analyzer(shape).IsValid());
 }
+
+// ---------------------------------------------------------------- closed shapes
+
+// Surfaces closed in u, in v and in both, polynomial and rational, and volumes
+// closed in one direction (a solid ring) or two (a thick torus shell): periodic
+// B-splines built by hand (tests/io/closed_shapes.hpp), written by interpatch's
+// writers, read back by OCCT. The files hold their clamped forms, which interpatch
+// makes by interpolation exact up to rounding (~1e-15 of the size): the same
+// 1e-9 relative tolerance as above holds, and a wrong seam, knot or flag moves
+// points by far more.
+struct ClosedCase {
+  std::string name;
+  io::ExactForm form;
+  std::array<bool, 2> periodic{};  // a surface's u and v, a volume's u and v (w is open)
+};
+
+void PrintTo(const ClosedCase& c, std::ostream* os) { *os << c.name; }
+
+std::vector<ClosedCase> closed_cases() {
+  std::vector<ClosedCase> cases;
+  const std::pair<const char*, std::array<bool, 2>> directions[] = {
+      {"u", {true, false}}, {"v", {false, true}}, {"uv", {true, true}}};
+  for (const auto& [tag, periodic] : directions) {
+    for (const unsigned seed : {1u, 2u})
+      for (const bool rational : {false, true})
+        cases.push_back({std::string("surface_") + tag + "_" + std::to_string(seed) + (rational ? "_rational" : ""),
+                         test::closed_surface(periodic, seed, rational), periodic});
+    cases.push_back({std::string("volume_") + tag, test::closed_volume(periodic, 3), periodic});
+  }
+  return cases;
+}
+
+// Many parameters besides the grids: OCCT's surface at random (u, v) of the domain,
+// and at the seam's two sides (front and back of a closed direction), against
+// interpatch's own surface there. Faces are those of a surface form (one face).
+void expect_surface_points(const TopoDS_Face& face, const BSplineSurface& s, const std::string& what) {
+  const Handle(Geom_Surface) g = BRep_Tool::Surface(face);
+  Standard_Real u0, u1, v0, v1;
+  g->Bounds(u0, u1, v0, v1);
+  EXPECT_EQ(u0, s.domain_u().first) << what;  // the parametrization is the form's own
+  EXPECT_EQ(u1, s.domain_u().second) << what;
+  EXPECT_EQ(v0, s.domain_v().first) << what;
+  EXPECT_EQ(v1, s.domain_v().second) << what;
+  const auto ref = s.evaluate(linspace(u0, u1, samples), linspace(v0, v1, samples));
+  const double tol = relative_tolerance * test::bbox_diagonal(ref.values());
+  auto rng = test::rng(11);
+  for (int k = 0; k < 500; ++k) {
+    const double u = test::uniform(rng, u0, u1), v = test::uniform(rng, v0, v1);
+    const gp_Pnt p = g->Value(u, v);
+    EXPECT_LE(norm(Vec3{p.X(), p.Y(), p.Z()} - s.point(u, v)), tol) << what << " at " << u << ", " << v;
+  }
+  for (const double t : linspace(0, 1, samples)) {
+    const double u = u0 + t * (u1 - u0), v = v0 + t * (v1 - v0);
+    const gp_Pnt a = g->Value(u0, v), b = g->Value(u1, v), c = g->Value(u, v0), d = g->Value(u, v1);
+    if (s.periodic()[0]) {
+      EXPECT_LE(a.Distance(b), tol) << what << ": the u seam opens at v = " << v;
+    }
+    if (s.periodic()[1]) {
+      EXPECT_LE(c.Distance(d), tol) << what << ": the v seam opens at u = " << u;
+    }
+  }
+}
+
+// Each face read back is closed (OCCT's own test on its surface) in as many
+// directions as the form is periodic: a surface in exactly its periodic ones; a
+// volume's faces each span both of the volume's directions but the face's own.
+void expect_closed_faces(const std::vector<TopoDS_Face>& faces, const ClosedCase& c, const std::string& what) {
+  for (const auto& f : faces) {
+    const Handle(Geom_Surface) g = BRep_Tool::Surface(f);
+    if (std::holds_alternative<BSplineSurface>(c.form)) {
+      EXPECT_EQ(g->IsUClosed(), c.periodic[0]) << what;
+      EXPECT_EQ(g->IsVClosed(), c.periodic[1]) << what;
+    } else {
+      EXPECT_EQ(int{g->IsUClosed()} + int{g->IsVClosed()}, int{c.periodic[0]} + int{c.periodic[1]}) << what;
+    }
+  }
+}
+
+class OcctReadbackClosed : public ::testing::TestWithParam<ClosedCase> {
+ protected:
+  void SetUp() override { Interface_Static::SetCVal("xstep.cascade.unit", "MM"); }
+  test::TempDir dir_;
+};
+
+TEST_P(OcctReadbackClosed, StepIsTheSameClosedShapeAndValid) {
+  const ClosedCase& c = GetParam();
+  const fs::path out = dir_ / (c.name + ".step");
+  io::write_step(out, c.form, {.name = c.name, .time_stamp = "2024-05-01T12:00:00"});
+  const TopoDS_Shape shape = read_step(out);
+  ASSERT_FALSE(shape.IsNull());
+  const auto faces = faces_of(shape);
+  report(c.name + ".step", compare(faces, reference_grids(c.form), c.name));
+  expect_exact_numbers(faces, c.form, c.name);
+  expect_closed_faces(faces, c, c.name);
+  EXPECT_TRUE(BRepCheck_Analyzer(shape).IsValid()) << c.name << ": OCCT's checker finds the shape invalid";
+  for (const auto& f : faces) EXPECT_TRUE(BRepCheck_Analyzer(f).IsValid()) << c.name << ": a face is invalid";
+
+  // Every closed direction of a face has its seam: one edge met twice on the face.
+  std::size_t seams = 0;
+  for (const auto& f : faces)
+    for (TopExp_Explorer e(f, TopAbs_EDGE); e.More(); e.Next()) seams += BRep_Tool::IsClosed(TopoDS::Edge(e.Current()), f);
+  const std::size_t closed_directions = std::size_t{c.periodic[0]} + std::size_t{c.periodic[1]};
+  EXPECT_EQ(seams, 2 * closed_directions * faces.size()) << c.name;
+
+  if (const auto* s = std::get_if<BSplineSurface>(&c.form)) {
+    ASSERT_EQ(faces.size(), 1u);
+    expect_surface_points(faces[0], *s, c.name);
+    return;
+  }
+  const auto& vol = std::get<BSplineVolume>(c.form);
+  if (closed_directions == 1) {
+    // A ring: its four faces close into one solid.
+    const auto d = vol.domain();
+    expect_solid_around(shape, vol.point(0.5 * (d[0].first + d[0].second), 0.5 * (d[1].first + d[1].second),
+                                         0.5 * (d[2].first + d[2].second)),
+                        c.name);
+  } else {
+    // A thick torus shell: its inner and outer skins, two closed shells apart.
+    EXPECT_EQ(count(shape, TopAbs_SOLID), 0u) << c.name;
+    ASSERT_EQ(count(shape, TopAbs_SHELL), 2u) << c.name;
+    for (TopExp_Explorer e(shape, TopAbs_SHELL); e.More(); e.Next())
+      EXPECT_TRUE(BRep_Tool::IsClosed(e.Current())) << c.name << ": a shell has free edges";
+  }
+}
+
+TEST_P(OcctReadbackClosed, IgesIsTheSameClosedShape) {
+  const ClosedCase& c = GetParam();
+  const fs::path out = dir_ / (c.name + ".igs");
+  io::write_iges(out, c.form, {.name = c.name, .time_stamp = "20240501.120000"});
+  const IgesRead r = read_iges(out);
+  const std::size_t expected = reference_grids(c.form).size();
+  EXPECT_EQ(r.entity_types.count(128), expected) << c.name;
+  EXPECT_EQ(r.entity_types.size(), expected) << c.name << ": entities other than 128";
+  ASSERT_FALSE(r.shape.IsNull());
+  const auto faces = faces_of(r.shape);
+  report(c.name + ".igs", compare(faces, reference_grids(c.form), c.name));
+  expect_exact_numbers(faces, c.form, c.name);
+  expect_closed_faces(faces, c, c.name);
+  for (const auto& f : faces) EXPECT_TRUE(BRepCheck_Analyzer(f).IsValid()) << c.name << ".igs: a face is invalid";
+  if (const auto* s = std::get_if<BSplineSurface>(&c.form)) {
+    ASSERT_EQ(faces.size(), 1u);
+    expect_surface_points(faces[0], *s, c.name);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Closed, OcctReadbackClosed, ::testing::ValuesIn(closed_cases()),
+                         [](const ::testing::TestParamInfo<ClosedCase>& i) { return i.param.name; });
 
 }  // namespace
 }  // namespace interpatch

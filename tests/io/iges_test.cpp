@@ -9,6 +9,7 @@
 
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/bspline_volume.hpp"
+#include "io/closed_shapes.hpp"
 #include "temp_dir.hpp"
 #include "test_util.hpp"
 
@@ -213,6 +214,86 @@ TEST(Iges, FileWrittenAtomicallyMatchesTheStreamForm) {
   write_iges(dir / "part.igs", quarter_cylinder(), {.name = "part.igs", .time_stamp = "20240501.120000"});
   EXPECT_EQ(test::read_text(dir / "part.igs"), iges_text(quarter_cylinder()));
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"part.igs"});
+}
+
+// ---------------------------------------------------------------- closed shapes
+
+// Entity 128's surface, read back from its parameters as this test reads IGES.
+BSplineSurface surface_of(const std::vector<std::string>& tok) {
+  const std::size_t n = std::stoul(tok[1]) + 1, m = std::stoul(tok[2]) + 1;
+  const int du = std::stoi(tok[3]), dv = std::stoi(tok[4]);
+  std::size_t at = 10;
+  const auto knots = [&](int p, std::size_t count) {
+    std::vector<double> k;
+    for (std::size_t i = 0; i < count + static_cast<std::size_t>(p) + 1; ++i) k.push_back(number(tok[at++]));
+    return KnotVector(p, std::move(k));
+  };
+  const KnotVector ku = knots(du, n), kv = knots(dv, m);
+  Grid<double, 2> w({n, m});
+  PointGrid cp({n, m});
+  for (std::size_t j = 0; j < m; ++j)
+    for (std::size_t i = 0; i < n; ++i) w(i, j) = number(tok[at++]);
+  for (std::size_t j = 0; j < m; ++j)
+    for (std::size_t i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c) cp(i, j)[c] = number(tok[at++]);
+  return BSplineSurface(ku, kv, std::move(cp), tok[7] == "1" ? Grid<double, 2>() : std::move(w));
+}
+
+// A surface closed in u, v or both is entity 128 of its clamped form — the same
+// surface, its knots clamped — flagged closed (PROP1/PROP2) and periodic
+// (PROP4/PROP5) in exactly those directions.
+TEST(Iges, ClosedSurfaceIsItsClampedFormFlaggedClosedAndPeriodic) {
+  const std::pair<const char*, std::array<bool, 2>> directions[] = {
+      {"u", {true, false}}, {"v", {false, true}}, {"uv", {true, true}}};
+  for (const auto& [tag, periodic] : directions)
+    for (unsigned seed = 1; seed <= 4; ++seed)
+      for (const bool rational : {false, true}) {
+        SCOPED_TRACE(std::string(tag) + " seed " + std::to_string(seed) + (rational ? " rational" : ""));
+        const BSplineSurface s = test::closed_surface(periodic, seed, rational);
+        const auto tok = parameters(parse(iges_text(s)), 1);
+        EXPECT_EQ(tok[5], periodic[0] ? "1" : "0");  // PROP1: closed in u
+        EXPECT_EQ(tok[6], periodic[1] ? "1" : "0");  // PROP2: closed in v
+        EXPECT_EQ(tok[7], rational ? "0" : "1");     // PROP3: polynomial
+        EXPECT_EQ(tok[8], periodic[0] ? "1" : "0");  // PROP4: periodic in u
+        EXPECT_EQ(tok[9], periodic[1] ? "1" : "0");  // PROP5: periodic in v
+        const BSplineSurface r = surface_of(tok);
+        EXPECT_EQ(r.knots_u(), s.knots_u().clamped());
+        EXPECT_EQ(r.knots_v(), s.knots_v().clamped());
+        EXPECT_EQ(r.domain_u(), s.domain_u());  // the parameter range closes the entity
+        EXPECT_EQ(r.domain_v(), s.domain_v());
+        // The clamped form is the periodic one up to the rounding of the banded solve
+        // that makes it (~1e-15 of the size); 1e-12 leaves room for that and nothing else.
+        const double tol = 1e-12 * test::bbox_diagonal(s.control_points().values());
+        auto g = test::rng(seed);
+        for (int k = 0; k < 200; ++k) {
+          const double u = test::uniform(g, r.domain_u().first, r.domain_u().second);
+          const double v = test::uniform(g, r.domain_v().first, r.domain_v().second);
+          EXPECT_LE(norm(r.point(u, v) - s.point(u, v)), tol) << u << ", " << v;
+        }
+      }
+}
+
+// A volume closed in u has no faces at u0 and u1 (they meet inside it): four
+// entities 128, each closed and periodic along the volume's u. Closed in u and v,
+// two (its inner and outer skins), closed and periodic both ways.
+TEST(Iges, ClosedVolumeIsItsBoundaryFacesFlaggedClosed) {
+  for (const auto& periodic : {std::array{true, false}, std::array{false, true}, std::array{true, true}}) {
+    const BSplineVolume vol = test::closed_volume(periodic, 4);
+    const Parsed p = parse(iges_text(vol));
+    const std::size_t faces = periodic[0] && periodic[1] ? 2 : 4;
+    ASSERT_EQ(p.sections.at('D').size(), 2 * faces);
+    for (std::size_t e = 0; e < faces; ++e) {
+      const auto tok = parameters(p, 2 * e + 1);
+      // Each face spans both of the volume's directions but its own: closed and
+      // periodic in as many directions as the volume.
+      const int expected = int{periodic[0]} + int{periodic[1]};
+      EXPECT_EQ(std::stoi(tok[5]) + std::stoi(tok[6]), expected) << "face " << e;
+      EXPECT_EQ(std::stoi(tok[8]) + std::stoi(tok[9]), expected) << "face " << e;
+      EXPECT_EQ(tok[5], tok[8]) << "face " << e;
+      EXPECT_EQ(tok[6], tok[9]) << "face " << e;
+    }
+  }
+  EXPECT_ERRC(iges_text(test::volume_closed_everywhere()), no_exact_form, "closed (periodic) in u, v and w");
 }
 
 }  // namespace

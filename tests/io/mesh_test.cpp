@@ -18,6 +18,9 @@
 #include <string>
 #include <vector>
 
+#include "interpatch/bspline_surface.hpp"
+#include "interpatch/evaluate.hpp"
+#include "io/closed_shapes.hpp"
 #include "temp_dir.hpp"
 #include "test_util.hpp"
 
@@ -550,6 +553,294 @@ TEST(Mesh, SingleRowHasPointsButNoFaces) {
   EXPECT_EQ(le<std::uint32_t>(read_bytes(dir / "row.stl"), 80), 0u);
   write_surface_mesh(dir / "row.vts", m);
   EXPECT_EQ(read_vts(read_bytes(dir / "row.vts")).arrays.at("Points").size(), 15u);
+}
+
+// --- Closed meshes ---------------------------------------------------------------------
+
+/// An unstructured mesh as these tests read it back: vertex positions, per-vertex
+/// normals (empty without), faces as vertex indices, and for OBJ each corner's
+/// texture coordinate.
+struct MeshRead {
+  std::vector<Vec3> vertices, normals;
+  std::vector<std::vector<std::size_t>> faces;
+  std::vector<std::vector<std::array<double, 2>>> uv;
+};
+
+MeshRead read_obj(const std::string& text) {
+  MeshRead r;
+  std::vector<std::array<double, 2>> vt;
+  for (const auto& l : lines(text)) {
+    const auto t = tokens(l);
+    if (t.empty() || t[0] == "#") continue;
+    if (t[0] == "v") r.vertices.push_back({number(t[1]), number(t[2]), number(t[3])});
+    if (t[0] == "vt") vt.push_back({number(t[1]), number(t[2])});
+    if (t[0] == "vn") r.normals.push_back({number(t[1]), number(t[2]), number(t[3])});
+    if (t[0] != "f") continue;
+    std::vector<std::size_t> f;
+    std::vector<std::array<double, 2>> uv;
+    for (std::size_t k = 1; k < t.size(); ++k) {
+      const auto parts = tokens(t[k], '/');
+      EXPECT_EQ(parts.size(), r.normals.empty() ? 2u : 3u) << l;
+      if (parts.size() == 3) {
+        EXPECT_EQ(parts[0], parts[2]) << l;  // v and vn share the index
+      }
+      f.push_back(std::stoul(parts[0]) - 1);
+      const std::size_t q = std::stoul(parts[1]) - 1;
+      EXPECT_LT(q, vt.size()) << l;
+      uv.push_back(q < vt.size() ? vt[q] : std::array<double, 2>{});
+    }
+    r.faces.push_back(f);
+    r.uv.push_back(uv);
+  }
+  return r;
+}
+
+MeshRead read_ply(const std::string& s) {
+  MeshRead r;
+  const auto end = s.find("end_header\n");
+  EXPECT_NE(end, std::string::npos);
+  std::size_t nvert = 0, nface = 0;
+  bool normals = false;
+  for (const auto& l : lines(s.substr(0, end))) {
+    const auto t = tokens(l);
+    if (t.size() == 3 && t[0] == "element") (t[1] == "vertex" ? nvert : nface) = std::stoul(t[2]);
+    normals = normals || l == "property double nx";
+  }
+  std::size_t off = end + 11;
+  for (std::size_t k = 0; k < nvert; ++k) {
+    r.vertices.push_back({le<double>(s, off), le<double>(s, off + 8), le<double>(s, off + 16)});
+    off += 24;
+    if (normals) {
+      r.normals.push_back({le<double>(s, off), le<double>(s, off + 8), le<double>(s, off + 16)});
+      off += 24;
+    }
+  }
+  for (std::size_t k = 0; k < nface; ++k) {
+    const std::size_t n = static_cast<unsigned char>(s[off++]);
+    std::vector<std::size_t> f;
+    for (std::size_t c = 0; c < n; ++c, off += 4) f.push_back(static_cast<std::size_t>(le<std::int32_t>(s, off)));
+    r.faces.push_back(f);
+  }
+  EXPECT_EQ(off, s.size());
+  return r;
+}
+
+/// STL triangles, their corners as vertices: equal floats are one vertex.
+MeshRead read_stl(const std::string& s) {
+  MeshRead r;
+  std::map<std::array<float, 3>, std::size_t> index;
+  const auto count = le<std::uint32_t>(s, 80);
+  EXPECT_EQ(s.size(), 84u + 50u * count);
+  for (std::size_t t = 0; t < count; ++t) {
+    std::vector<std::size_t> f;
+    for (std::size_t c = 0; c < 3; ++c) {
+      const std::size_t off = 84 + 50 * t + 12 + 12 * c;
+      const std::array<float, 3> p{le<float>(s, off), le<float>(s, off + 4), le<float>(s, off + 8)};
+      const auto [it, added] = index.try_emplace(p, r.vertices.size());
+      if (added) r.vertices.push_back({p[0], p[1], p[2]});
+      f.push_back(it->second);
+    }
+    r.faces.push_back(f);
+  }
+  return r;
+}
+
+/// Newell's normal of a polygon: its area vector, whatever its corner count.
+Vec3 polygon_normal(const MeshRead& r, const std::vector<std::size_t>& f) {
+  Vec3 n{};
+  for (std::size_t k = 0; k < f.size(); ++k) n = n + cross(r.vertices[f[k]], r.vertices[f[(k + 1) % f.size()]]);
+  return n;
+}
+
+/// The properties every mesh of a surface closed in some directions has, written
+/// from the NU × NV samples m: the vertices are the samples less the repeated last
+/// row (column), no two at one place; every face index is a vertex; every inner
+/// edge joins exactly two faces that run it in opposite directions (one orientation
+/// throughout, the seam included), and the edges used once are those of the open
+/// boundary lines only — none for a torus. `cells_are` says how many faces a cell
+/// makes (1, or 2 triangles in STL).
+void expect_closed_mesh(const MeshRead& r, const SurfaceMesh& m, std::size_t cells_are, const std::string& what) {
+  SCOPED_TRACE(what);
+  const std::size_t nu = m.points.extent(0), nv = m.points.extent(1);
+  const std::size_t rows = nu - (m.closed[0] ? 1 : 0), cols = nv - (m.closed[1] ? 1 : 0);
+  ASSERT_EQ(r.vertices.size(), rows * cols);
+  EXPECT_EQ(r.faces.size(), cells_are * (nu - 1) * (nv - 1));
+  // Doubled seam vertices would be copies or differ by rounding (~1e-15 of the
+  // size); distinct samples of these meshes lie 1e-2 of it apart or more.
+  const double close = 1e-9 * test::bbox_diagonal(m.points.values());
+  for (std::size_t a = 0; a < r.vertices.size(); ++a)
+    for (std::size_t b = a + 1; b < r.vertices.size(); ++b)
+      EXPECT_GT(norm(r.vertices[a] - r.vertices[b]), close) << "vertices " << a << " and " << b;
+  std::map<std::pair<std::size_t, std::size_t>, int> directed;
+  for (const auto& f : r.faces)
+    for (std::size_t k = 0; k < f.size(); ++k) {
+      ASSERT_LT(f[k], r.vertices.size());
+      ++directed[{f[k], f[(k + 1) % f.size()]}];
+    }
+  std::size_t boundary = 0;
+  for (const auto& [e, n] : directed) {
+    EXPECT_EQ(n, 1) << "edge " << e.first << " -> " << e.second << " run " << n << " times the same way";
+    boundary += directed.count({e.second, e.first}) == 0;
+  }
+  EXPECT_EQ(boundary, (m.closed[0] ? 0 : 2 * (nv - 1)) + (m.closed[1] ? 0 : 2 * (nu - 1)));
+}
+
+/// Each vertex keeps the point and normal of its sample (the first row's on the
+/// seam), and every face turns the way its vertices' normals point.
+void expect_vertex_normals(const MeshRead& r, const SurfaceMesh& m, const std::string& what) {
+  SCOPED_TRACE(what);
+  const std::size_t cols = m.points.extent(1) - (m.closed[1] ? 1 : 0);
+  ASSERT_EQ(r.normals.size(), r.vertices.size());
+  for (std::size_t k = 0; k < r.vertices.size(); ++k) {
+    EXPECT_EQ(r.vertices[k], m.points(k / cols, k % cols)) << k;
+    EXPECT_EQ(r.normals[k], m.normals(k / cols, k % cols)) << k;
+  }
+  for (const auto& f : r.faces) {
+    const Vec3 n = polygon_normal(r, f);
+    for (const std::size_t q : f) EXPECT_GT(dot(n, r.normals[q]), 0) << "a face turned against vertex " << q;
+  }
+}
+
+std::vector<std::pair<std::string, SurfaceMesh>> closed_meshes() {
+  std::vector<std::pair<std::string, SurfaceMesh>> out;
+  const std::array<bool, 2> directions[] = {{true, false}, {false, true}, {true, true}};
+  // Five samples or more about every closed direction: coarser, a face across a third
+  // of a turn may lean away from its corners' normals for reasons the seam has no part in.
+  const std::array<std::size_t, 2> sizes[] = {{5, 6}, {8, 7}, {13, 10}};
+  for (const auto& periodic : directions)
+    for (unsigned seed = 1; seed <= 3; ++seed)
+      for (const auto& [nu, nv] : sizes) {
+        const BSplineSurface s = test::closed_surface(periodic, seed);
+        const auto [u0, u1] = s.domain_u();
+        const auto [v0, v1] = s.domain_v();
+        SurfaceMesh m = sample_mesh(s, linspace(u0, u1, nu), linspace(v0, v1, nv));
+        EXPECT_EQ(m.closed, periodic);
+        out.push_back({std::string(periodic[0] ? "u" : "") + (periodic[1] ? "v" : "") + " seed " +
+                           std::to_string(seed) + " " + std::to_string(nu) + "x" + std::to_string(nv),
+                       std::move(m)});
+      }
+  return out;
+}
+
+TEST(Mesh, ClosedSurfaceObjAndPlyShareTheSeamVertices) {
+  TempDir dir;
+  for (const auto& [what, m] : closed_meshes()) {
+    for (const char* name : {"closed.obj", "closed.ply"}) {
+      write_surface_mesh(dir / name, m);
+      const std::string bytes = read_bytes(dir / name);
+      const MeshRead r = fs::path(name).extension() == ".obj" ? read_obj(bytes) : read_ply(bytes);
+      expect_closed_mesh(r, m, 1, what + " " + name);
+      expect_vertex_normals(r, m, what + " " + name);
+    }
+    // OBJ's texture coordinates stay one per sample: no face spans more than one
+    // cell of them, those across the seam included.
+    const MeshRead r = read_obj(read_bytes(dir / "closed.obj"));
+    const double du = 1.0 / static_cast<double>(m.points.extent(0) - 1);
+    const double dv = 1.0 / static_cast<double>(m.points.extent(1) - 1);
+    for (const auto& uv : r.uv)
+      for (const auto& a : uv)
+        for (const auto& b : uv) {
+          EXPECT_LE(std::abs(a[0] - b[0]), du * (1 + 1e-12)) << what;  // 1e-12: the quotient's rounding
+          EXPECT_LE(std::abs(a[1] - b[1]), dv * (1 + 1e-12)) << what;
+        }
+  }
+}
+
+/// The mesh with every seam sample's x on the far side of a float rounding boundary
+/// from the first row's (column's) x, a few 1e-15 away: rounding in evaluating the
+/// two ends of a period can leave them so.
+SurfaceMesh straddling_floats(SurfaceMesh m) {
+  const std::size_t nu = m.points.extent(0), nv = m.points.extent(1);
+  const std::size_t rows = nu - (m.closed[0] ? 1 : 0), cols = nv - (m.closed[1] ? 1 : 0);
+  const auto midpoint = [](double x) {  // halfway between float(x) and the next float up
+    const float f = static_cast<float>(x);
+    return 0.5 * (static_cast<double>(f) + static_cast<double>(std::nextafter(f, HUGE_VALF)));
+  };
+  for (std::size_t i = 0; i < rows; ++i)
+    for (std::size_t j = 0; j < cols; ++j) {
+      const double mid = midpoint(m.points(i, j).x);
+      m.points(i, j).x = mid - 1e-15 * std::abs(mid);
+    }
+  for (std::size_t i = 0; i < nu; ++i)
+    for (std::size_t j = 0; j < nv; ++j) {
+      if (i < rows && j < cols) continue;
+      const double mid = midpoint(m.points(i % rows, j % cols).x);
+      m.points(i, j).x = mid + 1e-15 * std::abs(mid);
+      EXPECT_NE(static_cast<float>(m.points(i, j).x), static_cast<float>(m.points(i % rows, j % cols).x));
+    }
+  return m;
+}
+
+// STL has no shared vertices, only coordinates: the seam's triangles on both sides
+// carry the first row's floats, so a torus is watertight edge for edge even where
+// the last row's own coordinates would round to other floats.
+TEST(Mesh, ClosedSurfaceStlIsWatertightAcrossTheSeam) {
+  TempDir dir;
+  for (const auto& [what, m] : closed_meshes()) {
+    write_surface_mesh(dir / "closed.stl", m);
+    expect_closed_mesh(read_stl(read_bytes(dir / "closed.stl")), m, 2, what);
+    write_surface_mesh(dir / "straddling.stl", straddling_floats(m));
+    expect_closed_mesh(read_stl(read_bytes(dir / "straddling.stl")), m, 2, what + ", seam straddling floats");
+  }
+}
+
+// The structured formats keep the doubled row: a structured grid needs it.
+TEST(Mesh, ClosedSurfaceStructuredGridKeepsEverySample) {
+  TempDir dir;
+  const BSplineSurface s = test::closed_surface({true, true}, 4);
+  const SurfaceMesh m = sample_mesh(s, linspace(0, 1, 6), linspace(0.5, 2.5, 5));
+  ASSERT_EQ(m.closed, (std::array{true, true}));
+  write_surface_mesh(dir / "torus.vtk", m);
+  const VtkGrid g = read_legacy_vtk(read_bytes(dir / "torus.vtk"));
+  EXPECT_EQ(g.dims, (std::array<std::size_t, 3>{6, 5, 1}));
+  ASSERT_EQ(g.points.size(), 30u);
+  for (std::size_t j = 0; j < 5; ++j) EXPECT_EQ(g.points[5 + 6 * j], g.points[6 * j]) << j;
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(g.points[i + 6 * 4], g.points[i]) << i;
+}
+
+// sample_mesh closes a direction exactly when the surface is periodic there and the
+// samples span one whole period (wherever it starts); the last row is then a copy of
+// the first, points and normals.
+TEST(Mesh, SampleMeshClosesWhereTheSamplesSpanAPeriod) {
+  const BSplineSurface torus = test::closed_surface({true, true}, 6);
+  const BSplineSurface pipe = test::closed_surface({false, true}, 6);
+  struct Case {
+    const BSplineSurface* s;
+    double u0, u1, v0, v1;
+    std::array<bool, 2> closed;
+  };
+  const Case cases[] = {{&torus, 0, 1, 0.5, 2.5, {true, true}},   {&torus, 0.3, 1.3, 0.5, 2.5, {true, true}},
+                        {&torus, 1, 0, 2.5, 0.5, {true, true}},   {&torus, 0, 0.5, 0.5, 2.5, {false, true}},
+                        {&torus, 0, 1, 0.5, 2.0, {true, false}},  {&pipe, 0, 1, 0.5, 2.5, {false, true}},
+                        {&pipe, 0, 1, 1.0, 3.0, {false, true}}};
+  for (const Case& c : cases) {
+    const std::size_t nu = 5, nv = 6;
+    const SurfaceMesh m = sample_mesh(*c.s, linspace(c.u0, c.u1, nu), linspace(c.v0, c.v1, nv));
+    EXPECT_EQ(m.closed, c.closed) << c.u0 << ".." << c.u1 << " x " << c.v0 << ".." << c.v1;
+    for (std::size_t j = 0; c.closed[0] && j < nv; ++j) {
+      EXPECT_EQ(m.points(nu - 1, j), m.points(0, j));
+      EXPECT_EQ(m.normals(nu - 1, j), m.normals(0, j));
+    }
+    for (std::size_t i = 0; c.closed[1] && i < nu; ++i) {
+      EXPECT_EQ(m.points(i, nv - 1), m.points(i, 0));
+      EXPECT_EQ(m.normals(i, nv - 1), m.normals(i, 0));
+    }
+  }
+}
+
+TEST(Mesh, ClosedMeshWhoseLastRowIsNotTheFirstIsRefused) {
+  TempDir dir;
+  SurfaceMesh m = sample_mesh(test::closed_surface({true, true}, 7), linspace(0, 1, 5), linspace(0.5, 2.5, 6));
+  m.points(4, 2) = m.points(4, 2) + Vec3{0, 0, 1e-3};
+  for (const char* name : {"m.obj", "m.ply", "m.stl", "m.vtk"})
+    EXPECT_ERRC(write_surface_mesh(dir / name, m), closing_gap, "closed in u but its last row does not repeat the first: point [4][2]");
+  m = sample_mesh(test::closed_surface({true, true}, 7), linspace(0, 1, 5), linspace(0.5, 2.5, 6));
+  m.points(1, 5) = m.points(1, 5) + Vec3{1e-3, 0, 0};
+  EXPECT_ERRC(write_surface_mesh(dir / "m.obj", m), closing_gap, "closed in v but its last column does not repeat the first: point [1][5]");
+  SurfaceMesh line = cap(3, 1);
+  line.closed = {false, true};
+  EXPECT_ERRC(write_surface_mesh(dir / "m.obj", line), size_mismatch, "closed in v needs 2 columns or more");
+  EXPECT_EQ(dir.count(), 0u);
 }
 
 // --- Volumes -------------------------------------------------------------------------

@@ -16,6 +16,7 @@
 
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/bspline_volume.hpp"
+#include "io/closed_shapes.hpp"
 #include "temp_dir.hpp"
 #include "test_util.hpp"
 
@@ -103,6 +104,18 @@ void expect_counts(const std::map<int, std::string>& e, const std::map<std::stri
   for (const auto& [prefix, n] : expected) EXPECT_EQ(count_of(e, prefix), n) << prefix;
 }
 
+// How each edge is used by the loops: edge "#n" -> its ORIENTED_EDGEs' .T./.F.
+std::map<std::string, std::multiset<std::string>> edge_orientations(const std::map<int, std::string>& e) {
+  std::map<std::string, std::multiset<std::string>> uses;
+  const std::string head = "ORIENTED_EDGE('',*,*,";
+  for (const auto& [n, body] : e) {
+    if (body.rfind(head, 0) != 0) continue;
+    const auto comma = body.find(',', head.size());
+    uses[body.substr(head.size(), comma - head.size())].insert(body.substr(comma + 1, 3));
+  }
+  return uses;
+}
+
 BSplineSurface bilinear_patch() {
   PointGrid cp({2, 2});
   cp(0, 0) = {0, 0, 0};
@@ -186,13 +199,7 @@ TEST(Step, VolumeIsAClosedShellWithEveryEdgeRunBothWays) {
   const auto e = entities(step_text(unit_cube()));
   expect_counts(e, {{"ADVANCED_FACE(", 6}, {"EDGE_CURVE(", 12}, {"VERTEX_POINT(", 8}, {"CLOSED_SHELL(", 1},
                     {"MANIFOLD_SOLID_BREP(", 1}, {"ADVANCED_BREP_SHAPE_REPRESENTATION(", 1}});
-  std::map<std::string, std::multiset<std::string>> uses;  // edge -> orientations
-  const std::string head = "ORIENTED_EDGE('',*,*,";
-  for (const auto& [n, body] : e) {
-    if (body.rfind(head, 0) != 0) continue;
-    const auto comma = body.find(',', head.size());
-    uses[body.substr(head.size(), comma - head.size())].insert(body.substr(comma + 1, 3));
-  }
+  const auto uses = edge_orientations(e);
   ASSERT_EQ(uses.size(), 12u);
   for (const auto& [edge, o] : uses) EXPECT_EQ(o, (std::multiset<std::string>{".F.", ".T."})) << edge;
 }
@@ -283,6 +290,192 @@ TEST(Step, AFailingStreamIsFileUnwritable) {
   std::ostringstream os;
   os.setstate(std::ios::badbit);
   EXPECT_ERRC(write_step(os, bilinear_patch()), file_unwritable, "STEP");
+}
+
+// ---------------------------------------------------------------- closed shapes
+
+// A parameter of a Part 21 entity: an atom (a number, #n, .ENUM., 'text', $, *) or a list.
+struct Param {
+  std::string atom;
+  std::vector<Param> list;
+};
+
+// The list opening at text[at] == '(' (at moves past its ')').
+Param parse_list(const std::string& text, std::size_t& at) {
+  Param p;
+  EXPECT_EQ(text[at], '(');
+  ++at;
+  while (at < text.size() && text[at] != ')') {
+    if (text[at] == ',' || text[at] == '\n' || text[at] == ' ') {
+      ++at;
+    } else if (text[at] == '(') {
+      p.list.push_back(parse_list(text, at));
+    } else {
+      const std::size_t end = text.find_first_of(",)", at);
+      p.list.push_back({text.substr(at, end - at), {}});
+      at = end;
+    }
+  }
+  ++at;
+  return p;
+}
+
+// The parameters of (partial) entity `name` in an entity's text: NAME(...).
+std::vector<Param> params_of(const std::string& body, const std::string& name) {
+  const std::size_t at = body.find(name + "(");
+  EXPECT_NE(at, std::string::npos) << name << " in " << body.substr(0, 80);
+  if (at == std::string::npos) return {};
+  std::size_t open = at + name.size();
+  return parse_list(body, open).list;
+}
+
+double real_of(const Param& p) {
+  EXPECT_TRUE(is_step_real(p.atom)) << p.atom;
+  double v = 0;
+  std::from_chars(p.atom.data(), p.atom.data() + p.atom.size(), v);
+  return v;
+}
+
+int int_of(const Param& p) { return std::stoi(p.atom); }
+
+// A clamped knot vector from a B_SPLINE_..._WITH_KNOTS pair of lists.
+KnotVector knots_of(int degree, const Param& multiplicities, const Param& values) {
+  EXPECT_EQ(multiplicities.list.size(), values.list.size());
+  std::vector<double> k;
+  for (std::size_t i = 0; i < values.list.size(); ++i)
+    k.insert(k.end(), static_cast<std::size_t>(int_of(multiplicities.list[i])), real_of(values.list[i]));
+  return KnotVector(degree, std::move(k));
+}
+
+Vec3 point_of(const std::map<int, std::string>& e, const Param& ref) {
+  const auto p = params_of(e.at(std::stoi(ref.atom.substr(1))), "CARTESIAN_POINT");
+  EXPECT_EQ(p.size(), 2u);
+  EXPECT_EQ(p[1].list.size(), 3u);
+  return {real_of(p[1].list[0]), real_of(p[1].list[1]), real_of(p[1].list[2])};
+}
+
+// The file's one B-spline surface, read back as this test reads Part 21: its net,
+// weights and knots, and its u_closed/v_closed flags.
+struct SurfaceRead {
+  BSplineSurface surface;
+  std::array<std::string, 2> closed;
+};
+
+SurfaceRead surface_of(const std::map<int, std::string>& e) {
+  std::string body;
+  for (const auto& [n, b] : e)
+    if (b.find("B_SPLINE_SURFACE") != std::string::npos) body = b;
+  const bool rational = body.find("RATIONAL_B_SPLINE_SURFACE") != std::string::npos;
+  // The simple entity lists name, degrees, net, form, flags, then the knots; the
+  // complex one splits them between its partial entities.
+  const auto head = params_of(body, rational ? "B_SPLINE_SURFACE" : "B_SPLINE_SURFACE_WITH_KNOTS");
+  const std::size_t h = rational ? 0 : 1;
+  const auto with_knots = rational ? params_of(body, "B_SPLINE_SURFACE_WITH_KNOTS")
+                                   : std::vector<Param>(head.begin() + 8, head.end());
+  const int du = int_of(head[h]), dv = int_of(head[h + 1]);
+  const Param& net = head[h + 2];
+  const std::size_t n = net.list.size(), m = net.list[0].list.size();
+  PointGrid cp({n, m});
+  Grid<double, 2> w = rational ? Grid<double, 2>({n, m}) : Grid<double, 2>();
+  const auto weights = rational ? params_of(body, "RATIONAL_B_SPLINE_SURFACE") : std::vector<Param>{};
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < m; ++j) {
+      cp(i, j) = point_of(e, net.list[i].list[j]);
+      if (rational) w(i, j) = real_of(weights[0].list[i].list[j]);
+    }
+  return {BSplineSurface(knots_of(du, with_knots[0], with_knots[2]), knots_of(dv, with_knots[1], with_knots[3]),
+                         std::move(cp), std::move(w)),
+          {head[h + 4].atom, head[h + 5].atom}};
+}
+
+// The clamped knots a periodic direction must be written with, worked out from its
+// breaks: the domain's ends p+1 times, every other break of the period with its
+// multiplicity.
+std::vector<double> expected_clamped_knots(const KnotVector& k) {
+  std::vector<double> out(static_cast<std::size_t>(k.degree()) + 1, k.front());
+  for (const auto& [x, mult] : k.interior_breaks())
+    if (x != k.front()) out.insert(out.end(), static_cast<std::size_t>(mult), x);
+  out.insert(out.end(), static_cast<std::size_t>(k.degree()) + 1, k.back());
+  return out;
+}
+
+const std::pair<const char*, std::array<bool, 2>> closed_directions[] = {
+    {"u", {true, false}}, {"v", {false, true}}, {"uv", {true, true}}};
+
+// A surface closed in u, v or both is written as its clamped form — the same surface,
+// the domain's ends as (p+1)-fold knots, first and last control lines on the seam —
+// and declared closed in exactly those directions.
+TEST(Step, ClosedSurfaceIsItsClampedFormDeclaredClosed) {
+  for (const auto& [tag, periodic] : closed_directions)
+    for (unsigned seed = 1; seed <= 4; ++seed)
+      for (const bool rational : {false, true}) {
+        SCOPED_TRACE(std::string(tag) + " seed " + std::to_string(seed) + (rational ? " rational" : ""));
+        const BSplineSurface s = test::closed_surface(periodic, seed, rational);
+        const SurfaceRead r = surface_of(entities(step_text(s)));
+        EXPECT_EQ(r.closed[0], periodic[0] ? ".T." : ".F.");
+        EXPECT_EQ(r.closed[1], periodic[1] ? ".T." : ".F.");
+        EXPECT_EQ(r.surface.knots_u().values(), expected_clamped_knots(s.knots_u()));
+        EXPECT_EQ(r.surface.knots_v().values(), expected_clamped_knots(s.knots_v()));
+        EXPECT_EQ(r.surface.rational(), rational);
+        // The clamped form is the periodic one up to the rounding of the banded solve
+        // that makes it (~1e-15 of the size); 1e-12 leaves room for that and nothing else.
+        const double tol = 1e-12 * test::bbox_diagonal(s.control_points().values());
+        auto g = test::rng(seed);
+        const auto [u0, u1] = s.domain_u();
+        const auto [v0, v1] = s.domain_v();
+        for (int k = 0; k < 200; ++k) {
+          const double u = test::uniform(g, u0, u1), v = test::uniform(g, v0, v1);
+          EXPECT_LE(norm(r.surface.point(u, v) - s.point(u, v)), tol) << u << ", " << v;
+        }
+        const auto& cp = r.surface.control_points();
+        const std::size_t n = cp.extent(0), m = cp.extent(1);
+        for (std::size_t j = 0; periodic[0] && j < m; ++j) EXPECT_LE(norm(cp(0, j) - cp(n - 1, j)), tol) << j;
+        for (std::size_t i = 0; periodic[1] && i < n; ++i) EXPECT_LE(norm(cp(i, 0) - cp(i, m - 1)), tol) << i;
+      }
+}
+
+// The face of a surface closed in one direction is a pipe: one seam edge used twice
+// and two closed boundary curves; closed in both, a torus: two seams, one vertex.
+TEST(Step, ClosedSurfaceFaceHasItsSeamsAndClosedEdges) {
+  for (const auto& [tag, periodic] : closed_directions) {
+    SCOPED_TRACE(tag);
+    const bool torus = periodic[0] && periodic[1];
+    const auto e = entities(step_text(test::closed_surface(periodic, 5)));
+    expect_counts(e, {{"ADVANCED_FACE(", 1}, {"SEAM_CURVE(", torus ? 2u : 1u}, {"SURFACE_CURVE(", torus ? 0u : 2u},
+                      {"EDGE_CURVE(", torus ? 2u : 3u}, {"VERTEX_POINT(", torus ? 1u : 2u},
+                      {"ORIENTED_EDGE(", 4}, {"OPEN_SHELL(", 1}});
+    // B_SPLINE_CURVE_WITH_KNOTS('', degree, points, form, closed_curve, ...): the
+    // circles about a closed direction are closed, the seam across an open one is not.
+    std::size_t closed = 0, open = 0;
+    for (const auto& [n, body] : e) {
+      if (body.rfind("B_SPLINE_CURVE_WITH_KNOTS(", 0) != 0) continue;
+      const std::string flag = params_of(body, "B_SPLINE_CURVE_WITH_KNOTS")[4].atom;
+      ++(flag == ".T." ? closed : open);
+    }
+    EXPECT_EQ(closed, 2u);
+    EXPECT_EQ(open, torus ? 0u : 1u);
+  }
+}
+
+// A volume closed in u is a ring: no faces at u0 and u1 (they meet inside it), the
+// other four closing into one solid. Closed in u and v, a thick torus shell: its
+// inner and outer skins, two closed shells. Closed in all three, it has no boundary.
+TEST(Step, ClosedVolumeHasNoFacesAcrossItsSeam) {
+  const auto ring = entities(step_text(test::closed_volume({true, false}, 1)));
+  expect_counts(ring, {{"ADVANCED_FACE(", 4}, {"SEAM_CURVE(", 4}, {"CLOSED_SHELL(", 1}, {"MANIFOLD_SOLID_BREP(", 1},
+                       {"OPEN_SHELL(", 0}});
+  for (const auto& [edge, o] : edge_orientations(ring)) EXPECT_EQ(o, (std::multiset<std::string>{".F.", ".T."})) << edge;
+
+  const auto shell = entities(step_text(test::closed_volume({true, true}, 2)));
+  expect_counts(shell, {{"ADVANCED_FACE(", 2}, {"CLOSED_SHELL(", 2}, {"MANIFOLD_SOLID_BREP(", 0},
+                        {"SHELL_BASED_SURFACE_MODEL(", 1}});
+  for (const auto& [n, body] : shell) {
+    if (body.rfind("SHELL_BASED_SURFACE_MODEL(", 0) == 0) {
+      EXPECT_EQ(references(body).size(), 2u) << body;
+    }
+  }
+
+  EXPECT_ERRC(step_text(test::volume_closed_everywhere()), no_exact_form, "closed (periodic) in u, v and w");
 }
 
 }  // namespace

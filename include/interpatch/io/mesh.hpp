@@ -3,6 +3,7 @@
 /// Tessellated surfaces and structured grids in the formats graphics, CAD and
 /// CFD-meshing tools read.
 
+#include <array>
 #include <filesystem>
 #include <span>
 #include <string_view>
@@ -18,11 +19,19 @@ struct SurfaceMesh {
   PointGrid points;
   /// Unit normals per vertex (same shape as points), or empty.
   PointGrid normals;
+  /// Whether the grid closes on itself in u (its last row of points is its first
+  /// again) and in v (its last column): a surface periodic there, sampled over one
+  /// whole period. The .obj, .ply and .stl writers write that row (column) once.
+  std::array<bool, 2> closed = {false, false};
 };
 
 /// The mesh of a surface on the grid us × vs: points and unit normals
 /// (unit_normal()). Derivatives are taken a block of rows at a time (the whole grid
-/// of them would be six times the mesh); both cores share every block.
+/// of them would be six times the mesh); both cores share every block. Where the
+/// surface is a B-spline surface periodic in a direction and the parameters span
+/// exactly one period there (first and last a period apart, to 1e-12 of it), the
+/// mesh is closed in that direction: its last row (column) of points and normals is
+/// set to the first.
 /// @throws error out_of_domain, too_large, and what the surface's evaluation throws.
 [[nodiscard]] SurfaceMesh sample_mesh(const Surface& surface, std::span<const double> us, std::span<const double> vs,
                                       const progress_callback& progress = {});
@@ -41,15 +50,24 @@ struct SurfaceMesh {
 /// splits quads into two triangles and drops those of zero area. Structured
 /// formats (.vtk, .vts, .xyz) keep every point, u index fastest.
 ///
+/// A mesh closed in u (v) has no seam of doubled vertices in .obj, .ply and .stl:
+/// its last row (column) is not written, and the cells next to it use the first
+/// row's vertices and normals — (NU − 1) × NV vertices and still (NU − 1) × (NV − 1)
+/// cells, a torus closed both ways watertight. OBJ texture coordinates stay one per
+/// grid point, the seam cells running up to 1. Structured formats keep the doubled
+/// row, which a structured grid needs.
+///
 /// Example:
 /// @code
 ///   const auto t = interpatch::linspace(0, 1, 64);
 ///   interpatch::io::SurfaceMesh m{surface.evaluate(t, t), {}};  // 64 × 64 vertices, no normals
 ///   interpatch::io::write_surface_mesh("patch.obj", m);
 /// @endcode
-/// @throws error wrong_type (unknown extension), size_mismatch (no points, or
-///   normals not of the points' shape), too_large (more than 2^32 - 1 STL
-///   triangles), file_unwritable.
+/// @throws error wrong_type (unknown extension), size_mismatch (no points, normals
+///   not of the points' shape, or closed in a direction with fewer than 2 samples),
+///   closing_gap (closed in a direction whose last row or column is not the first
+///   again, to 1e-9 of the bounding-box diagonal; the message names the point),
+///   too_large (more than 2^32 - 1 STL triangles), file_unwritable.
 void write_surface_mesh(const std::filesystem::path& path, const SurfaceMesh& mesh);
 
 /// Writes a structured NU × NV × NW grid of points (a volume mesh, first index

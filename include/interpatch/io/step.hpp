@@ -34,6 +34,13 @@ struct StepOptions {
 /// vertex. Two opposite boundaries that coincide (a surface closed around an
 /// axis) are one SEAM_CURVE edge used twice.
 ///
+/// A surface closed (periodic) in a direction is written as its clamped form
+/// (BSplineSurface::clamped: the same surface over the domain, the ends as (p+1)-fold
+/// knots, its first and last control lines on the seam), declared closed there
+/// (u_closed / v_closed .T.; .F. in an open direction unless its net closes on
+/// itself), the seam one SEAM_CURVE edge used twice and the boundary curves across
+/// it closed (closed_curve .T.).
+///
 /// A volume has no B-spline entity that CAD systems read, so it is written as its
 /// six boundary faces (u0, u1, v0, v1, w0, w1, each the exact B-spline surface of
 /// that side of the control net), sharing their 12 edges and 8 vertices, oriented
@@ -41,6 +48,12 @@ struct StepOptions {
 /// ADVANCED_BREP_SHAPE_REPRESENTATION. Where the faces do not close (a collapsed or
 /// doubled face, so that an edge is not shared by exactly two faces in opposite
 /// directions) the same faces go into an OPEN_SHELL as for a surface.
+///
+/// A volume closed (periodic) in a direction has no faces at that direction's two
+/// sides, which meet inside it: a ring closed in u is its v0, v1, w0 and w1 faces,
+/// each closed in u, one solid. Faces that fall apart into sets sharing no edge (a
+/// volume closed in two directions: its inner and outer skins) are one shell each
+/// in the SHELL_BASED_SURFACE_MODEL, CLOSED_SHELLs when every edge is used twice.
 ///
 /// Every number is written in the shortest form that reads back to the same double.
 /// Entities are numbered #1, #2, ... in the order written, each referring only to
@@ -52,11 +65,12 @@ struct StepOptions {
 ///   std::ostringstream text;
 ///   interpatch::io::write_step(text, *c.exact, {.name = "dome", .time_stamp = "2024-05-01T12:00:00"});
 /// @endcode
-/// @throws error file_unwritable (the stream fails).
+/// @throws error file_unwritable (the stream fails), no_exact_form (a volume closed in
+///   u, v and w: it has no boundary to write).
 void write_step(std::ostream& os, const ExactForm& exact, const StepOptions& options = {});
 
 /// The same, written atomically to a file (nothing is left behind when it fails).
-/// @throws error file_unwritable.
+/// @throws error file_unwritable, no_exact_form.
 void write_step(const std::filesystem::path& path, const ExactForm& exact, const StepOptions& options = {});
 
 }  // namespace interpatch::io

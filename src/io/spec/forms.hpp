@@ -29,7 +29,8 @@ inline constexpr auto ruled = std::to_array({"type"sv, "curves"sv});
 inline constexpr auto coons = std::to_array(
     {"type"sv, "boundary"sv, "blending"sv, "cross_derivatives"sv, "twists"sv, "twist_correction"sv, "tolerance"sv});
 inline constexpr auto network =
-    std::to_array({"type"sv, "u_curves"sv, "v_curves"sv, "u_params"sv, "v_params"sv, "method"sv, "tolerance"sv});
+    std::to_array({"type"sv, "u_curves"sv, "v_curves"sv, "u_params"sv, "v_params"sv, "method"sv, "tolerance"sv,
+                   "periodic"sv});
 inline constexpr auto interpolate = std::to_array({"type"sv, "points"sv, "degree"sv, "param"sv, "periodic"sv});
 inline constexpr auto hermite_patch = std::to_array({"type"sv, "corners"sv});
 // bspline_surface and bspline_volume: the form by its fields, or "npz", an archive
