@@ -21,6 +21,7 @@
 #include "io/crc32.hpp"
 #include "io/npz_internal.hpp"
 #include "cli_specs.hpp"
+#include "io/closed_shapes.hpp"
 #include "npy_util.hpp"
 #include "temp_dir.hpp"
 #include "test_util.hpp"
@@ -291,7 +292,9 @@ TEST(Npz, MembersAreStoredNpyFilesInOrderWithTheirChecksums) {
 }
 
 // Closed forms: a pipe (closed around v, odd and even degrees), a tube's wall as a
-// volume, and a surface closed around u and v.
+// volume, a surface closed around u and v; and forms made by hand about a torus
+// (closed_shapes.hpp): uneven and doubled periodic knots, weights, a domain other
+// than [0, 1], a volume closed in every direction.
 std::vector<ExactForm> closed_forms() {
   std::vector<ExactForm> f;
   for (const int q : {2, 3}) {
@@ -303,7 +306,24 @@ std::vector<ExactForm> closed_forms() {
   both["periodic"] = {true, true};
   f.push_back(*build(both).exact);
   f.push_back(*build(test::tube_spec(3, 7, 4, true)).exact);
+  f.push_back(test::closed_surface({true, false}, 1, true));
+  f.push_back(test::closed_surface({false, true}, 2));
+  f.push_back(test::closed_surface({true, true}, 3, true));
+  f.push_back(test::closed_volume({true, true}, 4));
+  f.push_back(test::volume_closed_everywhere());
   return f;
+}
+
+// The form a spec of it builds: its knots mapped onto [0, 1] when they are not.
+ExactForm on_unit_domain(const ExactForm& f) {
+  if (const auto* s = std::get_if<BSplineSurface>(&f)) {
+    const auto d = s->domain();
+    return d[0] == std::pair{0.0, 1.0} && d[1] == std::pair{0.0, 1.0} ? f : ExactForm(s->mapped(0, 1, 0, 1));
+  }
+  const auto& v = std::get<BSplineVolume>(f);
+  const auto d = v.domain();
+  const bool unit = std::all_of(d.begin(), d.end(), [](const auto& x) { return x == std::pair{0.0, 1.0}; });
+  return unit ? f : ExactForm(v.mapped(0, 1, 0, 1, 0, 1));
 }
 
 TEST(Npz, ClosedFormsRoundTripBitIdentically) {
@@ -322,10 +342,10 @@ TEST(Npz, ClosedFormsRoundTripBitIdentically) {
       for (const bool p : std::get<BSplineVolume>(f).periodic()) expected += p ? '\1' : '\0';
     EXPECT_EQ(m.back().name, "periodic.npy");
     EXPECT_EQ(flags, expected);
-    // The same form as the .json exact form reads back to.
+    // The .json exact form reads back to the same form, over [0, 1] as every spec's.
     std::ostringstream text;
     write_exact_json(text, f);
-    expect_identical(*build(parse_json(text.str())).exact, back);
+    expect_identical(*build(parse_json(text.str())).exact, on_unit_domain(back));
   }
 }
 
@@ -623,7 +643,8 @@ TEST(NpzForNumpy, WritesSamples) {
                                                                 {"volume", random_volume(33, false)},
                                                                 {"rational_volume", random_volume(34, true)},
                                                                 {"closed_surface", closed_forms()[1]},
-                                                                {"closed_volume", closed_forms()[3]}};
+                                                                {"closed_volume", closed_forms()[3]},
+                                                                {"closed_rational_surface", closed_forms()[6]}};
   for (const auto& [name, form] : forms)
     for (const bool zip64 : {false, true}) {
       const std::string base = (fs::path(out) / (name + (zip64 ? "_zip64" : ""))).string();
