@@ -145,25 +145,6 @@ Construction build_coons(const json& spec, Context& ctx) {
   return blended("coons", at("", [&] { return coons(boundary, o); }), std::move(data), std::move(parameters));
 }
 
-namespace {
-
-// "periodic": [u, v], the closed directions of a network; absent means neither.
-std::array<bool, 2> periodic_of(const json& spec) {
-  std::array<bool, 2> r{false, false};
-  const json* p = find_member(spec, "periodic");
-  if (!p) return r;
-  constexpr std::string_view form = "2 booleans [u, v], one per direction";
-  if (!p->is_array()) wrong_type("/periodic", cat("an array of ", form), *p);
-  if (p->size() != 2) fail(errc::wrong_type, place("/periodic"), ": expected ", form, ", got ", p->size());
-  for (std::size_t a = 0; a < 2; ++a) {
-    if (!(*p)[a].is_boolean()) wrong_type(child("/periodic", a), cat("true or false (is ", axis_name(a), " closed?)"), (*p)[a]);
-    r[a] = (*p)[a].get<bool>();
-  }
-  return r;
-}
-
-}  // namespace
-
 Construction build_network(const json& spec, Context& ctx) {
   auto curves = [&](const char* key) {
     const std::string ptr = child("", key);
@@ -173,7 +154,8 @@ Construction build_network(const json& spec, Context& ctx) {
     for (std::size_t i = 0; i < a.size(); ++i) c.push_back(curve_impl(a[i], child(ptr, i), ctx));
     return c;
   };
-  CurveNetwork net{curves("u_curves"), curves("v_curves"), {}, {}, periodic_of(spec)};
+  const std::array<bool, 3> closed = periodic_flags(spec, "", 2);
+  CurveNetwork net{curves("u_curves"), curves("v_curves"), {}, {}, {closed[0], closed[1]}};
   if (const json* p = find_member(spec, "u_params")) net.u_params = numbers(*p, "/u_params");
   if (const json* p = find_member(spec, "v_params")) net.v_params = numbers(*p, "/v_params");
   const std::string method = choice(spec, "method", "", {"coons_linear", "coons_hermite", "gordon"}, "gordon");
