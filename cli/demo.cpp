@@ -247,6 +247,36 @@ ojson network_spec(const char* method) {
           {"v_curves", v_curves}};
 }
 
+// A duct closed around u: four elliptic sections (closed curves through 8 points
+// each, uniform parameters, so the points at 0, 90, 180 and 270 degrees sit at
+// u = 0, 1/4, 1/2, 3/4) and four curves along it through those points.
+ojson closed_network_spec() {
+  auto section_point = [](double angle, double z) {
+    const double r = 1 + 0.35 * std::sin(std::numbers::pi * z / 3);
+    return Vec3{1.3 * r * std::cos(angle), r * std::sin(angle), z + 0.15 * std::sin(2 * angle) * z};
+  };
+  ojson u_curves = ojson::array(), v_curves = ojson::array();
+  for (int k = 0; k < 4; ++k) {
+    ojson pts = ojson::array();
+    for (int j = 0; j < 8; ++j) pts.push_back(point_json(section_point(j * std::numbers::pi / 4, k)));
+    u_curves.push_back({{"interpolate", pts}, {"periodic", true}, {"param", "uniform"}});
+  }
+  for (int i = 0; i < 4; ++i) {
+    ojson pts = ojson::array();
+    for (int k = 0; k < 4; ++k) pts.push_back(point_json(section_point(i * std::numbers::pi / 2, k)));
+    v_curves.push_back({{"interpolate", pts}, {"param", "uniform"}});
+  }
+  return {{"type", "network"},
+          {"comment", "A duct: four closed elliptic sections along it (u around, closed) and four curves along it; "
+                      "the Gordon surface is closed in u and C2 across the seam."},
+          {"method", "gordon"},
+          {"periodic", {true, false}},
+          {"u_curves", u_curves},
+          {"v_curves", v_curves},
+          {"u_params", {0, 0.25, 0.5, 0.75}},
+          {"v_params", {0, 1.0 / 3, 2.0 / 3, 1}}};
+}
+
 ojson hermite_corners() {
   ojson c = ojson::object();
   for (int i = 0; i < 2; ++i)
@@ -439,6 +469,8 @@ std::vector<Example> examples() {
                 false});
   ex.push_back({"network_coons", "C1 network of Coons patches with Hermite blending", network_spec("coons_hermite"),
                 nullptr, "", false});
+  ex.push_back({"network_closed", "closed Gordon surface through 4 closed sections and 4 curves along them",
+                closed_network_spec(), nullptr, "", false});
   ex.push_back({"hermite_patch", "bicubic Hermite (Ferguson) patch from corner data",
                 {{"type", "hermite_patch"},
                  {"comment", "Positions, tangents and twists at the corners of a bicubic dome."},
