@@ -133,6 +133,7 @@ std::vector<double> closed_curve_parameters(std::span<const Vec3> points, Parame
     fail(errc::not_finite, "the closed polygon's length overflows (", total, "): the points span more than ",
          std::numeric_limits<double>::max());
   const double root = root_scale(point_exponent(points));
+  double len = 0;
   for (std::size_t i = 1; i <= n; ++i) {
     const std::size_t j = i % n;
     const double d = distance(points[j], points[i - 1]);
@@ -142,9 +143,9 @@ std::vector<double> closed_curve_parameters(std::span<const Vec3> points, Parame
            ", closed polygon length ", total, "): parameters must increase");
     const double st = step(points[i - 1], points[j], param, root);
     if (i < n) t[i] = t[i - 1] + st;
-    else total = t[i - 1] + st;
+    else len = t[i - 1] + st;  // back at the first point: the whole closed polygon's steps
   }
-  for (std::size_t i = 1; i < n; ++i) t[i] /= total;
+  for (std::size_t i = 1; i < n; ++i) t[i] /= len;
   return t;
 }
 
@@ -187,12 +188,17 @@ double box_diagonal(std::size_t count, const PointAt& point) {
 // Whether the last point of each of `lines` closed lines of n points repeats the
 // first (closing_point; the rule is the same for every line of a grid, and all must
 // repeat for the last line to be left out). point(l, k) is point k of line l;
-// diagonal() the data's bounding-box diagonal, computed only when a gap is small;
-// where(l) names line l's last point in a message.
-template <class PointAt, class Diagonal, class Where>
-Closing find_closing(std::size_t lines, std::size_t n, const PointAt& point, const Diagonal& diagonal,
-                     const Where& where) {
-  if (n < 3) return {n, false};
+// diagonal() the data's bounding-box diagonal, computed only when a gap is small.
+// With a near miss, `line` is the first line that misses.
+struct LineEnding {
+  Closing closing;
+  std::size_t line = 0;
+  double gap = 0, adjacent = 0, tol = 0;
+};
+
+template <class PointAt, class Diagonal>
+LineEnding line_ending(std::size_t lines, std::size_t n, const PointAt& point, const Diagonal& diagonal) {
+  if (n < 3) return {{n, false, false}};
   bool all_zero = true, near = false;
   for (std::size_t l = 0; l < lines; ++l) {
     const double gap = distance(point(l, n - 1), point(l, 0));
@@ -201,23 +207,32 @@ Closing find_closing(std::size_t lines, std::size_t n, const PointAt& point, con
     const double adjacent = std::min(distance(point(l, 1), point(l, 0)), distance(point(l, n - 1), point(l, n - 2)));
     near = near || gap < 1e-3 * adjacent;
   }
-  if (all_zero) return {n - 1, true};
-  if (!near) return {n, false};
+  if (all_zero) return {{n - 1, true, false}};
+  if (!near) return {{n, false, false}};
   const double tol = 1e-12 * diagonal();
   bool all_close = true;
   for (std::size_t l = 0; l < lines && all_close; ++l) all_close = distance(point(l, n - 1), point(l, 0)) <= tol;
-  if (all_close) return {n - 1, true};
+  if (all_close) return {{n - 1, true, false}};
   for (std::size_t l = 0; l < lines; ++l) {
-    const Vec3 &last = point(l, n - 1), &first = point(l, 0);
-    const double gap = distance(last, first);
-    const double adjacent = std::min(distance(point(l, 1), first), distance(last, point(l, n - 2)));
-    if (gap > tol && gap < 1e-3 * adjacent)
-      fail(errc::closing_gap, where(l), " = ", last, " nearly repeats the first point ", first, ": gap ", gap,
-           ", more than the ", tol, " (1e-12 of the bounding-box diagonal) that makes it the closing point and less than ",
-           "1e-3 of the chords next to it (", adjacent, "), which would leave a kink at the seam; repeat the first point "
-           "exactly, or leave the last one out");
+    const double gap = distance(point(l, n - 1), point(l, 0));
+    const double adjacent = std::min(distance(point(l, 1), point(l, 0)), distance(point(l, n - 1), point(l, n - 2)));
+    if (gap > tol && gap < 1e-3 * adjacent) return {{n, false, true}, l, gap, adjacent, tol};
   }
-  return {n, false};
+  return {{n, false, false}};
+}
+
+// line_ending, a near miss refused; where(l) names line l's last point.
+template <class PointAt, class Diagonal, class Where>
+Closing find_closing(std::size_t lines, std::size_t n, const PointAt& point, const Diagonal& diagonal,
+                     const Where& where) {
+  const LineEnding e = line_ending(lines, n, point, diagonal);
+  if (e.closing.nearly)
+    fail(errc::closing_gap, where(e.line), " = ", point(e.line, n - 1), " nearly repeats the first point ",
+         point(e.line, 0), ": gap ", e.gap, ", more than the ", e.tol,
+         " (1e-12 of the bounding-box diagonal) that makes it the closing point and less than ",
+         "1e-3 of the chords next to it (", e.adjacent, "), which would leave a kink at the seam; repeat the first point "
+         "exactly, or leave the last one out");
+  return e.closing;
 }
 
 }  // namespace
@@ -850,23 +865,46 @@ void drop_last_line(Grid<Vec3, Rank>& points, std::size_t axis) {
   points = Grid<Vec3, Rank>(shape, std::move(values));
 }
 
+// The lines of a grid along `axis`: at(l, k) is point k of line l.
+template <std::size_t Rank>
+struct GridLines {
+  GridLines(const Grid<Vec3, Rank>& g, std::size_t axis) : points(g), n(g.shape()[axis]) {
+    for (std::size_t a = axis + 1; a < Rank; ++a) inner *= g.shape()[a];
+  }
+  [[nodiscard]] std::size_t count() const { return points.size() / n; }
+  [[nodiscard]] std::size_t index(std::size_t l, std::size_t k) const { return (l / inner) * n * inner + k * inner + l % inner; }
+  [[nodiscard]] const Vec3& at(std::size_t l, std::size_t k) const { return points.data()[index(l, k)]; }
+  [[nodiscard]] double diagonal() const {
+    return box_diagonal(points.size(), [&](std::size_t i) -> const Vec3& { return points.data()[i]; });
+  }
+  const Grid<Vec3, Rank>& points;
+  std::size_t n, inner = 1;
+};
+
 // The closing line along `axis`, if any (find_closing over the grid's lines).
 template <std::size_t Rank>
-Closing grid_closing(const Grid<Vec3, Rank>& points, std::size_t axis) {
+Closing closing_line(const Grid<Vec3, Rank>& points, std::size_t axis) {
+  const GridLines<Rank> g(points, axis);
   const auto& shape = points.shape();
-  std::size_t inner = 1;
-  for (std::size_t a = axis + 1; a < Rank; ++a) inner *= shape[a];
-  const std::size_t n = shape[axis], lines = points.size() / n;
-  const Vec3* q = points.data();
-  auto at = [&](std::size_t l, std::size_t k) -> const Vec3& { return q[(l / inner) * n * inner + k * inner + l % inner]; };
-  auto diagonal = [&] { return box_diagonal(points.size(), [&](std::size_t i) -> const Vec3& { return q[i]; }); };
   auto where = [&](std::size_t l) {
-    const std::size_t k = (l / inner) * n * inner + (n - 1) * inner + l % inner;
     std::string idx;
-    for (std::size_t a = Rank, rest = k; a-- > 0; rest /= shape[a]) idx = detail::cat("[", rest % shape[a], "]", idx);
+    for (std::size_t a = Rank, rest = g.index(l, g.n - 1); a-- > 0; rest /= shape[a])
+      idx = detail::cat("[", rest % shape[a], "]", idx);
     return detail::cat("point ", idx, ", the last along ", axis_name(static_cast<int>(axis)), ",");
   };
-  return find_closing(lines, n, at, diagonal, where);
+  return find_closing(
+      g.count(), g.n, [&](std::size_t l, std::size_t k) -> const Vec3& { return g.at(l, k); }, [&] { return g.diagonal(); },
+      where);
+}
+
+template <std::size_t Rank>
+Closing grid_closing_of(const Grid<Vec3, Rank>& points, int axis) {
+  if (axis < 0 || axis >= static_cast<int>(Rank))
+    fail(errc::out_of_domain, "axis ", axis, " is outside 0..", Rank - 1, " for a grid of rank ", Rank);
+  const GridLines<Rank> g(points, static_cast<std::size_t>(axis));
+  return line_ending(g.count(), g.n, [&](std::size_t l, std::size_t k) -> const Vec3& { return g.at(l, k); },
+                     [&] { return g.diagonal(); })
+      .closing;
 }
 
 // Re-anchors a closed axis of even degree at its first parameter (seam_insertion on
@@ -917,7 +955,7 @@ GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional
   std::array<bool, Rank> dropped{};
   for (std::size_t a = 0; a < Rank; ++a)
     if (periodic[a])
-      if (const Closing c = grid_closing(points, a); c.dropped) {
+      if (const Closing c = closing_line(points, a); c.dropped) {
         drop_last_line(points, a);
         dropped[a] = true;
       }
@@ -1000,6 +1038,9 @@ GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional
 }
 
 }  // namespace
+
+Closing grid_closing(const PointGrid& points, int axis) { return grid_closing_of(points, axis); }
+Closing grid_closing(const PointGrid3& points, int axis) { return grid_closing_of(points, axis); }
 
 SurfaceInterpolation interpolate_surface(PointGrid points, const SurfaceInterpolationOptions& options) {
   GridSolution s = solve_grid<2>(points, {options.degree_u, options.degree_v}, options.param, options.progress, "surface",

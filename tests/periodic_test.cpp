@@ -421,6 +421,35 @@ TEST(PeriodicClosingPoint, DetectsDropsAndRefuses) {
   EXPECT_EQ(closing_point(closed).count, 5u);
 }
 
+TEST(PeriodicClosingPoint, GridClosingReportsWithoutThrowing) {
+  // A 4 x 5 ring closed along v: the last column repeats the first.
+  PointGrid g({4, 5});
+  for (std::size_t i = 0; i < 4; ++i)
+    for (std::size_t j = 0; j < 5; ++j) {
+      const double a = 2 * std::numbers::pi * static_cast<double>(j % 4) / 4;
+      g(i, j) = {std::cos(a), std::sin(a), static_cast<double>(i)};
+    }
+  const Closing v = grid_closing(g, 1);
+  EXPECT_TRUE(v.dropped);
+  EXPECT_FALSE(v.nearly);
+  EXPECT_EQ(v.count, 4u);
+  const Closing u = grid_closing(g, 0);  // rows at z = 0 and 3: not closed
+  EXPECT_FALSE(u.dropped);
+  EXPECT_FALSE(u.nearly);
+  EXPECT_EQ(u.count, 4u);
+  // One point of the last column 1e-8 off its first (chords next to it about 1.4):
+  // a near miss, reported here, refused by interpolation closed along v.
+  g(2, 4).z += 1e-8;
+  const Closing near = grid_closing(g, 1);
+  EXPECT_FALSE(near.dropped);
+  EXPECT_TRUE(near.nearly);
+  EXPECT_EQ(near.count, 5u);
+  SurfaceInterpolationOptions o;
+  o.periodic = {false, true};
+  EXPECT_ERRC((void)interpolate_surface(g, o), closing_gap, "point [2][4], the last along v,");
+  EXPECT_ERRC((void)grid_closing(g, 2), out_of_domain, "axis 2 is outside 0..1");
+}
+
 // ---------------------------------------------------------------------------
 // Interpolation at every data point
 // ---------------------------------------------------------------------------

@@ -58,6 +58,9 @@ enum class Parametrization {
 struct Closing {
   std::size_t count = 0;
   bool dropped = false;
+  /// A last point nearly repeats its first: closer than 1e-3 of the chords next to it,
+  /// farther than 1e-12 of the diagonal (closing_point refuses it as closing_gap).
+  bool nearly = false;
 };
 
 /// Whether the last point of a closed curve repeats the first: within 1e-12 of the
@@ -67,6 +70,15 @@ struct Closing {
 /// size at the seam.
 /// @throws error closing_gap (naming the point, its distance and the tolerance).
 [[nodiscard]] Closing closing_point(std::span<const Vec3> points);
+
+/// The same rule for the lines of a grid along `axis` (0: u, 1: v, 2: w), all at once:
+/// the last line is left out when every point of it repeats the first line's. It
+/// does not throw: a near miss is reported in `nearly` (interpolating the grid closed
+/// along `axis` refuses it as closing_gap). For callers that warn about data that
+/// close in a direction not declared periodic.
+/// @throws error out_of_domain (no such axis).
+[[nodiscard]] Closing grid_closing(const PointGrid& points, int axis);
+[[nodiscard]] Closing grid_closing(const PointGrid3& points, int axis);
 
 struct CurveInterpolationOptions {
   /// Degree; unset means min(3, points − 1).

@@ -1,6 +1,6 @@
 #pragma once
 // The bounding box of points, and its diagonal: the size the io library measures
-// data by (info's relative error, a grid's closing line).
+// data by (info's relative error).
 
 #include <algorithm>
 #include <limits>

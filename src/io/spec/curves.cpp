@@ -41,7 +41,7 @@ BSplineCurve interpolated_curve(const json& obj, std::string_view ptr, Context& 
            "end derivatives, not both");
     (end[0] == 's' ? options.start_derivative : options.end_derivative) = point_value(*d, dptr);
   }
-  const Closing closing = options.periodic ? at(pts_at, [&] { return closing_point(pts); }) : Closing{pts.size(), false};
+  const Closing closing = options.periodic ? at(pts_at, [&] { return closing_point(pts); }) : Closing{pts.size(), false, false};
   const std::size_t n = closing.count;  // the points the curve is made of
   const std::size_t ends = (options.start_derivative ? 1u : 0u) + (options.end_derivative ? 1u : 0u);
   options.degree = degrees(obj, ptr, 1)[0];

@@ -11,7 +11,6 @@
 #include "interpatch/bspline_volume.hpp"
 #include "interpatch/interpolate.hpp"
 #include "interpatch/memory.hpp"
-#include "io/box.hpp"
 #include "io/npz_internal.hpp"
 #include "io/spec/reader.hpp"
 
@@ -98,37 +97,6 @@ typename Grid<Vec3, D>::shape_type grid_shape(const std::vector<std::size_t>& sh
   return s;
 }
 
-// How a grid of data ends along an axis, by the rule interpolation follows in a
-// closed direction (closing_point, for every line along the axis at once): its last
-// line repeats the first (every point of it equal to the first line's, or within
-// 1e-12 of the bounding-box diagonal when some last point is nearer its first than
-// 1e-3 of the chords next to it), nearly does (such a near point, but a gap above
-// that tolerance: a closed direction refuses it as closing_gap), or does not.
-enum class Ending { open, closes, nearly };
-
-Ending ending_along(const PointStorage& q, const std::vector<std::size_t>& shape, std::size_t axis) {
-  const std::size_t n = shape[axis];
-  if (n < 3) return Ending::open;  // as in interpolation: of two lines, the last is never a closing line
-  std::size_t inner = 1;
-  for (std::size_t a = axis + 1; a < shape.size(); ++a) inner *= shape[a];
-  const std::size_t lines = q.size() / n;
-  const auto at = [&](std::size_t l, std::size_t k) -> const Vec3& { return q[(l / inner) * n * inner + k * inner + l % inner]; };
-  bool all_equal = true, near = false;
-  double largest = 0;
-  for (std::size_t l = 0; l < lines; ++l) {
-    const double gap = distance(at(l, n - 1), at(l, 0));
-    if (gap == 0.0) continue;
-    all_equal = false;
-    largest = std::max(largest, gap);
-    near = near || gap < 1e-3 * std::min(distance(at(l, 1), at(l, 0)), distance(at(l, n - 1), at(l, n - 2)));
-  }
-  if (all_equal) return Ending::closes;
-  if (!near) return Ending::open;
-  internal::Box box;
-  for (const Vec3& p : q) box.add(p);
-  return largest <= 1e-12 * box.diagonal() ? Ending::closes : Ending::nearly;
-}
-
 // "domain": {"u": [a, b], ...}, as the exact form had it before it was mapped onto [0, 1].
 template <class Exact>
 nlohmann::ordered_json domain_json(const Exact& s) {
@@ -181,12 +149,17 @@ Construction build_interpolate(const json& spec, Context& ctx) {
     if (count < 2)
       fail(errc::too_few_points, "/points: the grid has ", count, " point", count == 1 ? "" : "s", " along ", axis_name(a),
            " (shape ", shape, "); interpolation needs at least 2");
-    const Ending ending = ending_along(pts.points, pts.shape, a);
+  }
+  typename T::Points grid(grid_shape<D>(pts.shape), std::move(pts.points));
+  for (std::size_t a = 0; a < D; ++a) {
+    const std::size_t count = pts.shape[a];
+    // Interpolation's own rule (grid_closing): whether the last line repeats the first.
+    const Closing ending = grid_closing(grid, static_cast<int>(a));
     // A closed direction is made of its distinct lines: a closing line is left out.
-    const bool dropped = periodic[a] && ending == Ending::closes;
+    const bool dropped = periodic[a] && ending.dropped;
     const std::size_t lines = dropped ? count - 1 : count;
     // A closing line nearly equal to the first: interpolation refuses it (closing_gap) before any degree.
-    const bool refused = periodic[a] && ending == Ending::nearly;
+    const bool refused = periodic[a] && ending.nearly;
     if (degree[a] && static_cast<std::size_t>(*degree[a]) >= lines && !refused)
       fail(errc::too_few_points, degree_pointer(spec, "", a), ": degree ", *degree[a], periodic[a] ? " around " : " along ",
            axis_name(a), periodic[a] ? " (closed)" : "", " needs at least ", *degree[a] + 1,
@@ -195,7 +168,7 @@ Construction build_interpolate(const json& spec, Context& ctx) {
     if (dropped)
       notes.push_back(cat("the last line of points along ", axis_name(a), " repeats the first and is left out: ", lines,
                           " distinct lines around ", axis_name(a)));
-    if (!periodic[a] && ending == Ending::closes) {
+    if (!periodic[a] && ending.dropped) {
       std::array<bool, 3> suggested = periodic;
       suggested[a] = true;
       const std::string what = cat("the data close along ", axis_name(a), " (the last line of points repeats the first), but ",
@@ -205,7 +178,6 @@ Construction build_interpolate(const json& spec, Context& ctx) {
       notes.push_back(what);
     }
   }
-  typename T::Points grid(grid_shape<D>(pts.shape), std::move(pts.points));
   DataSet data;
   data.pointer = "/points";
   if (ctx.keep_data) {
