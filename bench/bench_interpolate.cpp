@@ -308,7 +308,7 @@ const interpatch::BlendedSurface& terrain_network(std::size_t n, interpatch::Net
       net.u_params.push_back(static_cast<double>(i) / static_cast<double>(n - 1));
     }
     net.v_params = net.u_params;
-    it = cache.emplace(key, interpatch::curve_network(net, {method, {}})).first;
+    it = cache.emplace(key, interpatch::curve_network(net, {method, {}, {}})).first;
   }
   return it->second;
 }

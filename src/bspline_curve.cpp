@@ -175,7 +175,8 @@ void BSplineCurve::derivatives(double t, int n, Vec3* out) const {
   const int nb = std::min(n, p);
   const int s = knots_.find_span(t);
   double ders[(max_degree + 1) * (max_degree + 1)];
-  knots_.basis_derivatives(s, t, nb, ders);
+  if (nb == 0) knots_.basis(s, t, ders);  // the same numbers, without the derivative table
+  else knots_.basis_derivatives(s, t, nb, ders);
   for (int k = nb + 1; k <= n; ++k) out[k] = {};  // polynomial pieces of degree p
   if (!rational()) {
     for (int k = 0; k <= nb; ++k) {

@@ -21,6 +21,7 @@ std::string_view to_string(errc code) noexcept {
     case errc::singular: return "singular";
     case errc::corner_gap: return "corner_gap";
     case errc::network_gap: return "network_gap";
+    case errc::network_order: return "network_order";
     case errc::incompatible_twist: return "incompatible_twist";
     case errc::tangent_mismatch: return "tangent_mismatch";
     case errc::invalid_blend: return "invalid_blend";

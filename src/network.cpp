@@ -4,12 +4,14 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <string>
 
 #include "blended_terms.hpp"
 #include "detail/text.hpp"
 #include "interpatch/evaluate.hpp"
 #include "interpatch/interpolate.hpp"
+#include "network_curves.hpp"
 
 namespace interpatch {
 
@@ -34,60 +36,6 @@ void check_counts(const CurveNetwork& n) {
 double wrap_unit(double t) {
   const double r = t - std::floor(t);
   return r < 1.0 ? r : 0.0;  // a tiny negative t rounds to 1
-}
-
-// Closest points of two curves over [0, 1]: a coarse search, then Gauss–Newton on
-// F(s, t) = U(s) − V(t). A closed curve's parameter wraps around its seam; an open
-// one's stays in [0, 1].
-std::pair<double, double> closest(const BSplineCurve& U, const BSplineCurve& V, bool closed_u, bool closed_v) {
-  constexpr int samples = 64;
-  Vec3 us[samples + 1], vs[samples + 1];
-  for (int k = 0; k <= samples; ++k) {
-    us[k] = U.point(static_cast<double>(k) / samples);
-    vs[k] = V.point(static_cast<double>(k) / samples);
-  }
-  double best = std::numeric_limits<double>::infinity(), s = 0, t = 0;
-  for (int a = 0; a <= samples; ++a)
-    for (int b = 0; b <= samples; ++b) {
-      const double d = distance(us[a], vs[b]);
-      if (d < best) {
-        best = d;
-        s = static_cast<double>(a) / samples;
-        t = static_cast<double>(b) / samples;
-      }
-    }
-  // The next parameter, and how far it moved (around the circle for a closed curve).
-  const auto step = [](double x, double dx, bool closed) {
-    if (!closed) {
-      const double n = std::clamp(x + dx, 0.0, 1.0);
-      return std::pair{n, std::abs(n - x)};
-    }
-    const double n = wrap_unit(x + dx), moved = std::abs(n - x);
-    return std::pair{n, std::min(moved, 1.0 - moved)};
-  };
-  for (int it = 0; it < 50; ++it) {
-    Vec3 du[2], dv[2];
-    U.derivatives(s, 1, du);
-    V.derivatives(t, 1, dv);
-    // Normal equations of J = [U'(s), −V'(t)], with U', V' and F in units of 2^e, e the
-    // exponent of the largest component of U' and V': exact, and it keeps det, a
-    // product of four of them, in range at any scale of the data (and the test below
-    // relative to the tangents), while the steps ds, dt come out as they are.
-    const int e = scale_exponent(std::max(max_abs(du[1]), max_abs(dv[1])));
-    const Vec3 Us = ldexp(du[1], -e), Vs = ldexp(dv[1], -e), F = ldexp(du[0] - dv[0], -e);
-    const double a11 = dot(Us, Us), a12 = -dot(Us, Vs), a22 = dot(Vs, Vs);
-    const double r1 = -dot(Us, F), r2 = dot(Vs, F);
-    const double det = a11 * a22 - a12 * a12;
-    if (!(std::abs(det) > 1e-300)) break;  // parallel tangents: keep the sampled pair
-    const double ds = (r1 * a22 - a12 * r2) / det, dt = (a11 * r2 - a12 * r1) / det;
-    const auto [ns, ms] = step(s, ds, closed_u);
-    const auto [nt, mt] = step(t, dt, closed_v);
-    const bool done = ms < 1e-15 && mt < 1e-15;
-    s = ns;
-    t = nt;
-    if (done) break;
-  }
-  return {s, t};
 }
 
 // Given crossing parameters of a family of curves: increasing, from 0 to 1, or in a
@@ -231,16 +179,27 @@ struct Prepared {
   std::array<std::vector<BSplineCurve>, 2> along;  // along[0]: the u_curves, along[1]: the v_curves
   std::array<bool, 2> closed{false, false};
   std::array<bool, 2> closing{false, false};  // closing[a]: the last curve across direction a left out
-  double tol = 0;  // how far curves may miss each other (NetworkOptions::tolerance)
+  std::array<std::vector<BSplineCurve>, 2> input;  // the curves as given, over [0, 1]
+  std::array<std::vector<bool>, 2> reshaped;       // along[a][j] is not input[a][j] (closed with a C0 seam)
+  double tol = 0;       // how far curves may miss each other (NetworkOptions::tolerance)
+  double diagonal = 0;  // of the control points' bounding box
   std::vector<std::string> notes;
+  std::function<std::string(int, std::size_t)> curve_name;
+  [[nodiscard]] std::string name(int family, std::size_t index) const {
+    return curve_name ? curve_name(family, index) : detail::cat(curves_name(family), "[", index, "]");
+  }
 };
 
 Prepared prepare(const CurveNetwork& n, const NetworkOptions& o) {
   check_counts(n);
   Prepared r;
-  const double tol = r.tol = o.tolerance ? *o.tolerance : 1e-7 * control_diagonal(n);
+  r.diagonal = control_diagonal(n);
+  const double tol = r.tol = o.tolerance ? *o.tolerance : 1e-7 * r.diagonal;
   r.closed = n.periodic;
-  r.along = {on_unit(n.u_curves), on_unit(n.v_curves)};
+  r.curve_name = o.curve_name;
+  r.input = {on_unit(n.u_curves), on_unit(n.v_curves)};
+  r.along = r.input;
+  r.reshaped = {std::vector<bool>(r.input[0].size(), false), std::vector<bool>(r.input[1].size(), false)};
   for (int a = 0; a < 2; ++a) {
     auto& along = r.along[static_cast<std::size_t>(a)];
     if (!r.closed[static_cast<std::size_t>(a)]) {
@@ -251,10 +210,11 @@ Prepared prepare(const CurveNetwork& n, const NetworkOptions& o) {
     for (std::size_t j = 0; j < along.size(); ++j) {
       if (along[j].periodic()) continue;
       if (!ends_meet(along[j], tol))
-        fail(errc::network_gap, curves_name(a), "[", j, "] is not closed, and the network is closed in ",
+        fail(errc::network_gap, r.name(a, j), " is not closed, and the network is closed in ",
              a == 0 ? "u" : "v", ": its ends ", along[j].point(0.0), " and ", along[j].point(1.0), " are ",
              distance(along[j].point(0.0), along[j].point(1.0)), " apart (tolerance ", tol, ")");
       along[j] = closed_form(along[j]);
+      r.reshaped[static_cast<std::size_t>(a)][j] = true;
       opened.push_back(j);
     }
     if (!opened.empty()) {
@@ -273,56 +233,16 @@ Prepared prepare(const CurveNetwork& n, const NetworkOptions& o) {
     const double apart = curve_distance(across.front(), across.back());
     if (given.empty() ? !(apart <= tol) : given.size() != across.size() || given.back() != 1.0) continue;
     if (!(apart <= tol))
-      fail(errc::network_gap, curves_name(1 - a), "[", across.size() - 1, "] is at ", a == 0 ? "u" : "v", " = 1 (",
+      fail(errc::network_gap, r.name(1 - a, across.size() - 1), " is at ", a == 0 ? "u" : "v", " = 1 (",
            params_name(a), "[", across.size() - 1, "]), where a network closed in ", a == 0 ? "u" : "v", " has ",
-           curves_name(1 - a), "[0] again, but the two are up to ", apart, " apart (tolerance ", tol,
-           "): give parameters below 1, or repeat ", curves_name(1 - a), "[0] there");
+           r.name(1 - a, 0), " again, but the two are up to ", apart, " apart (tolerance ", tol,
+           "): give parameters below 1, or repeat ", r.name(1 - a, 0), " there");
     across.pop_back();
     r.closing[static_cast<std::size_t>(a)] = true;
     r.notes.push_back(detail::cat("the last of the ", curves_name(1 - a), " repeats the first: the closing curve, left out"));
     if (across.size() < 2)
       fail(errc::too_few_points, "a curve network closed in ", a == 0 ? "u" : "v", " needs at least 2 distinct ",
            curves_name(1 - a), ", got 1 and the closing curve");
-  }
-  return r;
-}
-
-// The crossing parameters of the prepared curves, one per curve used (closing curves
-// left out).
-NetworkParameters crossings(const Prepared& n) {
-  const auto& U = n.along[0];
-  const auto& V = n.along[1];
-  const std::size_t nu = V.size(), nv = U.size();  // nodes along u, along v
-  NetworkParameters r{std::vector<double>(nu, 0.0), std::vector<double>(nv, 0.0)};
-  // In a closed direction a curve's crossings are taken within half a period of its
-  // first one before they are averaged, so that crossings on either side of the seam
-  // do not average to the far side of the curve.
-  std::vector<double> first_u(nu), first_v(nv);
-  auto near = [](double x, double ref, bool closed) { return closed ? x + std::round(ref - x) : x; };
-  for (std::size_t i = 0; i < nu; ++i)
-    for (std::size_t j = 0; j < nv; ++j) {
-      auto [s, t] = closest(U[j], V[i], n.closed[0], n.closed[1]);
-      if (j == 0) first_u[i] = s;
-      if (i == 0) first_v[j] = t;
-      s = near(s, first_u[i], n.closed[0]);
-      t = near(t, first_v[j], n.closed[1]);
-      r.u_params[i] += s / static_cast<double>(nv);
-      r.v_params[j] += t / static_cast<double>(nu);
-    }
-  for (int a = 0; a < 2; ++a) {
-    auto& p = a == 0 ? r.u_params : r.v_params;
-    if (n.closed[static_cast<std::size_t>(a)]) {
-      for (double& x : p) x = wrap_unit(x);
-      p.front() = 0.0;  // where the closed curves start
-    } else {
-      p.front() = 0.0;  // the end curves bound the network
-      p.back() = 1.0;
-    }
-    for (std::size_t i = 1; i < p.size(); ++i)
-      if (!(p[i] > p[i - 1]))
-        fail(errc::non_increasing, "the ", curves_name(1 - a), " ", i - 1, " and ", i,
-             " cross the other curves at parameters ", p[i - 1], " and ", p[i],
-             ", which do not increase: the curves are not in order");
   }
   return r;
 }
@@ -335,55 +255,467 @@ void given_params(std::vector<double>& p, std::size_t curves, const Prepared& n,
   if (n.closing[static_cast<std::size_t>(a)]) p.pop_back();
 }
 
-}  // namespace
+// ---------------------------------------------------------------- as drawn
 
-NetworkParameters network_parameters(const CurveNetwork& network, const NetworkOptions& options) {
-  const Prepared n = prepare(network, options);
-  NetworkParameters r = crossings(n);
-  if (n.closing[0]) r.u_params.push_back(1.0);
-  if (n.closing[1]) r.v_params.push_back(1.0);
+// What the crossings tell: every pair's closest points, the order of each family,
+// the curves that run against theirs, and the common parameters. Family 0 is the
+// u-curves, 1 the v-curves; indices are those of the prepared curves (the given ones,
+// a closing curve left out).
+struct Arrangement {
+  std::vector<std::vector<detail::Crossing>> X;  // X[j][i]: u-curve j and v-curve i
+  std::array<std::vector<std::size_t>, 2> order;  // order[a][k]: the curve of family a at position k
+  std::array<std::vector<bool>, 2> reversed, degenerate;
+  std::array<std::vector<double>, 2> params;  // params[a][k]: where the surface has the curve at position k
+  // to[a][j]: curve j's own parameters at its crossings, by position of the other family
+  // (closed: unwrapped, from the seam's on; a curve against its family: decreasing).
+  std::array<std::vector<std::vector<double>>, 2> to;
+  double keep = 0;  // how close a curve must pass its crossings at the common parameters to be kept
+};
+
+// Own parameter on curve j of family a where it crosses curve i of the other family.
+double crossing_param(const Arrangement& r, int a, std::size_t j, std::size_t i) {
+  return a == 0 ? r.X[j][i].s : r.X[i][j].t;
+}
+
+// A curve shrunk to a point (a pole): every control point within tol of the first.
+bool is_point(const BSplineCurve& c, double tol) {
+  return std::all_of(c.control_points().begin(), c.control_points().end(),
+                     [&](const Vec3& p) { return distance(p, c.control_points().front()) <= tol; });
+}
+
+std::string list(const std::vector<std::size_t>& v) {
+  std::string s;
+  for (std::size_t x : v) s += detail::cat(s.empty() ? "" : ", ", x);
+  return s;
+}
+
+// Orders the family across a's curves (1 − a) by where they cross the curves of
+// family a, turns those of family a that run the other way, and finds the common
+// parameters of family 1 − a (or takes the given ones).
+void arrange(const Prepared& n, Arrangement& r, int a, const std::vector<double>& given) {
+  const auto az = static_cast<std::size_t>(a), bz = 1 - az;
+  const int b = 1 - a;
+  const auto& along = n.along[az];
+  const std::size_t na = along.size(), nb = n.along[bz].size();
+  const bool closed = n.closed[az];
+  const auto& deg = r.degenerate[az];
+  std::vector<std::size_t> live;
+  for (std::size_t j = 0; j < na; ++j)
+    if (!deg[j]) live.push_back(j);
+  if (live.empty())
+    fail(errc::network_gap, "every one of the ", curves_name(a), " is a single point: the network has no extent in ",
+         a == 0 ? "u" : "v");
+  const std::size_t ref = live.front();
+  // The order in which curve j meets the other family (closed: from the seam curve, 0, on).
+  const auto order_on = [&](std::size_t j) {
+    std::vector<double> key(nb);
+    for (std::size_t i = 0; i < nb; ++i) {
+      const double x = crossing_param(r, a, j, i);
+      key[i] = closed ? wrap_unit(x - crossing_param(r, a, j, 0)) : x;
+    }
+    std::vector<std::size_t> o(nb);
+    std::iota(o.begin(), o.end(), 0);
+    std::stable_sort(o.begin(), o.end(), [&](std::size_t x, std::size_t y) { return key[x] < key[y]; });
+    for (std::size_t k = 0; k + 1 < nb; ++k)
+      if (!(key[o[k]] + 1e-12 < key[o[k + 1]]))
+        fail(errc::network_order, n.name(b, std::min(o[k], o[k + 1])), " and ", n.name(b, std::max(o[k], o[k + 1])),
+             " cross ", n.name(a, j), " at the same point ", along[j].point(key[o[k]]),
+             ": curves of one family must not meet");
+    return o;
+  };
+  const auto turned = [&](std::vector<std::size_t> o) {
+    if (closed) std::reverse(o.begin() + 1, o.end());
+    else std::reverse(o.begin(), o.end());
+    return o;
+  };
+  std::vector<std::size_t> R(nb);
+  std::iota(R.begin(), R.end(), 0);
+  if (given.empty()) R = order_on(ref);
+  auto& rev = r.reversed[az];
+  rev.assign(na, false);
+  std::size_t against = 0;
+  for (std::size_t j : live) {
+    const auto o = order_on(j);
+    if (o == R) continue;
+    if (o != turned(R))
+      fail(errc::network_order, n.name(a, j), " crosses the ", curves_name(b), " in the order ", list(o), ", ",
+           given.empty() ? n.name(a, ref) : std::string(params_name(a)), given.empty() ? " in the order " : " put them in the order ",
+           list(R), ": no order of the ", curves_name(b), " and direction of the ", curves_name(a), " agrees with both");
+    rev[j] = true;
+    ++against;
+  }
+  if (given.empty() && 2 * against > live.size()) {  // most run the other way: that is the family's direction
+    R = turned(R);
+    for (std::size_t j : live) rev[j] = !rev[j];
+  }
+  r.order[bz] = R;
+  // Each curve's crossings in its family's direction (σ: the own parameter turned
+  // when the curve runs against it), the ends (open) or seam (closed) snapped to
+  // the curve's own when it passes there within `keep`.
+  auto& to = r.to[az];
+  to.assign(na, {});
+  std::vector<std::vector<double>> lam(na);  // per curve: normalized crossing positions
+  for (std::size_t j = 0; j < na; ++j) {
+    std::vector<double> x(nb);
+    for (std::size_t k = 0; k < nb; ++k) x[k] = crossing_param(r, a, j, R[k]);
+    if (deg[j]) {
+      to[j] = x;
+      continue;
+    }
+    const bool rj = rev[j];
+    const auto sigma = [&](double t) { return rj ? (closed ? -t : 1 - t) : t; };
+    const BSplineCurve& c = along[j];
+    if (!closed) {
+      double first = sigma(x.front()), last = sigma(x.back());
+      if (distance(c.point(rj ? 1.0 : 0.0), c.point(x.front())) <= r.keep) first = 0;
+      if (distance(c.point(rj ? 0.0 : 1.0), c.point(x.back())) <= r.keep) last = 1;
+      lam[j].resize(nb);
+      for (std::size_t k = 0; k < nb; ++k) lam[j][k] = (sigma(x[k]) - first) / (last - first);
+      to[j] = x;
+      to[j].front() = sigma(first);  // σ is its own inverse
+      to[j].back() = sigma(last);
+    } else {
+      const double shift = distance(c.point(0.0), c.point(x.front())) <= r.keep ? 0.0 : sigma(x.front());
+      lam[j].resize(nb);
+      for (std::size_t k = 0; k < nb; ++k) lam[j][k] = sigma(x[k]) - shift;
+      to[j].resize(nb + 1);
+      for (std::size_t k = 0; k < nb; ++k) to[j][k] = sigma(shift + (k == 0 ? 0.0 : wrap_unit(sigma(x[k]) - shift)));
+      to[j][nb] = sigma(shift + 1.0);
+    }
+  }
+  auto& p = r.params[bz];
+  if (!given.empty()) {
+    p = given;
+    return;
+  }
+  p.assign(nb, 0.0);
+  const auto count = static_cast<double>(live.size());
+  for (std::size_t k = 0; k < nb; ++k)
+    for (std::size_t j : live) {
+      double x = lam[j][k];
+      if (closed) x += std::round(lam[ref][k] - x);  // within half a period of the first curve's
+      p[k] += x / count;
+    }
+  if (closed) {
+    for (double& x : p) x = wrap_unit(x);
+    p.front() = 0.0;  // where the closed curves start
+  } else {
+    p.front() = 0.0;  // the end curves bound the network
+    p.back() = 1.0;
+  }
+  for (std::size_t k = 1; k < nb; ++k)
+    if (!(p[k] > p[k - 1]))
+      fail(errc::non_increasing, n.name(b, R[k - 1]), " and ", n.name(b, R[k]), " cross the ", curves_name(a),
+           " at parameters ", p[k - 1], " and ", p[k], " on average, which do not increase");
+}
+
+Arrangement arrangement(const Prepared& n, const CurveNetwork& net) {
+  Arrangement r;
+  const double strict = std::min(n.tol, 1e-7 * n.diagonal);
+  r.keep = 1e-3 * strict;
+  const auto& U = n.along[0];
+  const auto& V = n.along[1];
+  for (std::size_t a = 0; a < 2; ++a) {
+    r.degenerate[a].clear();
+    for (const auto& c : n.along[a]) r.degenerate[a].push_back(is_point(c, n.tol));
+  }
+  std::vector<double> gu = net.u_params, gv = net.v_params;
+  if (!gu.empty()) given_params(gu, net.v_curves.size(), n, 0);
+  if (!gv.empty()) given_params(gv, net.u_curves.size(), n, 1);
+  if (!gu.empty()) check_params(gu, "u_params", n.closed[0]);
+  if (!gv.empty()) check_params(gv, "v_params", n.closed[1]);
+  // Both families' parameters given and every pair of curves meeting there: the
+  // network as it was given, every curve kept, nothing searched.
+  if (!gu.empty() && !gv.empty()) {
+    std::vector<std::vector<detail::Crossing>> X(U.size(), std::vector<detail::Crossing>(V.size()));
+    bool meet = true;
+    for (std::size_t j = 0; j < U.size() && meet; ++j)
+      for (std::size_t i = 0; i < V.size() && meet; ++i) {
+        auto& x = X[j][i];
+        x = {gu[i], gv[j], U[j].point(gu[i]), V[i].point(gv[j]), 0};
+        x.gap = distance(x.a, x.b);
+        meet = x.gap <= n.tol;
+      }
+    if (meet) {
+      r.X = std::move(X);
+      for (std::size_t a = 0; a < 2; ++a) {
+        const std::size_t count = n.along[a].size();
+        r.order[a].resize(count);
+        std::iota(r.order[a].begin(), r.order[a].end(), 0);
+        r.reversed[a].assign(count, false);
+        std::vector<double> at = a == 0 ? gv : gu;  // family a lies at these
+        r.params[a] = at;
+        std::vector<double> along = a == 0 ? gu : gv;  // and crosses the other there
+        if (n.closed[a]) along.push_back(1.0);
+        r.to[a].assign(count, along);
+      }
+      return r;
+    }
+  }
+  std::vector<detail::CurveSamples> su, sv;
+  for (const auto& c : U) su.emplace_back(c);
+  for (const auto& c : V) sv.emplace_back(c);
+  r.X.assign(U.size(), std::vector<detail::Crossing>(V.size()));
+  for (std::size_t j = 0; j < U.size(); ++j)
+    for (std::size_t i = 0; i < V.size(); ++i) {
+      const auto x = detail::closest_points(U[j], V[i], n.closed[0], n.closed[1], n.tol, su[j], sv[i]);
+      if (!(x.gap <= n.tol)) {
+        const auto own = [](const BSplineCurve& given, double t) {
+          const auto [lo, hi] = given.domain();
+          return lo + t * (hi - lo);
+        };
+        fail(errc::network_gap, n.name(0, j), " and ", n.name(1, i), " do not meet: they come closest at ", x.a,
+             " (t = ", own(net.u_curves[j], x.s), " on ", n.name(0, j), ") and ", x.b, " (t = ", own(net.v_curves[i], x.t), " on ", n.name(1, i),
+             "), ", x.gap, " apart (tolerance ", n.tol, ")");
+      }
+      r.X[j][i] = x;
+    }
+  arrange(n, r, 0, gu);  // orders the v-curves, turns u-curves, finds u_params
+  arrange(n, r, 1, gv);
   return r;
 }
 
-BlendedSurface curve_network(const CurveNetwork& network, const NetworkOptions& options) {
-  Prepared n = prepare(network, options);
-  const double tol = n.tol;
-  const auto& U = n.along[0];
-  const auto& V = n.along[1];
-  const std::size_t nu = V.size(), nv = U.size();
-  std::vector<double> tu = network.u_params, tv = network.v_params;
-  if (tu.empty() || tv.empty()) {
-    const auto found = crossings(n);
-    if (tu.empty()) tu = found.u_params;
-    else given_params(tu, network.v_curves.size(), n, 0);
-    if (tv.empty()) tv = found.v_params;
-    else given_params(tv, network.u_curves.size(), n, 1);
-  } else {
-    given_params(tu, network.v_curves.size(), n, 0);
-    given_params(tv, network.u_curves.size(), n, 1);
+// Σ_k g_k φ_k(t) for the cardinal functions φ_k (B-splines on one knot vector) as one curve.
+BSplineCurve combination(const std::vector<detail::Scalar>& phi, const std::vector<Vec3>& g) {
+  const BSplineCurve& first = *phi.front().spline;
+  std::vector<Vec3> cp(first.control_points().size());
+  for (std::size_t k = 0; k < phi.size(); ++k) {
+    const auto& c = phi[k].spline->control_points();
+    INTERPATCH_ASSERT(c.size() == cp.size());
+    for (std::size_t q = 0; q < cp.size(); ++q) cp[q] += c[q].x * g[k];
   }
-  check_params(tu, "u_params", n.closed[0]);
-  check_params(tv, "v_params", n.closed[1]);
+  return BSplineCurve(first.knots(), std::move(cp));
+}
+
+// Which curves of family a are kept as they are and which re-expressed, with their
+// maps (over [0, 1] both ways) in the report; the points each will have at the
+// common parameters of the other family: node[k][i] for the curve at position k.
+struct Plan {
+  std::vector<bool> keep;  // by position
+  std::vector<std::vector<Vec3>> node;
+};
+
+Plan plan(const Prepared& n, const Arrangement& r, int a, std::vector<NetworkCurveReport>& report) {
+  const auto az = static_cast<std::size_t>(a), bz = 1 - az;
+  const auto& along = n.along[az];
+  const bool closed = n.closed[az];
+  std::vector<double> at = r.params[bz];
+  if (closed) at.push_back(1.0);
+  Plan out;
+  for (std::size_t k = 0; k < along.size(); ++k) {
+    const std::size_t j = r.order[az][k];
+    NetworkCurveReport& rep = report[j];
+    rep.position = k;
+    rep.reversed = r.reversed[az][j];
+    rep.degenerate = r.degenerate[az][j];
+    const auto& to = r.to[az][j];
+    bool keep = !rep.reversed;
+    for (std::size_t q = 0; keep && q < at.size() && !rep.degenerate; ++q)
+      keep = distance(along[j].point(at[q]), along[j].point(to[q])) <= r.keep;
+    rep.reexpressed = !keep;
+    rep.map = keep ? detail::monotone_map({0.0, 1.0}, {0.0, 1.0}, false) : detail::monotone_map(at, to, closed);
+    out.keep.push_back(keep);
+    // A re-expressed curve interpolates C(map(u_i)) = C(to_i) at u_i.
+    std::vector<Vec3> pts;
+    for (std::size_t i = 0; i < r.params[bz].size(); ++i) pts.push_back(along[j].point(keep ? at[i] : to[i]));
+    out.node.push_back(std::move(pts));
+  }
+  return out;
+}
+
+// The curves of family a in position order, as planned, and how far the surface is
+// from each given curve: S(u, v_j) = D_j(u) + Σ_i g_i φ_i(u) along u-curve j's line,
+// g_i = ½ (V_i(v_j) − D_j(u_i)), since ψ_l(v_j) = δ_lj (likewise for v-curves).
+std::vector<BSplineCurve> place_curves(const Prepared& n, const Arrangement& r, int a, const Plan& mine,
+                                       const Plan& other, const std::vector<detail::Scalar>& phi,
+                                       std::vector<NetworkCurveReport>& report) {
+  const auto az = static_cast<std::size_t>(a), bz = 1 - az;
+  const auto& along = n.along[az];
+  const bool closed = n.closed[az];
+  const double target = 0.5 * std::min(n.tol, 1e-7 * n.diagonal);
+  std::vector<std::optional<BSplineCurve>> out(along.size());
+  std::vector<std::size_t> redo;  // positions of the curves to re-express
+  std::vector<detail::FitJob> jobs;
+  std::vector<BSplineCurve> G;
+  G.reserve(along.size());
+  for (std::size_t k = 0; k < along.size(); ++k) {
+    std::vector<Vec3> g(other.node.size());
+    for (std::size_t i = 0; i < g.size(); ++i) g[i] = 0.5 * (other.node[i][k] - mine.node[k][i]);
+    G.push_back(combination(phi, g));
+  }
+  for (std::size_t k = 0; k < along.size(); ++k) {
+    const std::size_t j = r.order[az][k];
+    const BSplineCurve& given = n.input[az][j];
+    if (mine.keep[k]) {
+      double d = 0;
+      for (double u : detail::check_params(along[j].knots()))
+        d = std::max(d, distance(along[j].point(u) + G[k].point(u), given.point(closed ? u - std::floor(u) : u)));
+      report[j].distance = d;
+      out[k] = along[j];
+      continue;
+    }
+    redo.push_back(k);
+    jobs.push_back({&along[j], n.reshaped[az][j] ? &given : nullptr, &G[k], report[j].map});
+  }
+  if (!redo.empty()) {
+    auto fits = detail::refit(jobs, r.params[bz], closed, target);
+    for (std::size_t q = 0; q < redo.size(); ++q) {
+      auto& rep = report[r.order[az][redo[q]]];
+      rep.fit_error = fits[q].error;
+      rep.distance = fits[q].distance;
+      out[redo[q]] = std::move(fits[q].curve);
+    }
+  }
+  std::vector<BSplineCurve> placed;
+  placed.reserve(out.size());
+  for (auto& c : out) placed.push_back(std::move(*c));
+  return placed;
+}
+
+struct Built {
+  std::optional<BlendedSurface> surface;
+  NetworkReport report;
+};
+
+// The construction; with `fit` false only the parameters of the report.
+Built build(const CurveNetwork& network, const NetworkOptions& options, bool fit) {
+  Prepared n = prepare(network, options);
+  Arrangement r = arrangement(n, network);
+  NetworkReport rep;
+  rep.tolerance = n.tol;
+  rep.diagonal = n.diagonal;
+  rep.u_curves.resize(network.u_curves.size());
+  rep.v_curves.resize(network.v_curves.size());
+  // Common parameters per curve as given (a closing curve: 1).
+  for (int a = 0; a < 2; ++a) {
+    const auto az = static_cast<std::size_t>(a);
+    auto& out = a == 0 ? rep.v_params : rep.u_params;  // the parameters of family a
+    out.assign((a == 0 ? network.u_curves : network.v_curves).size(), 1.0);
+    for (std::size_t k = 0; k < r.order[az].size(); ++k) out[r.order[az][k]] = r.params[az][k];
+  }
+  const bool found = network.u_params.empty() || network.v_params.empty();
+  for (std::size_t j = 0; j < r.X.size(); ++j)
+    for (std::size_t i = 0; i < r.X[j].size(); ++i) {
+      const double g = r.X[j][i].gap;
+      rep.u_curves[j].max_gap = std::max(rep.u_curves[j].max_gap, g);
+      rep.v_curves[i].max_gap = std::max(rep.v_curves[i].max_gap, g);
+      if (g > rep.max_gap) {
+        rep.max_gap = g;
+        rep.max_gap_at = {j, i};
+      }
+    }
+  if (!fit) return {std::nullopt, std::move(rep)};
+  const auto& tu = r.params[1];  // u of the v-curves, by position
+  const auto& tv = r.params[0];
   auto t = std::make_shared<detail::BlendedTerms>();
+  t->f = cardinals(tu, options.method, n.closed[0]);
+  t->g = cardinals(tv, options.method, n.closed[1]);
+  const Plan pu = plan(n, r, 0, rep.u_curves), pv = plan(n, r, 1, rep.v_curves);
+  std::vector<BSplineCurve> U = place_curves(n, r, 0, pu, pv, t->f, rep.u_curves);
+  std::vector<BSplineCurve> V = place_curves(n, r, 1, pv, pu, t->g, rep.v_curves);
+  const std::size_t nu = V.size(), nv = U.size();
   t->c = PointGrid({nu, nv});
   for (std::size_t i = 0; i < nu; ++i)
-    for (std::size_t j = 0; j < nv; ++j) {
-      const Vec3 a = U[j].point(tu[i]), b = V[i].point(tv[j]);
-      const double gap = distance(a, b);
-      if (gap > tol)
-        fail(errc::network_gap, "u_curves[", j, "] and v_curves[", i, "] miss each other at node (", i, ", ", j,
-             ") = (u ", tu[i], ", v ", tv[j], "): u_curves[", j, "] gives ", a, ", v_curves[", i, "] gives ", b,
-             ", gap ", gap, " (tolerance ", tol, ")");
-      t->c(i, j) = -0.5 * (a + b);
+    for (std::size_t j = 0; j < nv; ++j) t->c(i, j) = -0.5 * (U[j].point(tu[i]) + V[i].point(tv[j]));
+  // Own parameters of the crossings, in the given curves' domains, and the maps.
+  for (int a = 0; a < 2; ++a) {
+    const auto az = static_cast<std::size_t>(a);
+    const auto& given = a == 0 ? network.u_curves : network.v_curves;
+    auto& reports = a == 0 ? rep.u_curves : rep.v_curves;
+    for (std::size_t j = 0; j < n.along[az].size(); ++j) {
+      const auto [lo, hi] = given[j].domain();
+      auto& c = reports[j];
+      c.crossings.clear();
+      for (std::size_t k = 0; k < r.order[1 - az].size(); ++k)
+        c.crossings.push_back(lo + crossing_param(r, a, j, r.order[1 - az][k]) * (hi - lo));
+      for (double& x : c.map.to) x = lo + x * (hi - lo);
+      for (double& x : c.map.slope) x *= hi - lo;
+      c.map.start = lo;
+      c.map.period = n.closed[az] ? hi - lo : 0.0;
     }
-  t->f = cardinals(tu, options.method, n.closed[0]);
-  t->a = V;
-  t->g = cardinals(tv, options.method, n.closed[1]);
-  t->b = U;
+  }
+  const double strict = 1e-7 * n.diagonal;
+  std::vector<std::string> far;
+  for (int a = 0; a < 2; ++a) {
+    const auto& reports = a == 0 ? rep.u_curves : rep.v_curves;
+    for (std::size_t j = 0; j < n.along[static_cast<std::size_t>(a)].size(); ++j)
+      if (reports[j].distance > strict) far.push_back(detail::cat(n.name(a, j), " by ", reports[j].distance));
+  }
+  // The closing curves: the seam curve's line against each.
+  for (int a = 0; a < 2; ++a) {
+    if (!n.closing[static_cast<std::size_t>(1 - a)]) continue;
+    auto& reports = a == 0 ? rep.u_curves : rep.v_curves;
+    const auto& given = a == 0 ? network.u_curves : network.v_curves;
+    NetworkCurveReport& c = reports.back();
+    const std::size_t seam = r.order[static_cast<std::size_t>(a)].front();
+    c = reports[seam];
+    c.closing = true;
+    c.position = n.along[static_cast<std::size_t>(a)].size();
+    const auto [lo, hi] = given.back().domain();
+    const auto [slo, shi] = given[seam].domain();
+    for (double& x : c.map.to) x = lo + (x - slo) / (shi - slo) * (hi - lo);
+    for (double& x : c.map.slope) x *= (hi - lo) / (shi - slo);
+    for (double& x : c.crossings) x = lo + (x - slo) / (shi - slo) * (hi - lo);
+    c.map.start = lo;
+    if (c.map.period > 0) c.map.period = hi - lo;
+    double d = 0;
+    const BlendedSurface probe(t);
+    for (double x : linspace(0, 1, 129)) {
+      const Vec3 s = a == 0 ? probe.point(x, 1.0) : probe.point(1.0, x);
+      d = std::max(d, distance(s, given.back().point(c.map(x))));
+    }
+    c.distance = d;
+    if (d > strict) far.push_back(detail::cat(n.name(a, given.size() - 1), " by ", d));
+  }
+  t->a = std::move(V);
+  t->b = std::move(U);
   t->notes = std::move(n.notes);
-  if (network.u_params.empty() || network.v_params.empty())
-    t->notes.push_back("crossing parameters found from the curves");
-  return BlendedSurface(std::move(t));
+  if (found) t->notes.push_back("crossing parameters found from the curves");
+  for (int a = 0; a < 2; ++a) {
+    const auto& reports = a == 0 ? rep.u_curves : rep.v_curves;
+    std::vector<std::size_t> re, turned;
+    double worst = 0;
+    bool sorted = true;
+    for (std::size_t j = 0; j < reports.size(); ++j) {
+      if (reports[j].reexpressed) {
+        re.push_back(j);
+        worst = std::max(worst, reports[j].fit_error);
+      }
+      if (reports[j].reversed) turned.push_back(j);
+      if (!reports[j].closing && reports[j].position != j) sorted = false;
+    }
+    if (!sorted) {
+      std::vector<std::size_t> o(r.order[static_cast<std::size_t>(a)]);
+      t->notes.push_back(detail::cat(curves_name(a), " sorted into the order ", list(o)));
+    }
+    if (!turned.empty()) t->notes.push_back(detail::cat(curves_name(a), " ", list(turned), " turned round to run with the others"));
+    if (!re.empty())
+      t->notes.push_back(detail::cat(curves_name(a), " ", list(re), " re-expressed with their crossings at the common "
+                                     "parameters, within ", worst, " of the curves given"));
+  }
+  if (!far.empty()) {
+    std::string s;
+    for (const auto& f : far) s += (s.empty() ? "" : ", ") + f;
+    t->notes.push_back(detail::cat("the surface departs from ", s, ": more than 1e-7 of the diagonal (", strict,
+                                   "); the tolerance ", n.tol, " lets curves miss each other by that much"));
+  }
+  return {BlendedSurface(std::move(t)), std::move(rep)};
+}
+
+}  // namespace
+
+NetworkParameters network_parameters(const CurveNetwork& network, const NetworkOptions& options) {
+  auto r = build(network, options, false).report;
+  return {std::move(r.u_params), std::move(r.v_params)};
+}
+
+NetworkSurface network_surface(const CurveNetwork& network, const NetworkOptions& options) {
+  auto b = build(network, options, true);
+  return {std::move(*b.surface), std::move(b.report)};
+}
+
+BlendedSurface curve_network(const CurveNetwork& network, const NetworkOptions& options) {
+  return std::move(*build(network, options, true).surface);
 }
 
 }  // namespace interpatch

@@ -51,7 +51,7 @@ TEST(BlendedSurface, NetworkCardinalFunctionsAreDeltas) {
         CurveNetwork n{std::vector<BSplineCurve>(tv.size(), zero), std::vector<BSplineCurve>(tu.size(), zero), tu, tv,
                        {closed, false}};
         n.v_curves[k] = bump;
-        const auto s = curve_network(n, {method, {}});
+        const auto s = curve_network(n, {method, {}, {}});
         for (double t : linspace(0, 1, 11)) {
           for (std::size_t i = 0; i < tu.size(); ++i)
             EXPECT_LT(distance(s.point(tu[i], t), i == k ? bump_at(t) : Vec3{}), 1e-15 * 16);
@@ -77,7 +77,7 @@ TEST(BlendedSurface, TranslatingTheDataTranslatesTheSurface) {
   n.u_params = m.u_params = tu;
   n.v_params = m.v_params = tv;
   for (auto method : {NetworkMethod::coons_linear, NetworkMethod::coons_hermite, NetworkMethod::gordon}) {
-    const auto a = curve_network(n, {method, {}}), b = curve_network(m, {method, {}});
+    const auto a = curve_network(n, {method, {}, {}}), b = curve_network(m, {method, {}, {}});
     for (double u : linspace(0, 1, 9))
       for (double v : linspace(0, 1, 9)) EXPECT_LT(distance(b.point(u, v) - d, a.point(u, v)), 1e-13);
   }
@@ -122,8 +122,8 @@ TEST(BlendedSurface, BatchEvaluationMatchesPointwise) {
     gregory.twists[0] = Vec3{1, 2, 3};  // disagrees with the curves: Gregory's terms are active
     const std::vector<BlendedSurface> surfaces{
         coons(b), coons(b, hermite), coons(b, callable), coons(b, cross), coons(b, cross, gregory),
-        ruled(b.v0, b.v1), curve_network(n, {NetworkMethod::coons_linear, {}}),
-        curve_network(n, {NetworkMethod::coons_hermite, {}}), curve_network(n, {NetworkMethod::gordon, {}})};
+        ruled(b.v0, b.v1), curve_network(n, {NetworkMethod::coons_linear, {}, {}}),
+        curve_network(n, {NetworkMethod::coons_hermite, {}, {}}), curve_network(n, {NetworkMethod::gordon, {}, {}})};
     std::vector<double> us = linspace(0, 1, 23), vs = linspace(0, 1, 17);
     for (auto& u : us) u = u * u;  // uneven spacing, ends kept
     for (const auto& s : surfaces) {
@@ -156,8 +156,8 @@ std::vector<std::pair<BlendedSurface, std::size_t>> large_blended_surfaces() {
   b.u0 = b.u0.elevated(1);
   const auto net = test::network_on(src, linspace(0, 1, 7), {0, 0.2, 0.45, 0.7, 1});
   return {{coons(b), 4},
-          {curve_network(net, {NetworkMethod::gordon, {}}), 12},
-          {curve_network(net, {NetworkMethod::coons_hermite, {}}), 12}};
+          {curve_network(net, {NetworkMethod::gordon, {}, {}}), 12},
+          {curve_network(net, {NetworkMethod::coons_hermite, {}, {}}), 12}};
 }
 
 TEST(BlendedSurface, LargeExactFormsEqualTheFormula) {
@@ -212,7 +212,7 @@ TEST(BlendedSurface, ClosedNetworkCardinalFunctionsSumToOne) {
     n.v_params = tv;
     n.periodic = {true, false};
     for (auto method : {NetworkMethod::coons_linear, NetworkMethod::coons_hermite, NetworkMethod::gordon}) {
-      const auto s = curve_network(n, {method, {}});
+      const auto s = curve_network(n, {method, {}, {}});
       // Sums of up to 6 cardinal functions (up to ~2 between the nodes) times points of
       // size ~1, twice: rounding, up to 1e-14 in these trials.
       for (double u : linspace(0, 1, 23))
@@ -266,7 +266,7 @@ TEST(BlendedSurface, ClosedNetworkBatchEvaluationMatchesPointwise) {
     std::vector<double> us = linspace(0, 1, 23), vs = linspace(0, 1, 17);
     for (auto& u : us) u = u * u;  // uneven spacing, both ends kept: the seam from both sides
     for (auto method : {NetworkMethod::coons_linear, NetworkMethod::coons_hermite, NetworkMethod::gordon}) {
-      const auto s = curve_network(n, {method, {}});
+      const auto s = curve_network(n, {method, {}, {}});
       const PointGrid grid = s.evaluate(us, vs);
       const auto d = s.evaluate_derivatives(us, vs);
       double worst = 0;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <regex>
 
 #include "interpatch/interpolate.hpp"
 #include "interpatch/io/spec.hpp"
@@ -28,7 +29,7 @@ TEST(Network, EveryMethodInterpolatesEveryCurveAndConvertsExactly) {
     const auto s = test::random_bspline_surface(g, 3, 2 + trial % 2, 7, 6);
     const auto n = test::network_on(s, {0, 0.2, 0.45, 0.7, 1}, {0, 0.3, 0.6, 1});
     for (auto m : kMethods) {
-      const auto c = curve_network(n, {m, {}});
+      const auto c = curve_network(n, {m, {}, {}});
       expect_interpolates(c, n, 1e-13);
       // Exact form: elevation and merging of up to ~15 knots per direction.
       EXPECT_LT(test::max_distance(c, c.to_bspline()), 1e-12 * 8);
@@ -43,7 +44,7 @@ TEST(Network, GordonReproducesBicubicsAndTwoByTwoIsCoons) {
   const auto gordon = curve_network(n);
   EXPECT_LT(test::max_distance(gordon, bez), 1e-13);  // cubic cardinal splines reproduce cubics
   EXPECT_EQ(gordon.to_bspline().knots_u().continuity(), 2);  // C2 across the nodes
-  EXPECT_GT(test::max_distance(curve_network(n, {NetworkMethod::coons_linear, {}}), bez), 1e-3);
+  EXPECT_GT(test::max_distance(curve_network(n, {NetworkMethod::coons_linear, {}, {}}), bez), 1e-3);
 }
 
 TEST(Network, HermiteBlendingIsC1AcrossCellsLinearIsNot) {
@@ -60,10 +61,10 @@ TEST(Network, HermiteBlendingIsC1AcrossCellsLinearIsNot) {
     return e;
   };
   // Smooth: the jump is second derivative × 2h ~ 1e-5 at most.
-  EXPECT_LT(jump(curve_network(n, {NetworkMethod::coons_hermite, {}})), 1e-5);
-  EXPECT_LT(jump(curve_network(n, {NetworkMethod::gordon, {}})), 1e-5);
-  EXPECT_GT(jump(curve_network(n, {NetworkMethod::coons_linear, {}})), 1e-2);  // the kink the check must see
-  const auto b = curve_network(n, {NetworkMethod::coons_hermite, {}}).to_bspline();
+  EXPECT_LT(jump(curve_network(n, {NetworkMethod::coons_hermite, {}, {}})), 1e-5);
+  EXPECT_LT(jump(curve_network(n, {NetworkMethod::gordon, {}, {}})), 1e-5);
+  EXPECT_GT(jump(curve_network(n, {NetworkMethod::coons_linear, {}, {}})), 1e-2);  // the kink the check must see
+  const auto b = curve_network(n, {NetworkMethod::coons_hermite, {}, {}}).to_bspline();
   EXPECT_GE(b.knots_u().continuity(), 1);
 }
 
@@ -89,8 +90,22 @@ TEST(Network, InvalidInput) {
   auto cp = bad.u_curves[1].control_points();
   for (auto& x : cp) x.z += 0.125;
   bad.u_curves[1] = BSplineCurve(bad.u_curves[1].knots(), cp);
-  EXPECT_ERRC((void)curve_network(bad), network_gap, "u_curves[1] and v_curves[0] miss each other at node (0, 1)");
-  EXPECT_ERRC((void)curve_network(bad), network_gap, "gap 0.125");
+  // Lifted by 0.125, u_curves[1] comes no closer than that to v_curves[0] where they
+  // would cross, and a little closer where v_curves[0] climbs: the gap named is the
+  // closest distance, found, with the closest points and their parameters.
+  EXPECT_ERRC((void)curve_network(bad), network_gap, "u_curves[1] and v_curves[0] do not meet: they come closest at (");
+  try {
+    (void)curve_network(bad);
+  } catch (const error& e) {
+    std::smatch m;
+    const std::string what = e.what();
+    ASSERT_TRUE(std::regex_search(what, m, std::regex(R"(\(t = ([^ ]+) on u_curves\[1\]\) and .* \(t = ([^ ]+) on v_curves\[0\]\), ([^ ]+) apart)")))
+        << what;
+    const double s_at = std::stod(m[1]), t_at = std::stod(m[2]), gap = std::stod(m[3]);
+    EXPECT_NEAR(gap, distance(bad.u_curves[1].point(s_at), bad.v_curves[0].point(t_at)), 1e-5);  // printed to 6 digits
+    EXPECT_LE(gap, 0.125 + 1e-6);
+    EXPECT_GT(gap, 0.1);
+  }
   auto few = n;
   few.u_curves.pop_back();
   few.u_curves.pop_back();
@@ -208,7 +223,7 @@ TEST(Network, ClosedNetworksInterpolateEveryCurveAndConvertExactly) {
     const CurveNetwork n = random_tube_network(g, closed_v);
     const double scale = data_scale(n);
     for (auto m : kMethods) {
-      const auto s = curve_network(n, {m, {}});
+      const auto s = curve_network(n, {m, {}, {}});
       // The curves cross at the nodes to the rounding of their interpolations (~1e-15
       // of the data); the surface misses a curve by that times the cardinal functions'
       // sum of magnitudes (a few), plus the rounding of its own few terms.
@@ -259,8 +274,8 @@ TEST(Network, GordonIsC2AcrossTheSeamHermiteC1LinearC0) {
     // 4..6 sections and lines around: cubic closed cardinal functions.
     const auto nu = static_cast<std::size_t>(test::uniform(g, 4, 7)), nv = static_cast<std::size_t>(test::uniform(g, 4, 7));
     const CurveNetwork n = tube_network(tube, nodes(g, nu, kSections, true), nodes(g, nv, kStations, closed_v));
-    const auto gordon = curve_network(n), hermite = curve_network(n, {NetworkMethod::coons_hermite, {}}),
-               linear = curve_network(n, {NetworkMethod::coons_linear, {}});
+    const auto gordon = curve_network(n), hermite = curve_network(n, {NetworkMethod::coons_hermite, {}, {}}),
+               linear = curve_network(n, {NetworkMethod::coons_linear, {}, {}});
     for (int axis = 0; axis < (closed_v ? 2 : 1); ++axis) {
       // Both sides of the seam evaluate the same closed splines on different spans:
       // they agree to rounding, ~1e-14 of each derivative; 1e-10 leaves room for the
@@ -316,7 +331,7 @@ TEST(Network, ClosingCurveIsLeftOut) {
       c.v_params.push_back(1.0);
     }
     for (auto m : kMethods) {
-      const auto a = curve_network(n, {m, {}}), b = curve_network(c, {m, {}});
+      const auto a = curve_network(n, {m, {}, {}}), b = curve_network(c, {m, {}, {}});
       for (double u : linspace(0, 1, 7))
         for (double v : linspace(0, 1, 7)) EXPECT_EQ(a.point(u, v), b.point(u, v));  // the same terms exactly
       EXPECT_NE(std::find_if(b.notes().begin(), b.notes().end(),
@@ -346,7 +361,7 @@ TEST(Network, OpenCurvesWhoseEndsMeetCloseWithASeamOfMultiplicityP) {
     for (auto& c : open.u_curves) c = c.clamped();
     const double scale = data_scale(n);
     for (auto m : kMethods) {
-      const auto a = curve_network(n, {m, {}}), b = curve_network(open, {m, {}});
+      const auto a = curve_network(n, {m, {}, {}}), b = curve_network(open, {m, {}, {}});
       // clamped() re-solves each section in the open space: ~1e-15 of the data apart.
       EXPECT_LT(test::max_distance(a, b), 1e-13 * scale) << trial;
       EXPECT_LT(worst_miss(b, open), 1e-13 * scale) << trial;
@@ -398,7 +413,7 @@ TEST(Network, ClosedCurvesInAnOpenNetworkAreUsedOpen) {
     n.u_params.push_back(1.0);
     const double scale = data_scale(n);
     for (auto m : kMethods) {
-      const auto s = curve_network(n, {m, {}});
+      const auto s = curve_network(n, {m, {}, {}});
       EXPECT_LT(worst_miss(s, n), 1e-13 * scale) << trial;  // as for closed networks
       const BSplineSurface e = s.to_bspline();
       EXPECT_EQ(e.periodic(), (std::array<bool, 2>{false, false}));
@@ -449,7 +464,7 @@ TEST(Network, SpecPeriodicBuildsTheSameSurface) {
   bad["periodic"] = {true, 1};
   EXPECT_ERRC((void)io::build(bad), wrong_type, "/periodic/1: expected true or false (is v closed?), got a number");
   bad["periodic"] = {true, false};  // the u_curves are open and far from closed
-  EXPECT_ERRC((void)io::build(bad), network_gap, "u_curves[0] is not closed");
+  EXPECT_ERRC((void)io::build(bad), network_gap, "/u_curves/0 is not closed");
 }
 
 }  // namespace

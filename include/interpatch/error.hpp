@@ -27,7 +27,8 @@ enum class errc {
   out_of_domain,           ///< a parameter outside the domain
   singular,                ///< the linear system has no unique solution
   corner_gap,              ///< boundary curves do not meet at a corner
-  network_gap,             ///< curves of a network miss each other at a node
+  network_gap,             ///< curves of a network miss each other
+  network_order,           ///< curves of a network cross in orders no sorting makes agree, or meet within a family
   incompatible_twist,      ///< given twists disagree with the cross-derivative curves
   tangent_mismatch,        ///< cross-derivative curves disagree with the boundary tangents at a corner
   invalid_blend,           ///< a blending function that is not 0 at 0, 1 at 1 and monotone

@@ -4,7 +4,10 @@
 /// patches (C0 with linear blending, C1 with Hermite blending) and the Gordon surface.
 
 #include <array>
+#include <cstddef>
+#include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "interpatch/blended_surface.hpp"
@@ -45,11 +48,70 @@ enum class NetworkMethod {
 
 struct NetworkOptions {
   NetworkMethod method = NetworkMethod::gordon;
-  /// Curves missing each other at a node by more than this are an error; unset means
-  /// 1e-7 × the diagonal of the control points' bounding box. In a closed direction
-  /// also how close the ends of an open curve must be for it to close, and how close
-  /// a last curve must stay to the first to be the closing curve.
+  /// Curves missing each other by more than this are an error; unset means 1e-7 ×
+  /// the diagonal of the control points' bounding box. In a closed direction also how
+  /// close the ends of an open curve must be for it to close, and how close a last
+  /// curve must stay to the first to be the closing curve. The re-expression of a
+  /// curve (see curve_network) keeps within half of the smaller of this and the
+  /// default, so a loose tolerance lets curves miss each other, never loosens a fit.
   std::optional<double> tolerance;
+  /// How messages name a curve: family 0 (u_curves) or 1 (v_curves) and its index
+  /// as given. Unset: "u_curves[3]"; a spec reader names them by JSON Pointer.
+  std::function<std::string(int family, std::size_t index)> curve_name;
+};
+
+/// A monotone map from the surface's parameter (over [0, 1]) to a curve's own
+/// parameter: the piecewise cubic Hermite function through (at[i], to[i]) with slopes
+/// slope[i], C2 where the cubic spline through the points is monotone, C1 (Fritsch–
+/// Carlson slopes) where it is not. Decreasing for a curve that runs against its
+/// family. For a closed curve the value is moved by whole periods into
+/// [start, start + period) (period > 0).
+struct Reparametrization {
+  std::vector<double> at, to, slope;
+  double start = 0, period = 0;
+  [[nodiscard]] double operator()(double t) const;
+};
+
+/// How the network used one of its input curves.
+struct NetworkCurveReport {
+  /// Its place in its family as sorted: the surface has u_curves[j] at v_params[j]
+  /// and v_curves[i] at u_params[i] of the report (the closing curve of a closed
+  /// family: the count of the others, and its parameter 1).
+  std::size_t position = 0;
+  bool reversed = false;     ///< it runs against its family, and was turned round
+  bool reexpressed = false;  ///< false: used exactly as given (it crossed at the common parameters)
+  bool closing = false;      ///< the closing curve of a closed family, left out
+  bool degenerate = false;   ///< a curve shrunk to a point (a pole), used as given
+  /// Surface parameter (along the curve) → its own parameter. The part of the curve
+  /// the surface uses is map(0) to map(1): all of it unless it runs past the end
+  /// curves of the other family.
+  Reparametrization map;
+  /// Its own parameters where it crosses the curves of the other family, in their sorted order.
+  std::vector<double> crossings;
+  double max_gap = 0;    ///< largest distance to a curve it crosses, at the crossing
+  /// Largest distance between the re-expressed curve and the input curve at the same
+  /// surface parameter (0 when used as given), measured at 4 points of every span.
+  double fit_error = 0;
+  /// Largest distance from the input curve to the surface, measured at the same
+  /// points: |S(u, v_j) − C(map(u))| for u_curves[j] (the surface along its line
+  /// against the curve at the matching parameter; the distance to the nearest point
+  /// of the surface is no larger).
+  double distance = 0;
+};
+
+/// What curve_network found and did, curve by curve (in the order given).
+struct NetworkReport {
+  std::vector<double> u_params, v_params;  ///< as network_parameters returns them
+  std::vector<NetworkCurveReport> u_curves, v_curves;
+  double max_gap = 0;                         ///< largest gap at a crossing
+  std::array<std::size_t, 2> max_gap_at{0, 0};  ///< where: (u-curve, v-curve) as given
+  double tolerance = 0;                       ///< NetworkOptions::tolerance in effect
+  double diagonal = 0;                        ///< of the control points' bounding box
+};
+
+struct NetworkSurface {
+  BlendedSurface surface;
+  NetworkReport report;
 };
 
 /// Where the curves cross: u_params[i] for v_curves[i], v_params[j] for u_curves[j].
@@ -88,5 +150,11 @@ struct NetworkParameters {
 ///   (naming both curves, the node and the gap; an open curve of a closed direction
 ///   whose ends do not meet).
 [[nodiscard]] BlendedSurface curve_network(const CurveNetwork& network, const NetworkOptions& options = {});
+
+/// The same, with what was found and done curve by curve: the crossings and their
+/// gaps, the order and direction of each family, which curves were re-expressed, and
+/// how far the surface is from each input curve (NetworkReport).
+/// @throws error as curve_network.
+[[nodiscard]] NetworkSurface network_surface(const CurveNetwork& network, const NetworkOptions& options = {});
 
 }  // namespace interpatch

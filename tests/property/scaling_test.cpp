@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "detail/text.hpp"
+#include "network_curves.hpp"
 #include "interpatch/coons.hpp"
 #include "interpatch/coons_volume.hpp"
 #include "interpatch/evaluate.hpp"
@@ -572,7 +573,7 @@ TEST(Scaling, CurveNetworksEveryMethodCrossingsGivenAndFound) {
         expect_scale_free(detail::cat("network ", trial, " method ", static_cast<int>(m), n == &given ? " given" : " found"),
                           [&](int k) {
                             Outputs out;
-                            record(out, "network", curve_network(sc(*n, k), {m, {}}));
+                            record(out, "network", curve_network(sc(*n, k), {m, {}, {}}));
                             return out;
                           });
   }
@@ -729,7 +730,14 @@ TEST(Scaling, GapsAndTolerancesScaleWithTheData) {
     std::vector<Vec3> vp = n.v_curves[1].control_points();
     for (Vec3& p : vp) p.z += factor * 1e-7 * test::bbox_diagonal(all);
     n.v_curves[1] = BSplineCurve(n.v_curves[1].knots(), vp);
-    const double ngap = distance(n.u_curves[0].point(0.4), n.v_curves[1].control_points().front());
+    // The gap named is the closest distance of the two curves, found as the library
+    // finds it; its search scales exactly with the data (powers of two).
+    const detail::CurveSamples s0(n.u_curves[0]), s1(n.v_curves[1]);
+    const double ngap = detail::closest_points(n.u_curves[0], n.v_curves[1], false, false, 0.0, s0, s1).gap;
+    std::vector<Vec3> moved_all;  // the tolerance is the library's: of the curves as moved
+    for (const auto* list : {&n.u_curves, &n.v_curves})
+      for (const auto& c : *list) moved_all.insert(moved_all.end(), c.control_points().begin(), c.control_points().end());
+    const double ntol = 1e-7 * test::bbox_diagonal(moved_all);
     for (int k : kErrorScales) {
       const auto f = [&] { (void)curve_network(sc(n, k)); };
       if (factor < 1) {
@@ -737,7 +745,7 @@ TEST(Scaling, GapsAndTolerancesScaleWithTheData) {
         continue;
       }
       const std::string m = message_of(f, errc::network_gap);
-      const std::string want = "gap " + detail::num(std::ldexp(ngap, k)) + " (tolerance ";
+      const std::string want = detail::num(std::ldexp(ngap, k)) + " apart (tolerance " + detail::num(std::ldexp(ntol, k)) + ")";
       EXPECT_NE(m.find(want), std::string::npos) << m << "\nlacks " << want << " at scale 2^" << k;
     }
 

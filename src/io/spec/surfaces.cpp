@@ -4,6 +4,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 
 #include "interpatch/coons.hpp"
 #include "interpatch/evaluate.hpp"
@@ -17,12 +18,14 @@ namespace {
 
 constexpr std::size_t curve_samples = 65;
 
-// A curve of the spec sampled for the data check: S(u, fixed) (axis 0) or S(fixed, v).
-DataSet curve_data(const BSplineCurve& c, int axis, double fixed, std::string pointer) {
+// A curve of the spec sampled for the data check: S(u, fixed) (axis 0) or S(fixed, v)
+// against the curve at map(u) (a network's curves) or at u itself.
+DataSet curve_data(const BSplineCurve& c, int axis, double fixed, std::string pointer,
+                   const std::optional<Reparametrization>& map = std::nullopt) {
   DataSet d;
   const std::vector<double> t = linspace(0, 1, curve_samples);
   d.params = axis == 0 ? std::vector<std::vector<double>>{t, {fixed}} : std::vector<std::vector<double>>{{fixed}, t};
-  for (double x : t) d.points.push_back(c.point(x));
+  for (double x : t) d.points.push_back(c.point(map ? (*map)(x) : x));
   d.pointer = std::move(pointer);
   return d;
 }
@@ -164,24 +167,52 @@ Construction build_network(const json& spec, Context& ctx) {
              : method == "coons_hermite" ? NetworkMethod::coons_hermite
                                          : NetworkMethod::gordon;
   o.tolerance = tolerance_of(spec);
+  o.curve_name = [](int family, std::size_t i) { return child(family == 0 ? "/u_curves" : "/v_curves", i); };
   ctx.parsed();
-  if (net.u_params.empty() || net.v_params.empty()) {
-    const auto found = at("", [&] { return network_parameters(net, o); });
-    if (net.u_params.empty()) net.u_params = found.u_params;
-    if (net.v_params.empty()) net.v_params = found.v_params;
-  }
-  BlendedSurface s = at("", [&] { return curve_network(net, o); });
+  NetworkSurface built = at("", [&] { return network_surface(net, o); });
+  const NetworkReport& r = built.report;
+  // Each curve as given against the surface along its line, point for point through its map.
   std::vector<DataSet> data;
-  for (std::size_t j = 0; j < net.u_curves.size(); ++j)
-    data.push_back(curve_data(net.u_curves[j], 0, net.v_params[j], child("/u_curves", j)));
-  for (std::size_t i = 0; i < net.v_curves.size(); ++i)
-    data.push_back(curve_data(net.v_curves[i], 1, net.u_params[i], child("/v_curves", i)));
+  nlohmann::ordered_json reported = nlohmann::ordered_json::object();
+  for (int a = 0; a < 2; ++a) {
+    const auto& given = a == 0 ? net.u_curves : net.v_curves;
+    const auto& reports = a == 0 ? r.u_curves : r.v_curves;
+    const auto& line = a == 0 ? r.v_params : r.u_params;
+    for (std::size_t j = 0; j < given.size(); ++j) {
+      const std::string ptr = child(a == 0 ? "/u_curves" : "/v_curves", j);
+      const NetworkCurveReport& c = reports[j];
+      data.push_back(curve_data(given[j], a, line[j], ptr, c.map));
+      const double from = c.map(0.0), to = c.map(1.0);
+      reported[ptr] = {{"position", c.position},
+                     {"reversed", c.reversed},
+                     {"reexpressed", c.reexpressed},
+                     {"fit_error", c.fit_error},
+                     {"distance", c.distance},
+                     {"max_gap", c.max_gap},
+                     {"range", {from, to}}};
+      if (c.closing) reported[ptr]["closing"] = true;
+      if (c.degenerate) reported[ptr]["degenerate"] = true;
+      const double strict = 1e-7 * r.diagonal;
+      if (c.distance > strict)
+        ctx.warn(cat(ptr, ": the surface departs from this curve by up to ", c.distance, ", more than 1e-7 of the ",
+                     "diagonal (", strict, "): the tolerance ", r.tolerance, " lets curves miss each other by that much"));
+      const auto [lo, hi] = given[j].domain();
+      const double a0 = std::min(from, to), a1 = std::max(from, to);
+      if (!c.degenerate && c.map.period == 0 && (a0 > lo || a1 < hi))
+        ctx.warn(cat(ptr, ": only t from ", a0, " to ", a1, " (of ", lo, " to ", hi, ") lies between the end curves; ",
+                     "the rest runs past them and is not on the surface"));
+    }
+  }
   nlohmann::ordered_json parameters = {{"method", method},
                                        {"curves", {net.u_curves.size(), net.v_curves.size()}},
-                                       {"u_params", net.u_params},
-                                       {"v_params", net.v_params}};
+                                       {"u_params", r.u_params},
+                                       {"v_params", r.v_params}};
   if (net.periodic[0] || net.periodic[1]) parameters["periodic"] = net.periodic;
-  return blended("network", std::move(s), std::move(data), std::move(parameters));
+  parameters["crossings"] = {{"max_gap", r.max_gap},
+                             {"at", {child("/u_curves", r.max_gap_at[0]), child("/v_curves", r.max_gap_at[1])}},
+                             {"tolerance", r.tolerance}};
+  parameters["network_curves"] = std::move(reported);
+  return blended("network", std::move(built.surface), std::move(data), std::move(parameters));
 }
 
 Construction build_hermite_patch(const json& spec, Context& ctx) {

@@ -1,0 +1,550 @@
+#include "network_curves.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <optional>
+
+#include "detail/banded.hpp"
+#include "detail/collocation.hpp"
+#include "detail/parallel.hpp"
+#include "detail/text.hpp"
+
+namespace interpatch::detail {
+
+namespace {
+
+// t moved by whole periods into [0, 1).
+double wrap_unit(double t) {
+  const double r = t - std::floor(t);
+  return r < 1.0 ? r : 0.0;  // a tiny negative t rounds to 1
+}
+
+// Gauss–Newton on F(s, t) = U(s) − V(t) from (s, t).
+void newton(const BSplineCurve& U, const BSplineCurve& V, double& s, double& t, bool closed_u, bool closed_v) {
+  // The next parameter, and how far it moved (around the circle for a closed curve).
+  const auto step = [](double x, double dx, bool closed) {
+    if (!closed) {
+      const double n = std::clamp(x + dx, 0.0, 1.0);
+      return std::pair{n, std::abs(n - x)};
+    }
+    const double n = wrap_unit(x + dx), moved = std::abs(n - x);
+    return std::pair{n, std::min(moved, 1.0 - moved)};
+  };
+  for (int it = 0; it < 50; ++it) {
+    Vec3 du[2], dv[2];
+    U.derivatives(s, 1, du);
+    V.derivatives(t, 1, dv);
+    // Normal equations of J = [U'(s), −V'(t)], with U', V' and F in units of 2^e, e the
+    // exponent of the largest component of U' and V': exact, and it keeps det, a
+    // product of four of them, in range at any scale of the data (and the test below
+    // relative to the tangents), while the steps ds, dt come out as they are.
+    const int e = scale_exponent(std::max(max_abs(du[1]), max_abs(dv[1])));
+    const Vec3 Us = ldexp(du[1], -e), Vs = ldexp(dv[1], -e), F = ldexp(du[0] - dv[0], -e);
+    const double a11 = dot(Us, Us), a12 = -dot(Us, Vs), a22 = dot(Vs, Vs);
+    const double r1 = -dot(Us, F), r2 = dot(Vs, F);
+    const double det = a11 * a22 - a12 * a12;
+    if (!(std::abs(det) > 1e-300)) break;  // parallel tangents (or a point curve): keep the pair
+    const double ds = (r1 * a22 - a12 * r2) / det, dt = (a11 * r2 - a12 * r1) / det;
+    const auto [ns, ms] = step(s, ds, closed_u);
+    const auto [nt, mt] = step(t, dt, closed_v);
+    const bool done = ms < 1e-15 && mt < 1e-15;
+    s = ns;
+    t = nt;
+    if (done) break;
+  }
+}
+
+Crossing crossing_at(const BSplineCurve& U, const BSplineCurve& V, double s, double t) {
+  Crossing c{s, t, U.point(s), V.point(t), 0};
+  c.gap = distance(c.a, c.b);
+  return c;
+}
+
+double box_distance(const CurveSamples::Chunk& a, const CurveSamples::Chunk& b) {
+  double d2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double g = std::max({0.0, a.lo[k] - b.hi[k], b.lo[k] - a.hi[k]});
+    d2 += g * g;
+  }
+  return std::sqrt(d2);
+}
+
+// The distinct knots of c over its domain, increasing, front and back included.
+std::vector<double> breaks(const KnotVector& k) {
+  std::vector<double> b{k.front()};
+  for (double x : k.values())
+    if (x > b.back() && x <= k.back()) b.push_back(x);
+  if (b.back() != k.back()) b.push_back(k.back());
+  return b;
+}
+
+// The value and slope on [x0, x0 + h] of the cubic Hermite piece through y0, y1 with
+// slopes m0, m1, at x0 + τh.
+double hermite(double y0, double y1, double m0, double m1, double h, double tau) {
+  const double t2 = tau * tau, t3 = t2 * tau;
+  return (2 * t3 - 3 * t2 + 1) * y0 + (t3 - 2 * t2 + tau) * h * m0 + (-2 * t3 + 3 * t2) * y1 + (t3 - t2) * h * m1;
+}
+
+// Whether the Hermite piece with secant slope d and end slopes m0, m1 has a slope of
+// d's sign everywhere: q(τ) = 6τ(1 − τ)d + m0(1 − 4τ + 3τ²) + m1(3τ² − 2τ), a quadratic.
+bool strictly_monotone(double d, double m0, double m1) {
+  const double sg = d > 0 ? 1.0 : -1.0;
+  const auto q = [&](double t) { return sg * (6 * t * (1 - t) * d + m0 * (1 - 4 * t + 3 * t * t) + m1 * (3 * t * t - 2 * t)); };
+  if (!(q(0) > 0) || !(q(1) > 0)) return false;
+  // q(τ) = Aτ² + Bτ + C with A = −6d + 3m0 + 3m1, B = 6d − 4m0 − 2m1.
+  const double A = -6 * d + 3 * m0 + 3 * m1, B = 6 * d - 4 * m0 - 2 * m1;
+  if (A != 0) {
+    const double v = -B / (2 * A);
+    if (v > 0 && v < 1 && !(q(v) > 0)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------- samples
+
+void CurveSamples::make() const {
+  const std::vector<double> b = breaks(c_->knots());
+  constexpr int per_span = 8;
+  for (std::size_t i = 0; i + 1 < b.size(); ++i)
+    for (int k = 0; k < per_span; ++k) t_.push_back(b[i] + (b[i + 1] - b[i]) * k / per_span);
+  t_.push_back(b.back());
+  p_.reserve(t_.size());
+  for (double t : t_) p_.push_back(c_->point(t));
+  constexpr std::size_t chunk = 32;
+  for (std::size_t first = 0; first < p_.size(); first += chunk) {
+    Chunk ch{first, std::min(first + chunk, p_.size()) - 1, p_[first], p_[first]};
+    for (std::size_t i = first; i <= ch.last; ++i)
+      for (int k = 0; k < 3; ++k) {
+        ch.lo[k] = std::min(ch.lo[k], p_[i][k]);
+        ch.hi[k] = std::max(ch.hi[k], p_[i][k]);
+      }
+    chunks_.push_back(ch);
+  }
+}
+
+const std::vector<Vec3>& CurveSamples::points() const {
+  if (p_.empty()) make();
+  return p_;
+}
+const std::vector<double>& CurveSamples::params() const {
+  if (p_.empty()) make();
+  return t_;
+}
+const std::vector<CurveSamples::Chunk>& CurveSamples::chunks() const {
+  if (p_.empty()) make();
+  return chunks_;
+}
+
+// ------------------------------------------------------------------- crossings
+
+Crossing closest_points(const BSplineCurve& U, const BSplineCurve& V, bool closed_u, bool closed_v, double tol,
+                        const CurveSamples& su, const CurveSamples& sv) {
+  constexpr int samples = 64;
+  std::array<Vec3, samples + 1> us, vs;
+  for (int k = 0; k <= samples; ++k) {
+    us[static_cast<std::size_t>(k)] = U.point(static_cast<double>(k) / samples);
+    vs[static_cast<std::size_t>(k)] = V.point(static_cast<double>(k) / samples);
+  }
+  double best = std::numeric_limits<double>::infinity(), s = 0, t = 0;
+  for (std::size_t a = 0; a <= samples; ++a)
+    for (std::size_t b = 0; b <= samples; ++b) {
+      const double d = distance(us[a], vs[b]);
+      if (d < best) {
+        best = d;
+        s = static_cast<double>(a) / samples;
+        t = static_cast<double>(b) / samples;
+      }
+    }
+  newton(U, V, s, t, closed_u, closed_v);
+  const Crossing coarse = crossing_at(U, V, s, t);
+  if (coarse.gap <= tol) return coarse;
+  // The thorough pass: pairs of sample boxes nearest first, until a box pair cannot
+  // beat the closest samples found.
+  const auto& cu = su.chunks();
+  const auto& cv = sv.chunks();
+  const auto& pu = su.points();
+  const auto& pv = sv.points();
+  struct Pair {
+    double lower;
+    std::size_t a, b;
+  };
+  std::vector<Pair> pairs;
+  pairs.reserve(cu.size() * cv.size());
+  for (std::size_t a = 0; a < cu.size(); ++a)
+    for (std::size_t b = 0; b < cv.size(); ++b) pairs.push_back({box_distance(cu[a], cv[b]), a, b});
+  std::sort(pairs.begin(), pairs.end(), [](const Pair& x, const Pair& y) { return x.lower < y.lower; });
+  best = std::numeric_limits<double>::infinity();
+  std::size_t ia = 0, ib = 0;
+  for (const Pair& q : pairs) {
+    if (q.lower >= best) break;
+    for (std::size_t i = cu[q.a].first; i <= cu[q.a].last; ++i)
+      for (std::size_t j = cv[q.b].first; j <= cv[q.b].last; ++j) {
+        const double d = distance(pu[i], pv[j]);
+        if (d < best) {
+          best = d;
+          ia = i;
+          ib = j;
+        }
+      }
+  }
+  s = su.params()[ia];
+  t = sv.params()[ib];
+  newton(U, V, s, t, closed_u, closed_v);
+  const Crossing fine = crossing_at(U, V, s, t);
+  return fine.gap < coarse.gap ? fine : coarse;
+}
+
+// ------------------------------------------------------------------- the map
+
+Reparametrization monotone_map(std::vector<double> at, std::vector<double> to, bool closed) {
+  const std::size_t n = at.size();
+  INTERPATCH_ASSERT(n >= 2 && to.size() == n);
+  std::vector<double> h(n - 1), d(n - 1), m(n);
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    h[i] = at[i + 1] - at[i];
+    d[i] = (to[i + 1] - to[i]) / h[i];
+  }
+  const auto monotone = [&] {
+    for (std::size_t i = 0; i + 1 < n; ++i)
+      if (!strictly_monotone(d[i], m[i], m[i + 1])) return false;
+    return true;
+  };
+  if (n == 2) {
+    m[0] = m[1] = d[0];
+  } else {
+    // The C2 spline's slopes: h_i m_(i−1) + 2(h_(i−1) + h_i) m_i + h_(i−1) m_(i+1) =
+    // 3(h_i d_(i−1) + h_(i−1) d_i) at every inner node; natural ends (2 m_0 + m_1 = 3 d_0),
+    // or closed: node 0 is node n − 1, its neighbours wrapping.
+    const auto rows_of = [&](std::vector<std::vector<CyclicLU::Entry>>& rows, std::vector<double>& rhs) {
+      const std::size_t k = closed ? n - 1 : n;  // unknowns
+      rows.assign(k, {});
+      rhs.assign(k, 0.0);
+      for (std::size_t i = 0; i < k; ++i) {
+        const bool inner = closed || (i > 0 && i + 1 < n);
+        if (!inner) {
+          const std::size_t c = i == 0 ? 0 : n - 2;  // the end interval
+          const int self = static_cast<int>(i), other = i == 0 ? 1 : static_cast<int>(n - 2);
+          rows[i] = {{self, 2.0}, {other, 1.0}};
+          rhs[i] = 3 * d[c];
+          continue;
+        }
+        const std::size_t ip = i == 0 ? n - 2 : i - 1;  // the interval before node i
+        const int prev = static_cast<int>(i == 0 ? k - 1 : i - 1), next = static_cast<int>((i + 1) % k);
+        rows[i] = {{prev, h[i]}, {static_cast<int>(i), 2 * (h[ip] + h[i])}, {next, h[ip]}};
+        rhs[i] = 3 * (h[i] * d[ip] + h[ip] * d[i]);
+      }
+    };
+    std::vector<std::vector<CyclicLU::Entry>> rows;
+    std::vector<double> rhs;
+    rows_of(rows, rhs);
+    CyclicLU lu(static_cast<int>(rows.size()), rows);
+    bool ok = lu.factor();
+    if (ok) {
+      lu.solve(rhs.data(), 1, 1);
+      for (std::size_t i = 0; i < rhs.size(); ++i) m[i] = rhs[i];
+      if (closed) m[n - 1] = m[0];
+      ok = monotone();
+    }
+    if (!ok) {
+      // Fritsch–Butland: a weighted harmonic mean of the secants next to a node, at
+      // most 3 times the smaller, so every piece stays monotone (Fritsch & Carlson's
+      // box 0 <= m/d <= 3); the ends of an open map take their secant.
+      const auto mean = [&](std::size_t a, std::size_t b) {  // intervals a (before) and b (after)
+        return 3 * (h[a] + h[b]) / ((2 * h[b] + h[a]) / d[a] + (h[b] + 2 * h[a]) / d[b]);
+      };
+      for (std::size_t i = 1; i + 1 < n; ++i) m[i] = mean(i - 1, i);
+      if (closed) {
+        m[0] = m[n - 1] = mean(n - 2, 0);
+      } else {
+        m[0] = d[0];
+        m[n - 1] = d[n - 2];
+      }
+    }
+  }
+  Reparametrization r;
+  r.at = std::move(at);
+  r.to = std::move(to);
+  r.slope = std::move(m);
+  return r;
+}
+
+double inverse(const Reparametrization& map, double y) {
+  const std::size_t n = map.at.size();
+  const bool up = map.to.back() > map.to.front();
+  // The piece whose values span y.
+  std::size_t i = 0;
+  while (i + 2 < n && (up ? y > map.to[i + 1] : y < map.to[i + 1])) ++i;
+  const double h = map.at[i + 1] - map.at[i];
+  const auto f = [&](double tau) { return hermite(map.to[i], map.to[i + 1], map.slope[i], map.slope[i + 1], h, tau) - y; };
+  // Bisection on the monotone piece, then to the last bit.
+  double lo = 0, hi = 1;
+  const double flo = f(0);
+  if (flo == 0) return map.at[i];
+  for (int it = 0; it < 64 && hi - lo > 0; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if (mid <= lo || mid >= hi) break;
+    const double fm = f(mid);
+    if (fm == 0) return map.at[i] + mid * h;
+    if ((fm > 0) == (flo > 0)) lo = mid;
+    else hi = mid;
+  }
+  return std::clamp(map.at[i] + 0.5 * (lo + hi) * h, map.at[i], map.at[i + 1]);
+}
+
+// ------------------------------------------------------------------- refit
+
+std::vector<double> check_params(const KnotVector& k) {
+  const std::vector<double> b = breaks(k);
+  std::vector<double> t;
+  t.reserve(4 * b.size());
+  for (std::size_t i = 0; i + 1 < b.size(); ++i)
+    for (int q = 0; q < 4; ++q) t.push_back(b[i] + (b[i + 1] - b[i]) * q / 4);
+  t.push_back(b.back());
+  return t;
+}
+
+namespace {
+
+// One curve's fit on the shared interior knots (multiplicities capped at its degree):
+// collocation at the Greville abscissae, the one nearest each node moved onto it.
+// Empty when two nodes want one site (the caller splits between them: `clash`).
+struct OneFit {
+  std::optional<BSplineCurve> curve;
+  std::pair<double, double> clash{0, 0};
+  bool failed = false;  // no unique solution, or a weight <= 0: the caller refines
+};
+
+OneFit fit_one(const BSplineCurve& c, const Reparametrization& map, const std::vector<double>& nodes, bool closed,
+               const std::vector<double>& interior) {
+  const int p = c.degree();
+  const auto pz = static_cast<std::size_t>(p);
+  std::vector<double> knots;
+  for (double x : interior) {
+    const auto tail = std::min<std::size_t>(knots.size(), pz);
+    if (std::count(knots.end() - static_cast<std::ptrdiff_t>(tail), knots.end(), x) < p) knots.push_back(x);
+  }
+  // A closed spline needs p + 1 knots in its period, an open one none.
+  if (closed && knots.size() < pz + 1) return {std::nullopt, {0.0, 1.0}, true};
+  KnotVector kv = closed ? KnotVector::periodic_from(p, knots, 1.0) : [&] {
+    std::vector<double> all(pz + 1, 0.0);
+    all.insert(all.end(), knots.begin(), knots.end());
+    all.insert(all.end(), pz + 1, 1.0);
+    return KnotVector(p, std::move(all));
+  }();
+  std::vector<double> sites = kv.greville();
+  const std::vector<double> grev = sites;
+  std::vector<std::ptrdiff_t> taken(sites.size(), -1);
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const double u = nodes[k];
+    const auto dist = [&](double g) {
+      const double d = std::abs(g - u);
+      return closed ? std::min(d, 1.0 - wrap_unit(d)) : d;
+    };
+    // Greville abscissae increase (closed: around the circle): the nearest by bisection.
+    std::size_t near = static_cast<std::size_t>(std::lower_bound(grev.begin(), grev.end(), u) - grev.begin());
+    std::size_t best = near < grev.size() ? near : grev.size() - 1;
+    for (std::size_t q : {near == 0 ? grev.size() - 1 : near - 1, std::size_t{0}, grev.size() - 1})
+      if (q < grev.size() && dist(grev[q]) < dist(grev[best])) best = q;
+    if (taken[best] >= 0) return {std::nullopt, {nodes[static_cast<std::size_t>(taken[best])], u}, false};
+    taken[best] = static_cast<std::ptrdiff_t>(k);
+    sites[best] = closed ? u + std::round(grev[best] - u) : u;
+  }
+  const bool rational = c.rational();
+  std::optional<BSplineCurve> den;  // the weight function Σ N w, as a curve's x
+  if (rational) {
+    std::vector<Vec3> wx;
+    for (double x : c.weights()) wx.push_back({x, 0, 0});
+    den.emplace(c.knots(), std::move(wx));
+  }
+  const std::size_t n = sites.size(), w = rational ? 4 : 3;
+  std::vector<double> b(n * w);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double x = map(closed ? wrap_unit(sites[k]) : sites[k]);
+    const double y = closed ? x : std::clamp(x, 0.0, 1.0);
+    // A rational curve in homogeneous coordinates: Σ N w P and Σ N w.
+    const Vec3 q = c.point(y);
+    const double wy = rational ? den->point(y).x : 1.0;
+    b[k * w] = wy * q.x;
+    b[k * w + 1] = wy * q.y;
+    b[k * w + 2] = wy * q.z;
+    if (rational) b[k * w + 3] = wy;
+  }
+  try {
+    if (closed) factor_periodic_collocation(kv, sites).solve(b.data(), w, w);
+    else factor_collocation(kv, sites).solve(b.data(), w, w);
+  } catch (const error&) {
+    return {std::nullopt, {0, 0}, true};
+  }
+  std::vector<Vec3> cp(n);
+  std::vector<double> wt(rational ? n : 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double h = rational ? b[k * w + 3] : 1.0;
+    if (!(h > 0)) return {std::nullopt, {0, 0}, true};
+    if (rational) wt[k] = h;
+    cp[k] = Vec3{b[k * w], b[k * w + 1], b[k * w + 2]} / h;
+  }
+  return {BSplineCurve(kv, std::move(cp), std::move(wt)), {0, 0}, false};
+}
+
+}  // namespace
+
+std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<double>& nodes, bool closed, double target) {
+  const std::size_t m = jobs.size();
+  std::vector<const BSplineCurve*> curves;
+  std::vector<Reparametrization> maps;
+  for (const auto& j : jobs) {
+    curves.push_back(j.c);
+    maps.push_back(j.map);
+  }
+  // The knots of each curve, pulled back through its map: its corners (multiple knots)
+  // all kept; its simple knots averaged over the family quantile by quantile.
+  std::vector<double> corners;
+  std::vector<std::vector<double>> simple(m);
+  std::size_t most = 0;
+  for (std::size_t j = 0; j < m; ++j) {
+    Reparametrization unwrapped = maps[j];
+    unwrapped.period = 0;
+    const double lo = std::min(unwrapped(0.0), unwrapped(1.0)), hi = std::max(unwrapped(0.0), unwrapped(1.0));
+    for (const auto& [kappa, mult] : curves[j]->knots().interior_breaks())
+      for (int shift = closed ? -1 : 0; shift <= (closed ? 2 : 0); ++shift) {
+        const double y = kappa + shift;
+        if (!(closed ? y >= lo && y < hi : y > lo && y < hi)) continue;
+        double x = inverse(unwrapped, y);
+        if (closed && (x < 1e-12 || x > 1 - 1e-12)) x = 0;  // at the seam
+        if (!closed && (x <= 0 || x >= 1)) continue;
+        if (mult > 1) corners.insert(corners.end(), static_cast<std::size_t>(mult), x);
+        else simple[j].push_back(x);
+      }
+    std::sort(simple[j].begin(), simple[j].end());
+    most = std::max(most, simple[j].size());
+  }
+  std::vector<double> interior = corners;
+  const double room = 0.25 / static_cast<double>(most + 1);  // a simple knot this near a corner is left out
+  for (std::size_t k = 1; k <= most; ++k) {
+    const double q = static_cast<double>(k) / static_cast<double>(most + 1);
+    double sum = 0;
+    std::size_t count = 0;
+    for (const auto& s : simple) {
+      if (s.empty()) continue;
+      // The q-quantile of this curve's knots, between its neighbours (0 and 1 at the ends).
+      const double pos = q * static_cast<double>(s.size() + 1) - 1;
+      const auto at = [&](std::ptrdiff_t i) {
+        return i < 0 ? 0.0 : i >= static_cast<std::ptrdiff_t>(s.size()) ? 1.0 : s[static_cast<std::size_t>(i)];
+      };
+      const auto i0 = static_cast<std::ptrdiff_t>(std::floor(pos));
+      const double f = pos - static_cast<double>(i0);
+      sum += (1 - f) * at(i0) + f * at(i0 + 1);
+      ++count;
+    }
+    const double x = sum / static_cast<double>(count);
+    if (std::none_of(corners.begin(), corners.end(), [&](double c) { return std::abs(c - x) < room; })) interior.push_back(x);
+  }
+  if (closed) interior.push_back(0.0);
+  std::sort(interior.begin(), interior.end());
+  const auto insert_mid = [&](double a, double b) {
+    const double x = 0.5 * (a + b);
+    interior.insert(std::upper_bound(interior.begin(), interior.end(), x), x);
+  };
+  const auto spans = [&] {
+    std::vector<double> b{0.0};
+    for (double x : interior)
+      if (x > b.back()) b.push_back(x);
+    if (b.back() < 1.0) b.push_back(1.0);
+    return b;
+  };
+  const auto split_all = [&] {
+    const auto sp = spans();
+    for (std::size_t i = 0; i + 1 < sp.size(); ++i) insert_mid(sp[i], sp[i + 1]);
+  };
+  int p_max = 1;
+  for (const auto* c : curves) p_max = std::max(p_max, c->degree());
+  while (closed && spans().size() < static_cast<std::size_t>(p_max) + 2) split_all();
+  // Every curve's own knots, pulled back: where each curve has its breaks, so every fit
+  // converges at once, but as many knots as all curves together. Taken when refining
+  // the averaged knots outgrows it (curves whose parameters are irregular, e.g.
+  // centripetal through unevenly spaced points, break where the average does not).
+  std::vector<double> all = corners;
+  for (const auto& s : simple) all.insert(all.end(), s.begin(), s.end());
+  if (closed) all.push_back(0.0);
+  std::sort(all.begin(), all.end());
+  bool own = false;
+  const std::size_t initial = all.size();
+  std::vector<Refit> out;
+  for (int round = 0; round < 60; ++round) {
+    // Every curve fitted and checked at 4 points of every span (the next span's first
+    // is this one's end), in parallel: fit_one does not throw, and the check only reads.
+    const auto sp = spans();
+    std::vector<OneFit> fits(m);
+    std::vector<std::vector<char>> far(m, std::vector<char>(sp.size(), 0));
+    std::vector<double> worst_of(m, 0.0), apart(m, 0.0);
+    const auto count = static_cast<long long>(m);
+#pragma omp parallel for schedule(dynamic, 1) if (m * sp.size() * 16 >= parallel_min_work)
+    for (long long jj = 0; jj < count; ++jj) {
+      const auto j = static_cast<std::size_t>(jj);
+      fits[j] = fit_one(*curves[j], maps[j], nodes, closed, interior);
+      if (!fits[j].curve) continue;
+      for (std::size_t i = 0; i + 1 < sp.size(); ++i) {
+        double e = 0;
+        for (int q = 0; q <= (i + 2 == sp.size() ? 4 : 3); ++q) {
+          const double u = sp[i] + (sp[i + 1] - sp[i]) * q / 4;
+          const double x = maps[j](u), y = closed ? x : std::clamp(x, 0.0, 1.0);
+          const Vec3 d = fits[j].curve->point(u), c = curves[j]->point(y);
+          e = std::max(e, distance(d, c));
+          apart[j] = std::max(apart[j], distance(d + jobs[j].G->point(u), jobs[j].given ? jobs[j].given->point(y) : c));
+        }
+        worst_of[j] = std::max(worst_of[j], e);
+        far[j][i] = e > target;
+      }
+    }
+    bool again = false;
+    for (std::size_t j = 0; j < m && !again; ++j) {
+      if (fits[j].failed) split_all();
+      else if (!fits[j].curve) insert_mid(fits[j].clash.first, fits[j].clash.second);
+      again = !fits[j].curve;
+    }
+    if (again) continue;
+    std::vector<char> split(sp.size(), 0);
+    out.clear();
+    for (std::size_t j = 0; j < m; ++j) {
+      for (std::size_t i = 0; i < sp.size(); ++i) split[i] = static_cast<char>(split[i] | far[j][i]);
+      out.push_back({std::move(*fits[j].curve), worst_of[j], apart[j]});
+    }
+    if (std::none_of(split.begin(), split.end(), [](char x) { return x != 0; }) || interior.size() > 64 * initial + 4096)
+      break;
+    // Halving a span divides the distance by 8 or more (cubic pieces against a
+    // function C2 between the curve's own knots): when the halvings still needed
+    // would make more knots than the curves' own together, take those.
+    double worst = 0;
+    for (const auto& o : out) worst = std::max(worst, o.error);
+    const double halvings = std::ceil(std::log(worst / target) / std::log(8.0));
+    if (!own && std::ldexp(static_cast<double>(interior.size()), static_cast<int>(std::min(halvings, 60.0))) > static_cast<double>(all.size())) {
+      interior = all;
+      own = true;
+      continue;
+    }
+    for (std::size_t i = 0; i + 1 < sp.size(); ++i)
+      if (split[i]) insert_mid(sp[i], sp[i + 1]);
+  }
+  INTERPATCH_ASSERT(out.size() == m);
+  return out;
+}
+
+}  // namespace interpatch::detail
+
+namespace interpatch {
+
+double Reparametrization::operator()(double t) const {
+  const std::size_t n = at.size();
+  std::size_t i = static_cast<std::size_t>(std::upper_bound(at.begin(), at.end(), t) - at.begin());
+  i = std::clamp<std::size_t>(i, 1, n - 1) - 1;
+  const double h = at[i + 1] - at[i];
+  const double y = detail::hermite(to[i], to[i + 1], slope[i], slope[i + 1], h, (t - at[i]) / h);
+  if (!(period > 0)) return y;
+  const double r = y - start - std::floor((y - start) / period) * period;
+  return start + (r < period ? r : 0.0);
+}
+
+}  // namespace interpatch

@@ -1,0 +1,90 @@
+#pragma once
+// The curve work of a network as drawn (src/network.cpp): where two curves cross,
+// and a curve re-expressed so that it passes its crossings at given parameters.
+// Every curve here is over [0, 1].
+
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "interpatch/bspline_curve.hpp"
+#include "interpatch/network.hpp"
+
+namespace interpatch::detail {
+
+/// The closest points of two curves: U(s) and V(t), `gap` apart.
+struct Crossing {
+  double s = 0, t = 0;
+  Vec3 a, b;
+  double gap = std::numeric_limits<double>::infinity();
+};
+
+/// Samples of a curve for the thorough search, made on first use.
+class CurveSamples {
+ public:
+  explicit CurveSamples(const BSplineCurve& c) : c_(&c) {}
+  struct Chunk {
+    std::size_t first, last;  // samples [first, last]
+    Vec3 lo, hi;              // their bounding box
+  };
+  const std::vector<Vec3>& points() const;
+  const std::vector<double>& params() const;
+  const std::vector<Chunk>& chunks() const;
+
+ private:
+  void make() const;
+  const BSplineCurve* c_;
+  mutable std::vector<Vec3> p_;
+  mutable std::vector<double> t_;
+  mutable std::vector<Chunk> chunks_;
+};
+
+/// Where U and V come closest: a coarse pass over 65 × 65 parameter pairs and
+/// Gauss–Newton on U(s) − V(t); when that ends farther apart than `tol`, a thorough
+/// pass over 8 samples of every knot span of each curve (boxes of 32 samples pruned
+/// by their distance) and Gauss–Newton from the closest pair found. A closed curve's
+/// parameter wraps around its seam; an open one's stays in [0, 1].
+Crossing closest_points(const BSplineCurve& U, const BSplineCurve& V, bool closed_u, bool closed_v, double tol,
+                        const CurveSamples& su, const CurveSamples& sv);
+
+/// The monotone map through (at[i], to[i]) (at increasing, to strictly monotone):
+/// slopes of the C2 cubic spline (natural ends, or periodic when `closed`: to[last]
+/// is then to[0] ± 1 at at[last] = 1), or of Fritsch–Butland where that spline is
+/// not monotone. Two points: the straight line.
+Reparametrization monotone_map(std::vector<double> at, std::vector<double> to, bool closed);
+
+/// u with map(u) = y, for y between map(0) and map(1) (closed: unwrapped).
+double inverse(const Reparametrization& map, double y);
+
+/// One curve to re-express: C (the prepared curve), the curve as given (both over
+/// [0, 1]; null when C is it, up to rounding), the correction G the surface adds along the curve's line (see
+/// network.cpp: S = D + G there), and the map.
+struct FitJob {
+  const BSplineCurve* c;
+  const BSplineCurve* given;
+  const BSplineCurve* G;
+  Reparametrization map;
+};
+
+/// Curves of one family re-expressed over the surface's parameter on shared knots:
+/// D_j(u) ≈ C_j(map_j(u)), of C_j's degree, through C_j(map_j(nodes[k])) at nodes[k]
+/// exactly (to rounding). The shared interior knots are every curve's corners
+/// (multiple knots) pulled back through its map, and its simple knots pulled back and
+/// averaged over the family quantile by quantile (so the exact form of the surface
+/// has about as many control points as the densest curve, not the sum of all), or,
+/// when that would take more halvings than it is worth, all curves' own knots; spans
+/// where some curve is farther than `target` from its input, measured at 4 points of
+/// every span, are split until none is. Rational curves are fitted in homogeneous
+/// coordinates. `closed`: every C_j periodic, every D_j periodic over [0, 1).
+struct Refit {
+  BSplineCurve curve;
+  double error = 0;     ///< the largest |D(u) − C(map(u))| measured
+  double distance = 0;  ///< the largest |D(u) + G(u) − given(map(u))| at the same points
+};
+std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<double>& nodes, bool closed, double target);
+
+/// Parameters in [0, 1] at which a curve of the network is checked against the
+/// surface: 4 in every span of its knots (closed: of its period), and the ends.
+std::vector<double> check_params(const KnotVector& k);
+
+}  // namespace interpatch::detail
