@@ -389,6 +389,39 @@ OneFit fit_one(const BSplineCurve& c, const Reparametrization& map, const std::v
   return {BSplineCurve(kv, std::move(cp), std::move(wt)), {0, 0}, false};
 }
 
+// A knot of one curve of a family, pulled back to the surface's parameter.
+struct Knot {
+  double x;
+  int mult;
+  std::size_t curve;
+};
+
+// Knots of different curves nearer than this are one: the curves' knots at their
+// crossings all pull back to the common parameter, up to rounding.
+constexpr double knot_room = 1e-9;
+
+// The union of several curves' knots: a knot as many times as the curve that has it
+// most often there (not the sum: five curves' simple knots at one place are one
+// simple knot of the union), increasing.
+std::vector<double> merged(std::vector<Knot> k) {
+  std::sort(k.begin(), k.end(), [](const Knot& a, const Knot& b) { return a.x < b.x; });
+  std::vector<double> out;
+  for (std::size_t i = 0; i < k.size();) {
+    std::size_t e = i;
+    while (e < k.size() && k[e].x - k[i].x <= knot_room) ++e;
+    int most = 0;
+    for (std::size_t a = i; a < e; ++a) {
+      int sum = 0;
+      for (std::size_t b = i; b < e; ++b)
+        if (k[b].curve == k[a].curve) sum += k[b].mult;
+      most = std::max(most, sum);
+    }
+    out.insert(out.end(), static_cast<std::size_t>(most), k[i].x);
+    i = e;
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<double>& nodes, bool closed, double target) {
@@ -401,7 +434,7 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
   }
   // The knots of each curve, pulled back through its map: its corners (multiple knots)
   // all kept; its simple knots averaged over the family quantile by quantile.
-  std::vector<double> corners;
+  std::vector<Knot> corners;
   std::vector<std::vector<double>> simple(m);
   std::size_t most = 0;
   for (std::size_t j = 0; j < m; ++j) {
@@ -413,15 +446,15 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
         const double y = kappa + shift;
         if (!(closed ? y >= lo && y < hi : y > lo && y < hi)) continue;
         double x = inverse(unwrapped, y);
-        if (closed && (x < 1e-12 || x > 1 - 1e-12)) x = 0;  // at the seam
-        if (!closed && (x <= 0 || x >= 1)) continue;
-        if (mult > 1) corners.insert(corners.end(), static_cast<std::size_t>(mult), x);
+        if (closed && (x < knot_room || x > 1 - knot_room)) x = 0;  // at the seam
+        if (!closed && (x <= knot_room || x >= 1 - knot_room)) continue;
+        if (mult > 1) corners.push_back({x, mult, j});
         else simple[j].push_back(x);
       }
     std::sort(simple[j].begin(), simple[j].end());
     most = std::max(most, simple[j].size());
   }
-  std::vector<double> interior = corners;
+  std::vector<double> interior = merged(corners);
   const double room = 0.25 / static_cast<double>(most + 1);  // a simple knot this near a corner is left out
   for (std::size_t k = 1; k <= most; ++k) {
     const double q = static_cast<double>(k) / static_cast<double>(most + 1);
@@ -440,9 +473,10 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
       ++count;
     }
     const double x = sum / static_cast<double>(count);
-    if (std::none_of(corners.begin(), corners.end(), [&](double c) { return std::abs(c - x) < room; })) interior.push_back(x);
+    if (std::none_of(corners.begin(), corners.end(), [&](const Knot& c) { return std::abs(c.x - x) < room; }))
+      interior.push_back(x);
   }
-  if (closed) interior.push_back(0.0);
+  if (closed && std::find(interior.begin(), interior.end(), 0.0) == interior.end()) interior.push_back(0.0);
   std::sort(interior.begin(), interior.end());
   const auto insert_mid = [&](double a, double b) {
     const double x = 0.5 * (a + b);
@@ -466,10 +500,11 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
   // converges at once, but as many knots as all curves together. Taken when refining
   // the averaged knots outgrows it (curves whose parameters are irregular, e.g.
   // centripetal through unevenly spaced points, break where the average does not).
-  std::vector<double> all = corners;
-  for (const auto& s : simple) all.insert(all.end(), s.begin(), s.end());
-  if (closed) all.push_back(0.0);
-  std::sort(all.begin(), all.end());
+  std::vector<Knot> own_knots = corners;
+  for (std::size_t j = 0; j < m; ++j)
+    for (double x : simple[j]) own_knots.push_back({x, 1, j});
+  if (closed) own_knots.push_back({0.0, 1, m});
+  const std::vector<double> all = merged(std::move(own_knots));
   bool own = false;
   const std::size_t initial = all.size();
   std::vector<Refit> out;
@@ -500,6 +535,8 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
       }
     }
     bool again = false;
+    if (interior.size() > 64 * initial + 4096)
+      fail(errc::internal, "re-expressing ", m, " network curves found no knots that fit them (", interior.size(), " tried)");
     for (std::size_t j = 0; j < m && !again; ++j) {
       if (fits[j].failed) split_all();
       else if (!fits[j].curve) insert_mid(fits[j].clash.first, fits[j].clash.second);

@@ -188,8 +188,10 @@ Construction build_network(const json& spec, Context& ctx) {
                      {"reexpressed", c.reexpressed},
                      {"fit_error", c.fit_error},
                      {"distance", c.distance},
-                     {"max_gap", c.max_gap},
-                     {"range", {from, to}}};
+                     {"max_gap", c.max_gap}};
+      // The part used (open curves), or where the surface's seam u = 0 falls on the curve (closed ones).
+      if (c.map.period > 0) reported[ptr]["seam"] = from;
+      else reported[ptr]["range"] = {from, to};
       if (c.closing) reported[ptr]["closing"] = true;
       if (c.degenerate) reported[ptr]["degenerate"] = true;
       const double strict = 1e-7 * r.diagonal;
