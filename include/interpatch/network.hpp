@@ -17,8 +17,13 @@ namespace interpatch {
 /// u_curves[j] = S(u, v_j), j = 0..m; v_curves[i] = S(u_i, v), i = 0..n. Each curve is
 /// used over its own domain mapped onto [0, 1].
 ///
+/// The curves may be given as they are drawn: in any order within their family,
+/// either direction, crossing each other at different parameters of their own, and
+/// missing each other by up to the tolerance (see curve_network).
+///
 /// A network closed in u (periodic[0], the sections of a tube, say): every u_curve is
-/// a closed curve starting (parameter 0) where it crosses v_curves[0], and the
+/// a closed curve, whose seam may lie anywhere (the surface's u = 0 is where it
+/// crosses v_curves[0]; a curve crossing there at its parameter 0 is kept as it is), and the
 /// v_curves are a cyclic family at 0 = u_0 < u_1 < ... < u_n < 1, v_curves[0] serving
 /// at u = 1 as well. A last v_curve that repeats the first is the closing curve and
 /// is left out, as closed interpolation leaves out a closing point: given u_params
@@ -118,24 +123,50 @@ struct NetworkSurface {
 struct NetworkParameters {
   std::vector<double> u_params, v_params;
 };
-/// The parameters where the curves cross, when not given: for every pair (u-curve
-/// j, v-curve i) the closest points are found, and u_i (v_j) is the average of the
-/// parameters on the u-curves (v-curves). The first and last are 0 and 1 by
-/// convention; in a closed direction the first is 0 (where the closed curves start),
-/// the search wraps around their seam, and a closing curve gets 1. One parameter per
-/// curve given. `options.tolerance` tells closing curves (see CurveNetwork).
+/// The common parameters of the crossings, one per curve given (u_params[i] for
+/// v_curves[i]): the given ones, or found. Found: for every pair (u-curve j, v-curve
+/// i) the closest points are found; each family is sorted by where it crosses the
+/// other (curves running the other way turned round, see curve_network), each
+/// curve's crossings are scaled to run from 0 at its first to 1 at its last, and
+/// u_i (v_j) is their mean over the u-curves (v-curves). In a closed direction the
+/// first is 0 (where the closed curves cross v_curves[0]), the search wraps around
+/// the curves' seams, and a closing curve gets 1.
 /// @throws error too_few_points (fewer than 2 curves a direction, a closing curve
-///   not counted), network_gap (an open curve of a closed direction whose ends do
-///   not meet), non_increasing.
+///   not counted), network_gap (curves that do not meet; an open curve of a closed
+///   direction whose ends do not meet), network_order, non_increasing.
 [[nodiscard]] NetworkParameters network_parameters(const CurveNetwork& network, const NetworkOptions& options = {});
 
 /// S = Σ_i r_i(v) φ_i(u) + Σ_j r_j(u) ψ_j(v) − Σ_i Σ_j r(u_i, v_j) φ_i(u) ψ_j(v), with
 /// cardinal functions φ_i(u_k) = δ_ik: piecewise linear or Hermite (Coons
-/// networks), or B-spline interpolants (Gordon). Interpolates every curve of the
-/// network. In a closed direction the cardinal functions are periodic: Gordon's
-/// closed spline interpolants (C2 across the seam from 4 curves on), the linear hat
-/// functions with the last cell from u_n to 1, the Hermite functions of every cell,
-/// the last one wrapping.
+/// networks), or B-spline interpolants (Gordon). In a closed direction the cardinal
+/// functions are periodic: Gordon's closed spline interpolants (C2 across the seam
+/// from 4 curves on), the linear hat functions with the last cell from u_n to 1, the
+/// Hermite functions of every cell, the last one wrapping.
+///
+/// The curves r_i, r_j are the curves given, placed so that they cross at common
+/// parameters:
+/// - every u-curve is met with every v-curve at their closest points (a coarse
+///   pass and Gauss–Newton, then a search over 8 samples of every knot span when
+///   that ends farther apart than the tolerance); farther apart than the tolerance
+///   is an error naming both curves, their closest points and the gap;
+/// - each family is sorted by where it crosses the other, and a curve crossing the
+///   other family in the reverse order is turned round (most curves keep their
+///   direction); orders that no sorting makes agree are an error (network_order);
+/// - the common parameters are network_parameters' (or the given ones);
+/// - a curve that passes its crossings at the common parameters within 1e-3 of
+///   min(tolerance, 1e-7 × the diagonal) is used as it is — networks of curves
+///   parametrized alike build as they always did —, any other is re-expressed:
+///   D(u) ≈ C(map(u)) with a monotone map taking the common parameters to its own
+///   (NetworkCurveReport::map), a B-spline of its degree through its crossings at
+///   the common parameters, within half of min(tolerance, 1e-7 × the diagonal) of
+///   the curve given (measured at 4 points of every span). The curves of a family
+///   share their knots where they can, so the exact form grows no more than the
+///   densest curve needs; an open curve running past the end curves of the other
+///   family is used between them.
+/// The surface then passes within about the tolerance of every curve given (the
+/// report tells how far from each). With a loose tolerance, curves that miss each
+/// other by more than 1e-7 of the diagonal are accepted, the surface passing
+/// halfway between them: notes() and the report say by how much.
 ///
 /// Example:
 /// @code
@@ -147,8 +178,8 @@ struct NetworkParameters {
 /// form is periodic in u.
 /// @throws error too_few_points, size_mismatch (params and curve counts), non_increasing,
 ///   out_of_domain (params not from 0 to 1; a closing curve's not 1), network_gap
-///   (naming both curves, the node and the gap; an open curve of a closed direction
-///   whose ends do not meet).
+///   (curves that do not meet, naming both, their closest points and the gap; an
+///   open curve of a closed direction whose ends do not meet), network_order.
 [[nodiscard]] BlendedSurface curve_network(const CurveNetwork& network, const NetworkOptions& options = {});
 
 /// The same, with what was found and done curve by curve: the crossings and their
