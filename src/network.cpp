@@ -162,11 +162,15 @@ BSplineCurve closed_form(BSplineCurve c) {
   return BSplineCurve(std::move(closed), std::move(q), std::move(w));
 }
 
-// How far apart two curves over [0, 1] are at 129 parameters: 0 for a repeated curve.
+// How far apart two curves over [0, 1] are at 129 parameters, b taken either way
+// round: 0 for a repeated curve, drawn in either direction.
 double curve_distance(const BSplineCurve& a, const BSplineCurve& b) {
-  double d = 0;
-  for (double t : linspace(0, 1, 129)) d = std::max(d, distance(a.point(t), b.point(t)));
-  return d;
+  double d = 0, r = 0;
+  for (double t : linspace(0, 1, 129)) {
+    d = std::max(d, distance(a.point(t), b.point(t)));
+    r = std::max(r, distance(a.point(t), b.point(1 - t)));
+  }
+  return std::min(d, r);
 }
 
 constexpr const char* curves_name(int a) { return a == 0 ? "u_curves" : "v_curves"; }
@@ -319,7 +323,8 @@ void arrange(const Prepared& n, Arrangement& r, int a, const std::vector<double>
     for (std::size_t k = 0; k + 1 < nb; ++k)
       if (!(key[o[k]] + 1e-12 < key[o[k + 1]]))
         fail(errc::network_order, n.name(b, std::min(o[k], o[k + 1])), " and ", n.name(b, std::max(o[k], o[k + 1])),
-             " cross ", n.name(a, j), " at the same point ", along[j].point(key[o[k]]),
+             " cross ", n.name(a, j), " at the same point ",
+             a == 0 ? r.X[j][o[k]].a : r.X[o[k]][j].b,
              ": curves of one family must not meet");
     return o;
   };
@@ -641,7 +646,9 @@ Built build(const CurveNetwork& network, const NetworkOptions& options, bool fit
     for (std::size_t j = 0; j < n.along[static_cast<std::size_t>(a)].size(); ++j)
       if (reports[j].distance > strict) far.push_back(detail::cat(n.name(a, j), " by ", reports[j].distance));
   }
-  // The closing curves: the seam curve's line against each.
+  t->a = std::move(V);
+  t->b = std::move(U);
+  // The closing curves: the seam curve's line against each, on the finished surface.
   for (int a = 0; a < 2; ++a) {
     if (!n.closing[static_cast<std::size_t>(1 - a)]) continue;
     auto& reports = a == 0 ? rep.u_curves : rep.v_curves;
@@ -653,9 +660,22 @@ Built build(const CurveNetwork& network, const NetworkOptions& options, bool fit
     c.position = n.along[static_cast<std::size_t>(a)].size();
     const auto [lo, hi] = given.back().domain();
     const auto [slo, shi] = given[seam].domain();
-    for (double& x : c.map.to) x = lo + (x - slo) / (shi - slo) * (hi - lo);
-    for (double& x : c.map.slope) x *= (hi - lo) / (shi - slo);
-    for (double& x : c.crossings) x = lo + (x - slo) / (shi - slo) * (hi - lo);
+    // Drawn the other way round from the seam curve: its parameter runs back.
+    const auto& unit = n.input[static_cast<std::size_t>(a)];
+    double ahead = 0, back = 0;
+    for (double x : linspace(0, 1, 129)) {
+      ahead = std::max(ahead, distance(unit[seam].point(x), unit.back().point(x)));
+      back = std::max(back, distance(unit[seam].point(x), unit.back().point(1 - x)));
+    }
+    const bool turn = back < ahead;
+    if (turn) c.reversed = !c.reversed;
+    const auto move = [&](double x) {
+      const double f = (x - slo) / (shi - slo);
+      return lo + (turn ? 1 - f : f) * (hi - lo);
+    };
+    for (double& x : c.map.to) x = move(x);
+    for (double& x : c.map.slope) x *= (turn ? -1 : 1) * (hi - lo) / (shi - slo);
+    for (double& x : c.crossings) x = move(x);
     c.map.start = lo;
     if (c.map.period > 0) c.map.period = hi - lo;
     double d = 0;
@@ -667,8 +687,6 @@ Built build(const CurveNetwork& network, const NetworkOptions& options, bool fit
     c.distance = d;
     if (d > strict) far.push_back(detail::cat(n.name(a, given.size() - 1), " by ", d));
   }
-  t->a = std::move(V);
-  t->b = std::move(U);
   t->notes = std::move(n.notes);
   if (found) t->notes.push_back("crossing parameters found from the curves");
   for (int a = 0; a < 2; ++a) {

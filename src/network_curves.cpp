@@ -446,6 +446,11 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
         const double y = kappa + shift;
         if (!(closed ? y >= lo && y < hi : y > lo && y < hi)) continue;
         double x = inverse(unwrapped, y);
+        // A knot at a crossing (an interpolant's knots are often its data's parameters)
+        // pulls back to the common parameter up to rounding: put it there, where the
+        // cardinal functions have theirs, so the exact form has one knot, not two.
+        for (double u : nodes)
+          if (std::abs(x - u) <= knot_room) x = u;
         if (closed && (x < knot_room || x > 1 - knot_room)) x = 0;  // at the seam
         if (!closed && (x <= knot_room || x >= 1 - knot_room)) continue;
         if (mult > 1) corners.push_back({x, mult, j});

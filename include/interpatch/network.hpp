@@ -67,8 +67,8 @@ struct NetworkOptions {
 
 /// A monotone map from the surface's parameter (over [0, 1]) to a curve's own
 /// parameter: the piecewise cubic Hermite function through (at[i], to[i]) with slopes
-/// slope[i], C2 where the cubic spline through the points is monotone, C1 (Fritsch–
-/// Carlson slopes) where it is not. Decreasing for a curve that runs against its
+/// slope[i]: the C2 cubic spline through the points when it is monotone, otherwise
+/// C1 with Fritsch–Butland slopes (a weighted harmonic mean of the secants) throughout. Decreasing for a curve that runs against its
 /// family. For a closed curve the value is moved by whole periods into
 /// [start, start + period) (period > 0).
 struct Reparametrization {
