@@ -3,6 +3,7 @@
 // read back from there, so the demo goes through exactly the path a user's spec
 // takes; then every output the command line offers is written beside it.
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -146,7 +147,10 @@ bool is_point_grid(const ojson& v) {
   return v.is_array() && !v.empty() && v[0].is_array() && !v[0].empty() && v[0][0].is_array();
 }
 
-// A spec as people write them: one member per line, one grid row per line.
+bool is_object_list(const ojson& v) { return v.is_array() && !v.empty() && v[0].is_object(); }
+
+// A spec as people write them: one member per line, one grid row or object (a curve,
+// a corner) per line.
 std::string spec_text(const ojson& spec) {
   std::string s = "{\n";
   bool first = true;
@@ -154,7 +158,7 @@ std::string spec_text(const ojson& spec) {
     s += first ? "  " : ",\n  ";
     first = false;
     s += ojson(it.key()).dump() + ": ";
-    if (is_point_grid(it.value())) {
+    if (is_point_grid(it.value()) || is_object_list(it.value())) {
       s += "[\n";
       for (std::size_t i = 0; i < it.value().size(); ++i) s += (i ? ",\n    " : "    ") + it.value()[i].dump();
       s += "\n  ]";
@@ -275,6 +279,81 @@ ojson closed_network_spec() {
           {"v_curves", v_curves},
           {"u_params", {0, 0.25, 0.5, 0.75}},
           {"v_params", {0, 1.0 / 3, 2.0 / 3, 1}}};
+}
+
+// A network drawn freehand on a sheet over about [0, 4] x [0, 3]: 5 u_curves and 4
+// v_curves, as a designer sketches sections. The crossing (i, j) of v-curve i and
+// u-curve j lies off the sheet's iso-lines, and each curve runs through its crossings
+// and a few points between them, unevenly spaced, slightly bowed and rounded to 3
+// decimals; a crossing is a point of both curves, so the two meet exactly. Chord
+// parameters on the u_curves and centripetal ones on the v_curves put the crossings at
+// different parameters on every curve; the curves are listed out of order, and some
+// run the other way.
+Vec3 sheet(double a, double b) {
+  const double x = 4 * a, y = 3 * b;
+  return {x + 0.25 * std::sin(2.1 * b), y + 0.15 * std::sin(1.7 * a),
+          0.9 * std::sin(0.8 * x) * std::cos(0.6 * y) + 0.08 * x * y};
+}
+
+ojson drawn_network_spec() {
+  constexpr int nu = 5, nv = 4;  // u_curves, v_curves
+  const auto cross = [](int i, int j) {  // (a, b) of the crossing of v-curve i and u-curve j
+    const bool inner_i = i > 0 && i < nv - 1, inner_j = j > 0 && j < nu - 1;
+    const double a = i / double(nv - 1) + (inner_i ? 0.04 * std::sin(1.3 * j + 0.7 * i) : 0.02 * std::sin(2.0 * j + i));
+    const double b = j / double(nu - 1) + (inner_j ? 0.03 * std::cos(0.9 * i + 1.1 * j) : 0.015 * std::cos(1.5 * i + j));
+    return std::array<double, 2>{a, b};
+  };
+  const std::vector<std::vector<double>> between{{0.45}, {0.3, 0.72}, {0.2, 0.5, 0.85}, {0.6}, {0.35, 0.8}, {0.15, 0.55}};
+  const auto point = [](double a, double b) {
+    const Vec3 p = sheet(a, b);
+    return ojson{std::round(p.x * 1000) / 1000, std::round(p.y * 1000) / 1000, std::round(p.z * 1000) / 1000};
+  };
+  // From crossing p to crossing q: the points at fractions s of the way, bowed sideways.
+  const auto stroke = [&](ojson& pts, std::array<double, 2> p, std::array<double, 2> q, const std::vector<double>& s,
+                          std::size_t count, double bow) {
+    const double da = q[0] - p[0], db = q[1] - p[1], len = std::hypot(da, db);
+    for (std::size_t k = 0; k < count; ++k) {
+      const double side = bow * std::sin(pi * s[k]) / len;
+      pts.push_back(point(p[0] + s[k] * da - side * db, p[1] + s[k] * db + side * da));
+    }
+  };
+  std::vector<ojson> u(nu), v(nv);
+  for (int j = 0; j < nu; ++j) {
+    u[j] = ojson::array();
+    for (int i = 0; i < nv; ++i) {
+      const auto c = cross(i, j);
+      u[j].push_back(point(c[0], c[1]));
+      const auto& s = between[(i + 2 * j) % 6];
+      if (i + 1 < nv) stroke(u[j], c, cross(i + 1, j), s, s.size(), 0.012 * std::sin(j + 2 * i + 1));
+    }
+  }
+  for (int i = 0; i < nv; ++i) {
+    v[i] = ojson::array();
+    for (int j = 0; j < nu; ++j) {
+      const auto c = cross(i, j);
+      v[i].push_back(point(c[0], c[1]));
+      const auto& s = between[(3 * i + j + 1) % 6];
+      const std::size_t count = std::min<std::size_t>(s.size(), j % 2 ? 2 : 1);
+      if (j + 1 < nu) stroke(v[i], c, cross(i, j + 1), s, count, 0.01 * std::cos(i + j));
+    }
+  }
+  const auto reversed = [](const ojson& pts) {
+    ojson r = ojson::array();
+    for (auto it = pts.rbegin(); it != pts.rend(); ++it) r.push_back(*it);
+    return r;
+  };
+  ojson u_curves = ojson::array(), v_curves = ojson::array();
+  for (int j : {2, 0, 4, 1, 3})
+    u_curves.push_back({{"interpolate", j == 0 || j == 3 ? reversed(u[j]) : u[j]}, {"param", "chord"}});
+  for (int i : {1, 3, 0, 2})
+    v_curves.push_back({{"interpolate", i == 2 ? reversed(v[i]) : v[i]}, {"param", "centripetal"}});
+  return {{"type", "network"},
+          {"comment", "Curves drawn freehand on a sheet, 5 u_curves and 4 v_curves: listed out of order, some drawn the "
+                      "other way, through unevenly spaced points (chord parameters on the u_curves, centripetal on the "
+                      "v_curves), so that they cross at different parameters on every curve. interpatch sorts and turns "
+                      "them, and re-expresses each with its crossings at common parameters."},
+          {"u_curves", u_curves},
+          {"v_curves", v_curves}};
 }
 
 ojson hermite_corners() {
@@ -471,6 +550,8 @@ std::vector<Example> examples() {
                 nullptr, "", false});
   ex.push_back({"network_closed", "closed Gordon surface through 4 closed sections and 4 curves along them",
                 closed_network_spec(), nullptr, "", false});
+  ex.push_back({"network_drawn", "Gordon surface through 5 x 4 curves drawn freehand, in no order, some reversed",
+                drawn_network_spec(), nullptr, "", false});
   ex.push_back({"hermite_patch", "bicubic Hermite (Ferguson) patch from corner data",
                 {{"type", "hermite_patch"},
                  {"comment", "Positions, tangents and twists at the corners of a bicubic dome."},
