@@ -379,7 +379,7 @@ void report_warnings(const io::Construction& c) {
 int build_command(const Input& in, const fs::path& out) {
   check_build_output(out);
   io::check_writable(out);
-  const io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = false});
+  const io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = false, .arrays = {}});
   write_build(c, out);
   report_warnings(c);
   return 0;
@@ -391,7 +391,7 @@ int mesh_command(const Input& in, const fs::path& out, std::string_view res_text
   io::check_writable(out);
   if (given) require_mesh_memory(*given);
   // A mesh samples the construction; its exact form is made only if that costs less.
-  io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = true});
+  io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}});
   const Resolution res = given ? *given : (io::is_volume(c) ? default_volume_resolution : default_surface_resolution);
   check_mesh_kind(c, out, res);
   if (!given) require_mesh_memory(res);
@@ -408,7 +408,7 @@ int eval_command(const Input& in, const fs::path& out, std::string_view grid_tex
   // grid of the construction's kind (K of a volume: KxKxK).
   require_eval_room({counts[0], counts.size() > 1 ? counts[1] : counts[0], counts.size() > 2 ? counts[2] : 0}, out);
   // Evaluation samples the construction; its exact form is made only if that costs less.
-  io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = true});
+  io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}});
   const Resolution grid = grid_resolution(counts, c);
   require_eval_room(grid, out);
   write_eval(c, out, grid);

@@ -224,7 +224,7 @@ std::size_t first_difference(std::span<const double> got, std::span<const double
 }
 
 // How eval builds a construction: without its exact form, until the evaluation asks.
-const io::BuildOptions evaluation_options{.progress = {}, .keep_data = false, .defer_exact = true};
+const io::BuildOptions evaluation_options{.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}};
 
 // What evaluate() gives for construction c on linspace(0, 1, n) along each direction
 // (two counts for a surface, three for a volume): the doubles of a C-order array.

@@ -741,7 +741,7 @@ json coons_spec(std::size_t m) {
                         {"u0", {{"interpolate", side[2]}}}, {"u1", {{"interpolate", side[3]}}}}}};
 }
 
-const BuildOptions deferred{.progress = {}, .keep_data = false, .defer_exact = true};
+const BuildOptions deferred{.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}};
 
 TEST(SpecExact, DeferredUntilAskedThenTheSameAsBuiltAtOnce) {
   const json spec = coons_spec(40);

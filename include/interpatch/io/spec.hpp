@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -81,6 +82,8 @@ struct Construction {
   std::function<ExactForm()> convert;
 };
 
+struct PointArray;
+
 /// How build() builds a construction.
 ///
 /// Example: a Coons patch sampled by its formula, its exact form made when asked.
@@ -108,6 +111,10 @@ struct BuildOptions {
   /// time of writing its points, while the exact form first needs a control net of
   /// the merged knots of every curve (4.2 million points for four 1024-point curves).
   bool defer_exact = false;
+  /// Point arrays held in memory, which a spec names as {"array": NAME} wherever it
+  /// takes a point array (in place of {"npy": FILE}): how the Python module's
+  /// constructors pass NumPy arrays without writing them to a file.
+  std::map<std::string, std::shared_ptr<const PointArray>, std::less<>> arrays;
 };
 
 /// The construction's exact form, converted on first use when the build deferred it.

@@ -12,6 +12,7 @@ using std::string_view_literals::operator""sv;
 
 // Point arrays given as files.
 inline constexpr auto npy = std::to_array({"npy"sv});
+inline constexpr auto array = std::to_array({"array"sv});
 inline constexpr auto csv = std::to_array({"csv"sv, "shape"sv});
 
 // Curves: the fields of the curve object ("interpolate", "line"), or of the object

@@ -182,7 +182,28 @@ PointArray csv_points(const json& obj, std::size_t rank, std::string_view ptr, C
 
 }  // namespace
 
+// {"array": NAME}: a point array the caller holds in memory (BuildOptions::arrays).
+PointArray memory_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx) {
+  check_fields(obj, ptr, forms::array, ctx);
+  const std::string aptr = child(ptr, "array");
+  const json& name = obj.at("array");
+  if (!name.is_string()) wrong_type(aptr, "the name of an array given with the spec", name);
+  const PointArray* given = nullptr;
+  if (ctx.arrays)
+    if (const auto it = ctx.arrays->find(name.get<std::string>()); it != ctx.arrays->end()) given = it->second.get();
+  if (!given) fail(errc::missing_field, place(aptr), ": no array named \"", name.get<std::string>(), "\" was given with the spec");
+  const PointArray& a = *given;
+  if (a.shape.size() != rank)
+    fail(errc::size_mismatch, place(ptr), ": the array has shape ", shape_text(a.shape), " (and 3 per point); expected ",
+         expected_shape(rank));
+  for (std::size_t s : a.shape)
+    if (s == 0) fail(errc::too_few_points, place(ptr), ": the array has shape ", shape_text(a.shape), ", no points");
+  check_finite_points(a.shape, a.points, ptr, "the array");
+  return a;
+}
+
 PointArray points_impl(const json& j, std::size_t rank, std::string_view ptr, Context& ctx) {
+  if (j.is_object() && j.contains("array")) return memory_points(j, rank, ptr, ctx);
   if (j.is_object()) {
     const bool npy = j.contains("npy"), csv = j.contains("csv");
     if (npy && csv) fail(errc::wrong_type, place(ptr), ": give either \"npy\" or \"csv\", not both");

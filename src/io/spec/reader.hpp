@@ -76,6 +76,7 @@ struct Context {
   progress_callback progress;
   bool keep_data = true;     // copy interpolated grids into Construction::data
   bool defer_exact = false;  // leave a formula's exact form to exact_form()
+  const std::map<std::string, std::shared_ptr<const PointArray>, std::less<>>* arrays = nullptr;  // BuildOptions::arrays
   std::vector<std::string> warnings;
   Clock::time_point start = Clock::now();
   std::optional<Clock::time_point> parsed_at;

@@ -220,12 +220,13 @@ Construction build(const json& spec, const std::filesystem::path& base_dir, cons
   ctx.progress = options.progress;
   ctx.keep_data = options.keep_data;
   ctx.defer_exact = options.defer_exact;
+  ctx.arrays = &options.arrays;
   return build_impl(spec, ctx);
 }
 
 Construction build(const json& spec, const std::filesystem::path& base_dir, const progress_callback& progress,
                    bool keep_data) {
-  return build(spec, base_dir, BuildOptions{.progress = progress, .keep_data = keep_data, .defer_exact = false});
+  return build(spec, base_dir, BuildOptions{.progress = progress, .keep_data = keep_data, .defer_exact = false, .arrays = {}});
 }
 
 Construction build_file(const std::filesystem::path& spec_path, const BuildOptions& options) {
@@ -235,11 +236,12 @@ Construction build_file(const std::filesystem::path& spec_path, const BuildOptio
   ctx.progress = options.progress;
   ctx.keep_data = options.keep_data;
   ctx.defer_exact = options.defer_exact;
+  ctx.arrays = &options.arrays;
   return build_impl(spec, ctx);
 }
 
 Construction build_file(const std::filesystem::path& spec_path, const progress_callback& progress, bool keep_data) {
-  return build_file(spec_path, BuildOptions{.progress = progress, .keep_data = keep_data, .defer_exact = false});
+  return build_file(spec_path, BuildOptions{.progress = progress, .keep_data = keep_data, .defer_exact = false, .arrays = {}});
 }
 
 PointArray points_from_json(const json& j, std::size_t rank, const std::filesystem::path& base_dir, std::string_view pointer) {

@@ -1,0 +1,195 @@
+"""NumPy-native constructors: each makes the spec the command line reads
+(docs/spec-format.md), with its arrays passed in memory rather than written to
+files, and builds it. Same semantics, defaults and errors as the command line;
+the messages name the spec's fields (/points, /u_curves/2, ...)."""
+
+from __future__ import annotations
+
+from typing import Any, Optional, Sequence
+
+import numpy as np
+
+from ._core import build as _build
+
+
+class _Arrays:
+    """The arrays of one spec, each named where the spec takes it."""
+
+    def __init__(self) -> None:
+        self.table: dict[str, np.ndarray] = {}
+
+    def add(self, points: Any) -> dict[str, str]:
+        name = f"a{len(self.table)}"
+        self.table[name] = np.asarray(points)
+        return {"array": name}
+
+
+def _point(p: Any) -> list[float]:
+    a = np.asarray(p, dtype=np.float64).reshape(-1)
+    return [float(x) for x in a]
+
+
+class Curve:
+    """A curve of a spec (a Coons side, a network curve, a ruled surface's curve):
+    make one with interpolate_curve, bspline_curve, hermite_curve or line."""
+
+    def __init__(self, make) -> None:
+        self._make = make
+
+    def _spec(self, arrays: _Arrays) -> dict[str, Any]:
+        return self._make(arrays)
+
+
+def interpolate_curve(points: Any, degree: Optional[int] = None, param: str = "chord",
+                      periodic: bool = False, start_derivative: Any = None, end_derivative: Any = None) -> Curve:
+    """The B-spline curve through `points` (shape (n, 3)), as the spec's
+    {"interpolate": ...} curve: degree min(3, n - 1) unless given, chord-length
+    parameters unless `param` says otherwise, closed with periodic=True, with given
+    end derivatives (over the curve's [0, 1]) if any.
+
+    Example: c = interpatch.interpolate_curve(np.array([[0, 0, 0], [1, 2, 0], [3, 3, 0]]))"""
+
+    def make(arrays: _Arrays) -> dict[str, Any]:
+        s: dict[str, Any] = {"interpolate": arrays.add(points), "param": param}
+        if degree is not None:
+            s["degree"] = int(degree)
+        if periodic:
+            s["periodic"] = True
+        if start_derivative is not None:
+            s["start_derivative"] = _point(start_derivative)
+        if end_derivative is not None:
+            s["end_derivative"] = _point(end_derivative)
+        return s
+
+    return Curve(make)
+
+
+def bspline_curve(degree: int, knots: Sequence[float], control_points: Any,
+                  weights: Optional[Sequence[float]] = None, periodic: bool = False) -> Curve:
+    """A B-spline curve given by its degree, knots and control points (shape (n, 3)),
+    rational with `weights`, closed with periodic=True (knots as the spec's
+    {"bspline": ...} curve takes them)."""
+
+    def make(arrays: _Arrays) -> dict[str, Any]:
+        b: dict[str, Any] = {"degree": int(degree), "knots": [float(x) for x in knots],
+                             "control_points": arrays.add(control_points)}
+        if weights is not None:
+            b["weights"] = [float(x) for x in weights]
+        if periodic:
+            b["periodic"] = True
+        return {"bspline": b}
+
+    return Curve(make)
+
+
+def hermite_curve(points: Any, tangents: Any = None, params: Optional[Sequence[float]] = None) -> Curve:
+    """The piecewise cubic Hermite curve through `points` with `tangents` (both shape
+    (n, 3); Catmull–Rom tangents when not given) at `params` (equally spaced by default)."""
+
+    def make(arrays: _Arrays) -> dict[str, Any]:
+        h: dict[str, Any] = {"points": arrays.add(points)}
+        if tangents is not None:
+            h["tangents"] = arrays.add(tangents)
+        if params is not None:
+            h["params"] = [float(x) for x in params]
+        return {"hermite": h}
+
+    return Curve(make)
+
+
+def line(a: Any, b: Any) -> Curve:
+    """The straight segment from a to b."""
+    return Curve(lambda arrays: {"line": [_point(a), _point(b)]})
+
+
+def _curve(c: Any, arrays: _Arrays) -> dict[str, Any]:
+    if isinstance(c, Curve):
+        return c._spec(arrays)
+    return interpolate_curve(c)._spec(arrays)  # an array of points: the curve through them
+
+
+def _options(spec: dict[str, Any], **kw: Any) -> dict[str, Any]:
+    for k, v in kw.items():
+        if v is None:
+            continue
+        if isinstance(v, tuple):
+            v = list(v)
+        spec[k] = v
+    return spec
+
+
+def interpolate_surface(points: Any, degree: Any = None, param: Optional[str] = None,
+                        periodic: Any = None):
+    """The B-spline surface through a grid of points, shape (n, m, 3), any float
+    dtype and memory order: bicubic unless `degree` (an int or (du, dv)) says
+    otherwise, chord-length parameters averaged over the lines unless `param` is
+    "uniform" or "centripetal", closed in the directions `periodic` = (pu, pv) says.
+
+    Example::
+
+        z = np.sin(x)[:, None] * np.cos(y)[None, :]
+        grid = np.stack(np.broadcast_arrays(x[:, None], y[None, :], z), axis=-1)
+        s = interpatch.interpolate_surface(grid)
+        pts = s.evaluate(np.linspace(0, 1, 200), np.linspace(0, 1, 200))  # (200, 200, 3)"""
+    a = _Arrays()
+    spec = _options({"type": "interpolate", "points": a.add(points)}, degree=degree, param=param, periodic=periodic)
+    return _build(spec, ".", a.table)
+
+
+def bilinear(p00: Any, p01: Any, p10: Any, p11: Any):
+    """The bilinear patch of four corners: S(0,0) = p00, S(0,1) = p01, S(1,0) = p10, S(1,1) = p11."""
+    return _build({"type": "bilinear", "p00": _point(p00), "p01": _point(p01), "p10": _point(p10),
+                   "p11": _point(p11)}, ".", {})
+
+
+def ruled(c0: Any, c1: Any):
+    """The ruled surface S(u, v) = (1 - v) c0(u) + v c1(u) of two curves (Curve objects,
+    or arrays of points to interpolate)."""
+    a = _Arrays()
+    return _build({"type": "ruled", "curves": [_curve(c0, a), _curve(c1, a)]}, ".", a.table)
+
+
+def coons(v0: Any, v1: Any, u0: Any, u1: Any, blending: Optional[str] = None,
+          tolerance: Optional[float] = None):
+    """The Coons patch of four boundary curves: v0 = S(u, 0), v1 = S(u, 1), u0 = S(0, v),
+    u1 = S(1, v); blending "linear" (default) or "hermite"."""
+    a = _Arrays()
+    spec = {"type": "coons", "boundary": {"v0": _curve(v0, a), "v1": _curve(v1, a), "u0": _curve(u0, a),
+                                          "u1": _curve(u1, a)}}
+    return _build(_options(spec, blending=blending, tolerance=tolerance), ".", a.table)
+
+
+def curve_network(u_curves: Sequence[Any], v_curves: Sequence[Any], method: Optional[str] = None,
+                  u_params: Optional[Sequence[float]] = None, v_params: Optional[Sequence[float]] = None,
+                  tolerance: Optional[float] = None, periodic: Any = None):
+    """The surface through a network of curves as drawn: any order, either
+    direction, crossings at different parameters (docs/spec-format.md, type
+    network); method "gordon" (default), "coons_linear" or "coons_hermite"."""
+    a = _Arrays()
+    spec = {"type": "network", "u_curves": [_curve(c, a) for c in u_curves],
+            "v_curves": [_curve(c, a) for c in v_curves]}
+    if u_params is not None:
+        spec["u_params"] = [float(x) for x in u_params]
+    if v_params is not None:
+        spec["v_params"] = [float(x) for x in v_params]
+    return _build(_options(spec, method=method, tolerance=tolerance, periodic=periodic), ".", a.table)
+
+
+def hermite_patch(corners: dict[str, dict[str, Any]]):
+    """The bicubic Hermite patch of four corners, each {"p", "du", "dv", "duv"}, keyed
+    "p00", "p01", "p10", "p11"."""
+    spec = {"type": "hermite_patch",
+            "corners": {k: {f: _point(v) for f, v in c.items()} for k, c in corners.items()}}
+    return _build(spec, ".", {})
+
+
+def build(spec: Any, base_dir: Any = ".", arrays: Optional[dict[str, Any]] = None):
+    """A spec (docs/spec-format.md) as a dict, or the path of a spec file, built.
+    A dict may name NumPy arrays given in `arrays` as {"array": NAME} wherever it
+    takes a point array.
+
+    Example::
+
+        s = interpatch.build({"type": "bilinear", "p00": [0, 0, 0], "p01": [0, 1, 0],
+                              "p10": [1, 0, 0], "p11": [1, 1, 1]})"""
+    return _build(spec, base_dir, arrays or {})
