@@ -12,13 +12,16 @@ SHELL := /bin/bash
 #   python3-scipy                    the closed-spline reference data (tools/reference/make_periodic_reference.py)
 #   python3-vtk9                     VTK's own readers read back the .vts/.vtk/.xyz files interpatch writes
 #   python3-matplotlib               make bench draws docs/bench_interpolation.png
+#   pybind11-dev python3-dev         the Python module (import interpatch)
+#   python3-pytest                   its test suite
 #   libocct-*-dev                    OpenCASCADE reads back the STEP and IGES files (tests) and races us (make bench)
 #   libsisl-dev                      SISL races us in make bench
 #   clang libclang-rt-14-dev libomp-14-dev   libFuzzer (with its OpenMP) runs the fuzz targets of make test
 DEBS := cmake ninja-build g++ pkg-config python3 libcli11-dev nlohmann-json3-dev \
         libgtest-dev libgmock-dev libbenchmark-dev python3-numpy python3-vtk9 python3-matplotlib \
         libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
-        libocct-foundation-dev libsisl-dev python3-scipy clang libclang-rt-14-dev libomp-14-dev
+        libocct-foundation-dev libsisl-dev python3-scipy clang libclang-rt-14-dev libomp-14-dev \
+        pybind11-dev python3-pybind11 python3-dev python3-pytest
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 

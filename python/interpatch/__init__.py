@@ -13,11 +13,11 @@ Errors raise interpatch.Error (a ValueError) whose .code names the problem
 ("zero_chord", "network_gap", ...) with the command line's message.
 """
 
-from ._core import Error, Surface
+from ._core import Construction, Error, Surface, Volume
 from ._specs import (Curve, bilinear, bspline_curve, build, coons, curve_network, hermite_curve, hermite_patch,
                      interpolate_curve, interpolate_surface, line, ruled)
 
 __version__ = "@PROJECT_VERSION@"
-__all__ = ["Error", "Surface", "Curve", "build", "interpolate_surface", "bilinear", "ruled", "coons",
+__all__ = ["Error", "Construction", "Surface", "Volume", "Curve", "build", "interpolate_surface", "bilinear", "ruled", "coons",
            "curve_network", "hermite_patch", "interpolate_curve", "bspline_curve", "hermite_curve", "line",
            "__version__"]

@@ -78,9 +78,80 @@ struct Built {
 
 py::object to_python(const nlohmann::ordered_json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
-class PySurface {
+// What surfaces and volumes share: the built spec, its info, its files.
+class PyBuilt {
  public:
-  explicit PySurface(std::shared_ptr<Built> b) : b_(std::move(b)) {}
+  explicit PyBuilt(std::shared_ptr<Built> b) : b_(std::move(b)) {}
+
+  py::object info() const {
+    nlohmann::ordered_json j;
+    {
+      py::gil_scoped_release free;
+      std::lock_guard<std::mutex> hold(b_->lock);
+      if (ip::io::has_exact_form(b_->c)) (void)ip::io::exact_form(b_->c);  // info reports it, as the command does
+      j = ip::io::info_json(b_->c);
+    }
+    return to_python(j);
+  }
+
+  [[nodiscard]] const std::string& type() const { return b_->c.type; }
+
+  // Written as the commands write: .json .npz .step/.stp .igs/.iges (the exact form) or
+  // a mesh (.obj .ply .stl .vtk .vts .xyz) of `res` vertices.
+  void write(const std::filesystem::path& path, const std::optional<std::vector<std::size_t>>& res) const {
+    namespace cli = ip::cli;
+    py::gil_scoped_release free;
+    std::lock_guard<std::mutex> hold(b_->lock);
+    try {
+      if (ip::io::is_mesh_format(path.extension().string())) {
+        const bool volume = ip::io::is_volume(b_->c);
+        cli::Resolution r = volume ? cli::default_volume_resolution : cli::default_surface_resolution;
+        if (res) {
+          if (res->size() != (volume ? 3u : 2u))
+            throw ip::error(ip::errc::size_mismatch, std::string("res: ") + (volume ? "(nu, nv, nw)" : "(nu, nv)") +
+                                                         " vertices, got " + std::to_string(res->size()) + " counts");
+          r = {(*res)[0], (*res)[1], volume ? (*res)[2] : 0};
+        }
+        cli::write_mesh(b_->c, path, r);
+        return;
+      }
+      cli::check_build_output(path);
+      if (ip::io::has_exact_form(b_->c)) (void)ip::io::exact_form(b_->c);
+      cli::write_build(b_->c, path);
+    } catch (const cli::usage_error& e) {
+      throw ip::error(ip::errc::wrong_type, e.what());
+    }
+  }
+
+  // The data's parameters along an axis, where the construction has data.
+  [[nodiscard]] py::object data_params(std::size_t axis) const {
+    const auto& data = b_->c.data;
+    if (data.empty() || data.front().params.size() <= axis) return py::none();
+    const auto& p = data.front().params[axis];
+    return py::array_t<double>(static_cast<py::ssize_t>(p.size()), p.data());
+  }
+
+ protected:
+  // A capsule that keeps the construction alive while arrays view its memory.
+  [[nodiscard]] py::capsule alive() const {
+    return py::capsule(new std::shared_ptr<Built>(b_), [](void* p) { delete static_cast<std::shared_ptr<Built>*>(p); });
+  }
+  template <class Exact>
+  const Exact& exact() const {
+    py::gil_scoped_release free;
+    std::lock_guard<std::mutex> hold(b_->lock);
+    return std::get<Exact>(ip::io::exact_form(b_->c));
+  }
+  std::shared_ptr<Built> b_;
+};
+
+py::array_t<double> knots_array(const ip::KnotVector& k, const py::capsule& alive) {
+  return py::array_t<double>(static_cast<py::ssize_t>(k.size()), k.values().data(), alive);
+}
+
+class PySurface : public PyBuilt {
+ public:
+  using PyBuilt::PyBuilt;
 
   py::array_t<double> evaluate(const py::handle& us_in, const py::handle& vs_in) const {
     auto us = params(us_in), vs = params(vs_in);
@@ -128,68 +199,21 @@ class PySurface {
     return d;
   }
 
-  py::object info() const {
-    nlohmann::ordered_json j;
-    {
-      py::gil_scoped_release free;
-      std::lock_guard<std::mutex> hold(b_->lock);
-      if (ip::io::has_exact_form(b_->c)) (void)ip::io::exact_form(b_->c);  // info reports it, as the command does
-      j = ip::io::info_json(b_->c);
-    }
-    return to_python(j);
-  }
-
-  [[nodiscard]] const std::string& type() const { return b_->c.type; }
-
   // The exact B-spline form: degree, knots, and control points (and weights) as arrays
   // over the construction's own memory.
   py::dict to_bspline() const {
-    const ip::BSplineSurface* e = nullptr;
-    {
-      py::gil_scoped_release free;
-      std::lock_guard<std::mutex> hold(b_->lock);
-      e = &std::get<ip::BSplineSurface>(ip::io::exact_form(b_->c));
-    }
-    py::capsule alive(new std::shared_ptr<Built>(b_), [](void* p) { delete static_cast<std::shared_ptr<Built>*>(p); });
+    const ip::BSplineSurface* e = &exact<ip::BSplineSurface>();
+    const py::capsule keep = alive();
     const auto nu = static_cast<py::ssize_t>(e->control_points().shape()[0]);
     const auto nv = static_cast<py::ssize_t>(e->control_points().shape()[1]);
     py::dict d;
     d["degree"] = py::make_tuple(e->knots_u().degree(), e->knots_v().degree());
-    d["knots_u"] = py::array_t<double>(static_cast<py::ssize_t>(e->knots_u().size()), e->knots_u().values().data(), alive);
-    d["knots_v"] = py::array_t<double>(static_cast<py::ssize_t>(e->knots_v().size()), e->knots_v().values().data(), alive);
-    d["control_points"] = py::array_t<double>({nu, nv, py::ssize_t{3}}, &e->control_points().data()->x, alive);
-    d["weights"] = e->rational() ? py::object(py::array_t<double>({nu, nv}, e->weights().data(), alive)) : py::none();
+    d["knots_u"] = knots_array(e->knots_u(), keep);
+    d["knots_v"] = knots_array(e->knots_v(), keep);
+    d["control_points"] = py::array_t<double>({nu, nv, py::ssize_t{3}}, &e->control_points().data()->x, keep);
+    d["weights"] = e->rational() ? py::object(py::array_t<double>({nu, nv}, e->weights().data(), keep)) : py::none();
     d["periodic"] = py::make_tuple(e->knots_u().periodic(), e->knots_v().periodic());
     return d;
-  }
-
-  // Written as the commands write: .json .npz .step/.stp .igs/.iges (the exact form) or
-  // a mesh (.obj .ply .stl .vtk .vts ...) of `res` vertices.
-  void write(const std::filesystem::path& path, const std::optional<std::pair<std::size_t, std::size_t>>& res) const {
-    namespace cli = ip::cli;
-    py::gil_scoped_release free;
-    std::lock_guard<std::mutex> hold(b_->lock);
-    try {
-      if (ip::io::is_mesh_format(path.extension().string())) {
-        cli::Resolution r = cli::default_surface_resolution;
-        if (res) r = {res->first, res->second, 0};
-        cli::write_mesh(b_->c, path, r);
-        return;
-      }
-      cli::check_build_output(path);
-      if (ip::io::has_exact_form(b_->c)) (void)ip::io::exact_form(b_->c);
-      cli::write_build(b_->c, path);
-    } catch (const cli::usage_error& e) {
-      throw ip::error(ip::errc::wrong_type, e.what());
-    }
-  }
-
-  // The data's parameters along u and v, where the construction has data.
-  [[nodiscard]] py::object data_params(std::size_t axis) const {
-    const auto& data = b_->c.data;
-    if (data.empty() || data.front().params.size() <= axis) return py::none();
-    const auto& p = data.front().params[axis];
-    return py::array_t<double>(static_cast<py::ssize_t>(p.size()), p.data());
   }
 
  private:
@@ -197,13 +221,73 @@ class PySurface {
     std::lock_guard<std::mutex> hold(b_->lock);
     return ip::io::evaluator(b_->c, points, what);
   }
-  std::shared_ptr<Built> b_;
+};
+
+class PyVolume : public PyBuilt {
+ public:
+  using PyBuilt::PyBuilt;
+
+  py::array_t<double> evaluate(const py::handle& us_in, const py::handle& vs_in, const py::handle& ws_in) const {
+    auto us = params(us_in), vs = params(vs_in), ws = params(ws_in);
+    auto out = std::make_unique<std::vector<ip::Vec3>>(us.size() * vs.size() * ws.size());
+    {
+      py::gil_scoped_release free;
+      ip::io::volume_evaluator(b_->c).evaluate_into(us, vs, ws, *out);
+    }
+    double* data = &(*out)[0].x;
+    return owning_array(std::move(out), data,
+                        {static_cast<py::ssize_t>(us.size()), static_cast<py::ssize_t>(vs.size()),
+                         static_cast<py::ssize_t>(ws.size()), 3});
+  }
+
+  py::tuple jacobians(const py::handle& us_in, const py::handle& vs_in, const py::handle& ws_in) const {
+    auto us = params(us_in), vs = params(vs_in), ws = params(ws_in);
+    std::unique_ptr<ip::VolumeJacobians> j;
+    {
+      py::gil_scoped_release free;
+      j = std::make_unique<ip::VolumeJacobians>(ip::io::volume_evaluator(b_->c).evaluate_jacobians(us, vs, ws));
+    }
+    const std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(us.size()), static_cast<py::ssize_t>(vs.size()),
+                                         static_cast<py::ssize_t>(ws.size())};
+    std::shared_ptr<ip::VolumeJacobians> owner(std::move(j));
+    py::capsule keep(new std::shared_ptr<ip::VolumeJacobians>(owner),
+                     [](void* p) { delete static_cast<std::shared_ptr<ip::VolumeJacobians>*>(p); });
+    auto points_shape = shape;
+    points_shape.push_back(3);
+    return py::make_tuple(py::array_t<double>(points_shape, &owner->points.data()->x, keep),
+                          py::array_t<double>(shape, owner->determinants.data(), keep));
+  }
+
+  py::array_t<double> point(double u, double v, double w) const {
+    const ip::Vec3 p = ip::io::volume_evaluator(b_->c).point(u, v, w);
+    return py::array_t<double>(3, &p.x);
+  }
+
+  py::dict to_bspline() const {
+    const ip::BSplineVolume* e = &exact<ip::BSplineVolume>();
+    const py::capsule keep = alive();
+    const auto& sh = e->control_points().shape();
+    const auto n0 = static_cast<py::ssize_t>(sh[0]), n1 = static_cast<py::ssize_t>(sh[1]), n2 = static_cast<py::ssize_t>(sh[2]);
+    py::dict d;
+    d["degree"] = py::make_tuple(e->knots_u().degree(), e->knots_v().degree(), e->knots_w().degree());
+    d["knots_u"] = knots_array(e->knots_u(), keep);
+    d["knots_v"] = knots_array(e->knots_v(), keep);
+    d["knots_w"] = knots_array(e->knots_w(), keep);
+    d["control_points"] = py::array_t<double>({n0, n1, n2, py::ssize_t{3}}, &e->control_points().data()->x, keep);
+    d["weights"] = e->rational() ? py::object(py::array_t<double>({n0, n1, n2}, e->weights().data(), keep)) : py::none();
+    d["periodic"] = py::make_tuple(e->knots_u().periodic(), e->knots_v().periodic(), e->knots_w().periodic());
+    return d;
+  }
 };
 
 py::object wrap(ip::io::Construction c) {
   auto b = std::make_shared<Built>();
   b->c = std::move(c);
-  if (ip::io::is_volume(b->c)) throw ip::error(ip::errc::wrong_type, "volumes are not yet available from Python");
+  if (ip::io::is_volume(b->c)) {
+    // A volume's formula evaluates without the lock: make its exact form now if it has one
+    // and the formula is not kept (volume_evaluator needs one of them).
+    return py::cast(PyVolume(std::move(b)));
+  }
   return py::cast(PySurface(std::move(b)));
 }
 
@@ -252,8 +336,21 @@ PYBIND11_MODULE(_core, m) {
     }
   });
 
-  py::class_<PySurface>(m, "Surface", "A surface over [0, 1]², built from a spec or a constructor.")
-      .def_property_readonly("type", &PySurface::type, "The spec's \"type\".")
+  py::class_<PyBuilt>(m, "Construction", "What surfaces and volumes share.")
+      .def_property_readonly("type", &PyBuilt::type, "The spec's \"type\".")
+      .def("info", &PyBuilt::info, "The dict `interpatch info` prints for this construction.")
+      .def("write", &PyBuilt::write, py::arg("path"), py::arg("res") = py::none(),
+           "Write as `interpatch build` (.json .npz .step .igs: the exact form) or `interpatch mesh` "
+           "(.obj .ply .stl .vtk .vts .xyz: res = (nu, nv) vertices, 64 x 64 by default; a volume's "
+           "(nu, nv, nw), 33 x 33 x 33) would.")
+      .def_property_readonly("params_u", [](const PyBuilt& s) { return s.data_params(0); },
+                             "Parameters of the data along u (None without data).")
+      .def_property_readonly("params_v", [](const PyBuilt& s) { return s.data_params(1); },
+                             "Parameters of the data along v (None without data).")
+      .def_property_readonly("params_w", [](const PyBuilt& s) { return s.data_params(2); },
+                             "Parameters of a volume's data along w (None without data).");
+
+  py::class_<PySurface, PyBuilt>(m, "Surface", "A surface over [0, 1]², built from a spec or a constructor.")
       .def("evaluate", &PySurface::evaluate, py::arg("us"), py::arg("vs"),
            "Points at every (us[i], vs[j]): a float64 array of shape (len(us), len(vs), 3) over the "
            "library's own result memory.\n\nExample: s.evaluate(np.linspace(0, 1, 100), np.linspace(0, 1, 50))")
@@ -264,17 +361,20 @@ PYBIND11_MODULE(_core, m) {
       .def("normal", &PySurface::normal, py::arg("u"), py::arg("v"), "The unit normal Su × Sv / |Su × Sv|, shape (3,).")
       .def("curvature", &PySurface::curvature, py::arg("u"), py::arg("v"),
            "{'gaussian', 'mean', 'k1', 'k2'} at (u, v), with respect to normal().")
-      .def("info", &PySurface::info, "The dict `interpatch info` prints for this construction.")
       .def("to_bspline", &PySurface::to_bspline,
            "The exact B-spline form: {'degree': (p, q), 'knots_u', 'knots_v', 'control_points' (shape (nu, nv, 3)), "
            "'weights' (shape (nu, nv), or None), 'periodic': (bool, bool)}; the arrays view the construction's memory.")
-      .def("write", &PySurface::write, py::arg("path"), py::arg("res") = py::none(),
-           "Write as `interpatch build` (.json .npz .step .igs: the exact form) or `interpatch mesh` "
-           "(.obj .ply .stl .vtk .vts: res = (nu, nv) vertices, 64 x 64 by default) would.")
-      .def_property_readonly("params_u", [](const PySurface& s) { return s.data_params(0); },
-                             "Parameters of the data along u (None without data).")
-      .def_property_readonly("params_v", [](const PySurface& s) { return s.data_params(1); },
-                             "Parameters of the data along v (None without data).");
+      ;
+
+  py::class_<PyVolume, PyBuilt>(m, "Volume", "A volume over [0, 1]³, built from a spec.")
+      .def("evaluate", &PyVolume::evaluate, py::arg("us"), py::arg("vs"), py::arg("ws"),
+           "Points at every (us[i], vs[j], ws[k]): shape (len(us), len(vs), len(ws), 3), over the library's memory.")
+      .def("jacobians", &PyVolume::jacobians, py::arg("us"), py::arg("vs"), py::arg("ws"),
+           "(points, det J) at every (us[i], vs[j], ws[k]): shapes (..., 3) and (len(us), len(vs), len(ws)); "
+           "det J < 0 where the volume folds.")
+      .def("point", &PyVolume::point, py::arg("u"), py::arg("v"), py::arg("w"), "S(u, v, w), shape (3,).")
+      .def("to_bspline", &PyVolume::to_bspline,
+           "The exact B-spline form: degree (p, q, r), knots_u/v/w, control_points (n0, n1, n2, 3), weights or None.");
 
   m.def("build", &build, py::arg("spec"), py::arg("base_dir") = std::filesystem::path("."), py::arg("arrays") = py::dict(),
         "A spec (docs/spec-format.md) as a dict, or the path of a spec file, built.\n\n"

@@ -1,0 +1,248 @@
+"""The Python module against the command line, SciPy and itself.
+
+Run by CTest (python_module) with PYTHONPATH=<build>/python, INTERPATCH_CLI (the
+command) and INTERPATCH_EXAMPLES (examples/) set."""
+
+import json
+import os
+import subprocess
+import sys
+import threading
+
+import numpy as np
+import pytest
+
+import interpatch
+
+CLI = os.environ.get("INTERPATCH_CLI", "interpatch")
+EXAMPLES = os.environ.get("INTERPATCH_EXAMPLES", os.path.join(os.path.dirname(__file__), "..", "..", "examples"))
+
+
+def example_specs():
+    return sorted(f for f in os.listdir(EXAMPLES) if f.endswith(".json"))
+
+
+def cli_eval(spec_path, grid, out):
+    subprocess.run([CLI, "eval", spec_path, "--grid", grid, "-o", out], check=True, capture_output=True)
+    return np.load(out)
+
+
+def terrain(nx=30, ny=40):
+    x = np.linspace(0, 4, nx)
+    y = np.linspace(0, 3, ny)
+    z = np.sin(x)[:, None] * np.cos(y)[None, :] + 0.1 * x[:, None] * y[None, :]
+    return np.stack(np.broadcast_arrays(x[:, None], y[None, :], z), axis=-1)
+
+
+def test_version():
+    assert interpatch.__version__.count(".") == 2
+
+
+@pytest.mark.parametrize("name", example_specs())
+def test_examples_give_the_command_lines_points(name, tmp_path):
+    path = os.path.join(EXAMPLES, name)
+    built = interpatch.build(path)
+    # Counts whose parameters k / (n - 1) are exact in binary, so NumPy's linspace and
+    # the command's are the same numbers.
+    if isinstance(built, interpatch.Volume):
+        want = cli_eval(path, "5x3x2", str(tmp_path / "out.npy"))
+        got = built.evaluate(np.linspace(0, 1, 5), np.linspace(0, 1, 3), np.linspace(0, 1, 2))
+    else:
+        want = cli_eval(path, "9x5", str(tmp_path / "out.npy"))
+        got = built.evaluate(np.linspace(0, 1, 9), np.linspace(0, 1, 5))
+    # The same library calls on the same parameters.
+    assert got.shape == want.shape
+    assert np.array_equal(got, want), np.abs(got - want).max()
+
+
+def test_info_is_the_command_lines(tmp_path):
+    path = os.path.join(EXAMPLES, "network_drawn.json")
+    out = subprocess.run([CLI, "info", path], check=True, capture_output=True, text=True).stdout
+    want = json.loads(out)
+    got = interpatch.build(path).info()
+    for key in ("type", "degree", "control_points", "knots", "max_data_error", "parameters"):
+        assert got[key] == want[key], key
+
+
+def test_constructors_make_what_the_spec_makes():
+    grid = terrain()
+    spec = {"type": "interpolate", "points": grid.tolist()}
+    a = interpatch.interpolate_surface(grid)
+    b = interpatch.build(spec)
+    us, vs = np.linspace(0, 1, 17), np.linspace(0, 1, 13)
+    assert np.array_equal(a.evaluate(us, vs), b.evaluate(us, vs))
+    assert np.array_equal(a.params_u, b.params_u)
+    # Every data point on the surface, to rounding (1e-12 of the data's size).
+    pts = a.evaluate(a.params_u, a.params_v)
+    assert np.abs(pts - grid).max() < 1e-12 * np.abs(grid).max()
+
+    s = interpatch.bilinear([0, 0, 0], [0, 1, 0], [1, 0, 0], [1, 1, 1])
+    assert np.allclose(s.point(0.5, 0.5), [0.5, 0.5, 0.25], atol=1e-15)
+    L = interpatch.line
+    c = interpatch.coons(L([0, 0, 0], [1, 0, 0]), L([0, 1, 0], [1, 1, 1]), L([0, 0, 0], [0, 1, 0]),
+                         L([1, 0, 0], [1, 1, 1]))
+    assert np.allclose(c.evaluate(us, vs), s.evaluate(us, vs), atol=1e-15)
+    r = interpatch.ruled(np.array([[0, 0, 0], [1, 0, 0.5], [2, 0, 0]]), L([0, 1, 0], [2, 1, 0]))
+    assert np.allclose(r.point(0, 1), [0, 1, 0], atol=1e-15)
+    h = interpatch.hermite_patch({k: {"p": p, "du": [1, 0, 0], "dv": [0, 1, 0]} for k, p in
+                                  {"p00": [0, 0, 0], "p01": [0, 1, 0], "p10": [1, 0, 0], "p11": [1, 1, 0]}.items()})
+    assert np.allclose(h.point(0.25, 0.75), [0.25, 0.75, 0], atol=1e-15)
+
+
+def test_a_network_as_drawn():
+    # Curves cut from z = x y at stations of their own, some reversed, out of order.
+    rng = np.random.default_rng(5)
+    def f(x, y):
+        return np.stack([x, y, x * y + 0.2 * np.sin(x)], axis=-1)
+    xs, ys = [0, 0.4, 1.1, 2], [0, 0.7, 1.5]
+    u_curves = []
+    for y in ys:
+        t = np.unique(np.concatenate([[0, 2], xs, rng.uniform(0, 2, 6)]))
+        u_curves.append(interpatch.interpolate_curve(f(t, np.full_like(t, y)), param="chord"))
+    v_curves = []
+    for x in xs:
+        t = np.unique(np.concatenate([[0, 1.5], ys, rng.uniform(0, 1.5, 5)]))
+        if len(v_curves) % 2:
+            t = t[::-1]  # every other v-curve drawn the other way
+        v_curves.append(interpatch.interpolate_curve(f(np.full_like(t, x), t), param="centripetal"))
+    s = interpatch.curve_network(u_curves[::-1], v_curves[1:] + v_curves[:1])
+    info = s.info()
+    # Within the re-expression target of the default tolerance (1e-7 of the diagonal).
+    assert info["max_data_error"]["relative"] < 1e-7
+    assert any(c["reversed"] for c in info["parameters"]["network_curves"].values())
+
+
+def test_any_dtype_and_memory_order_gives_the_same_surface():
+    grid = terrain(12, 9)
+    want = interpatch.interpolate_surface(grid).evaluate(np.linspace(0, 1, 7), np.linspace(0, 1, 5))
+    strided = np.zeros((grid.shape[0], 2 * grid.shape[1], 3))
+    strided[:, ::2] = grid
+    for g in (np.asfortranarray(grid), grid.astype(np.longdouble), strided[:, ::2], grid.transpose(1, 0, 2).swapaxes(0, 1)):
+        got = interpatch.interpolate_surface(g).evaluate(np.linspace(0, 1, 7), np.linspace(0, 1, 5))
+        assert np.array_equal(got, want)
+    # float32 data is another surface (the points are rounded), within float32's rounding.
+    f32 = interpatch.interpolate_surface(grid.astype(np.float32)).evaluate(np.linspace(0, 1, 7), np.linspace(0, 1, 5))
+    assert np.abs(f32 - want).max() < 1e-5
+    # Parameters of any numeric dtype.
+    a = interpatch.interpolate_surface(grid)
+    assert np.array_equal(a.evaluate(np.linspace(0, 1, 7).astype(np.float32), [0, 1]),
+                          a.evaluate(np.linspace(0, 1, 7).astype(np.float32).astype(np.float64), [0.0, 1.0]))
+
+
+def test_results_view_the_librarys_memory():
+    s = interpatch.interpolate_surface(terrain())
+    pts = s.evaluate(np.linspace(0, 1, 100), np.linspace(0, 1, 50))
+    assert pts.dtype == np.float64 and pts.shape == (100, 50, 3)
+    assert not pts.flags.owndata and pts.base is not None  # no copy: the capsule owns the library's buffer
+    cp = s.to_bspline()["control_points"]
+    assert not cp.flags.owndata
+    del s  # the arrays keep the construction alive
+    assert np.isfinite(cp).all() and np.isfinite(pts).all()
+
+
+def test_threads_evaluate_in_parallel_with_the_same_result():
+    s = interpatch.interpolate_surface(terrain(60, 70))
+    us, vs = np.linspace(0, 1, 300), np.linspace(0, 1, 300)
+    want = s.evaluate(us, vs)
+    results = [None] * 4
+
+    def work(k):
+        results[k] = s.evaluate(us, vs)
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for r in results:
+        assert np.array_equal(r, want)
+
+
+def test_scipy_rect_bivariate_spline_is_the_same_bicubic():
+    scipy_interpolate = pytest.importorskip("scipy.interpolate")
+    # Evenly spaced x and y with uniform parameters: x(u) and y(v) are linear, and the
+    # bicubic interpolant's z is SciPy's not-a-knot RectBivariateSpline(s=0).
+    grid = terrain(20, 25)
+    x, y, z = grid[:, 0, 0], grid[0, :, 1], grid[..., 2]
+    s = interpatch.interpolate_surface(grid, param="uniform")
+    ref = scipy_interpolate.RectBivariateSpline(x, y, z, kx=3, ky=3, s=0)
+    us, vs = np.linspace(0, 1, 37), np.linspace(0, 1, 41)
+    pts = s.evaluate(us, vs)
+    want = ref(pts[:, 0, 0], pts[0, :, 1])
+    # Two solvers of the same system: rounding of well-conditioned banded solves.
+    assert np.abs(pts[..., 2] - want).max() < 1e-12 * np.abs(z).max()
+
+
+ERRORS = [
+    ("zero_chord", {"type": "interpolate", "points": [[[0, 0, 0], [0, 0, 0]], [[0, 0, 0], [0, 0, 0]]]}),
+    ("not_finite", {"type": "bilinear", "p00": [0, 0, float("nan")], "p01": [0, 1, 0], "p10": [1, 0, 0],
+                    "p11": [1, 1, 1]}),
+    ("missing_field", {"type": "bilinear", "p00": [0, 0, 0]}),
+    ("unknown_type", {"type": "teapot"}),
+    ("wrong_type", {"type": "interpolate", "points": "many"}),
+    ("too_few_points", {"type": "interpolate", "points": [[[0, 0, 0]]]}),
+    ("invalid_degree", {"type": "interpolate", "points": [[[0, 0, 0], [0, 1, 0]], [[1, 0, 0], [1, 1, 0]]],
+                        "degree": 0}),
+    ("corner_gap", {"type": "coons", "boundary": {"v0": {"line": [[0, 0, 0], [1, 0, 0]]},
+                                                  "v1": {"line": [[0, 1, 0], [1, 1, 0]]},
+                                                  "u0": {"line": [[0, 0, 0], [0, 1, 0]]},
+                                                  "u1": {"line": [[1, 0, 1], [1, 1, 0]]}}}),
+    ("invalid_knots", {"type": "ruled", "curves": [
+        {"bspline": {"degree": 1, "knots": [0, 0.5, 1, 1], "control_points": [[0, 0, 0], [1, 0, 0]]}},
+        {"line": [[0, 1, 0], [1, 1, 0]]}]}),
+    ("invalid_weight", {"type": "ruled", "curves": [
+        {"bspline": {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0, 0], [1, 0, 0]],
+                     "weights": [1, -1]}},
+        {"line": [[0, 1, 0], [1, 1, 0]]}]}),
+]
+
+
+@pytest.mark.parametrize("code,spec", ERRORS, ids=[e[0] for e in ERRORS])
+def test_errors_carry_their_code_and_the_command_lines_message(code, spec, tmp_path):
+    with pytest.raises(interpatch.Error) as e:
+        interpatch.build(spec)
+    assert e.value.code == code
+    assert isinstance(e.value, ValueError)
+    path = tmp_path / "spec.json"
+    path.write_text(json.dumps(spec))
+    r = subprocess.run([CLI, "info", str(path)], capture_output=True, text=True)
+    assert r.returncode == 3
+    # The same message; a JSON parse error names the text it read ("spec" for a dict).
+    message = str(e.value)
+    if message.startswith("spec:"):
+        message = message.split(": ", 1)[1]
+    assert message in r.stderr
+
+
+def test_file_and_array_errors():
+    with pytest.raises(interpatch.Error) as e:
+        interpatch.build("/nonexistent/spec.json")
+    assert e.value.code == "file_unreadable"
+    with pytest.raises(interpatch.Error) as e:
+        interpatch.interpolate_surface(np.zeros((3, 3, 2)))
+    assert e.value.code == "size_mismatch"
+    bad = terrain(5, 5)
+    bad[2, 3, 1] = np.inf
+    with pytest.raises(interpatch.Error) as e:
+        interpatch.interpolate_surface(bad)
+    assert e.value.code == "not_finite" and "/points/2/3/1" in str(e.value)
+    s = interpatch.interpolate_surface(terrain(5, 5))
+    with pytest.raises(interpatch.Error) as e:
+        s.evaluate([1.5], [0])
+    assert e.value.code == "out_of_domain"
+    with pytest.raises(interpatch.Error) as e:
+        s.write("/tmp/x.unknown")
+    assert e.value.code == "wrong_type"
+
+
+def test_write_gives_the_command_lines_files(tmp_path):
+    path = os.path.join(EXAMPLES, "coons.json")
+    for ext in (".json", ".npz", ".obj"):
+        # A fresh object each time, as each command is a fresh process: a mesh samples
+        # the formula until something has made the exact form (both exact, to rounding).
+        s = interpatch.build(path)
+        mine, theirs = tmp_path / ("mine" + ext), tmp_path / ("theirs" + ext)
+        s.write(str(mine))
+        cmd = "mesh" if ext == ".obj" else "build"
+        subprocess.run([CLI, cmd, path, "-o", str(theirs)], check=True, capture_output=True)
+        assert mine.read_bytes() == theirs.read_bytes(), ext
