@@ -1,30 +1,91 @@
-# Type stubs of the interpatch module.
+# Type stubs of the interpatch module: shapes in the docstrings.
 from os import PathLike
-from typing import Any, Sequence, Union
+from typing import Any, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
 
+_Array = npt.NDArray[np.float64]
+_Params = Union[Sequence[float], npt.ArrayLike]
+_Path = Union[str, PathLike[str]]
+
 class Error(ValueError):
-    """Bad input; .code names the problem (e.g. 'zero_chord')."""
+    """Bad input; .code names the problem (e.g. 'zero_chord'), the message the place and size."""
     code: str
 
-_Params = Union[Sequence[float], npt.ArrayLike]
-
-class Surface:
-    """A surface over [0, 1]²."""
+class Construction:
+    """What surfaces and volumes share."""
     @property
     def type(self) -> str: ...
-    def evaluate(self, us: _Params, vs: _Params) -> npt.NDArray[np.float64]:
-        """Points at every (us[i], vs[j]): shape (len(us), len(vs), 3)."""
-    def evaluate_derivatives(self, us: _Params, vs: _Params) -> npt.NDArray[np.float64]:
-        """S, Su, Sv, Suu, Suv, Svv at every (us[i], vs[j]): shape (len(us), len(vs), 6, 3)."""
-    def point(self, u: float, v: float) -> npt.NDArray[np.float64]: ...
-    def normal(self, u: float, v: float) -> npt.NDArray[np.float64]: ...
-    def curvature(self, u: float, v: float) -> dict[str, float]: ...
-    def info(self) -> dict[str, Any]: ...
+    def info(self) -> dict[str, Any]:
+        """The dict `interpatch info` prints."""
+    def write(self, path: _Path, res: Optional[Sequence[int]] = None) -> None:
+        """.json .npz .step .igs (the exact form) or .obj .ply .stl .vtk .vts .xyz (a mesh of res vertices)."""
+    @property
+    def params_u(self) -> Optional[_Array]: ...
+    @property
+    def params_v(self) -> Optional[_Array]: ...
+    @property
+    def params_w(self) -> Optional[_Array]: ...
 
-def build(spec: Union[dict[str, Any], str, PathLike[str]], base_dir: Union[str, PathLike[str]] = ".") -> Surface:
-    """A spec as a dict, or the path of a spec file, built."""
+class Surface(Construction):
+    """A surface over [0, 1]²."""
+    def evaluate(self, us: _Params, vs: _Params) -> _Array:
+        """Points at every (us[i], vs[j]): shape (len(us), len(vs), 3)."""
+    def evaluate_derivatives(self, us: _Params, vs: _Params) -> _Array:
+        """S, Su, Sv, Suu, Suv, Svv at every (us[i], vs[j]): shape (len(us), len(vs), 6, 3)."""
+    def point(self, u: float, v: float) -> _Array:
+        """S(u, v): shape (3,)."""
+    def normal(self, u: float, v: float) -> _Array:
+        """The unit normal: shape (3,)."""
+    def curvature(self, u: float, v: float) -> dict[str, float]:
+        """{'gaussian', 'mean', 'k1', 'k2'}."""
+    def to_bspline(self) -> dict[str, Any]:
+        """{'degree': (p, q), 'knots_u', 'knots_v', 'control_points' (nu, nv, 3), 'weights' (nu, nv) or None, 'periodic'}."""
+
+class Volume(Construction):
+    """A volume over [0, 1]³."""
+    def evaluate(self, us: _Params, vs: _Params, ws: _Params) -> _Array:
+        """Points: shape (len(us), len(vs), len(ws), 3)."""
+    def jacobians(self, us: _Params, vs: _Params, ws: _Params) -> tuple[_Array, _Array]:
+        """(points (..., 3), det J (len(us), len(vs), len(ws)))."""
+    def point(self, u: float, v: float, w: float) -> _Array: ...
+    def to_bspline(self) -> dict[str, Any]:
+        """{'degree': (p, q, r), 'knots_u', 'knots_v', 'knots_w', 'control_points' (n0, n1, n2, 3), 'weights', 'periodic'}."""
+
+class Curve:
+    """A curve of a spec: interpolate_curve, bspline_curve, hermite_curve or line."""
+
+_CurveLike = Union[Curve, npt.ArrayLike]
+
+def build(spec: Union[dict[str, Any], _Path], base_dir: _Path = ".",
+          arrays: Optional[dict[str, npt.ArrayLike]] = None) -> Union[Surface, Volume]:
+    """A spec as a dict (arrays named {"array": NAME}) or the path of a spec file, built."""
+def interpolate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int], None] = None,
+                        param: Optional[str] = None, periodic: Optional[Sequence[bool]] = None) -> Surface:
+    """Through a grid of points, shape (n, m, 3)."""
+def interpolate_volume(points: npt.ArrayLike, degree: Union[int, Sequence[int], None] = None,
+                       param: Optional[str] = None, periodic: Optional[Sequence[bool]] = None) -> Volume:
+    """Through a grid of points, shape (n, m, l, 3)."""
+def bilinear(p00: npt.ArrayLike, p01: npt.ArrayLike, p10: npt.ArrayLike, p11: npt.ArrayLike) -> Surface: ...
+def ruled(c0: _CurveLike, c1: _CurveLike) -> Surface: ...
+def coons(v0: _CurveLike, v1: _CurveLike, u0: _CurveLike, u1: _CurveLike, blending: Optional[str] = None,
+          tolerance: Optional[float] = None) -> Surface: ...
+def curve_network(u_curves: Sequence[_CurveLike], v_curves: Sequence[_CurveLike], method: Optional[str] = None,
+                  u_params: Optional[Sequence[float]] = None, v_params: Optional[Sequence[float]] = None,
+                  tolerance: Optional[float] = None, periodic: Optional[Sequence[bool]] = None) -> Surface: ...
+def hermite_patch(corners: dict[str, dict[str, npt.ArrayLike]]) -> Surface: ...
+def trilinear(corners: npt.ArrayLike) -> Volume:
+    """Corners of shape (2, 2, 2, 3): corners[i][j][k] = S(i, j, k)."""
+def coons_volume(faces: dict[str, Any], blending: Optional[str] = None, tolerance: Optional[float] = None) -> Volume: ...
+def hermite_volume(corners: Sequence[dict[str, npt.ArrayLike]]) -> Volume: ...
+def interpolate_curve(points: npt.ArrayLike, degree: Optional[int] = None, param: str = "chord",
+                      periodic: bool = False, start_derivative: Optional[npt.ArrayLike] = None,
+                      end_derivative: Optional[npt.ArrayLike] = None) -> Curve: ...
+def bspline_curve(degree: int, knots: Sequence[float], control_points: npt.ArrayLike,
+                  weights: Optional[Sequence[float]] = None, periodic: bool = False) -> Curve: ...
+def hermite_curve(points: npt.ArrayLike, tangents: Optional[npt.ArrayLike] = None,
+                  params: Optional[Sequence[float]] = None) -> Curve: ...
+def line(a: npt.ArrayLike, b: npt.ArrayLike) -> Curve: ...

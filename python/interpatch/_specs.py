@@ -9,6 +9,7 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
+from ._core import Error as Error_
 from ._core import build as _build
 
 
@@ -180,6 +181,50 @@ def hermite_patch(corners: dict[str, dict[str, Any]]):
     "p00", "p01", "p10", "p11"."""
     spec = {"type": "hermite_patch",
             "corners": {k: {f: _point(v) for f, v in c.items()} for k, c in corners.items()}}
+    return _build(spec, ".", {})
+
+
+def interpolate_volume(points: Any, degree: Any = None, param: Optional[str] = None, periodic: Any = None):
+    """The B-spline volume through a grid of points, shape (n, m, l, 3): tricubic unless
+    `degree` (an int or (p, q, r)) says otherwise, parameters by `param` averaged over
+    the lines, closed in the directions `periodic` = (pu, pv, pw) says."""
+    a = _Arrays()
+    spec = _options({"type": "interpolate_volume", "points": a.add(points)}, degree=degree, param=param,
+                    periodic=periodic)
+    return _build(spec, ".", a.table)
+
+
+def trilinear(corners: Any):
+    """The trilinear volume of eight corners, shape (2, 2, 2, 3): corners[i][j][k] = S(i, j, k)."""
+    c = np.asarray(corners, dtype=np.float64)
+    if c.shape != (2, 2, 2, 3):
+        raise Error_(f"trilinear: corners must have shape (2, 2, 2, 3), got {c.shape}")
+    spec = {"type": "trilinear"}
+    for i in range(2):
+        for j in range(2):
+            for k in range(2):
+                spec[f"p{i}{j}{k}"] = _point(c[i, j, k])
+    return _build(spec, ".", {})
+
+
+def _surface_spec(face: Any, arrays: _Arrays) -> dict[str, Any]:
+    if isinstance(face, dict):
+        return face
+    return {"type": "interpolate", "points": arrays.add(face)}
+
+
+def coons_volume(faces: dict[str, Any], blending: Optional[str] = None, tolerance: Optional[float] = None):
+    """The Coons volume of six faces keyed u0, u1, v0, v1, w0, w1 (S(0, v, w), S(1, v, w),
+    S(u, 0, w), ...): each a grid of points (n, m, 3) to interpolate, or a surface spec dict."""
+    a = _Arrays()
+    spec = {"type": "coons_volume", "faces": {k: _surface_spec(f, a) for k, f in faces.items()}}
+    return _build(_options(spec, blending=blending, tolerance=tolerance), ".", a.table)
+
+
+def hermite_volume(corners: Sequence[dict[str, Any]]):
+    """The tricubic Hermite volume of 8 corners (index 4i + 2j + k for corner (i, j, k)), each
+    {"p", "du", "dv", "dw"} and optionally "duv", "duw", "dvw", "duvw"."""
+    spec = {"type": "hermite_volume", "corners": [{f: _point(v) for f, v in c.items()} for c in corners]}
     return _build(spec, ".", {})
 
 

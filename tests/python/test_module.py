@@ -246,3 +246,16 @@ def test_write_gives_the_command_lines_files(tmp_path):
         cmd = "mesh" if ext == ".obj" else "build"
         subprocess.run([CLI, cmd, path, "-o", str(theirs)], check=True, capture_output=True)
         assert mine.read_bytes() == theirs.read_bytes(), ext
+
+
+def test_the_readmes_python_example_runs(tmp_path, monkeypatch):
+    pytest.importorskip("matplotlib")
+    import re
+    readme = open(os.path.join(EXAMPLES, "..", "README.md")).read()
+    code = re.search(r"## Python\n.*?```python\n(.*?)```", readme, re.S).group(1)
+    monkeypatch.chdir(tmp_path)
+    scope = {}
+    exec(compile(code, "README.md", "exec"), scope)
+    assert scope["pts"].shape == (200, 150, 3)
+    assert scope["b"]["control_points"].shape == (30, 25, 3)  # what the README says
+    assert (tmp_path / "terrain.png").stat().st_size > 0 and (tmp_path / "terrain.step").stat().st_size > 0
