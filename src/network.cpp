@@ -274,6 +274,7 @@ struct Arrangement {
   // (closed: unwrapped, from the seam's on; a curve against its family: decreasing).
   std::array<std::vector<std::vector<double>>, 2> to;
   double keep = 0;  // how close a curve must pass its crossings at the common parameters to be kept
+  double snap = 0;  // how near its end a crossing must be to be at its end: min(tolerance, 1e-7 diagonal)
 };
 
 // Own parameter on curve j of family a where it crosses curve i of the other family.
@@ -372,8 +373,10 @@ void arrange(const Prepared& n, Arrangement& r, int a, const std::vector<double>
     const BSplineCurve& c = along[j];
     if (!closed) {
       double first = sigma(x.front()), last = sigma(x.back());
-      if (distance(c.point(rj ? 1.0 : 0.0), c.point(x.front())) <= r.keep) first = 0;
-      if (distance(c.point(rj ? 0.0 : 1.0), c.point(x.back())) <= r.keep) last = 1;
+      // A crossing this near the curve's end is at its end: the search stops a rounding
+      // short of an end that lies on the other curve.
+      if (distance(c.point(rj ? 1.0 : 0.0), c.point(x.front())) <= r.snap) first = 0;
+      if (distance(c.point(rj ? 0.0 : 1.0), c.point(x.back())) <= r.snap) last = 1;
       lam[j].resize(nb);
       for (std::size_t k = 0; k < nb; ++k) lam[j][k] = (sigma(x[k]) - first) / (last - first);
       to[j] = x;
@@ -418,6 +421,7 @@ Arrangement arrangement(const Prepared& n, const CurveNetwork& net) {
   Arrangement r;
   const double strict = std::min(n.tol, 1e-7 * n.diagonal);
   r.keep = 1e-3 * strict;
+  r.snap = strict;
   const auto& U = n.along[0];
   const auto& V = n.along[1];
   for (std::size_t a = 0; a < 2; ++a) {

@@ -21,7 +21,10 @@ double wrap_unit(double t) {
 }
 
 // Gauss–Newton on F(s, t) = U(s) − V(t) from (s, t).
-void newton(const BSplineCurve& U, const BSplineCurve& V, double& s, double& t, bool closed_u, bool closed_v) {
+// With `hold`, a parameter at an open curve's end that a step would push past it is
+// held there, and the other moves alone.
+void newton(const BSplineCurve& U, const BSplineCurve& V, double& s, double& t, bool closed_u, bool closed_v,
+            bool hold) {
   // The next parameter, and how far it moved (around the circle for a closed curve).
   const auto step = [](double x, double dx, bool closed) {
     if (!closed) {
@@ -45,7 +48,20 @@ void newton(const BSplineCurve& U, const BSplineCurve& V, double& s, double& t, 
     const double r1 = -dot(Us, F), r2 = dot(Vs, F);
     const double det = a11 * a22 - a12 * a12;
     if (!(std::abs(det) > 1e-300)) break;  // parallel tangents (or a point curve): keep the pair
-    const double ds = (r1 * a22 - a12 * r2) / det, dt = (a11 * r2 - a12 * r1) / det;
+    double ds = (r1 * a22 - a12 * r2) / det, dt = (a11 * r2 - a12 * r1) / det;
+    // An open curve held at its end: the closest point of the other curve to that end,
+    // by Gauss–Newton in the other parameter alone (a joint step clamped at the end
+    // would stop short of the foot point, and overstate the gap).
+    const auto at_end = [](double x, double dx, bool closed) { return !closed && ((x <= 0 && dx < 0) || (x >= 1 && dx > 0)); };
+    const bool hold_s = hold && at_end(s, ds, closed_u), hold_t = hold && at_end(t, dt, closed_v);
+    if (hold_s && hold_t) break;
+    if (hold_s) {
+      ds = 0;
+      dt = a22 > 0 ? r2 / a22 : 0;
+    } else if (hold_t) {
+      dt = 0;
+      ds = a11 > 0 ? r1 / a11 : 0;
+    }
     const auto [ns, ms] = step(s, ds, closed_u);
     const auto [nt, mt] = step(t, dt, closed_v);
     const bool done = ms < 1e-15 && mt < 1e-15;
@@ -158,8 +174,16 @@ Crossing closest_points(const BSplineCurve& U, const BSplineCurve& V, bool close
         t = static_cast<double>(b) / samples;
       }
     }
-  newton(U, V, s, t, closed_u, closed_v);
-  const Crossing coarse = crossing_at(U, V, s, t);
+  newton(U, V, s, t, closed_u, closed_v, false);
+  Crossing coarse = crossing_at(U, V, s, t);
+  // Stopped at an open curve's end with a gap: the joint steps were clamped there, and
+  // the foot point on the other curve is found with the end held.
+  const auto at_bound = [](double x, bool closed) { return !closed && (x <= 0 || x >= 1); };
+  if (coarse.gap > 1e-3 * tol && (at_bound(s, closed_u) || at_bound(t, closed_v))) {
+    newton(U, V, s, t, closed_u, closed_v, true);
+    const Crossing held = crossing_at(U, V, s, t);
+    if (held.gap < coarse.gap) coarse = held;
+  }
   if (coarse.gap <= tol) return coarse;
   // The thorough pass: pairs of sample boxes nearest first, until a box pair cannot
   // beat the closest samples found.
@@ -192,7 +216,7 @@ Crossing closest_points(const BSplineCurve& U, const BSplineCurve& V, bool close
   }
   s = su.params()[ia];
   t = sv.params()[ib];
-  newton(U, V, s, t, closed_u, closed_v);
+  newton(U, V, s, t, closed_u, closed_v, true);
   const Crossing fine = crossing_at(U, V, s, t);
   return fine.gap < coarse.gap ? fine : coarse;
 }
@@ -487,6 +511,19 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
     const double x = 0.5 * (a + b);
     interior.insert(std::upper_bound(interior.begin(), interior.end(), x), x);
   };
+  // Two nodes that want one collocation site: a knot between them, in the widest gap
+  // left there (the midpoint of the two may already be a knot of full multiplicity).
+  const auto split_between = [&](double a, double b) {
+    if (a > b) std::swap(a, b);
+    std::vector<double> at{a};
+    for (double x : interior)
+      if (x > a && x < b && x > at.back()) at.push_back(x);
+    at.push_back(b);
+    std::size_t w = 0;
+    for (std::size_t i = 0; i + 1 < at.size(); ++i)
+      if (at[i + 1] - at[i] > at[w + 1] - at[w]) w = i;
+    insert_mid(at[w], at[w + 1]);
+  };
   const auto spans = [&] {
     std::vector<double> b{0.0};
     for (double x : interior)
@@ -532,11 +569,14 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
           const double u = sp[i] + (sp[i + 1] - sp[i]) * q / 4;
           const double x = maps[j](u), y = closed ? x : std::clamp(x, 0.0, 1.0);
           const Vec3 d = fits[j].curve->point(u), c = curves[j]->point(y);
-          e = std::max(e, distance(d, c));
+          const double here = distance(d, c);
+          e = std::max(e, here);
+          // Too far at a knot: the span before it is as much to blame as this one.
+          if (q == 0 && i > 0 && here > target) far[j][i - 1] = 1;
           apart[j] = std::max(apart[j], distance(d + jobs[j].G->point(u), jobs[j].given ? jobs[j].given->point(y) : c));
         }
         worst_of[j] = std::max(worst_of[j], e);
-        far[j][i] = e > target;
+        far[j][i] = static_cast<char>(far[j][i] | (e > target));
       }
     }
     bool again = false;
@@ -544,7 +584,7 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
       fail(errc::internal, "re-expressing ", m, " network curves found no knots that fit them (", interior.size(), " tried)");
     for (std::size_t j = 0; j < m && !again; ++j) {
       if (fits[j].failed) split_all();
-      else if (!fits[j].curve) insert_mid(fits[j].clash.first, fits[j].clash.second);
+      else if (!fits[j].curve) split_between(fits[j].clash.first, fits[j].clash.second);
       again = !fits[j].curve;
     }
     if (again) continue;
@@ -570,7 +610,8 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
     for (std::size_t i = 0; i + 1 < sp.size(); ++i)
       if (split[i]) insert_mid(sp[i], sp[i + 1]);
   }
-  INTERPATCH_ASSERT(out.size() == m);
+  if (out.size() != m)
+    fail(errc::internal, "re-expressing ", m, " network curves found no knots that fit them after 60 rounds");
   return out;
 }
 
