@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <cstring>
 #include <map>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -313,6 +314,104 @@ const interpatch::BlendedSurface& terrain_network(std::size_t n, interpatch::Net
   return it->second;
 }
 
+// ---------------------------------------------------------------- networks as drawn
+
+// The networks of tools/make_network_bench.py, built in memory: 15 u-curves and 15
+// v-curves on f(u, v) = (4u, 3v + 0.3 sin 3u, sin 2.5u cos 1.7v + 0.4uv), u-curve j
+// through f(t, v_j), v-curve i through f(u_i, t), u_i = i/14, v_j = j/14.
+//   common:   491 equally spaced stations (the nodes among them: 490 = 35 · 14),
+//             uniform parameters: the curves cross at the common parameters.
+//   drawn:    500 uneven stations (the ends, the 15 nodes, random ones), chord
+//             parameters along u, centripetal along v: each curve crosses the others at
+//             parameters of its own, so the network finds the crossings of every pair
+//             and re-expresses the curves on shared knots.
+//   shuffled: drawn, the families in random order and every other curve reversed.
+// No crossing parameters given (as in the specs): the network finds them in every case.
+enum class NetworkKind { common, drawn, shuffled };
+
+constexpr std::size_t network_curves = 15;
+
+Vec3 network_shape(double u, double v) {
+  return {4 * u, 3 * v + 0.3 * std::sin(3 * u), std::sin(2.5 * u) * std::cos(1.7 * v) + 0.4 * u * v};
+}
+
+const interpatch::CurveNetwork& bench_network(NetworkKind kind) {
+  static std::map<int, interpatch::CurveNetwork> cache;
+  auto it = cache.find(static_cast<int>(kind));
+  if (it != cache.end()) return it->second;
+  const std::size_t n = network_curves;
+  std::vector<double> nodes(n);
+  for (std::size_t i = 0; i < n; ++i) nodes[i] = static_cast<double>(i) / static_cast<double>(n - 1);
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  auto stations = [&] {
+    if (kind == NetworkKind::common) return interpatch::linspace(0.0, 1.0, 35 * (n - 1) + 1);
+    std::vector<double> t = nodes;  // 0 and 1 among them
+    while (t.size() < 500) {
+      while (t.size() < 500) t.push_back(unit(rng));
+      std::sort(t.begin(), t.end());
+      t.erase(std::unique(t.begin(), t.end()), t.end());
+    }
+    return t;
+  };
+  // The points of every curve first, then (shuffled) the families reordered and
+  // every other list reversed, as the generator does, then the interpolation.
+  auto points = [&](bool along_u, double at) {
+    std::vector<Vec3> p;
+    for (double t : stations()) p.push_back(along_u ? network_shape(t, at) : network_shape(at, t));
+    return p;
+  };
+  std::vector<std::vector<Vec3>> u_points, v_points;
+  for (double v : nodes) u_points.push_back(points(true, v));
+  for (double u : nodes) v_points.push_back(points(false, u));
+  if (kind == NetworkKind::shuffled) {
+    std::shuffle(u_points.begin(), u_points.end(), rng);
+    std::shuffle(v_points.begin(), v_points.end(), rng);
+    for (std::size_t i = 0; i < n; i += 2) std::reverse(u_points[i].begin(), u_points[i].end());
+    for (std::size_t i = 1; i < n; i += 2) std::reverse(v_points[i].begin(), v_points[i].end());
+  }
+  auto curve = [&](const std::vector<Vec3>& p, bool along_u) {
+    interpatch::CurveInterpolationOptions o;
+    o.param = kind == NetworkKind::common ? interpatch::Parametrization::uniform
+              : along_u                   ? interpatch::Parametrization::chord
+                                          : interpatch::Parametrization::centripetal;
+    return interpatch::interpolate_curve(p, o).curve;
+  };
+  interpatch::CurveNetwork net;
+  for (const auto& p : u_points) net.u_curves.push_back(curve(p, true));
+  for (const auto& p : v_points) net.v_curves.push_back(curve(p, false));
+  return cache.emplace(static_cast<int>(kind), std::move(net)).first->second;
+}
+
+// What is timed after the network is built: nothing, 1000 × 1000 points by the
+// surface's formula (BlendedSurface::evaluate_into), or by its exact form
+// (to_bspline, then BSplineSurface::evaluate_into). `interpatch eval` takes whichever
+// costs fewer operations (io::evaluator): the exact form for the common network
+// (502 × 499 control points), the formula for the drawn one (511 × 7455).
+enum class NetworkSample { none, formula, exact };
+
+// network_surface (what `interpatch eval` and `info` call: the surface and its report,
+// the crossings of every u-curve × v-curve pair, the re-expression, the distance of the
+// surface from every curve), Gordon, then the sampling; the output is allocated and
+// touched before the clock starts, the curves are made before it starts.
+void network_as_drawn(benchmark::State& state, NetworkKind kind, NetworkSample sample) {
+  const interpatch::CurveNetwork& net = bench_network(kind);
+  const auto us = interpatch::linspace(0.0, 1.0, eval_points), vs = us;
+  const bool evaluate = sample != NetworkSample::none;
+  std::vector<Vec3> out(evaluate ? eval_points * eval_points : 0, Vec3{1, 1, 1});
+  for (auto _ : state) {
+    const auto t0 = clock_type::now();
+    auto r = interpatch::network_surface(net, {interpatch::NetworkMethod::gordon, {}, {}});
+    if (sample == NetworkSample::formula) r.surface.evaluate_into(us, vs, out);
+    if (sample == NetworkSample::exact) r.surface.to_bspline().evaluate_into(us, vs, out);
+    const auto t1 = clock_type::now();
+    benchmark::DoNotOptimize(out.data());
+    state.SetIterationTime(seconds(t0, t1));
+    discard(state, r);
+  }
+  set_counters(state, evaluate ? eval_points * eval_points : 0, out.size() * sizeof(Vec3));
+}
+
 // The linear Coons volume of six faces, each a bicubic through an N x N grid of a
 // smooth map of the unit cube at equally spaced parameters: faces that share an edge
 // share its samples and its parameters, hence its curve.
@@ -422,6 +521,17 @@ BENCHMARK(memcpy_eval_mt)
     ->Apply(common)
     ->Arg(static_cast<std::int64_t>(sizeof(Vec3)))
     ->Arg(static_cast<std::int64_t>(sizeof(interpatch::SurfaceDerivatives)));
+// A second or less each: run them with repetitions and
+// --benchmark_enable_random_interleaving=true so that the kinds take turns
+// (docs/BENCHMARKS.md, "Networks as drawn against common parameters").
+BENCHMARK_CAPTURE(network_as_drawn, build_common, NetworkKind::common, NetworkSample::none)->Apply(common);
+BENCHMARK_CAPTURE(network_as_drawn, build_drawn, NetworkKind::drawn, NetworkSample::none)->Apply(common);
+BENCHMARK_CAPTURE(network_as_drawn, build_shuffled, NetworkKind::shuffled, NetworkSample::none)->Apply(common);
+BENCHMARK_CAPTURE(network_as_drawn, eval_common, NetworkKind::common, NetworkSample::formula)->Apply(common);
+BENCHMARK_CAPTURE(network_as_drawn, eval_drawn, NetworkKind::drawn, NetworkSample::formula)->Apply(common);
+BENCHMARK_CAPTURE(network_as_drawn, eval_shuffled, NetworkKind::shuffled, NetworkSample::formula)->Apply(common);
+BENCHMARK_CAPTURE(network_as_drawn, exact_common, NetworkKind::common, NetworkSample::exact)->Apply(common);
+BENCHMARK_CAPTURE(network_as_drawn, exact_drawn, NetworkKind::drawn, NetworkSample::exact)->Apply(common);
 BENCHMARK(to_bspline_coons)->Apply(common)->Arg(1024);
 BENCHMARK(to_bspline_gordon)->Apply(common)->Arg(1024);
 BENCHMARK(to_bspline_network_c1)->Apply(common)->Arg(1024);
