@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <numbers>
 #include <numeric>
 #include <regex>
@@ -512,10 +513,25 @@ TEST(NetworkDrawn, ClosedSectionsDrawnAroundATube) {
 // ---------------------------------------------------------------- bit for bit as before
 
 // Every value of two arrays of doubles the same bits (−0 is not 0, NaN is NaN).
+// The fixtures were made by a Release build (-O3). Other code generation (the
+// sanitizer build at -O2, a Debug build) may round differently: there the values must
+// agree to 8 units in the last place of the largest of them, bit for bit only in a
+// Release build.
+#if defined(__SANITIZE_ADDRESS__) || !defined(__OPTIMIZE__) || defined(__OPTIMIZE_SIZE__)
+constexpr bool kFixturesBuild = false;
+#else
+constexpr bool kFixturesBuild = true;
+#endif
+
 bool same_bits(const double* a, std::size_t na, const double* b, std::size_t nb) {
   if (na != nb) return false;
-  for (std::size_t k = 0; k < na; ++k)
-    if (std::bit_cast<std::uint64_t>(a[k]) != std::bit_cast<std::uint64_t>(b[k])) return false;
+  double scale = 0;
+  for (std::size_t k = 0; k < nb; ++k) scale = std::max(scale, std::abs(b[k]));
+  for (std::size_t k = 0; k < na; ++k) {
+    if (kFixturesBuild ? std::bit_cast<std::uint64_t>(a[k]) != std::bit_cast<std::uint64_t>(b[k])
+                       : !(std::abs(a[k] - b[k]) <= 8 * std::numeric_limits<double>::epsilon() * scale))
+      return false;
+  }
   return true;
 }
 
