@@ -662,8 +662,9 @@ Built build(const CurveNetwork& network, const NetworkOptions& options, bool fit
     c = reports[seam];
     c.closing = true;
     c.position = n.along[static_cast<std::size_t>(a)].size();
-    const auto [lo, hi] = given.back().domain();
-    const auto [slo, shi] = given[seam].domain();
+    // Plain variables, not structured bindings: the lambda below captures them.
+    const double lo = given.back().domain().first, hi = given.back().domain().second;
+    const double slo = given[seam].domain().first, shi = given[seam].domain().second;
     // Drawn the other way round from the seam curve: its parameter runs back.
     const auto& unit = n.input[static_cast<std::size_t>(a)];
     double ahead = 0, back = 0;
