@@ -15,6 +15,9 @@ class Error(ValueError):
     """Bad input; .code names the problem (e.g. 'zero_chord'), the message the place and size."""
     code: str
 
+ERROR_CODES: tuple[str, ...]
+"""Every code an Error can carry (docs/spec-format.md, "Bad input")."""
+
 class Construction:
     """What surfaces and volumes share."""
     @property

@@ -53,7 +53,7 @@ std::vector<double> params(const py::handle& x) {
 
 // A point array of any float dtype and memory order, shape (..., 3), as the library
 // stores points (float64 triples in C order): the one copy an input costs.
-std::shared_ptr<const ip::io::PointArray> point_array(const py::handle& x, const std::string& name) {
+std::shared_ptr<ip::io::PointArray> point_array(const py::handle& x, const std::string& name) {
   const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(x);
   if (!a) throw ip::error(ip::errc::wrong_type, name + ": expected an array of points, shape (..., 3)");
   if (a.ndim() < 2 || a.shape(a.ndim() - 1) != 3) {
@@ -155,13 +155,13 @@ class PySurface : public PyBuilt {
 
   py::array_t<double> evaluate(const py::handle& us_in, const py::handle& vs_in) const {
     auto us = params(us_in), vs = params(vs_in);
-    auto out = std::make_unique<std::vector<ip::Vec3>>(us.size() * vs.size());
+    std::unique_ptr<ip::PointGrid> out;
     {
       py::gil_scoped_release free;
-      const ip::Surface& s = surface(out->size(), ip::io::Sample::points);
-      s.evaluate_into(us, vs, *out);
+      const ip::Surface& s = surface(us.size() * vs.size(), ip::io::Sample::points);
+      out = std::make_unique<ip::PointGrid>(s.evaluate(us, vs));  // its pages first touched by the threads that fill them
     }
-    double* data = &(*out)[0].x;
+    double* data = &out->data()->x;
     return owning_array(std::move(out), data, {static_cast<py::ssize_t>(us.size()), static_cast<py::ssize_t>(vs.size()), 3});
   }
 
@@ -229,12 +229,12 @@ class PyVolume : public PyBuilt {
 
   py::array_t<double> evaluate(const py::handle& us_in, const py::handle& vs_in, const py::handle& ws_in) const {
     auto us = params(us_in), vs = params(vs_in), ws = params(ws_in);
-    auto out = std::make_unique<std::vector<ip::Vec3>>(us.size() * vs.size() * ws.size());
+    std::unique_ptr<ip::PointGrid3> out;
     {
       py::gil_scoped_release free;
-      ip::io::volume_evaluator(b_->c).evaluate_into(us, vs, ws, *out);
+      out = std::make_unique<ip::PointGrid3>(ip::io::volume_evaluator(b_->c).evaluate(us, vs, ws));
     }
-    double* data = &(*out)[0].x;
+    double* data = &out->data()->x;
     return owning_array(std::move(out), data,
                         {static_cast<py::ssize_t>(us.size()), static_cast<py::ssize_t>(vs.size()),
                          static_cast<py::ssize_t>(ws.size()), 3});
@@ -323,6 +323,11 @@ PYBIND11_MODULE(_core, m) {
                                          "names the place and the size of the problem, as the command line does.",
                                          PyExc_ValueError, nullptr);
   m.attr("Error") = py::handle(error_type);
+  // Every code an Error can carry, in the order of interpatch::errc.
+  py::list codes;
+  for (int k = 0; k <= static_cast<int>(ip::errc::internal); ++k)
+    codes.append(std::string(ip::to_string(static_cast<ip::errc>(k))));
+  m.attr("ERROR_CODES") = py::tuple(codes);
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);

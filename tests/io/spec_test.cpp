@@ -90,6 +90,54 @@ TEST(Spec, InterpolateReproducesTheDataOverRandomGrids) {
   }
 }
 
+// Arrays held in memory ({"array": NAME}, BuildOptions::arrays): the same surface as
+// the same points written inline; an array named once and held by nobody else is
+// taken (its entry left empty), one named twice or still held by the caller copied.
+TEST(Spec, InMemoryArraysTakenWhenNamedOnceAndHeldByNobodyElse) {
+  auto g = test::rng(21);
+  const PointGrid q = test::random_grid(g, 7, 5);
+  const auto inline_surface = std::get<BSplineSurface>(*build(interpolate_spec(q)).exact);
+  const auto array_of = [&] {
+    auto a = std::make_shared<PointArray>();
+    a->shape = {q.extent(0), q.extent(1)};
+    a->points.assign(q.values().begin(), q.values().end());
+    return a;
+  };
+  const auto same_net = [&](const Construction& c) {
+    const auto& s = std::get<BSplineSurface>(*c.exact);
+    ASSERT_EQ(s.control_points().size(), inline_surface.control_points().size());
+    for (std::size_t i = 0; i < s.control_points().size(); ++i)
+      EXPECT_EQ(s.control_points().data()[i], inline_surface.control_points().data()[i]) << "control point " << i;
+  };
+  const json spec = {{"type", "interpolate"}, {"points", {{"array", "q"}}}};
+
+  BuildOptions taken;
+  taken.arrays["q"] = array_of();
+  same_net(build(spec, {}, taken));
+  EXPECT_TRUE(taken.arrays.at("q")->points.empty()) << "named once, held by nobody else: taken";
+
+  BuildOptions held;
+  const auto callers = array_of();
+  held.arrays["q"] = callers;
+  same_net(build(spec, {}, held));
+  EXPECT_EQ(callers->points.size(), q.size()) << "the caller still holds it: copied";
+
+  // A ruled surface between two curves through the same array: both see its points.
+  PointStorage row(q.values().begin(), q.values().begin() + static_cast<std::ptrdiff_t>(q.extent(1)));
+  auto line_array = std::make_shared<PointArray>();
+  line_array->shape = {row.size()};
+  line_array->points = row;
+  BuildOptions twice;
+  twice.arrays["c"] = line_array;
+  line_array.reset();
+  const json ruled = {{"type", "ruled"},
+                      {"curves", {{{"interpolate", {{"array", "c"}}}}, {{"interpolate", {{"array", "c"}}}}}}};
+  const Construction r = build(ruled, {}, twice);
+  const auto& s = std::get<BSplineSurface>(*r.exact);
+  EXPECT_EQ(twice.arrays.at("c")->points.size(), row.size()) << "named twice: copied both times";
+  for (const double u : {0.0, 0.3, 1.0}) EXPECT_EQ(s.point(u, 0.0), s.point(u, 1.0)) << "both curves the same, at u " << u;
+}
+
 // build, mesh and eval build without the copy of the data points (keep_data false):
 // the same exact form, bit for bit, and no data set; info's error check needs them.
 TEST(Spec, WithoutDataTheSameExactFormAndNoDataSet) {

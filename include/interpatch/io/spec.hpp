@@ -114,7 +114,11 @@ struct BuildOptions {
   /// Point arrays held in memory, which a spec names as {"array": NAME} wherever it
   /// takes a point array (in place of {"npy": FILE}): how the Python module's
   /// constructors pass NumPy arrays without writing them to a file.
-  std::map<std::string, std::shared_ptr<const PointArray>, std::less<>> arrays;
+  ///
+  /// An array the spec names once and that nothing but this map holds
+  /// (`use_count() == 1`) is taken, not copied: its points move into the
+  /// construction and the map's entry is left empty. Any other array is copied.
+  std::map<std::string, std::shared_ptr<PointArray>, std::less<>> arrays;
 };
 
 /// The construction's exact form, converted on first use when the build deferred it.

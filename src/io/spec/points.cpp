@@ -188,17 +188,20 @@ PointArray memory_points(const json& obj, std::size_t rank, std::string_view ptr
   const std::string aptr = child(ptr, "array");
   const json& name = obj.at("array");
   if (!name.is_string()) wrong_type(aptr, "the name of an array given with the spec", name);
-  const PointArray* given = nullptr;
+  const std::shared_ptr<PointArray>* given = nullptr;
   if (ctx.arrays)
-    if (const auto it = ctx.arrays->find(name.get<std::string>()); it != ctx.arrays->end()) given = it->second.get();
+    if (const auto it = ctx.arrays->find(name.get<std::string>()); it != ctx.arrays->end() && it->second) given = &it->second;
   if (!given) fail(errc::missing_field, place(aptr), ": no array named \"", name.get<std::string>(), "\" was given with the spec");
-  const PointArray& a = *given;
+  const PointArray& a = **given;
   if (a.shape.size() != rank)
     fail(errc::size_mismatch, place(ptr), ": the array has shape ", shape_text(a.shape), " (and 3 per point); expected ",
          expected_shape(rank));
   for (std::size_t s : a.shape)
     if (s == 0) fail(errc::too_few_points, place(ptr), ": the array has shape ", shape_text(a.shape), ", no points");
   check_finite_points(a.shape, a.points, ptr, "the array");
+  // Named once and held by nobody else (BuildOptions::arrays): taken, not copied.
+  const auto uses = ctx.array_uses.find(name.get<std::string>());
+  if (given->use_count() == 1 && uses != ctx.array_uses.end() && uses->second == 1) return std::move(**given);
   return a;
 }
 

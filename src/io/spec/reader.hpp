@@ -76,7 +76,8 @@ struct Context {
   progress_callback progress;
   bool keep_data = true;     // copy interpolated grids into Construction::data
   bool defer_exact = false;  // leave a formula's exact form to exact_form()
-  const std::map<std::string, std::shared_ptr<const PointArray>, std::less<>>* arrays = nullptr;  // BuildOptions::arrays
+  const std::map<std::string, std::shared_ptr<PointArray>, std::less<>>* arrays = nullptr;  // BuildOptions::arrays
+  std::map<std::string, std::size_t, std::less<>> array_uses;  // how many times the spec names each of them
   std::vector<std::string> warnings;
   Clock::time_point start = Clock::now();
   std::optional<Clock::time_point> parsed_at;

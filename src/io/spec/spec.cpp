@@ -43,7 +43,20 @@ constexpr ConstructionType construction_types[] = {
     {"bspline_volume", build_bspline<3>, 3, forms::bspline},
 };
 
+// How many times the spec names each in-memory array ({"array": NAME}): an array
+// named once can be taken rather than copied (BuildOptions::arrays).
+void count_array_uses(const json& j, std::map<std::string, std::size_t, std::less<>>& uses) {
+  if (j.is_object()) {
+    if (const auto it = j.find("array"); it != j.end() && it->is_string()) ++uses[it->get<std::string>()];
+    for (const auto& member_value : j) count_array_uses(member_value, uses);
+  } else if (j.is_array()) {
+    for (const auto& element : j)
+      if (element.is_structured()) count_array_uses(element, uses);
+  }
+}
+
 Construction build_impl(const json& spec, Context& ctx) {
+  if (ctx.arrays && !ctx.arrays->empty()) count_array_uses(spec, ctx.array_uses);
   if (!spec.is_object())
     fail(errc::wrong_type, "(top level): the spec must be a JSON object with a \"type\", got ", kind(spec));
   const json& t = member(spec, "type", "", cat("a string, one of ", type_list()));
