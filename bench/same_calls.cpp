@@ -1,10 +1,11 @@
 // bench/same_calls: the calls tools/bench_python.py makes from Python, made from C++
 // in the same way, so the two are compared call for call.
 //
-//   same_calls GRID.npy K REPEATS
+//   same_calls GRID.npy K REPEATS PARAM
 //
-// Reads an (n, m, 3) grid, then REPEATS times: interpolate_surface of the grid (copied
-// in: the caller keeps its grid, as a Python caller keeps its array), then evaluate on
+// Reads an (n, m, 3) grid, then REPEATS times: interpolate_surface of the grid with
+// PARAM parameters (uniform, chord or centripetal; copied in: the caller keeps its
+// grid, as a Python caller keeps its array), then evaluate on
 // K × K parameters spread evenly over the domain. Prints one line per repeat: the
 // seconds of the interpolation and of the evaluation.
 
@@ -20,8 +21,8 @@
 #include "interpatch/io/npy.hpp"
 
 int main(int argc, char** argv) {
-  if (argc != 4) {
-    std::fprintf(stderr, "usage: same_calls GRID.npy K REPEATS\n");
+  if (argc != 5) {
+    std::fprintf(stderr, "usage: same_calls GRID.npy K REPEATS uniform|chord|centripetal\n");
     return 2;
   }
   try {
@@ -33,9 +34,14 @@ int main(int argc, char** argv) {
       grid.data()[i] = {npy.data[3 * i], npy.data[3 * i + 1], npy.data[3 * i + 2]};
     const auto k = static_cast<std::size_t>(std::stoul(argv[2]));
     const int repeats = std::stoi(argv[3]);
+    const std::string name = argv[4];
+    interpatch::SurfaceInterpolationOptions options;
+    options.param = name == "uniform"       ? interpatch::Parametrization::uniform
+                    : name == "centripetal" ? interpatch::Parametrization::centripetal
+                                            : interpatch::Parametrization::chord;
     for (int r = 0; r < repeats; ++r) {
       const auto t0 = clock_type::now();
-      auto fit = interpatch::interpolate_surface(grid);
+      auto fit = interpatch::interpolate_surface(grid, options);
       const auto t1 = clock_type::now();
       const auto [u0, u1] = fit.surface.domain_u();
       const auto [v0, v1] = fit.surface.domain_v();
