@@ -227,21 +227,6 @@ void basis_pass(const Axis& ax, const double* in, Shape<R>& shape, std::size_t a
   shape[a] = out_rows;
 }
 
-// S at every data point, from the control net `cp` (shape: the control counts).
-template <std::size_t R>
-void evaluate_at_data(const std::array<Axis, R>& axes, const std::vector<double>& cp, std::vector<double>& out,
-                      std::vector<double>& scratch) {
-  Shape<R> shape{};
-  for (std::size_t a = 0; a < R; ++a) shape[a] = static_cast<std::size_t>(axes[a].c);
-  const std::vector<double>* cur = &cp;
-  for (std::size_t a = 0; a < R; ++a) {
-    // The last pass writes into `out`, the others alternate through `scratch`.
-    std::vector<double>& dst = ((R - 1 - a) % 2 == 0) ? out : scratch;
-    basis_pass<false, R>(axes[a], cur->data(), shape, a, dst);
-    cur = &dst;
-  }
-}
-
 // Bᵀ (w Q) over every direction: the right-hand side of the normal equations.
 template <std::size_t R>
 std::vector<double> right_hand_side(const std::array<Axis, R>& axes, const Data<R>& d) {
@@ -257,8 +242,9 @@ std::vector<double> right_hand_side(const std::array<Axis, R>& axes, const Data<
     }
     src = a1.data();
   }
-  // The last direction first: it shrinks the rows, which stay in cache.
-  for (std::size_t a = R; a-- > 0;) {
+  // The first direction first: its rows are whole rows of the grid (long, contiguous
+  // runs the multiply-adds stream through), and it shrinks the grid for the others.
+  for (std::size_t a = 0; a < R; ++a) {
     basis_pass<true, R>(axes[a], src, shape, a, a0);
     std::swap(a0, a1);
     src = a1.data();
@@ -594,45 +580,134 @@ KnotVector knots_from_breaks(const Axis& ax, const std::vector<double>& breaks) 
 
 template <std::size_t R>
 struct Residuals {
-  double max = 0, sum_sq = 0;
+  double max = -1, sum_sq = 0, weighted_sq = 0;
   std::size_t worst = 0;
   std::array<std::vector<double>, R> interval_max;
   std::array<std::vector<std::size_t>, R> interval_worst;
+
+  explicit Residuals(const std::array<Axis, R>& axes) {
+    for (std::size_t a = 0; a < R; ++a) {
+      interval_max[a].assign(static_cast<std::size_t>(axes[a].intervals), -1.0);
+      interval_worst[a].assign(static_cast<std::size_t>(axes[a].intervals), 0);
+    }
+  }
+  // Point i (of multi-index idx) with error e: the first of equal errors stays.
+  void add(std::size_t i, const std::array<std::size_t, R>& idx, const std::array<Axis, R>& axes, double e) {
+    if (e > max) {
+      max = e;
+      worst = i;
+    }
+    for (std::size_t a = 0; a < R; ++a) {
+      const auto k = static_cast<std::size_t>(axes[a].interval[idx[a]]);
+      if (e > interval_max[a][k]) {
+        interval_max[a][k] = e;
+        interval_worst[a][k] = i;
+      }
+    }
+  }
+  // Another block's, of later points: the same result as one pass in storage order.
+  void merge(const Residuals& o) {
+    sum_sq += o.sum_sq;
+    weighted_sq += o.weighted_sq;
+    if (o.max > max) {
+      max = o.max;
+      worst = o.worst;
+    }
+    for (std::size_t a = 0; a < R; ++a)
+      for (std::size_t k = 0; k < interval_max[a].size(); ++k)
+        if (o.interval_max[a][k] > interval_max[a][k]) {
+          interval_max[a][k] = o.interval_max[a][k];
+          interval_worst[a][k] = o.interval_worst[a][k];
+        }
+  }
 };
 
+// The distances |S(t_i) − Q_i| at every point present, evaluated a row at a time
+// (every index but the last fixed) and never stored: the control net goes through B
+// along every direction but the last once (n_0 ⋯ n_{R−2} × c_{R−1} values), and each
+// row of S is made from its row of that and compared at once. Blocks of rows run in
+// parallel and merge in order.
 template <std::size_t R>
-Residuals<R> residuals(const std::array<Axis, R>& axes, const Data<R>& d, const std::vector<double>& s) {
-  Residuals<R> r;
-  for (std::size_t a = 0; a < R; ++a) {
-    r.interval_max[a].assign(static_cast<std::size_t>(axes[a].intervals), -1.0);
-    r.interval_worst[a].assign(static_cast<std::size_t>(axes[a].intervals), 0);
+Residuals<R> residuals(const std::array<Axis, R>& axes, const Data<R>& d, const std::vector<double>& cp) {
+  Shape<R> shape{};
+  for (std::size_t a = 0; a < R; ++a) shape[a] = static_cast<std::size_t>(axes[a].c);
+  std::vector<double> partial = cp, scratch;
+  for (std::size_t a = 0; a + 1 < R; ++a) {
+    basis_pass<false, R>(axes[a], partial.data(), shape, a, scratch);
+    std::swap(partial, scratch);
   }
-  std::array<std::size_t, R> idx{};
-  for (std::size_t i = 0; i < d.points.size(); ++i) {
-    if (d.w(i) > 0) {
-      const Vec3& q = d.points.data()[i];
-      const double dx = s[3 * i] - q.x, dy = s[3 * i + 1] - q.y, dz = s[3 * i + 2] - q.z;
-      const double e2 = dx * dx + dy * dy + dz * dz;
-      r.sum_sq += e2;
-      const double e = std::sqrt(e2);
-      if (e > r.max) {
-        r.max = e;
-        r.worst = i;
-      }
-      for (std::size_t a = 0; a < R; ++a) {
-        const auto k = static_cast<std::size_t>(axes[a].interval[idx[a]]);
-        if (e > r.interval_max[a][k]) {
-          r.interval_max[a][k] = e;
-          r.interval_worst[a][k] = i;
+  const Axis& last = axes[R - 1];
+  const std::size_t n = last.n, c = static_cast<std::size_t>(last.c), pp = static_cast<std::size_t>(last.p) + 1;
+  const std::size_t rows = d.points.size() / n;
+  constexpr std::size_t rows_per_block = 16;
+  const std::size_t blocks = (rows + rows_per_block - 1) / rows_per_block;
+  std::vector<Residuals<R>> part(blocks, Residuals<R>(axes));
+  const auto nb = static_cast<long long>(blocks);
+#pragma omp parallel if (d.points.size() * pp >= detail::parallel_min_work)
+  {
+    std::vector<double> row(3 * n);
+#pragma omp for schedule(static)
+    for (long long bi = 0; bi < nb; ++bi) {
+      const auto b = static_cast<std::size_t>(bi);
+      Residuals<R>& r = part[b];
+      for (std::size_t q = b * rows_per_block; q < std::min(rows, (b + 1) * rows_per_block); ++q) {
+        const double* src = partial.data() + q * c * 3;
+        for (std::size_t i = 0; i < n; ++i) {
+          double x = 0, y = 0, z = 0;
+          for (std::size_t k = 0; k < pp; ++k) {
+            const double w = last.b[i * pp + k];
+            const double* v = src + 3 * last.col(last.first[i] + static_cast<int>(k));
+            x += w * v[0];
+            y += w * v[1];
+            z += w * v[2];
+          }
+          row[3 * i] = x, row[3 * i + 1] = y, row[3 * i + 2] = z;
+        }
+        std::array<std::size_t, R> idx{};
+        for (std::size_t a = R - 1, rest = q; a-- > 0; rest /= d.shape[a]) idx[a] = rest % d.shape[a];
+        for (std::size_t i = 0; i < n; ++i) {
+          const std::size_t flat = q * n + i;
+          const double w = d.w(flat);
+          if (!(w > 0)) continue;
+          const Vec3& p = d.points.data()[flat];
+          const double dx = row[3 * i] - p.x, dy = row[3 * i + 1] - p.y, dz = row[3 * i + 2] - p.z;
+          const double e2 = dx * dx + dy * dy + dz * dz;
+          r.sum_sq += e2;
+          r.weighted_sq += w * e2;
+          idx[R - 1] = i;
+          r.add(flat, idx, axes, std::sqrt(e2));
         }
       }
     }
-    for (std::size_t a = R; a-- > 0;) {  // the next multi-index
-      if (++idx[a] < d.shape[a]) break;
-      idx[a] = 0;
-    }
   }
-  return r;
+  Residuals<R> all(axes);
+  for (const auto& r : part) all.merge(r);
+  return all;
+}
+
+// S at one data point (its flat index), from the control net.
+template <std::size_t R>
+Vec3 value_at(const std::array<Axis, R>& axes, const std::vector<double>& cp, std::size_t flat, const Shape<R>& data_shape) {
+  const std::vector<std::size_t> idx = unflatten<R>(flat, data_shape);
+  std::array<std::size_t, R> pp{}, k{};
+  for (std::size_t a = 0; a < R; ++a) pp[a] = static_cast<std::size_t>(axes[a].p) + 1;
+  Vec3 s{};
+  for (;;) {
+    double w = 1;
+    std::size_t at = 0;
+    for (std::size_t a = 0; a < R; ++a) {
+      const Axis& ax = axes[a];
+      w *= ax.b[idx[a] * pp[a] + k[a]];
+      at = at * static_cast<std::size_t>(ax.c) + ax.col(ax.first[idx[a]] + static_cast<int>(k[a]));
+    }
+    s = s + w * Vec3{cp[3 * at], cp[3 * at + 1], cp[3 * at + 2]};
+    std::size_t a = R;
+    while (a-- > 0) {
+      if (++k[a] < pp[a]) break;
+      k[a] = 0;
+    }
+    if (a == static_cast<std::size_t>(-1)) return s;
+  }
 }
 
 // ------------------------------------------------------------------ the fit
@@ -689,7 +764,6 @@ template <std::size_t R>
 void solve_gcv(Fit<R>& f, const Data<R>& d) {
   SparseSystem<R> sys(f.axes, d);
   const std::vector<double> rhs = right_hand_side<R>(f.axes, d);
-  std::vector<double> s, scratch;
   const auto n = static_cast<double>(d.present);
   // Probes of the trace estimate: its error, about sqrt(2 / probes) of the Frobenius
   // norm of M⁻¹ λ s K (at most sqrt(C)), stays a small part of n − tr H.
@@ -706,15 +780,7 @@ void solve_gcv(Fit<R>& f, const Data<R>& d) {
       return std::numeric_limits<double>::infinity();  // too little fairness for the data: not a candidate
     }
     f.cp = sys.solve(rhs);
-    evaluate_at_data<R>(f.axes, f.cp, s, scratch);
-    double rss = 0;
-    for (std::size_t i = 0; i < d.points.size(); ++i) {
-      const double w = d.w(i);
-      if (!(w > 0)) continue;
-      const Vec3& q = d.points.data()[i];
-      const double dx = s[3 * i] - q.x, dy = s[3 * i + 1] - q.y, dz = s[3 * i + 2] - q.z;
-      rss += w * (dx * dx + dy * dy + dz * dz);
-    }
+    const double rss = residuals<R>(f.axes, d, f.cp).weighted_sq;
     // n − tr H = n − C + tr(M⁻¹ λ s K).
     const double rest = n - static_cast<double>(sys.data.rows()) + sys.fairness_trace(lambda, probes);
     if (!(rest > 0)) return std::numeric_limits<double>::infinity();
@@ -752,8 +818,9 @@ void solve_gcv(Fit<R>& f, const Data<R>& d) {
 // through it (missing points taking the approximation's values): whether direction
 // a lacks knots there.
 template <std::size_t R>
-double line_residual(const Axis& ax, const AxisSolver& lu, const Data<R>& d, const std::vector<double>& s, std::size_t a,
-                     std::size_t i) {
+double line_residual(const std::array<Axis, R>& axes, const AxisSolver& lu, const Data<R>& d, const std::vector<double>& cp,
+                     std::size_t a, std::size_t i) {
+  const Axis& ax = axes[a];
   std::size_t inner = 1;
   for (std::size_t x = a + 1; x < R; ++x) inner *= d.shape[x];
   const std::size_t n = d.shape[a], pos = (i / inner) % n, base = i - pos * inner;
@@ -761,8 +828,8 @@ double line_residual(const Axis& ax, const AxisSolver& lu, const Data<R>& d, con
   std::vector<double> line(n * 3), x(static_cast<std::size_t>(ax.c) * 3, 0.0);
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t j = base + k * inner;
-    for (std::size_t m = 0; m < 3; ++m)
-      line[3 * k + m] = d.w(j) > 0 ? d.points.data()[j][static_cast<int>(m)] : s[3 * j + m];
+    const Vec3 v = d.w(j) > 0 ? d.points.data()[j] : value_at<R>(axes, cp, j, d.shape);
+    for (std::size_t m = 0; m < 3; ++m) line[3 * k + m] = v[static_cast<int>(m)];
   }
   for (std::size_t k = 0; k < n; ++k)
     for (std::size_t l = 0; l < pp; ++l)
@@ -800,6 +867,53 @@ bool split_interval(const Axis& ax, std::vector<double>& breaks, int k) {
   return true;
 }
 
+// What removing each interior knot of an open axis a would cost, estimated from the
+// fit: the largest jump, over the lines of the control net along a, of the p-th
+// derivative at the knot (where the two polynomial pieces differ), times the p-th
+// power of the two intervals beside it (The NURBS Book §5.4: the deviation a
+// removal brings is of that order).
+template <std::size_t R>
+std::vector<double> removal_costs(const Fit<R>& f, std::size_t a, const std::vector<double>& breaks) {
+  const Axis& ax = f.axes[a];
+  const int p = ax.p;
+  const auto pp = static_cast<std::size_t>(p) + 1;
+  std::vector<double> u{ax.t.front()};
+  u.insert(u.end(), breaks.begin(), breaks.end());
+  u.push_back(ax.t.back());
+  const std::size_t pieces = u.size() - 1;
+  // The p-th derivatives of the basis on each piece (constant there).
+  std::vector<int> first(pieces);
+  std::vector<double> der(pieces * pp);
+  double tmp[(max_degree + 1) * (max_degree + 1)];
+  for (std::size_t j = 0; j < pieces; ++j) {
+    const double mid = 0.5 * (u[j] + u[j + 1]);
+    const int span = ax.knots.find_span(mid);
+    ax.knots.basis_derivatives(span, mid, p, tmp);
+    first[j] = span - p;
+    std::copy(tmp + static_cast<std::size_t>(p) * pp, tmp + static_cast<std::size_t>(p + 1) * pp, der.begin() + static_cast<std::ptrdiff_t>(j * pp));
+  }
+  std::size_t outer = 1, inner = 1;
+  for (std::size_t x = 0; x < a; ++x) outer *= static_cast<std::size_t>(f.axes[x].c);
+  for (std::size_t x = a + 1; x < R; ++x) inner *= static_cast<std::size_t>(f.axes[x].c);
+  const auto c = static_cast<std::size_t>(ax.c);
+  std::vector<double> jump(breaks.size(), 0.0);
+  std::vector<Vec3> d(pieces);
+  for (std::size_t o = 0; o < outer; ++o)
+    for (std::size_t in = 0; in < inner; ++in) {
+      for (std::size_t j = 0; j < pieces; ++j) {
+        Vec3 v{};
+        for (std::size_t k = 0; k < pp; ++k) {
+          const std::size_t i = (o * c + static_cast<std::size_t>(first[j]) + k) * inner + in;
+          v = v + der[j * pp + k] * Vec3{f.cp[3 * i], f.cp[3 * i + 1], f.cp[3 * i + 2]};
+        }
+        d[j] = v;
+      }
+      for (std::size_t k = 0; k < breaks.size(); ++k) jump[k] = std::max(jump[k], distance(d[k + 1], d[k]));
+    }
+  for (std::size_t k = 0; k < breaks.size(); ++k) jump[k] *= std::pow(u[k + 2] - u[k], p);
+  return jump;
+}
+
 template <std::size_t R>
 void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_callback& progress) {
   std::array<std::vector<double>, R> breaks;
@@ -808,17 +922,18 @@ void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_cal
     breaks[a] = ax.periodic ? least_squares_breaks(ax, ax.p + 1) : std::vector<double>{};
     ax.set_knots(knots_from_breaks(ax, breaks[a]));
   }
-  std::vector<double> s, scratch;
-  for (;;) {
+  auto max_error = [&] {
     solve_once<R>(f, d, std::nullopt);
-    evaluate_at_data<R>(f.axes, f.cp, s, scratch);
-    const Residuals<R> r = residuals<R>(f.axes, d, s);
-    if (progress) progress(std::min(0.9, 0.1 + 0.05 * f.fits));
-    if (r.max <= tol) return;
-    // Knots go where the error is largest: in every interval whose worst point is
-    // beyond the tolerance, in the directions along which that point's line, fitted
-    // on its own, misses it by more than half the tolerance (where neither does,
-    // in every direction).
+    if (progress) progress(std::min(0.9, 0.1 + 0.04 * f.fits));
+    return residuals<R>(f.axes, d, f.cp);
+  };
+  // Growth: knots go where the error is largest, in every interval whose worst point
+  // is beyond the tolerance, in the directions along which that point's line, fitted
+  // on its own, misses it by more than half the tolerance (where neither does, in
+  // every direction).
+  for (;;) {
+    const Residuals<R> r = max_error();
+    if (r.max <= tol) break;
     std::array<std::vector<int>, R> split;
     bool any = false;
     for (std::size_t a = 0; a < R; ++a) {
@@ -828,7 +943,7 @@ void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_cal
       for (int k = 0; k < ax.intervals; ++k) {
         const auto kk = static_cast<std::size_t>(k);
         if (!(r.interval_max[a][kk] > tol)) continue;
-        if (R == 1 || line_residual<R>(ax, lu, d, s, a, r.interval_worst[a][kk]) > 0.5 * tol) {
+        if (R == 1 || line_residual<R>(f.axes, lu, d, f.cp, a, r.interval_worst[a][kk]) > 0.5 * tol) {
           split[a].push_back(k);
           any = true;
         }
@@ -849,6 +964,51 @@ void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_cal
       }
     }
     if (!added) return;  // every interval is as fine as the data allow
+  }
+  // Pruning: growth splits several intervals at once and overshoots. The knots whose
+  // removal costs least go, as long as the refit stays within the tolerance: first
+  // a quarter of them at once, half as many after each refusal, one at a time at
+  // the end; a few refused single removals end it.
+  constexpr int refusals = 3;
+  std::vector<std::pair<std::size_t, double>> refused;
+  std::size_t total = 0;
+  for (std::size_t a = 0; a < R; ++a) total += f.axes[a].periodic ? 0 : breaks[a].size();
+  std::size_t batch = std::max<std::size_t>(1, total / 4);
+  while (static_cast<int>(refused.size()) < refusals) {
+    struct Candidate {
+      double cost;
+      std::size_t axis;
+      double knot;
+    };
+    std::vector<Candidate> cand;
+    for (std::size_t a = 0; a < R; ++a) {
+      if (f.axes[a].periodic) continue;
+      const std::vector<double> cost = removal_costs<R>(f, a, breaks[a]);
+      for (std::size_t k = 0; k < cost.size(); ++k)
+        if (std::none_of(refused.begin(), refused.end(),
+                         [&](const auto& x) { return x.first == a && x.second == breaks[a][k]; }))
+          cand.push_back({cost[k], a, breaks[a][k]});
+    }
+    if (cand.empty()) return;
+    std::stable_sort(cand.begin(), cand.end(), [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
+    batch = std::min(batch, cand.size());
+    const Fit<R> kept = f;
+    const std::array<std::vector<double>, R> kept_breaks = breaks;
+    std::array<bool, R> changed{};
+    for (std::size_t k = 0; k < batch; ++k) {
+      auto& b = breaks[cand[k].axis];
+      b.erase(std::find(b.begin(), b.end(), cand[k].knot));
+      changed[cand[k].axis] = true;
+    }
+    for (std::size_t a = 0; a < R; ++a)
+      if (changed[a]) f.axes[a].set_knots(knots_from_breaks(f.axes[a], breaks[a]));
+    if (max_error().max <= tol) continue;
+    const int fits = f.fits;
+    f = kept;
+    f.fits = fits;
+    breaks = kept_breaks;
+    if (batch == 1) refused.emplace_back(cand[0].axis, cand[0].knot);
+    batch = std::max<std::size_t>(1, batch / 2);
   }
 }
 
@@ -957,9 +1117,7 @@ Result<R> approximate(Data<R> d, const ApproximationOptions<R>& o, const char* w
   }
 
   // The report.
-  std::vector<double> s, scratch;
-  evaluate_at_data<R>(f.axes, f.cp, s, scratch);
-  const Residuals<R> r = residuals<R>(f.axes, d, s);
+  const Residuals<R> r = residuals<R>(f.axes, d, f.cp);
   ApproximationReport& rep = res.report;
   rep.max_error = r.max;
   rep.max_error_at = unflatten<R>(r.worst, d.shape);

@@ -53,7 +53,7 @@ TEST(ApproximateSurface, ToleranceBringsNoisyDataBackWithinThreeSigma) {
     PointGrid q = noisy_terrain(g, 60, 45, amp);
     PointGrid truth({60, 45});
     for (std::size_t i = 0; i < 60; ++i)
-      for (std::size_t j = 0; j < 45; ++j) truth(i, j) = {q(i, j).x, q(i, j).y, terrain(i / 59.0, j / 44.0)};
+      for (std::size_t j = 0; j < 45; ++j) truth(i, j) = {q(i, j).x, q(i, j).y, terrain(static_cast<double>(i) / 59, static_cast<double>(j) / 44)};
     auto o = uniform_options();
     o.tolerance = 2.5 * sigma;
     const auto r = approximate_surface(q, o);
@@ -173,7 +173,7 @@ TEST(ApproximateSurface, AutoSmoothingLeavesResidualsNearTheNoise) {
     std::normal_distribution<double> noise(0.0, sigma);
     for (std::size_t i = 0; i < 40; ++i)
       for (std::size_t j = 0; j < 36; ++j) {
-        const double u = i / 39.0, v = j / 35.0;
+        const double u = static_cast<double>(i) / 39, v = static_cast<double>(j) / 35;
         q(i, j) = {2 * u, v, terrain(u, v) + noise(g)};
       }
     auto o = uniform_options();

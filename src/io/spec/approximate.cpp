@@ -1,7 +1,7 @@
 // Approximation in a spec: {"type": "approximate"} through a grid of points,
 // {"type": "approximate_volume"} through a 3-D grid, and curves {"approximate":
-// points}. One reader of the options serves the three; missing points (null in an
-// inline list, NaN in a .npy or .csv file) are allowed here only.
+// points}. One reader of the options serves the three; missing points (a null
+// coordinate in an inline list, NaN in a .npy or .csv file) are allowed here only.
 
 #include <array>
 #include <cmath>

@@ -82,10 +82,6 @@ PointArray inline_points(const json& j, std::size_t rank, std::string_view ptr, 
   }
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   out.shape = walk_grid(j, rank, 1, true, ptr, idx, [&](const json& node) {
-    if (missing_allowed && node.is_null()) {  // a missing point
-      out.points.push_back({nan, nan, nan});
-      return;
-    }
     if (!node.is_array()) fail(errc::wrong_type, place(index_pointer(ptr, idx, rank)), ": expected a point [x, y, z], got ", kind(node));
     if (node.size() != 3)
       fail(errc::ragged_grid, place(index_pointer(ptr, idx, rank)), ": a point must be 3 numbers [x, y, z], got ",

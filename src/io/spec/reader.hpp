@@ -141,7 +141,7 @@ std::string choice(const json& obj, std::string_view key, std::string_view ptr,
 
 /// A point array of the given rank in any of its forms (inline lists, npy, csv).
 /// With `missing_allowed` (approximation only), a missing point is NaN: null for a
-/// point or a coordinate of an inline list, NaN in a file; infinities are refused still.
+/// coordinate of an inline list, NaN in a file; infinities are refused still.
 PointArray points_impl(const json& j, std::size_t rank, std::string_view ptr, Context& ctx, bool missing_allowed = false);
 /// points_impl for interpolation's data: a missing point (NaN in a file, null in a
 /// list) is refused, and the message says that approximation takes missing points.
