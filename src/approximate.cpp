@@ -842,27 +842,23 @@ double line_residual(const std::array<Axis, R>& axes, const AxisSolver& lu, cons
   return distance(e, Vec3{line[3 * pos], line[3 * pos + 1], line[3 * pos + 2]});
 }
 
-// Splits knot interval k of an axis at the middle of the data in it; false when it
-// holds fewer than 2 data parameters (or the direction has as many control points as data).
-bool split_interval(const Axis& ax, std::vector<double>& breaks, int k) {
+// Splits knot interval k of an axis at the middle of the data in it, between two
+// lines across the axis that hold data (a knot between missing lines would leave
+// the fairness term alone to settle a control point there); false when it holds
+// fewer than 2 such lines (or the direction has as many control points as data).
+bool split_interval(const Axis& ax, std::vector<double>& breaks, int k, const std::vector<bool>& has_data) {
   if (static_cast<std::size_t>(ax.c) >= ax.n) return false;
-  std::vector<std::size_t> in;
+  std::vector<std::size_t> in;  // the lines across the axis in the interval that hold data
   for (std::size_t i = 0; i < ax.n; ++i)
-    if (ax.interval[i] == k) in.push_back(i);
+    if (ax.interval[i] == k && has_data[i]) in.push_back(i);
   if (in.size() < 2) return false;
-  // The interval across a closed direction's seam holds the last data and then the
-  // first: in the order along the interval.
-  for (std::size_t j = 1; j < in.size(); ++j)
-    if (in[j] != in[j - 1] + 1) {
-      std::rotate(in.begin(), in.begin() + static_cast<std::ptrdiff_t>(j), in.end());
-      break;
-    }
+  // In a closed direction, the order along the interval is that of the parameters
+  // wrapped into the period: the interval across the seam holds the last lines and
+  // then the first.
+  auto at = [&](std::size_t i) { return ax.periodic ? ax.knots.wrap(ax.t[i]) : ax.t[i]; };
+  if (ax.periodic) std::stable_sort(in.begin(), in.end(), [&](std::size_t x, std::size_t y) { return at(x) < at(y); });
   const std::size_t mid = in.size() / 2;
-  const double a = ax.t[in[mid - 1]];
-  double b = ax.t[in[mid]];
-  if (b < a) b += 1.0;  // across the seam: one period on
-  double knot = 0.5 * (a + b);
-  if (ax.periodic && knot >= breaks.front() + 1.0) knot -= 1.0;
+  const double knot = 0.5 * (at(in[mid - 1]) + at(in[mid]));
   breaks.push_back(knot);
   return true;
 }
@@ -922,6 +918,15 @@ void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_cal
     breaks[a] = ax.periodic ? least_squares_breaks(ax, ax.p + 1) : std::vector<double>{};
     ax.set_knots(knots_from_breaks(ax, breaks[a]));
   }
+  // Which lines across each axis (every point with that index along it) hold data.
+  std::array<std::vector<bool>, R> has_data;
+  for (std::size_t a = 0; a < R; ++a) has_data[a].assign(d.shape[a], d.uniform());
+  if (!d.uniform())
+    for (std::size_t i = 0; i < d.points.size(); ++i)
+      if (d.w(i) > 0) {
+        const std::vector<std::size_t> idx = unflatten<R>(i, d.shape);
+        for (std::size_t a = 0; a < R; ++a) has_data[a][idx[a]] = true;
+      }
   auto max_error = [&] {
     solve_once<R>(f, d, std::nullopt);
     if (progress) progress(std::min(0.9, 0.1 + 0.04 * f.fits));
@@ -939,11 +944,18 @@ void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_cal
     for (std::size_t a = 0; a < R; ++a) {
       const Axis& ax = f.axes[a];
       if (static_cast<std::size_t>(ax.c) >= ax.n) continue;
-      const AxisSolver lu = factor_gram(ax, a);
+      // A direction whose knots outnumber the data under them (the fit then leans on
+      // the fairness term) has no line fit of its own: every bad interval of it splits.
+      std::optional<AxisSolver> lu;
+      try {
+        lu = factor_gram(ax, a);
+      } catch (const error& e) {
+        if (e.code() != errc::singular) throw;
+      }
       for (int k = 0; k < ax.intervals; ++k) {
         const auto kk = static_cast<std::size_t>(k);
         if (!(r.interval_max[a][kk] > tol)) continue;
-        if (R == 1 || line_residual<R>(f.axes, lu, d, f.cp, a, r.interval_worst[a][kk]) > 0.5 * tol) {
+        if (R == 1 || !lu || line_residual<R>(f.axes, *lu, d, f.cp, a, r.interval_worst[a][kk]) > 0.5 * tol) {
           split[a].push_back(k);
           any = true;
         }
@@ -957,7 +969,7 @@ void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_cal
     for (std::size_t a = 0; a < R; ++a) {
       const std::size_t before = breaks[a].size();
       for (int k : split[a])
-        if (split_interval(f.axes[a], breaks[a], k)) added = true;
+        if (split_interval(f.axes[a], breaks[a], k, has_data[a])) added = true;
       if (breaks[a].size() != before) {
         std::sort(breaks[a].begin(), breaks[a].end());
         f.axes[a].set_knots(knots_from_breaks(f.axes[a], breaks[a]));
@@ -1185,8 +1197,13 @@ Result<R> run(Grid<Vec3, R> points, const ApproximationOptions<R>& options, cons
     return approximate<R>(std::move(d), options, what);
   }
   ApproximationOptions<R> o = options;
+  const auto given = points.shape();
   Data<R> d = closed_data<R>(std::move(points), o.weights, o.periodic);
-  return approximate<R>(std::move(d), o, what);
+  Result<R> r = approximate<R>(std::move(d), o, what);
+  // A closing line left out has the parameter one period after the first line's.
+  for (std::size_t a = 0; a < R; ++a)
+    if (r.fit.axes[a].n < given[a]) r.fit.axes[a].t.push_back(r.fit.axes[a].t.front() + 1.0);
+  return r;
 }
 
 }  // namespace

@@ -144,6 +144,7 @@ struct VolumeApproximation {
 ///     for (int j = 0; j < 40; ++j) q(i, j) = {i / 29.0, j / 39.0, std::sin(i / 5.0) * std::cos(j / 7.0)};
 ///   for (int j = 0; j < 40; ++j) q(12, j).z = std::nan("");  // a missing row
 ///   SurfaceApproximationOptions o;
+///   o.param = Parametrization::uniform;  // a grid sampled evenly: its parameters are its indices
 ///   o.tolerance = 1e-3;
 ///   auto r = approximate_surface(q, o);  // the row is filled smoothly; r.report.missing == 40
 /// @endcode

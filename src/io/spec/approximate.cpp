@@ -8,6 +8,7 @@
 
 #include "detail/excerpt.hpp"
 #include "interpatch/approximate.hpp"
+#include "interpatch/memory.hpp"
 #include "io/spec/forms.hpp"
 #include "io/spec/reader.hpp"
 
@@ -94,6 +95,19 @@ ApproximationOptions<D> read_options(const json& obj, std::string_view ptr, cons
   return o;
 }
 
+// Data parameters mapped from a direction's domain onto [0, 1]; in a closed direction
+// whose period starts between two data lines (an even degree), those before the
+// start wrap to the end.
+std::vector<double> unit_params(std::vector<double> t, std::pair<double, double> domain, bool closed) {
+  if (!closed) return to_unit(std::move(t), domain);
+  const auto [a, b] = domain;
+  for (double& x : t) {
+    x = (x - a) / (b - a);
+    x -= std::floor(x);
+  }
+  return t;
+}
+
 // The report as info shows it.
 nlohmann::ordered_json report_json(const ApproximationReport& r, std::string_view pts_at) {
   nlohmann::ordered_json j;
@@ -123,6 +137,13 @@ Construction build_approximate(const json& spec, Context& ctx) {
   typename Grid<Vec3, D>::shape_type gs{};
   for (std::size_t a = 0; a < D; ++a) gs[a] = shape[a];
   Grid<Vec3, D> grid(gs, std::move(pts.points));
+  // The data as given, missing points and all: info's error at the data skips them.
+  DataSet data;
+  data.pointer = "/points";
+  if (ctx.keep_data) {
+    require_memory(grid.size(), sizeof(Vec3), cat("/points: a copy of the ", extents_text(shape), " data points for the error check"));
+    data.points.assign(grid.values().begin(), grid.values().end());
+  }
   ctx.parsed();
 
   Construction c;
@@ -132,12 +153,18 @@ Construction build_approximate(const json& spec, Context& ctx) {
     SurfaceApproximation r = at("/points", [&] { return approximate_surface(std::move(grid), o); });
     c.type = "approximate";
     degree = {r.surface.degree_u(), r.surface.degree_v()};
+    data.params = {unit_params(std::move(r.params_u), r.surface.domain_u(), o.periodic[0]),
+                   unit_params(std::move(r.params_v), r.surface.domain_v(), o.periodic[1])};
     c.exact = r.surface.mapped(0.0, 1.0, 0.0, 1.0);
     report = std::move(r.report);
   } else {
     VolumeApproximation r = at("/points", [&] { return approximate_volume(std::move(grid), o); });
     c.type = "approximate_volume";
     degree = {r.volume.degree_u(), r.volume.degree_v(), r.volume.degree_w()};
+    const auto dom = r.volume.domain();
+    data.params = {unit_params(std::move(r.params_u), dom[0], o.periodic[0]),
+                   unit_params(std::move(r.params_v), dom[1], o.periodic[1]),
+                   unit_params(std::move(r.params_w), dom[2], o.periodic[2])};
     c.exact = r.volume.mapped(0.0, 1.0, 0.0, 1.0, 0.0, 1.0);
     report = std::move(r.report);
   }
@@ -150,6 +177,7 @@ Construction build_approximate(const json& spec, Context& ctx) {
   if (o.auto_smoothing) c.parameters["smoothing"] = "auto";
   if (!o.weights.empty()) c.parameters["weights"] = true;
   c.parameters.update(report_json(report, "/points"));
+  if (ctx.keep_data) c.data.push_back(std::move(data));
   return c;
 }
 
