@@ -591,20 +591,6 @@ struct Residuals {
       interval_worst[a].assign(static_cast<std::size_t>(axes[a].intervals), 0);
     }
   }
-  // Point i (of multi-index idx) with error e: the first of equal errors stays.
-  void add(std::size_t i, const std::array<std::size_t, R>& idx, const std::array<Axis, R>& axes, double e) {
-    if (e > max) {
-      max = e;
-      worst = i;
-    }
-    for (std::size_t a = 0; a < R; ++a) {
-      const auto k = static_cast<std::size_t>(axes[a].interval[idx[a]]);
-      if (e > interval_max[a][k]) {
-        interval_max[a][k] = e;
-        interval_worst[a][k] = i;
-      }
-    }
-  }
   // Another block's, of later points: the same result as one pass in storage order.
   void merge(const Residuals& o) {
     sum_sq += o.sum_sq;
@@ -643,9 +629,14 @@ Residuals<R> residuals(const std::array<Axis, R>& axes, const Data<R>& d, const 
   const std::size_t blocks = (rows + rows_per_block - 1) / rows_per_block;
   std::vector<Residuals<R>> part(blocks, Residuals<R>(axes));
   const auto nb = static_cast<long long>(blocks);
+  // Where each basis function of each point along the last axis finds its control
+  // point's coordinates in a row of `partial`.
+  std::vector<std::size_t> off(n * pp);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < pp; ++k) off[i * pp + k] = 3 * last.col(last.first[i] + static_cast<int>(k));
 #pragma omp parallel if (d.points.size() * pp >= detail::parallel_min_work)
   {
-    std::vector<double> row(3 * n);
+    std::vector<double> row(3 * n), e2(n);
 #pragma omp for schedule(static)
     for (long long bi = 0; bi < nb; ++bi) {
       const auto b = static_cast<std::size_t>(bi);
@@ -656,32 +647,59 @@ Residuals<R> residuals(const std::array<Axis, R>& axes, const Data<R>& d, const 
           double x = 0, y = 0, z = 0;
           for (std::size_t k = 0; k < pp; ++k) {
             const double w = last.b[i * pp + k];
-            const double* v = src + 3 * last.col(last.first[i] + static_cast<int>(k));
+            const double* v = src + off[i * pp + k];
             x += w * v[0];
             y += w * v[1];
             z += w * v[2];
           }
           row[3 * i] = x, row[3 * i + 1] = y, row[3 * i + 2] = z;
         }
-        std::array<std::size_t, R> idx{};
-        for (std::size_t a = R - 1, rest = q; a-- > 0; rest /= d.shape[a]) idx[a] = rest % d.shape[a];
+        // Squared distances first (a loop the compiler vectorizes), then the maxima:
+        // of the row for the axes before the last, per interval along the last.
+        const Vec3* pts = d.points.data() + q * n;
         for (std::size_t i = 0; i < n; ++i) {
-          const std::size_t flat = q * n + i;
-          const double w = d.w(flat);
+          const double dx = row[3 * i] - pts[i].x, dy = row[3 * i + 1] - pts[i].y, dz = row[3 * i + 2] - pts[i].z;
+          e2[i] = dx * dx + dy * dy + dz * dz;
+        }
+        double row_max = -1;
+        std::size_t row_worst = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+          const double w = d.w(q * n + i);
           if (!(w > 0)) continue;
-          const Vec3& p = d.points.data()[flat];
-          const double dx = row[3 * i] - p.x, dy = row[3 * i + 1] - p.y, dz = row[3 * i + 2] - p.z;
-          const double e2 = dx * dx + dy * dy + dz * dz;
-          r.sum_sq += e2;
-          r.weighted_sq += w * e2;
-          idx[R - 1] = i;
-          r.add(flat, idx, axes, std::sqrt(e2));
+          r.sum_sq += e2[i];
+          r.weighted_sq += w * e2[i];
+          if (e2[i] > row_max) {
+            row_max = e2[i];
+            row_worst = i;
+          }
+          auto& m = r.interval_max[R - 1][static_cast<std::size_t>(last.interval[i])];
+          if (e2[i] > m) {
+            m = e2[i];
+            r.interval_worst[R - 1][static_cast<std::size_t>(last.interval[i])] = q * n + i;
+          }
+        }
+        if (row_max < 0) continue;  // every point of the row missing
+        const std::size_t flat = q * n + row_worst;
+        if (row_max > r.max) {
+          r.max = row_max;
+          r.worst = flat;
+        }
+        for (std::size_t a = R - 1, rest = q; a-- > 0; rest /= d.shape[a]) {
+          const auto k = static_cast<std::size_t>(axes[a].interval[rest % d.shape[a]]);
+          if (row_max > r.interval_max[a][k]) {
+            r.interval_max[a][k] = row_max;
+            r.interval_worst[a][k] = flat;
+          }
         }
       }
     }
   }
   Residuals<R> all(axes);
   for (const auto& r : part) all.merge(r);
+  // Squares were compared; distances are reported.
+  all.max = all.max < 0 ? 0.0 : std::sqrt(all.max);
+  for (std::size_t a = 0; a < R; ++a)
+    for (double& m : all.interval_max[a]) m = m < 0 ? m : std::sqrt(m);
   return all;
 }
 
