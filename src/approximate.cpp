@@ -928,14 +928,14 @@ std::vector<double> removal_costs(const Fit<R>& f, std::size_t a, const std::vec
   return jump;
 }
 
+// Growth from the knots in `breaks`: knots go where the error is largest, in every
+// interval whose worst point is beyond the tolerance, in the directions along which
+// that point's line, fitted on its own, misses it by more than half the tolerance
+// (where neither does, in every direction). True when the fit is within the
+// tolerance; false when no interval can split any more.
 template <std::size_t R>
-void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_callback& progress) {
-  std::array<std::vector<double>, R> breaks;
-  for (std::size_t a = 0; a < R; ++a) {
-    Axis& ax = f.axes[a];
-    breaks[a] = ax.periodic ? least_squares_breaks(ax, ax.p + 1) : std::vector<double>{};
-    ax.set_knots(knots_from_breaks(ax, breaks[a]));
-  }
+bool grow(Fit<R>& f, const Data<R>& d, double tol, std::array<std::vector<double>, R>& breaks,
+          const progress_callback& progress) {
   // Which lines across each axis (every point with that index along it) hold data.
   std::array<std::vector<bool>, R> has_data;
   for (std::size_t a = 0; a < R; ++a) has_data[a].assign(d.shape[a], d.uniform());
@@ -945,18 +945,11 @@ void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_cal
         const std::vector<std::size_t> idx = unflatten<R>(i, d.shape);
         for (std::size_t a = 0; a < R; ++a) has_data[a][idx[a]] = true;
       }
-  auto max_error = [&] {
+  for (;;) {
     solve_once<R>(f, d, std::nullopt);
     if (progress) progress(std::min(0.9, 0.1 + 0.04 * f.fits));
-    return residuals<R>(f.axes, d, f.cp);
-  };
-  // Growth: knots go where the error is largest, in every interval whose worst point
-  // is beyond the tolerance, in the directions along which that point's line, fitted
-  // on its own, misses it by more than half the tolerance (where neither does, in
-  // every direction).
-  for (;;) {
-    const Residuals<R> r = max_error();
-    if (r.max <= tol) break;
+    const Residuals<R> r = residuals<R>(f.axes, d, f.cp);
+    if (r.max <= tol) return true;
     std::array<std::vector<int>, R> split;
     bool any = false;
     for (std::size_t a = 0; a < R; ++a) {
@@ -993,8 +986,76 @@ void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_cal
         f.axes[a].set_knots(knots_from_breaks(f.axes[a], breaks[a]));
       }
     }
-    if (!added) return;  // every interval is as fine as the data allow
+    if (!added) return false;  // every interval is as fine as the data allow
   }
+}
+
+// Every `step[a]`-th line of the data along each axis (the last one too): a grid to
+// grow the knots on before the whole grid refines them.
+template <std::size_t R>
+Data<R> thinned(const Data<R>& d, const std::array<std::vector<std::size_t>, R>& kept) {
+  Data<R> t;
+  typename Grid<Vec3, R>::shape_type shape{};
+  for (std::size_t a = 0; a < R; ++a) shape[a] = t.shape[a] = kept[a].size();
+  t.points = Grid<Vec3, R>(shape, for_overwrite);
+  if (!d.uniform()) t.weight.resize(t.points.size());
+  std::array<std::size_t, R> k{};
+  for (std::size_t i = 0; i < t.points.size(); ++i) {
+    std::size_t src = 0;
+    for (std::size_t a = 0; a < R; ++a) src = src * d.shape[a] + kept[a][k[a]];
+    t.points.data()[i] = d.points.data()[src];
+    if (!d.uniform()) t.weight[i] = d.weight[src];
+    if (d.w(src) > 0) {
+      ++t.present;
+      t.weight_sum += d.w(src);
+    } else {
+      ++t.missing;
+    }
+    for (std::size_t a = R; a-- > 0;) {
+      if (++k[a] < kept[a].size()) break;
+      k[a] = 0;
+    }
+  }
+  return t;
+}
+
+template <std::size_t R>
+void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_callback& progress) {
+  std::array<std::vector<double>, R> breaks;
+  for (std::size_t a = 0; a < R; ++a) {
+    Axis& ax = f.axes[a];
+    breaks[a] = ax.periodic ? least_squares_breaks(ax, ax.p + 1) : std::vector<double>{};
+    ax.set_knots(knots_from_breaks(ax, breaks[a]));
+  }
+  // A large grid grows its first knots on every 4th line of directions with 128 or
+  // more points (a sixteenth of a surface's work per fit): the coarse knots a smooth
+  // part of the data needs show on it as well. The whole grid then refines them.
+  constexpr std::size_t thin = 4, thin_from = 128;
+  if (d.points.size() >= (std::size_t{1} << 18)) {
+    Fit<R> coarse;
+    std::array<std::vector<std::size_t>, R> kept;
+    for (std::size_t a = 0; a < R; ++a) {
+      const std::size_t n = d.shape[a], step = n >= thin_from ? thin : 1;
+      for (std::size_t i = 0; i < n; i += step) kept[a].push_back(i);
+      if (!f.axes[a].periodic && kept[a].back() != n - 1) kept[a].push_back(n - 1);
+      Axis& ax = coarse.axes[a];
+      ax.n = kept[a].size();
+      ax.p = f.axes[a].p;
+      ax.periodic = f.axes[a].periodic;
+      for (std::size_t i : kept[a]) ax.t.push_back(f.axes[a].t[i]);
+      ax.set_knots(knots_from_breaks(ax, breaks[a]));
+    }
+    const Data<R> sub = thinned<R>(d, kept);
+    (void)grow<R>(coarse, sub, tol, breaks, {});
+    f.fits += coarse.fits;
+    for (std::size_t a = 0; a < R; ++a) f.axes[a].set_knots(knots_from_breaks(f.axes[a], breaks[a]));
+  }
+  if (!grow<R>(f, d, tol, breaks, progress)) return;
+  auto max_error = [&] {
+    solve_once<R>(f, d, std::nullopt);
+    if (progress) progress(std::min(0.9, 0.1 + 0.04 * f.fits));
+    return residuals<R>(f.axes, d, f.cp);
+  };
   // Pruning: growth splits several intervals at once and overshoots. The knots whose
   // removal costs least go, as long as the refit stays within the tolerance: first
   // a quarter of them at once, half as many after each refusal, one at a time at

@@ -66,6 +66,29 @@ TEST(ApproximateSurface, ToleranceBringsNoisyDataBackWithinThreeSigma) {
   }
 }
 
+// Grids of 2^18 points and more grow their first knots on every 4th line: the result
+// still keeps every point present within the tolerance, and the truth within 3σ.
+TEST(ApproximateSurface, LargeGridsToATolerance) {
+  auto g = test::rng(11);
+  const double sigma = 0.01, amp = std::sqrt(3.0) * sigma;  // uniform noise of standard deviation σ
+  PointGrid q = noisy_terrain(g, 520, 510, amp);
+  for (std::size_t i = 200; i < 260; ++i)
+    for (std::size_t j = 300; j < 330; ++j) q(i, j).z = nan_v;
+  auto o = uniform_options();
+  o.tolerance = 2.5 * sigma;
+  const auto r = approximate_surface(q, o);
+  EXPECT_LE(r.report.max_error, *o.tolerance);
+  EXPECT_EQ(r.report.missing, 60u * 30u);
+  double worst = 0;
+  for (std::size_t i = 0; i < 520; i += 7)
+    for (std::size_t j = 0; j < 510; j += 5) {
+      const double z = r.surface.point(r.params_u[i], r.params_v[j]).z;
+      worst = std::max(worst, std::abs(z - terrain(static_cast<double>(i) / 519, static_cast<double>(j) / 509)));
+    }
+  EXPECT_LE(worst, 3 * sigma);
+  EXPECT_LT(r.report.control_points[0] * r.report.control_points[1], 400);
+}
+
 TEST(ApproximateSurface, AsManyControlPointsAsDataReproduceInterpolation) {
   for (unsigned seed = 0; seed < 4; ++seed) {
     auto g = test::rng(seed);

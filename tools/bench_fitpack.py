@@ -46,12 +46,12 @@ def fitpack(points, s):
     from scipy.interpolate import RectBivariateSpline
     x = points[:, 0, 0]
     y = points[0, :, 1]
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     spline = RectBivariateSpline(x, y, points[..., 2], kx=3, ky=3, s=s)
-    seconds = time.perf_counter() - t0
+    seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     tx, ty = spline.get_knots()
     err = np.abs(spline(x, y) - points[..., 2])
-    return spline, {"seconds": seconds, "control_points": [len(tx) - 4, len(ty) - 4],
+    return spline, {"seconds": seconds, "cpu": cpu, "control_points": [len(tx) - 4, len(ty) - 4],
                     "max_error": float(err.max()), "rms_error": float(np.sqrt(np.mean(err ** 2)))}
 
 
@@ -101,15 +101,24 @@ def cmd_compare(args):
     print(f"interpatch tolerance {fp['max_error']:.6g}: {cp[0]} x {cp[1]} = {cp[0] * cp[1]} control points, "
           f"max error {ours['max_error']:.6g}, rms {ours['rms_error']:.6g}, {ours['fits']} fits, "
           f"build {info['timings']['build_ms']} ms, parse {info['timings']['parse_ms']} ms")
-    lib = []
+    # The library calls in turn, in this process: interpatch through its Python module
+    # (the array passed in memory, as NumPy holds it), FITPACK's fit; wall clock and
+    # the process's CPU time of each.
+    sys.path.insert(0, str(Path(ip).parent / "python"))
+    import interpatch
+    runs = {"interpatch": [], "fitpack": []}
     for _ in range(args.rounds):
-        i = json.loads(run(f"{ip} info {d / 'approx.json'}"))
-        _, f = fitpack(points, s)
-        lib.append((i["timings"]["build_ms"] / 1000, f["seconds"]))
-    lib_ip = float(np.median([a for a, _ in lib]))
-    lib_fp = float(np.median([b for _, b in lib]))
-    print(f"library call, median of {args.rounds}: interpatch {lib_ip:.3f} s, FITPACK {lib_fp:.3f} s, "
-          f"FITPACK / interpatch {lib_fp / lib_ip:.2f}")
+        t0, c0 = time.perf_counter(), time.process_time()
+        surface = interpatch.approximate_surface(points, param="uniform", tolerance=fp["max_error"])
+        runs["interpatch"].append((time.perf_counter() - t0, time.process_time() - c0))
+        assert surface.info()["parameters"]["control_points"] == cp
+        _, f = fitpack(points, s)  # the fit alone, not its error check
+        runs["fitpack"].append((f["seconds"], f["cpu"]))
+    med = {k: (float(np.median([w for w, _ in v])), float(np.median([c for _, c in v]))) for k, v in runs.items()}
+    print(f"library call, median of {args.rounds} in turn (load average {os.getloadavg()[0]:.2f}): "
+          f"interpatch {med['interpatch'][0]:.3f} s wall, {med['interpatch'][1]:.3f} s CPU; "
+          f"FITPACK {med['fitpack'][0]:.3f} s wall, {med['fitpack'][1]:.3f} s CPU; FITPACK / interpatch "
+          f"{med['fitpack'][0] / med['interpatch'][0]:.2f} (wall), {med['fitpack'][1] / med['interpatch'][1]:.2f} (CPU)")
     print(time_in_turn(args.rounds, {
         "interpatch": f"{ip} build {d / 'approx.json'} -o {d / 'approx.npz'}",
         "fitpack": f"{me} fit {d / 'noisy.npy'} --s {s!r} -o {d / 'fitpack.npz'}"}))
