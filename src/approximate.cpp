@@ -181,6 +181,12 @@ AxisSolver factor_gram(const Axis& ax, std::size_t a) {
 
 // ------------------------------------------------------------------ tensor passes
 
+// Passes with fewer multiply-adds than this stay on the calling thread: a fit to a
+// tolerance makes a few dozen passes, the early ones over a thinned grid, and a
+// parallel region costs as much as a few hundred thousand multiply-adds (more when
+// the machine is shared and a thread waits for the other to be scheduled).
+constexpr std::size_t parallel_work = detail::parallel_min_work * 16;
+
 // Runs f(o, c0, c1) over blocks of `outer` slabs × columns [c0, c1) of `width`
 // doubles, in parallel when there is enough work. Every number is computed by the
 // same operations whatever the thread count.
@@ -189,7 +195,7 @@ void for_blocks(std::size_t outer, std::size_t width, std::size_t work, const F&
   constexpr std::size_t chunk = 2048;
   const std::size_t per = outer >= 8 ? 1 : (width + chunk - 1) / chunk;
   const auto tasks = static_cast<long long>(outer * per);
-#pragma omp parallel for schedule(static) if (work >= detail::parallel_min_work)
+#pragma omp parallel for schedule(static) if (work >= parallel_work)
   for (long long k = 0; k < tasks; ++k) {
     const auto task = static_cast<std::size_t>(k);
     const std::size_t o = task / per, part = task % per;
@@ -634,7 +640,7 @@ Residuals<R> residuals(const std::array<Axis, R>& axes, const Data<R>& d, const 
   std::vector<std::size_t> off(n * pp);
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t k = 0; k < pp; ++k) off[i * pp + k] = 3 * last.col(last.first[i] + static_cast<int>(k));
-#pragma omp parallel if (d.points.size() * pp >= detail::parallel_min_work)
+#pragma omp parallel if (d.points.size() * pp * 3 >= parallel_work)
   {
     std::vector<double> row(3 * n), e2(n);
 #pragma omp for schedule(static)
