@@ -258,6 +258,15 @@ TEST(ApproximateSurface, HolesAreFilledWithoutOvershoot) {
   }
   {
     auto o = uniform_options();
+    o.auto_smoothing = true;  // cross-validation over the points present, λ never below the weight that fills
+    const auto r = approximate_surface(q, o);
+    EXPECT_GT(r.report.lambda, 0.0);
+    EXPECT_EQ(r.report.missing, missing);
+    expect_hole_filled(r, q, 14, 22, 9, 18, "auto, void");
+    expect_hole_filled(r, q, 30, 31, 0, 30, "auto, row");
+  }
+  {
+    auto o = uniform_options();
     o.control_points = std::array<int, 2>{40, 30};  // as many as data: the hole holds control points with no data
     const auto r = approximate_surface(q, o);
     EXPECT_LT(r.report.max_error, 1e-3);  // the fill term barely touches the data elsewhere
@@ -389,6 +398,31 @@ TEST(ApproximateCurve, ToleranceAndMissingPoints) {
   for (std::size_t i = 0; i < q.size(); ++i)
     if (i != 50) worst = std::max(worst, distance(r.curve.point(r.params[i]), q[i]));
   EXPECT_NEAR(worst, r.report.max_error, 1e-12);
+}
+
+TEST(ApproximateCurve, ClosedCurvesCloseSmoothly) {
+  auto g = test::rng(9);
+  std::vector<Vec3> q;
+  for (int i = 0; i < 120; ++i) {
+    const double a = 2 * M_PI * i / 120;
+    q.push_back({(2 + 0.3 * std::cos(5 * a)) * std::cos(a), (2 + 0.3 * std::cos(5 * a)) * std::sin(a),
+                 test::uniform(g, -0.002, 0.002)});
+  }
+  q.push_back(q.front());  // the closing point, left out
+  for (int degree : {2, 3}) {
+    CurveApproximationOptions o;
+    o.periodic = {true};
+    o.degree = {degree};
+    o.tolerance = 0.01;
+    const auto r = approximate_curve(q, o);
+    EXPECT_LE(r.report.max_error, 0.01) << degree;
+    EXPECT_TRUE(r.curve.knots().periodic()) << degree;
+    EXPECT_EQ(r.params.size(), q.size()) << degree;  // the closing point's parameter: the first's, one period on
+    double worst = 0;
+    for (std::size_t i = 0; i < q.size(); ++i) worst = std::max(worst, distance(r.curve.point(r.params[i]), q[i]));
+    EXPECT_NEAR(worst, r.report.max_error, 1e-12) << degree;
+    EXPECT_LT(r.curve.control_points().size(), 60u) << degree;
+  }
 }
 
 TEST(ApproximateVolume, AsManyControlPointsAsDataReproduceInterpolationAndHolesFill) {
