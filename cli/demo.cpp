@@ -12,6 +12,7 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <limits>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -68,6 +69,23 @@ PointGrid terrain() {
       const double z = 312 + 24 * std::sin(0.9 * x + 0.4) * std::cos(0.42 * y) +
                        9 * std::exp(-((x - 4) * (x - 4) + (y - 8) * (y - 8) / 4) / 3) + 1.5 * noise(i, j);
       g(i, j) = {40 * x, 30 * y, round_to(z, 0.01)};
+    }
+  return g;
+}
+
+// Heights surveyed every 10 m on a 60 x 45 grid, with up to 0.25 m of measurement
+// noise, a 12 x 9 void (a pond the survey could not reach) and one row lost: the
+// missing heights are NaN.
+PointGrid noisy_terrain() {
+  const double missing = std::numeric_limits<double>::quiet_NaN();
+  PointGrid g({60, 45});
+  for (std::size_t i = 0; i < 60; ++i)
+    for (std::size_t j = 0; j < 45; ++j) {
+      const double x = static_cast<double>(i) / 8, y = static_cast<double>(j) / 3.5;
+      const double z = 312 + 24 * std::sin(0.9 * x + 0.4) * std::cos(0.42 * y) +
+                       9 * std::exp(-((x - 4) * (x - 4) + (y - 8) * (y - 8) / 4) / 3) + 0.5 * noise(i, j);
+      const bool lost = (i >= 30 && i < 42 && j >= 20 && j < 29) || i == 12;
+      g(i, j) = {10.0 * static_cast<double>(i), 10.0 * static_cast<double>(j), lost ? missing : round_to(z, 0.01)};
     }
   return g;
 }
@@ -495,6 +513,13 @@ std::vector<Example> examples() {
                  {"param", "chord"},
                  {"points", grid_json(terrain())}},
                 nullptr, "", false});
+  ex.push_back({"approximate_terrain", "a noisy 60x45 survey with a void and a lost row, to a tolerance of 0.35 m",
+                {{"type", "approximate"},
+                 {"comment", "Heights every 10 m with up to 0.25 m of noise; NaN where the survey has none (a 12 x 9 void, "
+                             "row 12): the fewest control points keeping every height within 0.35 m, the gaps filled."},
+                 {"tolerance", 0.35},
+                 {"points", {{"npy", "approximate_terrain.npy"}}}},
+                [](const fs::path& dir) { write_points_npy(dir / "approximate_terrain.npy", noisy_terrain()); }, "", false});
   ex.push_back({"wave", "degrees (2, 3), uniform parameters, 6x9 grid",
                 {{"type", "interpolate"},
                  {"comment", "A wave: quadratic along u, cubic along v, uniformly spaced parameters."},
@@ -683,6 +708,9 @@ int demo_command(const fs::path& requested) {
     if (err.is_object())
       line += ", max error at the data " + short_number(err["absolute"].get<double>()) + " (relative " +
               short_number(err["relative"].get<double>()) + ")";
+    if (const auto& par = description["parameters"]; par.contains("rms_error"))  // an approximation
+      line += " at " + par["max_error_at"].get<std::string>() + ", rms " + short_number(par["rms_error"].get<double>()) +
+              ", " + par["missing_points"].dump() + " missing points filled";
     if (!ex.spec_file.empty() || ex.spec.contains("npz")) {
       // An exact form read back and built again: the same bytes as the file it came from.
       const fs::path original = ex.spec_file.empty() ? dir / ex.spec["npz"].get<std::string>() : spec_path;

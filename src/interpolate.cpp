@@ -495,7 +495,9 @@ GridShape grid_shape(const std::array<std::size_t, Rank>& shape) {
 [[noreturn]] void fail_not_finite(const Vec3* q, const GridShape& g, std::size_t k) {
   std::string at;
   for (std::size_t a = g.rank, rest = k; a-- > 0; rest /= g.n[a]) at = detail::cat("[", rest % g.n[a], "]", at);
-  fail(errc::not_finite, "point ", at, " is ", q[k]);
+  const bool missing = std::isnan(q[k].x) || std::isnan(q[k].y) || std::isnan(q[k].z);
+  fail(errc::not_finite, "point ", at, " is ", q[k],
+       missing ? " (interpolation needs every point; approximation takes missing points, marked by NaN)" : "");
 }
 
 void check_grid_finite(const Vec3* q, const GridShape& g) {

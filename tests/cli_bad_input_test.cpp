@@ -100,6 +100,14 @@ std::string npz_with_compressed(const std::string& member) {
 
 const std::string csv_spec = R"({"type": "interpolate", "points": {"csv": "grid.csv", "shape": [2, 2]}})";
 
+// The 4 x 5 grid approximated to a tolerance.
+json approximate_spec() {
+  json s = grid_spec();
+  s["type"] = "approximate";
+  s["tolerance"] = 0.01;
+  return s;
+}
+
 // --- the table ---------------------------------------------------------------------
 
 using Files = std::map<std::string, std::string>;  // name -> content; a name ending in '/' is a directory
@@ -443,6 +451,50 @@ std::vector<Row> rows() {
       {"VolumeEvalCsvOfCountsTooLarge", {{grid_file, vol}}, {"eval", grid_file, "--grid", "2000x3000x4000", "-o", "out.csv"}, 5,
        R"(evaluation grid 2000x3000x4000 needs [0-9.]+ [GTP]B \([0-9]+ bytes\), [0-9.]+ [kMGT]?B available)", errc::too_large,
        false},
+      // approximation
+      {"ApproximateWithAllPointsMissing",
+       {{grid_file, with(approximate_spec(), [](json& s) {
+           for (auto& row : s["points"])
+             for (auto& p : row) p[2] = nullptr;  // z missing: the point is missing
+         }).dump()}},
+       {"build", grid_file, "-o", "out.json"}, 3, R"(/points: all 20 points are missing or have weight 0)", errc::too_few_points},
+      {"ApproximateToleranceZero", {{grid_file, with(approximate_spec(), [](json& s) { s["tolerance"] = 0; }).dump()}},
+       {"info", grid_file}, 3, R"(/tolerance: tolerance 0 is not a positive distance)", errc::wrong_type},
+      {"ApproximateTwoWays", {{grid_file, with(approximate_spec(), [](json& s) { s["smoothing"] = "auto"; }).dump()}},
+       {"mesh", grid_file, "-o", "out.obj"}, 3,
+       R"(/smoothing: give exactly one of "control_points", "tolerance" and "smoothing"; "tolerance" is given too)",
+       errc::wrong_type},
+      {"ApproximateNoWay", {{grid_file, with(approximate_spec(), [](json& s) { s.erase("tolerance"); }).dump()}},
+       {"build", grid_file, "-o", "out.json"}, 3, R"(\(top level\): an approximation needs one of "control_points")",
+       errc::missing_field},
+      {"ApproximateMoreControlPointsThanData",
+       {{grid_file, with(approximate_spec(), [](json& s) {
+           s.erase("tolerance");
+           s["control_points"] = {4, 6};
+         }).dump()}},
+       {"eval", grid_file, "--grid", "3", "-o", "out.npy"}, 3,
+       R"(/control_points/1: 6 control points along v are more than the 5 data points there \(/points has shape 4x5\))",
+       errc::too_few_points},
+      {"ApproximateWeightsOfTheWrongShape",
+       {{grid_file, with(approximate_spec(), [](json& s) { s["weights"] = json::array({{1, 1, 1, 1, 1}, {1, 1, 1, 1, 1}}); }).dump()}},
+       {"build", grid_file, "-o", "out.json"}, 3, R"(/weights: shape 2x5 differs from /points, 4x5)", errc::size_mismatch},
+      {"ApproximateNegativeWeight",
+       {{grid_file, with(approximate_spec(), [](json& s) {
+           s["weights"] = json::array();
+           for (int i = 0; i < 4; ++i) s["weights"].push_back({1, 1, 1, 1, 1});
+           s["weights"][2][3] = -0.5;
+         }).dump()}},
+       {"build", grid_file, "-o", "out.json"}, 3, R"(/weights/2/3: weight -0\.5 is negative)", errc::invalid_weight},
+      {"ApproximateNanWeight",
+       {{grid_file, "{\"type\": \"approximate\", \"tolerance\": 0.1,\n \"points\": [[[0,0,0],[1,0,0]],[[0,1,0],[1,1,1]]],\n"
+                    " \"weights\": [[1, 1], [NaN, 1]]}"}},
+       {"info", grid_file}, 3, R"(s\.json:3:23: NaN is not a JSON number)", errc::not_finite},
+      {"ApproximateInfinityInNpy", {{grid_file, R"({"type": "approximate", "tolerance": 0.1, "points": {"npy": "grid.npy"}})"},
+                                    {"grid.npy", npy_bytes("<f8", "(2, 2, 3)", f8({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, INFINITY}))}},
+       {"build", grid_file, "-o", "out.json"}, 3, R"(/points/1/1/2: coordinate z is inf \(in grid\.npy\))", errc::not_finite},
+      {"InterpolateNanSaysApproximateTakesIt", {{grid_file, npy_spec}, {"grid.npy", npy_grid(true)}}, {"info", grid_file}, 3,
+       R"(/points/1/2/0: coordinate x is nan \(in grid\.npy\) \(interpolation needs every point; "type": "approximate" takes missing points)",
+       errc::not_finite},
       // a data file in place of the spec
       {"CsvWithoutShape", {{"grid.csv", "0,0,0\n1,0,0\n0,1,0\n1,1,1\n"}}, {"eval", "grid.csv", "--grid", "3", "-o", "out.npy"}, 2,
        R"('grid\.csv' is a CSV file of points: give the shape of its grid, --shape NxM \(a surface\) or --shape NxMxL)"},

@@ -4,6 +4,7 @@
 /// constructions and their evaluation (library interpatch::core; no JSON, no files).
 
 #include "interpatch/allocator.hpp"
+#include "interpatch/approximate.hpp"
 #include "interpatch/blend.hpp"
 #include "interpatch/blended_surface.hpp"
 #include "interpatch/blended_volume.hpp"

@@ -13,8 +13,13 @@ Errors raise interpatch.Error (a ValueError) whose .code names the problem
 ("zero_chord", "network_gap", ...) with the command line's message.
 """
 
+<<<<<<< HEAD
 from ._core import ERROR_CODES, Construction, Error, Surface, Volume
 from ._specs import (Curve, bilinear, bspline_curve, build, coons, coons_volume, curve_network, hermite_curve,
+=======
+from ._core import Construction, Error, Surface, Volume
+from ._specs import (Curve, approximate_curve, approximate_surface, approximate_volume, bilinear, bspline_curve, build, coons, coons_volume, curve_network, hermite_curve,
+>>>>>>> approx
                      hermite_patch, hermite_volume, interpolate_curve, interpolate_surface, interpolate_volume, line,
                      ruled, trilinear)
 
@@ -22,4 +27,5 @@ __version__ = "@PROJECT_VERSION@"
 __all__ = ["Error", "ERROR_CODES", "Construction", "Surface", "Volume", "Curve", "build", "interpolate_surface", "bilinear", "ruled", "coons",
            "curve_network", "hermite_patch", "interpolate_volume", "trilinear", "coons_volume", "hermite_volume",
            "interpolate_curve", "bspline_curve", "hermite_curve", "line",
+           "approximate_surface", "approximate_volume", "approximate_curve",
            "__version__"]

@@ -72,6 +72,21 @@ def interpolate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int],
 def interpolate_volume(points: npt.ArrayLike, degree: Union[int, Sequence[int], None] = None,
                        param: Optional[str] = None, periodic: Optional[Sequence[bool]] = None) -> Volume:
     """Through a grid of points, shape (n, m, l, 3)."""
+def approximate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int], None] = None,
+                        param: Optional[str] = None, periodic: Optional[Sequence[bool]] = None,
+                        control_points: Union[int, Sequence[int], None] = None, tolerance: Optional[float] = None,
+                        smoothing: Union[float, str, None] = None, weights: Optional[npt.ArrayLike] = None) -> Surface:
+    """Near a grid of points, shape (n, m, 3), NaN marking missing points; exactly one of
+    control_points, tolerance, smoothing (a number or "auto")."""
+def approximate_volume(points: npt.ArrayLike, degree: Union[int, Sequence[int], None] = None,
+                       param: Optional[str] = None, periodic: Optional[Sequence[bool]] = None,
+                       control_points: Union[int, Sequence[int], None] = None, tolerance: Optional[float] = None,
+                       smoothing: Union[float, str, None] = None, weights: Optional[npt.ArrayLike] = None) -> Volume:
+    """Near a grid of points, shape (n, m, l, 3), NaN marking missing points."""
+def approximate_curve(points: npt.ArrayLike, degree: Optional[int] = None, param: Optional[str] = None,
+                      periodic: bool = False, control_points: Optional[int] = None, tolerance: Optional[float] = None,
+                      smoothing: Union[float, str, None] = None, weights: Optional[npt.ArrayLike] = None) -> Curve:
+    """A curve near points, shape (n, 3), for the constructions that take curves."""
 def bilinear(p00: npt.ArrayLike, p01: npt.ArrayLike, p10: npt.ArrayLike, p11: npt.ArrayLike) -> Surface: ...
 def ruled(c0: _CurveLike, c1: _CurveLike) -> Surface: ...
 def coons(v0: _CurveLike, v1: _CurveLike, u0: _CurveLike, u1: _CurveLike, blending: Optional[str] = None,

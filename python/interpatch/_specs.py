@@ -137,6 +137,72 @@ def interpolate_surface(points: Any, degree: Any = None, param: Optional[str] = 
     return _build(spec, ".", a.table)
 
 
+def _approximation(spec: dict[str, Any], control_points: Any, tolerance: Optional[float], smoothing: Any,
+                   weights: Any) -> dict[str, Any]:
+    spec = _options(spec, control_points=control_points, tolerance=tolerance, smoothing=smoothing)
+    if weights is not None:
+        spec["weights"] = np.asarray(weights, dtype=np.float64).tolist()
+    return spec
+
+
+def approximate_surface(points: Any, degree: Any = None, param: Optional[str] = None, periodic: Any = None,
+                        control_points: Any = None, tolerance: Optional[float] = None, smoothing: Any = None,
+                        weights: Any = None):
+    """A B-spline surface near a grid of points, shape (n, m, 3), any float dtype and
+    memory order; NaN in a point marks it missing (the fairness term fills the hole).
+    Exactly one of `control_points` ((nu, nv): least squares with that net),
+    `tolerance` (the fewest control points keeping every point within that distance)
+    and `smoothing` (the fairness weight, or "auto" for generalized cross-validation);
+    optional `weights`, shape (n, m), non-negative. `degree`, `param` and `periodic` as
+    for interpolate_surface. info()["parameters"] reports max_error (and max_error_at),
+    rms_error, control_points, lambda and missing_points.
+
+    Example::
+
+        grid = terrain + np.random.default_rng(1).normal(0, 0.01, terrain.shape)
+        grid[40:60, 30:50] = np.nan                       # a void
+        s = interpatch.approximate_surface(grid, tolerance=0.03)
+        s.info()["parameters"]["max_error"]               # <= 0.03"""
+    a = _Arrays()
+    spec = _options({"type": "approximate", "points": a.add(points)}, degree=degree, param=param, periodic=periodic)
+    return _build(_approximation(spec, control_points, tolerance, smoothing, weights), ".", a.table)
+
+
+def approximate_volume(points: Any, degree: Any = None, param: Optional[str] = None, periodic: Any = None,
+                       control_points: Any = None, tolerance: Optional[float] = None, smoothing: Any = None,
+                       weights: Any = None):
+    """A B-spline volume near a grid of points, shape (n, m, l, 3), NaN marking missing
+    points; the options of approximate_surface, one per direction u, v, w.
+
+    Example::
+
+        v = interpatch.approximate_volume(grid, control_points=(6, 6, 6))"""
+    a = _Arrays()
+    spec = _options({"type": "approximate_volume", "points": a.add(points)}, degree=degree, param=param,
+                    periodic=periodic)
+    return _build(_approximation(spec, control_points, tolerance, smoothing, weights), ".", a.table)
+
+
+def approximate_curve(points: Any, degree: Optional[int] = None, param: Optional[str] = None, periodic: bool = False,
+                      control_points: Optional[int] = None, tolerance: Optional[float] = None, smoothing: Any = None,
+                      weights: Any = None) -> Curve:
+    """A curve near points, shape (n, 3), NaN marking missing ones: exactly one of
+    `control_points`, `tolerance`, `smoothing` as for approximate_surface.
+
+    Example::
+
+        c = interpatch.approximate_curve(noisy_points, tolerance=0.01)
+        s = interpatch.ruled(c, other)"""
+
+    def make(arrays: _Arrays) -> dict[str, Any]:
+        s: dict[str, Any] = _options({"approximate": arrays.add(points)}, degree=degree, param=param)
+        if periodic:
+            s["periodic"] = True
+        return _approximation(s, control_points, tolerance, smoothing, weights)
+
+    return Curve(make)
+
+
 def bilinear(p00: Any, p01: Any, p10: Any, p11: Any):
     """The bilinear patch of four corners: S(0,0) = p00, S(0,1) = p01, S(1,0) = p10, S(1,1) = p11."""
     return _build({"type": "bilinear", "p00": _point(p00), "p01": _point(p01), "p10": _point(p10),

@@ -138,7 +138,8 @@ void append_number(std::string& out, double v) {
 
 /// The points in `in`, of `size` bytes when known (0 otherwise); `name` names it in
 /// messages. What read_csv_points and parse_csv_points share.
-std::vector<Vec3> read_csv_stream(std::istream& in, std::uintmax_t size, const std::string& name, std::size_t expected) {
+std::vector<Vec3> read_csv_stream(std::istream& in, std::uintmax_t size, const std::string& name, std::size_t expected,
+                                  bool allow_nan) {
   LineReader reader(in, name, size);
 
   std::vector<Vec3> points;
@@ -184,7 +185,7 @@ std::vector<Vec3> read_csv_stream(std::istream& in, std::uintmax_t size, const s
       if (st[k] == parse_status::overflow) {
         detail::fail(errc::not_finite, where, ": '", excerpt(fields[k]), "' overflows a double");
       }
-      if (!std::isfinite(v[k])) detail::fail(errc::not_finite, where, ": '", excerpt(fields[k]), "' is not finite");
+      if (!std::isfinite(v[k]) && !(allow_nan && std::isnan(v[k]))) detail::fail(errc::not_finite, where, ": '", excerpt(fields[k]), "' is not finite");
     }
     if (nfields != 3) {
       detail::fail(errc::malformed_file, name, ":", row, ":", std::min<std::size_t>(nfields, 3) + 1, ": ", nfields,
@@ -202,16 +203,16 @@ std::vector<Vec3> read_csv_stream(std::istream& in, std::uintmax_t size, const s
 
 }  // namespace
 
-std::vector<Vec3> read_csv_points(const fs::path& path, std::size_t expected) {
+std::vector<Vec3> read_csv_points(const fs::path& path, std::size_t expected, bool allow_nan) {
   std::ifstream in = detail::open_input(path);
   std::error_code ec;
   const auto size = fs::file_size(path, ec);
-  return read_csv_stream(in, ec ? 0 : size, path.string(), expected);
+  return read_csv_stream(in, ec ? 0 : size, path.string(), expected, allow_nan);
 }
 
-std::vector<Vec3> parse_csv_points(std::string_view text, std::size_t expected, std::string_view name) {
+std::vector<Vec3> parse_csv_points(std::string_view text, std::size_t expected, std::string_view name, bool allow_nan) {
   detail::MemoryStream in(text);
-  return read_csv_stream(in, text.size(), std::string(name), expected);
+  return read_csv_stream(in, text.size(), std::string(name), expected, allow_nan);
 }
 
 void write_csv_grid(const fs::path& path, std::span<const std::vector<double>> params,

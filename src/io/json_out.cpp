@@ -161,6 +161,7 @@ void surface_data_error(const Surface& s, const DataSet& d, DataError& e, std::s
     for (std::size_t i = 0; i < nb; ++i)
       for (std::size_t j = 0; j < nv; ++j) {
         const double dist = distance(p(i, j), d.points[(i0 + i) * nv + j]);
+        if (std::isnan(dist)) continue;  // a missing point (approximation's data)
         if (dist > e.absolute || e.pointer.empty()) {
           e.absolute = dist;
           e.pointer = cat(d.pointer, "/", i0 + i, "/", j);
@@ -192,6 +193,7 @@ void volume_data_error(const Volume& s, const DataSet& d, DataError& e, std::siz
       for (std::size_t j = 0; j < nv; ++j)
         for (std::size_t k = 0; k < nw; ++k) {
           const double dist = distance(p(i, j, k), d.points[((i0 + i) * nv + j) * nw + k]);
+          if (std::isnan(dist)) continue;  // a missing point (approximation's data)
           if (dist > e.absolute || e.pointer.empty()) {
             e.absolute = dist;
             e.pointer = cat(d.pointer, "/", i0 + i, "/", j, "/", k);

@@ -379,3 +379,63 @@ def test_the_readmes_python_example_runs(tmp_path, monkeypatch):
     assert scope["pts"].shape == (200, 150, 3)
     assert scope["b"]["control_points"].shape == (30, 25, 3)  # what the README says
     assert (tmp_path / "terrain.png").stat().st_size > 0 and (tmp_path / "terrain.step").stat().st_size > 0
+
+
+def test_approximate_surface_fills_holes_and_reports(tmp_path):
+    rng = np.random.default_rng(3)
+    noisy = terrain(40, 30)
+    noisy[..., 2] += rng.uniform(-0.01, 0.01, noisy.shape[:2])
+    noisy[10:16, 8:14, 2] = np.nan  # a 6 x 6 void
+    s = interpatch.approximate_surface(noisy, tolerance=0.03)
+    p = s.info()["parameters"]
+    assert p["missing_points"] == 36
+    assert p["max_error"] <= 0.03
+    assert p["control_points"][0] * p["control_points"][1] < 40 * 30 / 4
+    # The error reported is the one at the data, checked here on its own.
+    u, v = np.asarray(s.params_u), np.asarray(s.params_v)
+    at = s.evaluate(u, v)
+    err = np.linalg.norm(at - noisy, axis=-1)
+    assert abs(np.nanmax(err) - p["max_error"]) < 1e-12
+    # The same spec from a file (NaN in the .npy) gives the same surface.
+    np.save(tmp_path / "noisy.npy", noisy)
+    f = interpatch.build({"type": "approximate", "points": {"npy": "noisy.npy"}, "tolerance": 0.03}, str(tmp_path))
+    us, vs = np.linspace(0, 1, 11), np.linspace(0, 1, 9)
+    assert np.array_equal(f.evaluate(us, vs), s.evaluate(us, vs))
+    # The hole is filled within the range of the heights around it (give or take 5%).
+    ring = noisy[8:18, 6:16, 2]
+    lo, hi = np.nanmin(ring), np.nanmax(ring)
+    inside = s.evaluate(np.linspace(u[10], u[15], 9), np.linspace(v[8], v[13], 9))[..., 2]
+    assert inside.min() >= lo - 0.05 * (hi - lo) and inside.max() <= hi + 0.05 * (hi - lo)
+
+
+def test_approximate_options_and_errors():
+    grid = terrain(20, 16)
+    a = interpatch.approximate_surface(grid, control_points=(8, 6), param="uniform")
+    assert a.to_bspline()["control_points"].shape == (8, 6, 3)
+    w = np.ones(grid.shape[:2])
+    w[3, 4] = 1e6
+    b = interpatch.approximate_surface(grid, control_points=(8, 6), param="uniform", weights=w)
+    assert not np.array_equal(a.to_bspline()["control_points"], b.to_bspline()["control_points"])
+    c = interpatch.approximate_surface(grid, smoothing="auto")
+    assert c.info()["parameters"]["lambda"] > 0
+    vol = np.stack(np.meshgrid(np.arange(5.0), np.arange(6.0), np.arange(4.0), indexing="ij"), axis=-1)
+    v = interpatch.approximate_volume(vol, control_points=(4, 4, 4))
+    assert v.to_bspline()["control_points"].shape == (4, 4, 4, 3)
+    curve = interpatch.approximate_curve(grid[:, 0], tolerance=0.05)
+    r = interpatch.ruled(curve, interpatch.line([0, 3, 0], [4, 3, 0]))
+    assert np.allclose(r.point(0, 1), [0, 3, 0], atol=1e-12)
+    with pytest.raises(interpatch.Error) as e:
+        interpatch.approximate_surface(grid, tolerance=0)
+    assert e.value.code == "wrong_type" and "/tolerance" in str(e.value)
+    with pytest.raises(interpatch.Error) as e:
+        interpatch.approximate_surface(grid, tolerance=0.1, weights=np.ones((3, 3)))
+    assert e.value.code == "size_mismatch"
+    with pytest.raises(interpatch.Error) as e:
+        interpatch.approximate_surface(np.full((4, 4, 3), np.nan), tolerance=0.1)
+    assert e.value.code == "too_few_points"
+    # Interpolation refuses NaN and says where to go.
+    holed = grid.copy()
+    holed[2, 2, 0] = np.nan
+    with pytest.raises(interpatch.Error) as e:
+        interpatch.interpolate_surface(holed)
+    assert e.value.code == "not_finite" and "approximate" in str(e.value)

@@ -27,8 +27,10 @@ namespace interpatch::io {
 /// @throws error file_unreadable, malformed_file ("file:row:column: 'abc' is not a
 ///   number", "file:row:column: 2 fields found, 3 expected"), not_finite (NaN, Inf or
 ///   overflow, naming file:row:column), size_mismatch (point count differs from
-///   `expected`, when expected > 0; both counts named).
-[[nodiscard]] std::vector<Vec3> read_csv_points(const std::filesystem::path& path, std::size_t expected = 0);
+///   `expected`, when expected > 0; both counts named). With `allow_nan`, a NaN field
+///   (`nan`) is read as NaN, a missing coordinate (approximation takes missing points).
+[[nodiscard]] std::vector<Vec3> read_csv_points(const std::filesystem::path& path, std::size_t expected = 0,
+                                                bool allow_nan = false);
 
 /// The same as read_csv_points, from text already in memory (the file reader and
 /// this one are one code path). `name` stands for the file in messages.
@@ -39,7 +41,7 @@ namespace interpatch::io {
 /// @endcode
 /// @throws error malformed_file, not_finite, size_mismatch, as read_csv_points.
 [[nodiscard]] std::vector<Vec3> parse_csv_points(std::string_view text, std::size_t expected = 0,
-                                                 std::string_view name = "csv");
+                                                 std::string_view name = "csv", bool allow_nan = false);
 
 /// Writes an evaluation grid: a header `u,v,x,y,z` (one name per parameter axis,
 /// then x,y,z), then one row per point in C order (first axis outermost). `params`

@@ -122,19 +122,20 @@ BSplineCurve line_curve(const json& l, std::string_view ptr, Context& ctx) {
 }  // namespace
 
 BSplineCurve curve_impl(const json& j, std::string_view ptr, Context& ctx) {
-  static constexpr std::array<std::string_view, 4> forms{"interpolate", "bspline", "hermite", "line"};
+  static constexpr std::array<std::string_view, 5> forms{"interpolate", "bspline", "hermite", "line", "approximate"};
   constexpr std::string_view expected =
-      "a curve: an object with one of \"interpolate\", \"bspline\", \"hermite\", \"line\"";
+      "a curve: an object with one of \"interpolate\", \"bspline\", \"hermite\", \"line\", \"approximate\"";
   if (!j.is_object()) wrong_type(ptr, expected, j);
   std::vector<std::string_view> present;
   for (const auto f : forms)
     if (j.contains(std::string(f))) present.push_back(f);
   if (present.empty()) fail(errc::missing_field, place(ptr), ": expected ", expected);
   if (present.size() > 1)
-    fail(errc::wrong_type, place(ptr), ": a curve has exactly one of \"interpolate\", \"bspline\", \"hermite\", \"line\"; got \"",
+    fail(errc::wrong_type, place(ptr), ": a curve has exactly one of \"interpolate\", \"bspline\", \"hermite\", \"line\", \"approximate\"; got \"",
          present[0], "\" and \"", present[1], "\"");
   const std::string_view form = present[0];
   if (form == "interpolate") return interpolated_curve(j, ptr, ctx);
+  if (form == "approximate") return approximated_curve(j, ptr, ctx);
   check_fields(j, ptr, {form}, ctx);
   const json& body = j.at(std::string(form));
   const std::string bptr = child(ptr, form);

@@ -23,6 +23,9 @@ inline constexpr auto bspline_curve =
     std::to_array({"degree"sv, "knots"sv, "control_points"sv, "weights"sv, "periodic"sv});
 inline constexpr auto hermite_curve = std::to_array({"points"sv, "tangents"sv, "params"sv});
 inline constexpr auto line_curve = std::to_array({"line"sv});
+inline constexpr auto approximate_curve =
+    std::to_array({"approximate"sv, "degree"sv, "param"sv, "periodic"sv, "weights"sv, "control_points"sv, "tolerance"sv,
+                   "smoothing"sv});
 
 // Construction types: the top-level fields, "type" included.
 inline constexpr auto bilinear = std::to_array({"type"sv, "p00"sv, "p01"sv, "p10"sv, "p11"sv});
@@ -34,6 +37,9 @@ inline constexpr auto network =
                    "periodic"sv});
 inline constexpr auto interpolate = std::to_array({"type"sv, "points"sv, "degree"sv, "param"sv, "periodic"sv});
 inline constexpr auto hermite_patch = std::to_array({"type"sv, "corners"sv});
+// approximate and approximate_volume.
+inline constexpr auto approximate = std::to_array({"type"sv, "points"sv, "degree"sv, "param"sv, "periodic"sv, "weights"sv,
+                                                   "control_points"sv, "tolerance"sv, "smoothing"sv});
 // bspline_surface and bspline_volume: the form by its fields, or "npz", an archive
 // that holds them all (and excludes the others).
 inline constexpr auto bspline =

@@ -138,7 +138,7 @@ Construction bspline_from_npz(const json& spec, Context& ctx) {
 template <std::size_t D>
 Construction build_interpolate(const json& spec, Context& ctx) {
   using T = Tensor<D>;
-  PointArray pts = points_impl(member(spec, "points", "", cat("a grid of points, ", T::grid_form)), D, "/points", ctx);
+  PointArray pts = interpolation_points(member(spec, "points", "", cat("a grid of points, ", T::grid_form)), D, "/points", ctx);
   const auto degree = degrees(spec, "", D);
   const Parametrization param = parametrization(spec, "");
   const std::array<bool, 3> periodic = periodic_flags(spec, "", D);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "detail/parallel.hpp"
 #include "interpatch/io/csv.hpp"
@@ -67,7 +68,7 @@ std::vector<std::size_t> walk_grid(const json& j, std::size_t rank, std::size_t 
   walk(walk, j, 0);
   return shape;
 }
-PointArray inline_points(const json& j, std::size_t rank, std::string_view ptr) {
+PointArray inline_points(const json& j, std::size_t rank, std::string_view ptr, bool missing_allowed) {
   PointArray out;
   std::vector<std::size_t> idx;
   // Size the result from the first entries before walking; the walk checks the rest.
@@ -79,6 +80,7 @@ PointArray inline_points(const json& j, std::size_t rank, std::string_view ptr) 
     require_memory(n, sizeof(Vec3), cat(place(ptr), ": ", n, " points"));
     out.points.reserve(n);
   }
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   out.shape = walk_grid(j, rank, 1, true, ptr, idx, [&](const json& node) {
     if (!node.is_array()) fail(errc::wrong_type, place(index_pointer(ptr, idx, rank)), ": expected a point [x, y, z], got ", kind(node));
     if (node.size() != 3)
@@ -88,6 +90,10 @@ PointArray inline_points(const json& j, std::size_t rank, std::string_view ptr) 
     for (int k = 0; k < 3; ++k) {
       const json& c = node[static_cast<std::size_t>(k)];
       idx[rank] = static_cast<std::size_t>(k);
+      if (missing_allowed && c.is_null()) {  // a missing coordinate: the point is missing
+        p[k] = nan;
+        continue;
+      }
       if (!c.is_number())
         fail(errc::wrong_type, place(index_pointer(ptr, idx, rank + 1)), ": expected a number (coordinate ", coord_name(k),
              "), got ", kind(c));
@@ -113,8 +119,12 @@ std::string expected_shape(std::size_t rank) {
 // Refuses the first point with a NaN or Inf coordinate, naming it as a JSON Pointer
 // below `ptr` (`/points/3/7/2`) and the file it came from.
 void check_finite_points(const std::vector<std::size_t>& shape, const PointStorage& points, std::string_view ptr,
-                         const std::string& file) {
-  if (const std::size_t i = interpatch::detail::first_non_finite(points.data(), points.size()); i < points.size()) {
+                         const std::string& file, bool missing_allowed) {
+  std::size_t i = interpatch::detail::first_non_finite(points.data(), points.size());
+  if (missing_allowed)  // NaN marks a missing point; infinities are still refused
+    for (; i < points.size(); ++i)
+      if (std::isinf(points[i].x) || std::isinf(points[i].y) || std::isinf(points[i].z)) break;
+  if (i < points.size()) {
     const Vec3& p = points[i];
     std::vector<std::size_t> idx(shape.size() + 1);
     std::size_t r = i;
@@ -122,14 +132,15 @@ void check_finite_points(const std::vector<std::size_t>& shape, const PointStora
       idx[a] = r % shape[a];
       r /= shape[a];
     }
-    const int k = std::isfinite(p.x) ? (std::isfinite(p.y) ? 2 : 1) : 0;
+    auto bad = [&](double x) { return missing_allowed ? std::isinf(x) : !std::isfinite(x); };
+    const int k = !bad(p.x) ? (!bad(p.y) ? 2 : 1) : 0;
     idx[shape.size()] = static_cast<std::size_t>(k);
     fail(errc::not_finite, place(index_pointer(ptr, idx, idx.size())), ": coordinate ", coord_name(k), " is ", p[k], " (in ",
          file, ")");
   }
 }
 
-PointArray npy_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx) {
+PointArray npy_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx, bool missing_allowed) {
   check_fields(obj, ptr, forms::npy, ctx);
   const std::string file = file_name(obj, "npy", ptr);
   // The values land in the point storage itself: float64 triples in C order are
@@ -149,11 +160,11 @@ PointArray npy_points(const json& obj, std::size_t rank, std::string_view ptr, C
     });
   });
   out.shape.assign(full.begin(), full.end() - 1);
-  check_finite_points(out.shape, out.points, ptr, file);
+  check_finite_points(out.shape, out.points, ptr, file, missing_allowed);
   return out;
 }
 
-PointArray csv_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx) {
+PointArray csv_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx, bool missing_allowed) {
   check_fields(obj, ptr, forms::csv, ctx);
   const std::string file = file_name(obj, "csv", ptr);
   const std::string sptr = child(ptr, "shape");
@@ -172,18 +183,19 @@ PointArray csv_points(const json& obj, std::size_t rank, std::string_view ptr, C
          ", 3]");
   const std::size_t n = checked_product(shape, sptr);
   require_memory(n, sizeof(Vec3), cat(place(ptr), ": ", n, " points from ", file));
-  const std::vector<Vec3> pts = at(ptr, [&] { return read_csv_points(ctx.resolve(file), n); });
+  const std::vector<Vec3> pts = at(ptr, [&] { return read_csv_points(ctx.resolve(file), n, missing_allowed); });
   if (pts.size() != n)
     fail(errc::size_mismatch, place(ptr), ": ", file, " has ", pts.size(), " points, shape ", shape_text(shape), " needs ", n);
   for (std::size_t i = 0; i < n; ++i)
-    if (!is_finite(pts[i])) fail(errc::not_finite, place(ptr), ": ", file, " point ", i, " is ", pts[i]);
+    if (!is_finite(pts[i]) && !(missing_allowed && !std::isinf(pts[i].x) && !std::isinf(pts[i].y) && !std::isinf(pts[i].z)))
+      fail(errc::not_finite, place(ptr), ": ", file, " point ", i, " is ", pts[i]);
   return {shape, PointStorage(pts.begin(), pts.end())};
 }
 
 }  // namespace
 
 // {"array": NAME}: a point array the caller holds in memory (BuildOptions::arrays).
-PointArray memory_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx) {
+PointArray memory_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx, bool missing_allowed) {
   check_fields(obj, ptr, forms::array, ctx);
   const std::string aptr = child(ptr, "array");
   const json& name = obj.at("array");
@@ -198,23 +210,37 @@ PointArray memory_points(const json& obj, std::size_t rank, std::string_view ptr
          expected_shape(rank));
   for (std::size_t s : a.shape)
     if (s == 0) fail(errc::too_few_points, place(ptr), ": the array has shape ", shape_text(a.shape), ", no points");
-  check_finite_points(a.shape, a.points, ptr, "the array");
+  check_finite_points(a.shape, a.points, ptr, "the array", missing_allowed);
   // Named once and held by nobody else (BuildOptions::arrays): taken, not copied.
   const auto uses = ctx.array_uses.find(name.get<std::string>());
   if (given->use_count() == 1 && uses != ctx.array_uses.end() && uses->second == 1) return std::move(**given);
   return a;
 }
 
-PointArray points_impl(const json& j, std::size_t rank, std::string_view ptr, Context& ctx) {
-  if (j.is_object() && j.contains("array")) return memory_points(j, rank, ptr, ctx);
+PointArray points_impl(const json& j, std::size_t rank, std::string_view ptr, Context& ctx, bool missing_allowed) {
+  if (j.is_object() && j.contains("array")) return memory_points(j, rank, ptr, ctx, missing_allowed);
   if (j.is_object()) {
     const bool npy = j.contains("npy"), csv = j.contains("csv");
     if (npy && csv) fail(errc::wrong_type, place(ptr), ": give either \"npy\" or \"csv\", not both");
-    if (npy) return npy_points(j, rank, ptr, ctx);
-    if (csv) return csv_points(j, rank, ptr, ctx);
+    if (npy) return npy_points(j, rank, ptr, ctx, missing_allowed);
+    if (csv) return csv_points(j, rank, ptr, ctx, missing_allowed);
     fail(errc::missing_field, place(ptr), ": a point array given as an object needs \"npy\": file or \"csv\": file with \"shape\"");
   }
-  return inline_points(j, rank, ptr);
+  return inline_points(j, rank, ptr, missing_allowed);
+}
+
+PointArray interpolation_points(const json& j, std::size_t rank, std::string_view ptr, Context& ctx) {
+  try {
+    return points_impl(j, rank, ptr, ctx);
+  } catch (const error& e) {
+    const std::string_view m = e.what();
+    const bool nan = e.code() == errc::not_finite && (m.find(" is nan") != m.npos || m.find(" is -nan") != m.npos ||
+                                                      m.find("nan,") != m.npos || m.find("'nan'") != m.npos);
+    const bool null = e.code() == errc::wrong_type && m.ends_with("got null");
+    if (!nan && !null) throw;
+    throw error(e.code(), cat(m, " (interpolation needs every point; \"type\": \"approximate\" takes missing points, ",
+                              "NaN in a file or null in a list)"));
+  }
 }
 
 template <std::size_t Rank>

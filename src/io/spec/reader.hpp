@@ -141,7 +141,12 @@ std::string choice(const json& obj, std::string_view key, std::string_view ptr,
 // Point arrays (points.cpp) and curves (curves.cpp).
 
 /// A point array of the given rank in any of its forms (inline lists, npy, csv).
-PointArray points_impl(const json& j, std::size_t rank, std::string_view ptr, Context& ctx);
+/// With `missing_allowed` (approximation only), a missing point is NaN: null for a
+/// coordinate of an inline list, NaN in a file; infinities are refused still.
+PointArray points_impl(const json& j, std::size_t rank, std::string_view ptr, Context& ctx, bool missing_allowed = false);
+/// points_impl for interpolation's data: a missing point (NaN in a file, null in a
+/// list) is refused, and the message says that approximation takes missing points.
+PointArray interpolation_points(const json& j, std::size_t rank, std::string_view ptr, Context& ctx);
 /// A grid of numbers (weights) given as nested lists, Rank 2 or 3.
 template <std::size_t Rank>
 Grid<double, Rank> inline_number_grid(const json& j, std::string_view ptr);
@@ -174,6 +179,10 @@ template <std::size_t Dims>
 Construction build_interpolate(const json& spec, Context& ctx);
 template <std::size_t Dims>
 Construction build_bspline(const json& spec, Context& ctx);
+template <std::size_t Dims>
+Construction build_approximate(const json& spec, Context& ctx);
+/// {"approximate": points, ...} as a curve (approximate.cpp), mapped onto [0, 1].
+BSplineCurve approximated_curve(const json& obj, std::string_view ptr, Context& ctx);
 Construction build_trilinear(const json& spec, Context& ctx);
 Construction build_hermite_volume(const json& spec, Context& ctx);
 Construction build_coons_volume(const json& spec, Context& ctx);

@@ -36,11 +36,13 @@ constexpr ConstructionType construction_types[] = {
     {"interpolate", build_interpolate<2>, 2, forms::interpolate},
     {"hermite_patch", build_hermite_patch, 2, forms::hermite_patch},
     {"bspline_surface", build_bspline<2>, 2, forms::bspline},
+    {"approximate", build_approximate<2>, 2, forms::approximate},
     {"trilinear", build_trilinear, 3, forms::trilinear},
     {"coons_volume", build_coons_volume, 3, forms::coons_volume},
     {"hermite_volume", build_hermite_volume, 3, forms::hermite_volume},
     {"interpolate_volume", build_interpolate<3>, 3, forms::interpolate},
     {"bspline_volume", build_bspline<3>, 3, forms::bspline},
+    {"approximate_volume", build_approximate<3>, 3, forms::approximate},
 };
 
 // How many times the spec names each in-memory array ({"array": NAME}): an array
@@ -123,6 +125,7 @@ std::vector<SpecForm> spec_forms() {
   add("curve", "bspline", forms::bspline_curve);
   add("curve", "hermite", forms::hermite_curve);
   add("curve", "line", forms::line_curve);
+  add("curve", "approximate", forms::approximate_curve);
   add("points", "npy", forms::npy);
   add("points", "csv", forms::csv);
   return v;

@@ -1,0 +1,1334 @@
+#include "interpatch/approximate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <random>
+#include <variant>
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include "detail/banded.hpp"
+#include "detail/parallel.hpp"
+#include "detail/text.hpp"
+#include "interpatch/memory.hpp"
+
+namespace interpatch {
+
+using detail::fail;
+
+namespace {
+
+// ------------------------------------------------------------------ data
+//
+// Every array of points or control points is a C-order array of doubles whose last
+// axis holds the 3 coordinates; shapes count points, not doubles.
+
+template <std::size_t R>
+using Shape = std::array<std::size_t, R>;
+
+template <std::size_t R>
+std::size_t count_of(const Shape<R>& s) {
+  std::size_t n = 1;
+  for (auto e : s) n *= e;
+  return n;
+}
+
+constexpr const char* axis_name(std::size_t a) { return a == 0 ? "u" : (a == 1 ? "v" : "w"); }
+
+bool is_missing(const Vec3& q) { return std::isnan(q.x) || std::isnan(q.y) || std::isnan(q.z); }
+
+template <std::size_t R>
+std::string index_text(std::size_t flat, const Shape<R>& s) {
+  std::string at;
+  for (std::size_t a = R; a-- > 0; flat /= s[a]) at = detail::cat("[", flat % s[a], "]", at);
+  return at;
+}
+
+template <std::size_t R>
+std::vector<std::size_t> unflatten(std::size_t flat, const Shape<R>& s) {
+  std::vector<std::size_t> idx(R);
+  for (std::size_t a = R; a-- > 0; flat /= s[a]) idx[a] = flat % s[a];
+  return idx;
+}
+
+// The data as the fit sees it: points, each point's weight (0 where missing).
+template <std::size_t R>
+struct Data {
+  Shape<R> shape{};
+  Grid<Vec3, R> points;
+  std::vector<double> weight;  // empty: every point present with weight 1
+  std::size_t missing = 0;
+  std::size_t present = 0;  // points with a positive weight
+  double weight_sum = 0;
+  [[nodiscard]] bool uniform() const { return weight.empty(); }
+  [[nodiscard]] double w(std::size_t i) const { return weight.empty() ? 1.0 : weight[i]; }
+};
+
+// ------------------------------------------------------------------ one direction
+
+// A band of a symmetric matrix along one direction: entry (i, i + d) for |d| <= h,
+// the column taken modulo c in a closed direction.
+struct Band {
+  int c = 0, h = 0;
+  std::vector<double> v;  // c × (2h + 1)
+  Band() = default;
+  Band(int count, int half) : c(count), h(half), v(static_cast<std::size_t>(count) * static_cast<std::size_t>(2 * half + 1), 0.0) {}
+  double& at(int i, int d) { return v[static_cast<std::size_t>(i) * static_cast<std::size_t>(2 * h + 1) + static_cast<std::size_t>(d + h)]; }
+  [[nodiscard]] double at(int i, int d) const {
+    return v[static_cast<std::size_t>(i) * static_cast<std::size_t>(2 * h + 1) + static_cast<std::size_t>(d + h)];
+  }
+};
+
+struct Axis {
+  std::size_t n = 0;  // data points along it
+  int p = 1;
+  bool periodic = false;
+  std::vector<double> t;  // data parameters
+  KnotVector knots = KnotVector::bezier(1);
+  int c = 0;                 // control points
+  std::vector<int> first;    // per data point: its first basis function (unwrapped)
+  std::vector<double> b;     // per data point: p + 1 basis values
+  std::vector<int> interval; // per data point: the knot interval it lies in
+  int intervals = 0;
+
+  [[nodiscard]] std::size_t col(int i) const { return static_cast<std::size_t>(i >= c ? i - c : i); }
+
+  void set_knots(KnotVector k) {
+    knots = std::move(k);
+    c = knots.count();
+    const auto pp = static_cast<std::size_t>(p) + 1;
+    first.assign(n, 0);
+    b.assign(n * pp, 0.0);
+    interval.assign(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double x = knots.periodic() ? knots.wrap(t[i]) : std::clamp(t[i], knots.front(), knots.back());
+      const int span = knots.find_span(x);
+      knots.basis(span, x, &b[i * pp]);
+      first[i] = span - p;
+      interval[i] = span - p;
+    }
+    intervals = periodic ? c : c - p;
+  }
+
+  // The Gram matrix Σ_i B(t_i) B(t_i)ᵀ of the basis at the data parameters.
+  [[nodiscard]] Band gram(int h) const {
+    Band g(c, h);
+    const auto pp = static_cast<std::size_t>(p) + 1;
+    for (std::size_t i = 0; i < n; ++i)
+      for (int k = 0; k <= p; ++k)
+        for (int l = 0; l <= p; ++l)
+          g.at(static_cast<int>(col(first[i] + k)), l - k) += b[i * pp + static_cast<std::size_t>(k)] * b[i * pp + static_cast<std::size_t>(l)];
+    return g;
+  }
+
+  // Σ ω_i d_i d_iᵀ: d_i the second divided difference of the control polygon at
+  // Greville abscissa i, ω_i half the distance of its neighbours (∫ f''² in effect).
+  [[nodiscard]] Band fairness(int h) const {
+    Band r(c, h);
+    const auto& u = knots.values();
+    auto greville = [&](int i) {  // i may be -1 or c in a closed direction
+      const double period = knots.back() - knots.front();
+      const int j = i < 0 ? i + c : (i >= c ? i - c : i);
+      double s = 0;
+      for (int k = 1; k <= p; ++k) s += u[static_cast<std::size_t>(j + k)];
+      return s / p + (i < 0 ? -period : (i >= c ? period : 0.0));
+    };
+    const int lo = periodic ? 0 : 1, hi = periodic ? c : c - 1;
+    for (int i = lo; i < hi; ++i) {
+      const double g0 = greville(i - 1), g1 = greville(i), g2 = greville(i + 1);
+      const double h1 = g1 - g0, h2 = g2 - g1, span = g2 - g0;
+      if (!(h1 > 0 && h2 > 0)) continue;  // coincident abscissae: no curvature to measure there
+      const double alpha = 2.0 / span, omega = 0.5 * span;
+      const double d[3] = {alpha / h1, -alpha * (1.0 / h1 + 1.0 / h2), alpha / h2};
+      for (int k = 0; k < 3; ++k)
+        for (int l = 0; l < 3; ++l) {
+          const int row = i - 1 + k;
+          r.at(static_cast<int>(col(row < 0 ? row + c : row)), l - k) += omega * d[k] * d[l];
+        }
+    }
+    return r;
+  }
+};
+
+using AxisSolver = std::variant<detail::BandedLU, detail::CyclicLU>;
+
+// The factored Gram matrix of a direction (the least-squares system along it).
+AxisSolver factor_gram(const Axis& ax, std::size_t a) {
+  const Band g = ax.gram(ax.p);
+  auto singular = [&](int row) {
+    fail(errc::singular, "along ", axis_name(a), ": the least-squares system of ", ax.c, " control points over ", ax.n,
+         " data points has no unique solution (control point ", row, " has no data under it)");
+  };
+  if (ax.periodic) {
+    std::vector<std::vector<detail::CyclicLU::Entry>> rows(static_cast<std::size_t>(ax.c));
+    for (int i = 0; i < ax.c; ++i)
+      for (int d = -ax.p; d <= ax.p; ++d)
+        if (const double v = g.at(i, d); v != 0.0) rows[static_cast<std::size_t>(i)].push_back({((i + d) % ax.c + ax.c) % ax.c, v});
+    detail::CyclicLU lu(ax.c, rows);
+    if (!lu.factor()) singular(lu.failed_row());
+    return lu;
+  }
+  detail::BandedLU lu(ax.c, ax.p, ax.p);
+  for (int i = 0; i < ax.c; ++i)
+    for (int d = -ax.p; d <= ax.p; ++d)
+      if (i + d >= 0 && i + d < ax.c) lu.at(i, i + d) = g.at(i, d);
+  if (!lu.factor()) singular(lu.failed_row());
+  return lu;
+}
+
+// ------------------------------------------------------------------ tensor passes
+
+// Passes with fewer multiply-adds than this stay on the calling thread: a fit to a
+// tolerance makes a few dozen passes, the early ones over a thinned grid, and a
+// parallel region costs as much as a few hundred thousand multiply-adds (more when
+// the machine is shared and a thread waits for the other to be scheduled).
+constexpr std::size_t parallel_work = detail::parallel_min_work * 16;
+
+// Runs f(o, c0, c1) over blocks of `outer` slabs × columns [c0, c1) of `width`
+// doubles, in parallel when there is enough work. Every number is computed by the
+// same operations whatever the thread count.
+template <class F>
+void for_blocks(std::size_t outer, std::size_t width, std::size_t work, const F& f) {
+  constexpr std::size_t chunk = 2048;
+  const std::size_t per = outer >= 8 ? 1 : (width + chunk - 1) / chunk;
+  const auto tasks = static_cast<long long>(outer * per);
+#pragma omp parallel for schedule(static) if (work >= parallel_work)
+  for (long long k = 0; k < tasks; ++k) {
+    const auto task = static_cast<std::size_t>(k);
+    const std::size_t o = task / per, part = task % per;
+    const std::size_t c0 = per == 1 ? 0 : part * chunk, c1 = per == 1 ? width : std::min(width, c0 + chunk);
+    f(o, c0, c1);
+  }
+}
+
+// One pass of the basis matrix B (n × c) of direction a over an array: out = Bᵀ in
+// (Transpose: `in` has shape[a] = n, out gets c) or out = B in (c to n). Both walk
+// the data rows i and their p + 1 basis functions; whole slabs of the other axes
+// move at once.
+template <bool Transpose, std::size_t R>
+void basis_pass(const Axis& ax, const double* in, Shape<R>& shape, std::size_t a, std::vector<double>& out) {
+  std::size_t outer = 1, inner = 3;
+  for (std::size_t x = 0; x < a; ++x) outer *= shape[x];
+  for (std::size_t x = a + 1; x < R; ++x) inner *= shape[x];
+  const std::size_t n = ax.n, c = static_cast<std::size_t>(ax.c), pp = static_cast<std::size_t>(ax.p) + 1;
+  const std::size_t in_rows = Transpose ? n : c, out_rows = Transpose ? c : n;
+  if (Transpose) out.assign(outer * out_rows * inner, 0.0);
+  else out.resize(outer * out_rows * inner);
+  double* o_ = out.data();
+  for_blocks(outer, inner, outer * n * inner * pp, [&](std::size_t o, std::size_t c0, std::size_t c1) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!Transpose) std::fill(o_ + (o * n + i) * inner + c0, o_ + (o * n + i) * inner + c1, 0.0);
+      for (std::size_t k = 0; k < pp; ++k) {
+        const double w = ax.b[i * pp + k];
+        const std::size_t j = ax.col(ax.first[i] + static_cast<int>(k));
+        const double* src = in + (o * in_rows + (Transpose ? i : j)) * inner;
+        double* dst = o_ + (o * out_rows + (Transpose ? j : i)) * inner;
+        for (std::size_t x = c0; x < c1; ++x) dst[x] += w * src[x];
+      }
+    }
+  });
+  shape[a] = out_rows;
+}
+
+// Bᵀ (w Q) over every direction: the right-hand side of the normal equations.
+template <std::size_t R>
+std::vector<double> right_hand_side(const std::array<Axis, R>& axes, const Data<R>& d) {
+  Shape<R> shape = d.shape;
+  std::vector<double> a0, a1;
+  const double* src = &d.points.data()->x;
+  if (!d.uniform()) {
+    require_memory(d.points.size(), sizeof(Vec3), "the weighted data points");
+    a1.resize(d.points.size() * 3);
+    for (std::size_t i = 0; i < d.points.size(); ++i) {
+      const double w = d.weight[i];
+      for (std::size_t k = 0; k < 3; ++k) a1[i * 3 + k] = w > 0 ? w * d.points.data()[i][static_cast<int>(k)] : 0.0;
+    }
+    src = a1.data();
+  }
+  // The first direction first: its rows are whole rows of the grid (long, contiguous
+  // runs the multiply-adds stream through), and it shrinks the grid for the others.
+  for (std::size_t a = 0; a < R; ++a) {
+    basis_pass<true, R>(axes[a], src, shape, a, a0);
+    std::swap(a0, a1);
+    src = a1.data();
+  }
+  return a1;
+}
+
+// ------------------------------------------------------------------ solvers
+
+// The separable least-squares fit: every point present with weight 1, no fairness
+// term. The normal equations are the Kronecker product of the directions' Gram
+// matrices, solved direction by direction.
+template <std::size_t R>
+std::vector<double> separable_fit(const std::array<Axis, R>& axes, const Data<R>& d) {
+  std::vector<double> x = right_hand_side<R>(axes, d);
+  Shape<R> shape{};
+  for (std::size_t a = 0; a < R; ++a) shape[a] = static_cast<std::size_t>(axes[a].c);
+  for (std::size_t a = 0; a < R; ++a) {
+    const AxisSolver lu = factor_gram(axes[a], a);
+    std::visit([&](const auto& s) { detail::solve_along_axis(s, x.data(), shape.data(), R, a, 3); }, lu);
+  }
+  return x;
+}
+
+// The normal equations of the control points as a sparse symmetric matrix: entries
+// of control point k with its neighbours k + δ, |δ_a| <= h_a, gathered in a stencil
+// per control point and handed to the sparse Cholesky decomposition.
+template <std::size_t R>
+struct Stencil {
+  Shape<R> c{}, half{}, stride{};  // stride of an offset code per direction
+  std::size_t size = 1, count = 1;
+  std::vector<double> v;  // count × size
+
+  explicit Stencil(const std::array<Axis, R>& axes) {
+    for (std::size_t a = R; a-- > 0;) {
+      c[a] = static_cast<std::size_t>(axes[a].c);
+      half[a] = static_cast<std::size_t>(std::max(axes[a].p, 2));
+      stride[a] = size;
+      size *= 2 * half[a] + 1;
+      count *= c[a];
+    }
+    require_memory(count * size, sizeof(double), "the normal equations of the control points");
+    v.assign(count * size, 0.0);
+  }
+
+  // Kronecker product of one band per direction, scaled, added in.
+  void add_kronecker(const std::array<const Band*, R>& bands, double scale) {
+    for (std::size_t k = 0; k < count; ++k) {
+      const std::vector<std::size_t> idx = unflatten<R>(k, c);
+      for (std::size_t code = 0; code < size; ++code) {
+        double prod = scale;
+        for (std::size_t a = 0; a < R && prod != 0.0; ++a) {
+          const int d = static_cast<int>((code / stride[a]) % (2 * half[a] + 1)) - static_cast<int>(half[a]);
+          prod = std::abs(d) <= bands[a]->h ? prod * bands[a]->at(static_cast<int>(idx[a]), d) : 0.0;
+        }
+        v[k * size + code] += prod;
+      }
+    }
+  }
+
+  Eigen::SparseMatrix<double> lower(const std::array<Axis, R>& axes) const {
+    std::vector<Eigen::Triplet<double>> trip;
+    trip.reserve(count * (size / 2 + 1));
+    for (std::size_t k = 0; k < count; ++k) {
+      const std::vector<std::size_t> idx = unflatten<R>(k, c);
+      for (std::size_t code = 0; code < size; ++code) {
+        const double val = v[k * size + code];
+        if (val == 0.0) continue;
+        std::size_t col = 0;
+        bool inside = true;
+        for (std::size_t a = 0; a < R; ++a) {
+          const long long d = static_cast<long long>((code / stride[a]) % (2 * half[a] + 1)) - static_cast<long long>(half[a]);
+          long long j = static_cast<long long>(idx[a]) + d;
+          const auto ca = static_cast<long long>(c[a]);
+          if (axes[a].periodic) j = ((j % ca) + ca) % ca;
+          else if (j < 0 || j >= ca) inside = false;
+          col = col * c[a] + static_cast<std::size_t>(std::max(j, 0LL));
+        }
+        if (inside && col <= k) trip.emplace_back(static_cast<int>(k), static_cast<int>(col), val);
+      }
+    }
+    Eigen::SparseMatrix<double> m(static_cast<Eigen::Index>(count), static_cast<Eigen::Index>(count));
+    m.setFromTriplets(trip.begin(), trip.end());
+    return m;
+  }
+};
+
+// Σ_i w_i B(t_i) B(t_i)ᵀ over the points, the tensor basis of each point expanded.
+template <std::size_t R>
+void add_weighted_data(Stencil<R>& st, const std::array<Axis, R>& axes, const Data<R>& d) {
+  std::array<std::size_t, R> pp{};
+  std::size_t support = 1;
+  for (std::size_t a = 0; a < R; ++a) {
+    pp[a] = static_cast<std::size_t>(axes[a].p) + 1;
+    support *= pp[a];
+  }
+  std::vector<double> val(support);
+  std::vector<std::size_t> row(support), code(support);
+  for (std::size_t i = 0; i < d.points.size(); ++i) {
+    const double w = d.w(i);
+    if (!(w > 0)) continue;
+    const std::vector<std::size_t> idx = unflatten<R>(i, d.shape);
+    for (std::size_t s = 0; s < support; ++s) {
+      double v = w;
+      std::size_t r = 0, cd = 0;
+      for (std::size_t a = 0, rest = s; a < R; ++a) {
+        const std::size_t div = support / [&] {
+          std::size_t q = 1;
+          for (std::size_t x = 0; x <= a; ++x) q *= pp[x];
+          return q;
+        }();
+        const std::size_t k = (rest / div) % pp[a];
+        const Axis& ax = axes[a];
+        v *= ax.b[idx[a] * pp[a] + k];
+        r = r * st.c[a] + ax.col(ax.first[idx[a]] + static_cast<int>(k));
+        cd += k * st.stride[a];
+      }
+      val[s] = v;
+      row[s] = r;
+      code[s] = cd;
+    }
+    std::size_t centre = 0;
+    for (std::size_t a = 0; a < R; ++a) centre += st.half[a] * st.stride[a];
+    for (std::size_t s = 0; s < support; ++s) {
+      if (val[s] == 0.0) continue;
+      double* dst = st.v.data() + row[s] * st.size + centre - code[s];
+      for (std::size_t t = 0; t < support; ++t) dst[code[t]] += val[s] * val[t] / w;
+    }
+  }
+}
+
+// The sparse normal equations G + λ s K: G the data term, K the fairness term
+// (Σ_a n_a R_a ⊗ the Gram matrices of the other directions), s = Σw / N.
+template <std::size_t R>
+struct SparseSystem {
+  Eigen::SparseMatrix<double> data, fairness;
+  double scale = 0;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+  bool analyzed = false;
+
+  SparseSystem(const std::array<Axis, R>& axes, const Data<R>& d) {
+    std::array<Band, R> gram, fair;
+    for (std::size_t a = 0; a < R; ++a) {
+      gram[a] = axes[a].gram(axes[a].p);
+      fair[a] = axes[a].fairness(2);
+    }
+    {
+      Stencil<R> st(axes);
+      if (d.uniform()) {
+        std::array<const Band*, R> bands{};
+        for (std::size_t a = 0; a < R; ++a) bands[a] = &gram[a];
+        st.add_kronecker(bands, 1.0);
+      } else {
+        add_weighted_data<R>(st, axes, d);
+      }
+      data = st.lower(axes);
+    }
+    Stencil<R> k(axes);
+    for (std::size_t a = 0; a < R; ++a) {
+      std::array<const Band*, R> bands{};
+      for (std::size_t b = 0; b < R; ++b) bands[b] = b == a ? &fair[b] : &gram[b];
+      k.add_kronecker(bands, static_cast<double>(axes[a].n));
+    }
+    fairness = k.lower(axes);
+    scale = d.weight_sum / static_cast<double>(count_of<R>(d.shape));
+  }
+
+  void factor(double lambda) {
+    Eigen::SparseMatrix<double> m = data;
+    if (lambda > 0) m += (lambda * scale) * fairness;
+    if (!analyzed) {
+      ldlt.analyzePattern(m);
+      analyzed = true;
+    }
+    ldlt.factorize(m);
+    bool ok = ldlt.info() == Eigen::Success;
+    // A positive definite matrix has positive pivots; one at or below 1e-14 of the
+    // largest (rounding) means no unique solution.
+    const double largest = ok ? ldlt.vectorD().cwiseAbs().maxCoeff() : 0.0;
+    for (Eigen::Index i = 0; i < ldlt.vectorD().size() && ok; ++i) ok = ldlt.vectorD()[i] > 1e-14 * largest;
+    if (!ok)
+      fail(errc::singular, "the least-squares system of ", m.rows(),
+           " control points has no unique solution: some control points have no data under them and no fairness "
+           "term to fix them");
+  }
+
+  // The ratio of the data term's diagonal to the fairness term's: what makes λ s K
+  // a given fraction of the data term.
+  [[nodiscard]] double diagonal_ratio() const {
+    const double k = fairness.diagonal().sum() * scale;
+    return k > 0 ? data.diagonal().sum() / k : 0.0;
+  }
+
+  std::vector<double> solve(const std::vector<double>& rhs) const {
+    const auto n = data.rows();
+    Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> b(rhs.data(), n, 3);
+    Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> x = ldlt.solve(Eigen::MatrixXd(b));
+    return {x.data(), x.data() + x.size()};
+  }
+
+  // tr(M⁻¹ λ s K) = C − tr(M⁻¹ G), M = G + λ s K: the control points minus the
+  // degrees of freedom of the fit, by Hutchinson's estimator, the mean of
+  // zᵀ M⁻¹ λ s K z over random ±1 vectors z (a fixed seed: the same value on every
+  // run). Estimating this part rather than tr(M⁻¹ G) keeps the estimate's error
+  // (of the order of its Frobenius norm) small where it is small: near
+  // interpolation, where n − tr H is the small difference that decides the score.
+  [[nodiscard]] double fairness_trace(double lambda, int probes) const {
+    const auto n = data.rows();
+    std::mt19937_64 rng(20261124);
+    double sum = 0;
+    for (int k = 0; k < probes; ++k) {
+      Eigen::VectorXd z(n);
+      for (Eigen::Index i = 0; i < n; ++i) z[i] = (rng() & 1) != 0 ? 1.0 : -1.0;
+      const Eigen::VectorXd kz = fairness.selfadjointView<Eigen::Lower>() * z;
+      sum += z.dot(ldlt.solve(kz));
+    }
+    return lambda * scale * sum / probes;
+  }
+};
+
+// ------------------------------------------------------------------ parameters and knots
+
+// Parameters along axis a, averaged over the lines of the grid: the mean chord of
+// each step over the lines where both its points are present (a step with none
+// takes the mean of the others). Without missing points along an open direction,
+// interpolation's own parameters.
+template <std::size_t R>
+std::vector<double> axis_parameters(const Data<R>& d, std::size_t a, Parametrization param, bool closed) {
+  const std::size_t n = d.shape[a];
+  const std::size_t steps = closed ? n : n - 1;
+  std::vector<double> t(closed ? n : n, 0.0);
+  if (param == Parametrization::uniform) {
+    for (std::size_t i = 0; i < n; ++i) t[i] = static_cast<double>(i) / static_cast<double>(steps);
+    if (!closed) t.back() = 1.0;
+    return t;
+  }
+  if (!closed && d.missing == 0) {
+    if constexpr (R == 1) return curve_parameters(std::span<const Vec3>(d.points.data(), n), param);
+    else return grid_parameters(d.points, static_cast<int>(a), param);
+  }
+  std::size_t outer = 1, inner = 1;
+  for (std::size_t x = 0; x < a; ++x) outer *= d.shape[x];
+  for (std::size_t x = a + 1; x < R; ++x) inner *= d.shape[x];
+  std::vector<double> sum(steps, 0.0);
+  std::vector<std::size_t> used(steps, 0);
+  for (std::size_t o = 0; o < outer; ++o)
+    for (std::size_t in = 0; in < inner; ++in)
+      for (std::size_t k = 1; k <= steps; ++k) {
+        const Vec3& p0 = d.points.data()[(o * n + k - 1) * inner + in];
+        const Vec3& p1 = d.points.data()[(o * n + k % n) * inner + in];
+        if (is_missing(p0) || is_missing(p1)) continue;
+        sum[k - 1] += distance(p0, p1);
+        ++used[k - 1];
+      }
+  double known = 0;
+  std::size_t known_count = 0;
+  for (std::size_t k = 0; k < steps; ++k)
+    if (used[k] > 0) {
+      sum[k] /= static_cast<double>(used[k]);
+      known += sum[k];
+      ++known_count;
+    }
+  if (known_count == 0) return axis_parameters(d, a, Parametrization::uniform, closed);
+  for (std::size_t k = 0; k < steps; ++k) {
+    if (used[k] == 0) sum[k] = known / static_cast<double>(known_count);
+    // Means below 1e-14 of the total are rounding noise: the points coincide in every line.
+    if (!(sum[k] > 1e-14 * known))
+      fail(errc::zero_chord, "along ", axis_name(a), ": points ", k, " and ", (k + 1) % n,
+           " coincide in every line (mean chord ", sum[k], "): parameters must increase");
+    if (param == Parametrization::centripetal) sum[k] = std::sqrt(sum[k]);
+  }
+  double total = 0;
+  for (std::size_t k = 0; k < steps; ++k) total += sum[k];
+  for (std::size_t k = 1; k < n; ++k) t[k] = t[k - 1] + sum[k - 1];
+  for (std::size_t k = 1; k < n; ++k) t[k] /= total;
+  if (!closed) t.back() = 1.0;
+  return t;
+}
+
+// Knots of a clamped spline with the given interior knots over [t.front(), t.back()].
+KnotVector clamped_knots(const Axis& ax, const std::vector<double>& interior) {
+  std::vector<double> u(static_cast<std::size_t>(ax.p) + 1, ax.t.front());
+  u.insert(u.end(), interior.begin(), interior.end());
+  u.insert(u.end(), static_cast<std::size_t>(ax.p) + 1, ax.t.back());
+  return KnotVector(ax.p, std::move(u));
+}
+
+// The interior knots (open) or the period's knots (closed) of `c` control points
+// for least squares over the data parameters: each knot interval holds data (The
+// NURBS Book eq. 9.69 for an open direction; evenly spaced in the data's order for
+// a closed one, shifted by half a step for an even degree). With as many control
+// points as data, interpolation's knots.
+std::vector<double> least_squares_breaks(const Axis& ax, int c) {
+  const auto& t = ax.t;
+  const auto n = static_cast<double>(ax.n);
+  std::vector<double> k;
+  if (ax.periodic) {
+    auto at = [&](double x) {  // the data parameters extended periodically, linear between
+      const double f = std::floor(x);
+      const auto i = static_cast<long long>(f);
+      auto tt = [&](long long j) {
+        const auto m = static_cast<long long>(ax.n);
+        const long long q = (j % m + m) % m;
+        return t[static_cast<std::size_t>(q)] + static_cast<double>((j - q) / m);
+      };
+      return tt(i) + (x - f) * (tt(i + 1) - tt(i));
+    };
+    const double shift = ax.p % 2 == 0 ? 0.5 : 0.0;
+    for (int j = 0; j < c; ++j) k.push_back(at(j * n / c + shift));
+    return k;
+  }
+  if (static_cast<std::size_t>(c) == ax.n) {
+    const KnotVector avg = averaged_knots(t, ax.p);
+    const auto& u = avg.values();
+    return {u.begin() + ax.p + 1, u.end() - ax.p - 1};
+  }
+  const double step = n / (c - ax.p);
+  for (int j = 1; j < c - ax.p; ++j) {
+    const double x = j * step;
+    const auto i = static_cast<std::size_t>(std::floor(x));
+    const double alpha = x - static_cast<double>(i);
+    k.push_back((1 - alpha) * t[i - 1] + alpha * t[std::min(i, ax.n - 1)]);
+  }
+  return k;
+}
+
+KnotVector knots_from_breaks(const Axis& ax, const std::vector<double>& breaks) {
+  if (ax.periodic) return KnotVector::periodic_from(ax.p, breaks, breaks.front() + 1.0);
+  return clamped_knots(ax, breaks);
+}
+
+// ------------------------------------------------------------------ errors
+
+template <std::size_t R>
+struct Residuals {
+  double max = -1, sum_sq = 0, weighted_sq = 0;
+  std::size_t worst = 0;
+  std::array<std::vector<double>, R> interval_max;
+  std::array<std::vector<std::size_t>, R> interval_worst;
+
+  explicit Residuals(const std::array<Axis, R>& axes) {
+    for (std::size_t a = 0; a < R; ++a) {
+      interval_max[a].assign(static_cast<std::size_t>(axes[a].intervals), -1.0);
+      interval_worst[a].assign(static_cast<std::size_t>(axes[a].intervals), 0);
+    }
+  }
+  // Another block's, of later points: the same result as one pass in storage order.
+  void merge(const Residuals& o) {
+    sum_sq += o.sum_sq;
+    weighted_sq += o.weighted_sq;
+    if (o.max > max) {
+      max = o.max;
+      worst = o.worst;
+    }
+    for (std::size_t a = 0; a < R; ++a)
+      for (std::size_t k = 0; k < interval_max[a].size(); ++k)
+        if (o.interval_max[a][k] > interval_max[a][k]) {
+          interval_max[a][k] = o.interval_max[a][k];
+          interval_worst[a][k] = o.interval_worst[a][k];
+        }
+  }
+};
+
+// The distances |S(t_i) − Q_i| at every point present, evaluated a row at a time
+// (every index but the last fixed) and never stored: the control net goes through B
+// along every direction but the last once (n_0 ⋯ n_{R−2} × c_{R−1} values), and each
+// row of S is made from its row of that and compared at once. Blocks of rows run in
+// parallel and merge in order.
+template <std::size_t R>
+Residuals<R> residuals(const std::array<Axis, R>& axes, const Data<R>& d, const std::vector<double>& cp) {
+  Shape<R> shape{};
+  for (std::size_t a = 0; a < R; ++a) shape[a] = static_cast<std::size_t>(axes[a].c);
+  std::vector<double> partial = cp, scratch;
+  for (std::size_t a = 0; a + 1 < R; ++a) {
+    basis_pass<false, R>(axes[a], partial.data(), shape, a, scratch);
+    std::swap(partial, scratch);
+  }
+  const Axis& last = axes[R - 1];
+  const std::size_t n = last.n, c = static_cast<std::size_t>(last.c), pp = static_cast<std::size_t>(last.p) + 1;
+  const std::size_t rows = d.points.size() / n;
+  constexpr std::size_t rows_per_block = 16;
+  const std::size_t blocks = (rows + rows_per_block - 1) / rows_per_block;
+  std::vector<Residuals<R>> part(blocks, Residuals<R>(axes));
+  const auto nb = static_cast<long long>(blocks);
+  // Where each basis function of each point along the last axis finds its control
+  // point's coordinates in a row of `partial`.
+  std::vector<std::size_t> off(n * pp);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < pp; ++k) off[i * pp + k] = 3 * last.col(last.first[i] + static_cast<int>(k));
+#pragma omp parallel if (d.points.size() * pp * 3 >= parallel_work)
+  {
+    std::vector<double> row(3 * n), e2(n);
+#pragma omp for schedule(static)
+    for (long long bi = 0; bi < nb; ++bi) {
+      const auto b = static_cast<std::size_t>(bi);
+      Residuals<R>& r = part[b];
+      for (std::size_t q = b * rows_per_block; q < std::min(rows, (b + 1) * rows_per_block); ++q) {
+        const double* src = partial.data() + q * c * 3;
+        for (std::size_t i = 0; i < n; ++i) {
+          double x = 0, y = 0, z = 0;
+          for (std::size_t k = 0; k < pp; ++k) {
+            const double w = last.b[i * pp + k];
+            const double* v = src + off[i * pp + k];
+            x += w * v[0];
+            y += w * v[1];
+            z += w * v[2];
+          }
+          row[3 * i] = x, row[3 * i + 1] = y, row[3 * i + 2] = z;
+        }
+        // Squared distances first (a loop the compiler vectorizes), then the maxima:
+        // of the row for the axes before the last, per interval along the last.
+        const Vec3* pts = d.points.data() + q * n;
+        for (std::size_t i = 0; i < n; ++i) {
+          const double dx = row[3 * i] - pts[i].x, dy = row[3 * i + 1] - pts[i].y, dz = row[3 * i + 2] - pts[i].z;
+          e2[i] = dx * dx + dy * dy + dz * dz;
+        }
+        double row_max = -1;
+        std::size_t row_worst = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+          const double w = d.w(q * n + i);
+          if (!(w > 0)) continue;
+          r.sum_sq += e2[i];
+          r.weighted_sq += w * e2[i];
+          if (e2[i] > row_max) {
+            row_max = e2[i];
+            row_worst = i;
+          }
+          auto& m = r.interval_max[R - 1][static_cast<std::size_t>(last.interval[i])];
+          if (e2[i] > m) {
+            m = e2[i];
+            r.interval_worst[R - 1][static_cast<std::size_t>(last.interval[i])] = q * n + i;
+          }
+        }
+        if (row_max < 0) continue;  // every point of the row missing
+        const std::size_t flat = q * n + row_worst;
+        if (row_max > r.max) {
+          r.max = row_max;
+          r.worst = flat;
+        }
+        for (std::size_t a = R - 1, rest = q; a-- > 0; rest /= d.shape[a]) {
+          const auto k = static_cast<std::size_t>(axes[a].interval[rest % d.shape[a]]);
+          if (row_max > r.interval_max[a][k]) {
+            r.interval_max[a][k] = row_max;
+            r.interval_worst[a][k] = flat;
+          }
+        }
+      }
+    }
+  }
+  Residuals<R> all(axes);
+  for (const auto& r : part) all.merge(r);
+  // Squares were compared; distances are reported.
+  all.max = all.max < 0 ? 0.0 : std::sqrt(all.max);
+  for (std::size_t a = 0; a < R; ++a)
+    for (double& m : all.interval_max[a]) m = m < 0 ? m : std::sqrt(m);
+  return all;
+}
+
+// S at one data point (its flat index), from the control net.
+template <std::size_t R>
+Vec3 value_at(const std::array<Axis, R>& axes, const std::vector<double>& cp, std::size_t flat, const Shape<R>& data_shape) {
+  const std::vector<std::size_t> idx = unflatten<R>(flat, data_shape);
+  std::array<std::size_t, R> pp{}, k{};
+  for (std::size_t a = 0; a < R; ++a) pp[a] = static_cast<std::size_t>(axes[a].p) + 1;
+  Vec3 s{};
+  for (;;) {
+    double w = 1;
+    std::size_t at = 0;
+    for (std::size_t a = 0; a < R; ++a) {
+      const Axis& ax = axes[a];
+      w *= ax.b[idx[a] * pp[a] + k[a]];
+      at = at * static_cast<std::size_t>(ax.c) + ax.col(ax.first[idx[a]] + static_cast<int>(k[a]));
+    }
+    s = s + w * Vec3{cp[3 * at], cp[3 * at + 1], cp[3 * at + 2]};
+    std::size_t a = R;
+    while (a-- > 0) {
+      if (++k[a] < pp[a]) break;
+      k[a] = 0;
+    }
+    if (a == static_cast<std::size_t>(-1)) return s;
+  }
+}
+
+// ------------------------------------------------------------------ the fit
+
+template <std::size_t R>
+struct Fit {
+  std::array<Axis, R> axes;
+  std::vector<double> cp;
+  double lambda = 0;
+  int fits = 0;
+};
+
+// Whether the sparse system is needed: missing points, weights, or a fairness term.
+template <std::size_t R>
+bool needs_fill(const Data<R>& d) {
+  if (d.uniform()) return false;
+  return std::any_of(d.weight.begin(), d.weight.end(), [](double w) { return !(w > 0); });
+}
+
+// The fairness weight that fills holes: a fraction 1e-5 of the data term's mean
+// diagonal. It keeps the system definite where there is no data and changes the fit
+// elsewhere by about that fraction at the finest scale of the control net, far below
+// any tolerance a user asks for.
+constexpr double fill_fraction = 1e-5;
+
+template <std::size_t R>
+void solve_once(Fit<R>& f, const Data<R>& d, std::optional<double> lambda) {
+  ++f.fits;
+  bool fill = needs_fill(d);
+  if (!lambda && d.uniform()) {
+    try {
+      f.lambda = 0;
+      f.cp = separable_fit<R>(f.axes, d);
+      return;
+    } catch (const error& e) {
+      // Knot intervals with too little data under them: the fairness term settles
+      // what the data leave open, as in a hole.
+      if (e.code() != errc::singular) throw;
+      fill = true;
+    }
+  }
+  SparseSystem<R> sys(f.axes, d);
+  const double filler = fill ? fill_fraction * sys.diagonal_ratio() : 0.0;
+  f.lambda = lambda ? std::max(*lambda, filler) : filler;
+  sys.factor(f.lambda);
+  f.cp = sys.solve(right_hand_side<R>(f.axes, d));
+}
+
+// λ by generalized cross-validation: the minimum over λ of
+//   V(λ) = n Σ w r² / (n − tr H(λ))²,
+// n the points present, H the map from data to fitted values (its trace estimated),
+// first on a grid of one value per decade, then by golden section around the best.
+template <std::size_t R>
+void solve_gcv(Fit<R>& f, const Data<R>& d) {
+  SparseSystem<R> sys(f.axes, d);
+  const std::vector<double> rhs = right_hand_side<R>(f.axes, d);
+  const auto n = static_cast<double>(d.present);
+  // Probes of the trace estimate: its error, about sqrt(2 / probes) of the Frobenius
+  // norm of M⁻¹ λ s K (at most sqrt(C)), stays a small part of n − tr H.
+  constexpr int probes = 24;
+  // With holes, λ never goes below the weight that fills them.
+  const double floor = needs_fill(d) ? fill_fraction * sys.diagonal_ratio() : 0.0;
+  auto score = [&](double log_lambda) {
+    ++f.fits;
+    const double lambda = std::max(floor, std::pow(10.0, log_lambda));
+    try {
+      sys.factor(lambda);
+    } catch (const error& e) {
+      if (e.code() != errc::singular) throw;
+      return std::numeric_limits<double>::infinity();  // too little fairness for the data: not a candidate
+    }
+    f.cp = sys.solve(rhs);
+    const double rss = residuals<R>(f.axes, d, f.cp).weighted_sq;
+    // n − tr H = n − C + tr(M⁻¹ λ s K).
+    const double rest = n - static_cast<double>(sys.data.rows()) + sys.fairness_trace(lambda, probes);
+    if (!(rest > 0)) return std::numeric_limits<double>::infinity();
+    return n * rss / (rest * rest);
+  };
+  double best = -12, best_v = std::numeric_limits<double>::infinity();
+  for (int e = -12; e <= 4; ++e)
+    if (const double v = score(e); v < best_v) {
+      best_v = v;
+      best = e;
+    }
+  const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
+  double lo = best - 1, hi = best + 1;
+  double x1 = hi - phi * (hi - lo), x2 = lo + phi * (hi - lo);
+  double v1 = score(x1), v2 = score(x2);
+  for (int it = 0; it < 10; ++it) {
+    if (v1 < v2) {
+      hi = x2, x2 = x1, v2 = v1;
+      x1 = hi - phi * (hi - lo);
+      v1 = score(x1);
+    } else {
+      lo = x1, x1 = x2, v1 = v2;
+      x2 = lo + phi * (hi - lo);
+      v2 = score(x2);
+    }
+  }
+  double x = v1 < v2 ? x1 : x2;
+  if (std::min(v1, v2) > best_v) x = best;
+  f.lambda = std::max(floor, std::pow(10.0, x));
+  sys.factor(f.lambda);
+  f.cp = sys.solve(rhs);
+}
+
+// The residual at point `i` of the least-squares fit along axis a alone of the line
+// through it (missing points taking the approximation's values): whether direction
+// a lacks knots there.
+template <std::size_t R>
+double line_residual(const std::array<Axis, R>& axes, const AxisSolver& lu, const Data<R>& d, const std::vector<double>& cp,
+                     std::size_t a, std::size_t i) {
+  const Axis& ax = axes[a];
+  std::size_t inner = 1;
+  for (std::size_t x = a + 1; x < R; ++x) inner *= d.shape[x];
+  const std::size_t n = d.shape[a], pos = (i / inner) % n, base = i - pos * inner;
+  const auto pp = static_cast<std::size_t>(ax.p) + 1;
+  std::vector<double> line(n * 3), x(static_cast<std::size_t>(ax.c) * 3, 0.0);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t j = base + k * inner;
+    const Vec3 v = d.w(j) > 0 ? d.points.data()[j] : value_at<R>(axes, cp, j, d.shape);
+    for (std::size_t m = 0; m < 3; ++m) line[3 * k + m] = v[static_cast<int>(m)];
+  }
+  for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t l = 0; l < pp; ++l)
+      for (std::size_t m = 0; m < 3; ++m) x[3 * ax.col(ax.first[k] + static_cast<int>(l)) + m] += ax.b[k * pp + l] * line[3 * k + m];
+  std::visit([&](const auto& solver) { solver.solve(x.data(), 3, 3); }, lu);
+  Vec3 e{};
+  for (std::size_t l = 0; l < pp; ++l)
+    for (std::size_t m = 0; m < 3; ++m)
+      e[static_cast<int>(m)] += ax.b[pos * pp + l] * x[3 * ax.col(ax.first[pos] + static_cast<int>(l)) + m];
+  return distance(e, Vec3{line[3 * pos], line[3 * pos + 1], line[3 * pos + 2]});
+}
+
+// Splits knot interval k of an axis at the middle of the data in it, between two
+// lines across the axis that hold data (a knot between missing lines would leave
+// the fairness term alone to settle a control point there); false when it holds
+// fewer than 2 such lines (or the direction has as many control points as data).
+bool split_interval(const Axis& ax, std::vector<double>& breaks, int k, const std::vector<bool>& has_data) {
+  if (static_cast<std::size_t>(ax.c) >= ax.n) return false;
+  std::vector<std::size_t> in;  // the lines across the axis in the interval that hold data
+  for (std::size_t i = 0; i < ax.n; ++i)
+    if (ax.interval[i] == k && has_data[i]) in.push_back(i);
+  if (in.size() < 2) return false;
+  // In a closed direction, the order along the interval is that of the parameters
+  // wrapped into the period: the interval across the seam holds the last lines and
+  // then the first.
+  auto at = [&](std::size_t i) { return ax.periodic ? ax.knots.wrap(ax.t[i]) : ax.t[i]; };
+  if (ax.periodic) std::stable_sort(in.begin(), in.end(), [&](std::size_t x, std::size_t y) { return at(x) < at(y); });
+  const std::size_t mid = in.size() / 2;
+  const double knot = 0.5 * (at(in[mid - 1]) + at(in[mid]));
+  breaks.push_back(knot);
+  return true;
+}
+
+// What removing each interior knot of an open axis a would cost, estimated from the
+// fit: the largest jump, over the lines of the control net along a, of the p-th
+// derivative at the knot (where the two polynomial pieces differ), times the p-th
+// power of the two intervals beside it (The NURBS Book §5.4: the deviation a
+// removal brings is of that order).
+template <std::size_t R>
+std::vector<double> removal_costs(const Fit<R>& f, std::size_t a, const std::vector<double>& breaks) {
+  const Axis& ax = f.axes[a];
+  const int p = ax.p;
+  const auto pp = static_cast<std::size_t>(p) + 1;
+  std::vector<double> u{ax.t.front()};
+  u.insert(u.end(), breaks.begin(), breaks.end());
+  u.push_back(ax.t.back());
+  const std::size_t pieces = u.size() - 1;
+  // The p-th derivatives of the basis on each piece (constant there).
+  std::vector<int> first(pieces);
+  std::vector<double> der(pieces * pp);
+  double tmp[(max_degree + 1) * (max_degree + 1)];
+  for (std::size_t j = 0; j < pieces; ++j) {
+    const double mid = 0.5 * (u[j] + u[j + 1]);
+    const int span = ax.knots.find_span(mid);
+    ax.knots.basis_derivatives(span, mid, p, tmp);
+    first[j] = span - p;
+    std::copy(tmp + static_cast<std::size_t>(p) * pp, tmp + static_cast<std::size_t>(p + 1) * pp, der.begin() + static_cast<std::ptrdiff_t>(j * pp));
+  }
+  std::size_t outer = 1, inner = 1;
+  for (std::size_t x = 0; x < a; ++x) outer *= static_cast<std::size_t>(f.axes[x].c);
+  for (std::size_t x = a + 1; x < R; ++x) inner *= static_cast<std::size_t>(f.axes[x].c);
+  const auto c = static_cast<std::size_t>(ax.c);
+  std::vector<double> jump(breaks.size(), 0.0);
+  std::vector<Vec3> d(pieces);
+  for (std::size_t o = 0; o < outer; ++o)
+    for (std::size_t in = 0; in < inner; ++in) {
+      for (std::size_t j = 0; j < pieces; ++j) {
+        Vec3 v{};
+        for (std::size_t k = 0; k < pp; ++k) {
+          const std::size_t i = (o * c + static_cast<std::size_t>(first[j]) + k) * inner + in;
+          v = v + der[j * pp + k] * Vec3{f.cp[3 * i], f.cp[3 * i + 1], f.cp[3 * i + 2]};
+        }
+        d[j] = v;
+      }
+      for (std::size_t k = 0; k < breaks.size(); ++k) jump[k] = std::max(jump[k], distance(d[k + 1], d[k]));
+    }
+  for (std::size_t k = 0; k < breaks.size(); ++k) jump[k] *= std::pow(u[k + 2] - u[k], p);
+  return jump;
+}
+
+// Growth from the knots in `breaks`: knots go where the error is largest, in every
+// interval whose worst point is beyond the tolerance, in the directions along which
+// that point's line, fitted on its own, misses it by more than half the tolerance
+// (where neither does, in every direction). True when the fit is within the
+// tolerance; false when no interval can split any more.
+template <std::size_t R>
+bool grow(Fit<R>& f, const Data<R>& d, double tol, std::array<std::vector<double>, R>& breaks,
+          const progress_callback& progress) {
+  // Which lines across each axis (every point with that index along it) hold data.
+  std::array<std::vector<bool>, R> has_data;
+  for (std::size_t a = 0; a < R; ++a) has_data[a].assign(d.shape[a], d.uniform());
+  if (!d.uniform())
+    for (std::size_t i = 0; i < d.points.size(); ++i)
+      if (d.w(i) > 0) {
+        const std::vector<std::size_t> idx = unflatten<R>(i, d.shape);
+        for (std::size_t a = 0; a < R; ++a) has_data[a][idx[a]] = true;
+      }
+  for (;;) {
+    solve_once<R>(f, d, std::nullopt);
+    if (progress) progress(std::min(0.9, 0.1 + 0.04 * f.fits));
+    const Residuals<R> r = residuals<R>(f.axes, d, f.cp);
+    if (r.max <= tol) return true;
+    std::array<std::vector<int>, R> split;
+    bool any = false;
+    for (std::size_t a = 0; a < R; ++a) {
+      const Axis& ax = f.axes[a];
+      if (static_cast<std::size_t>(ax.c) >= ax.n) continue;
+      // A direction whose knots outnumber the data under them (the fit then leans on
+      // the fairness term) has no line fit of its own: every bad interval of it splits.
+      std::optional<AxisSolver> lu;
+      try {
+        lu = factor_gram(ax, a);
+      } catch (const error& e) {
+        if (e.code() != errc::singular) throw;
+      }
+      for (int k = 0; k < ax.intervals; ++k) {
+        const auto kk = static_cast<std::size_t>(k);
+        if (!(r.interval_max[a][kk] > tol)) continue;
+        if (R == 1 || !lu || line_residual<R>(f.axes, *lu, d, f.cp, a, r.interval_worst[a][kk]) > 0.5 * tol) {
+          split[a].push_back(k);
+          any = true;
+        }
+      }
+    }
+    if (!any) {
+      const std::vector<std::size_t> w = unflatten<R>(r.worst, d.shape);
+      for (std::size_t a = 0; a < R; ++a) split[a].push_back(f.axes[a].interval[w[a]]);
+    }
+    bool added = false;
+    for (std::size_t a = 0; a < R; ++a) {
+      const std::size_t before = breaks[a].size();
+      for (int k : split[a])
+        if (split_interval(f.axes[a], breaks[a], k, has_data[a])) added = true;
+      if (breaks[a].size() != before) {
+        std::sort(breaks[a].begin(), breaks[a].end());
+        f.axes[a].set_knots(knots_from_breaks(f.axes[a], breaks[a]));
+      }
+    }
+    if (!added) return false;  // every interval is as fine as the data allow
+  }
+}
+
+// Every `step[a]`-th line of the data along each axis (the last one too): a grid to
+// grow the knots on before the whole grid refines them.
+template <std::size_t R>
+Data<R> thinned(const Data<R>& d, const std::array<std::vector<std::size_t>, R>& kept) {
+  Data<R> t;
+  typename Grid<Vec3, R>::shape_type shape{};
+  for (std::size_t a = 0; a < R; ++a) shape[a] = t.shape[a] = kept[a].size();
+  t.points = Grid<Vec3, R>(shape, for_overwrite);
+  if (!d.uniform()) t.weight.resize(t.points.size());
+  std::array<std::size_t, R> k{};
+  for (std::size_t i = 0; i < t.points.size(); ++i) {
+    std::size_t src = 0;
+    for (std::size_t a = 0; a < R; ++a) src = src * d.shape[a] + kept[a][k[a]];
+    t.points.data()[i] = d.points.data()[src];
+    if (!d.uniform()) t.weight[i] = d.weight[src];
+    if (d.w(src) > 0) {
+      ++t.present;
+      t.weight_sum += d.w(src);
+    } else {
+      ++t.missing;
+    }
+    for (std::size_t a = R; a-- > 0;) {
+      if (++k[a] < kept[a].size()) break;
+      k[a] = 0;
+    }
+  }
+  return t;
+}
+
+template <std::size_t R>
+void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_callback& progress) {
+  std::array<std::vector<double>, R> breaks;
+  for (std::size_t a = 0; a < R; ++a) {
+    Axis& ax = f.axes[a];
+    breaks[a] = ax.periodic ? least_squares_breaks(ax, ax.p + 1) : std::vector<double>{};
+    ax.set_knots(knots_from_breaks(ax, breaks[a]));
+  }
+  // A large grid grows its first knots on every 4th line of directions with 128 or
+  // more points (a sixteenth of a surface's work per fit): the coarse knots a smooth
+  // part of the data needs show on it as well. The whole grid then refines them.
+  constexpr std::size_t thin = 4, thin_from = 128;
+  const bool thinning = d.points.size() >= (std::size_t{1} << 18);
+  Fit<R> coarse;
+  Data<R> sub;
+  if (thinning) {
+    std::array<std::vector<std::size_t>, R> kept;
+    for (std::size_t a = 0; a < R; ++a) {
+      const std::size_t n = d.shape[a], step = n >= thin_from ? thin : 1;
+      for (std::size_t i = 0; i < n; i += step) kept[a].push_back(i);
+      if (!f.axes[a].periodic && kept[a].back() != n - 1) kept[a].push_back(n - 1);
+      Axis& ax = coarse.axes[a];
+      ax.n = kept[a].size();
+      ax.p = f.axes[a].p;
+      ax.periodic = f.axes[a].periodic;
+      for (std::size_t i : kept[a]) ax.t.push_back(f.axes[a].t[i]);
+      ax.set_knots(knots_from_breaks(ax, breaks[a]));
+    }
+    sub = thinned<R>(d, kept);
+    (void)grow<R>(coarse, sub, tol, breaks, {});
+    f.fits += coarse.fits;
+    coarse.fits = 0;
+    for (std::size_t a = 0; a < R; ++a) f.axes[a].set_knots(knots_from_breaks(f.axes[a], breaks[a]));
+  }
+  if (!grow<R>(f, d, tol, breaks, progress)) return;
+  auto max_error = [&] {
+    solve_once<R>(f, d, std::nullopt);
+    if (progress) progress(std::min(0.9, 0.1 + 0.04 * f.fits));
+    return residuals<R>(f.axes, d, f.cp);
+  };
+  // Pruning: growth splits several intervals at once and overshoots. The knots whose
+  // removal costs least go, as long as the refit stays within the tolerance: first
+  // a quarter of them at once, half as many after each refusal, one at a time at
+  // the end; a few refused single removals end it. On a large grid a removal is
+  // first tried on the thinned grid (a sixteenth of the work): one that fails there
+  // is refused without the whole grid's fit.
+  constexpr int refusals = 3;
+  std::vector<std::pair<std::size_t, double>> refused;
+  std::size_t total = 0;
+  for (std::size_t a = 0; a < R; ++a) total += f.axes[a].periodic ? 0 : breaks[a].size();
+  std::size_t batch = std::max<std::size_t>(1, total / 4);
+  while (static_cast<int>(refused.size()) < refusals) {
+    struct Candidate {
+      double cost;
+      std::size_t axis;
+      double knot;
+    };
+    std::vector<Candidate> cand;
+    for (std::size_t a = 0; a < R; ++a) {
+      if (f.axes[a].periodic) continue;
+      const std::vector<double> cost = removal_costs<R>(f, a, breaks[a]);
+      for (std::size_t k = 0; k < cost.size(); ++k)
+        if (std::none_of(refused.begin(), refused.end(),
+                         [&](const auto& x) { return x.first == a && x.second == breaks[a][k]; }))
+          cand.push_back({cost[k], a, breaks[a][k]});
+    }
+    if (cand.empty()) return;
+    std::stable_sort(cand.begin(), cand.end(), [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
+    batch = std::min(batch, cand.size());
+    const Fit<R> kept = f;
+    const std::array<std::vector<double>, R> kept_breaks = breaks;
+    std::array<bool, R> changed{};
+    for (std::size_t k = 0; k < batch; ++k) {
+      auto& b = breaks[cand[k].axis];
+      b.erase(std::find(b.begin(), b.end(), cand[k].knot));
+      changed[cand[k].axis] = true;
+    }
+    for (std::size_t a = 0; a < R; ++a)
+      if (changed[a]) f.axes[a].set_knots(knots_from_breaks(f.axes[a], breaks[a]));
+    bool within = true;
+    if (thinning) {
+      for (std::size_t a = 0; a < R; ++a) coarse.axes[a].set_knots(knots_from_breaks(coarse.axes[a], breaks[a]));
+      solve_once<R>(coarse, sub, std::nullopt);
+      within = residuals<R>(coarse.axes, sub, coarse.cp).max <= tol;
+      f.fits += coarse.fits;
+      coarse.fits = 0;
+    }
+    if (within && max_error().max <= tol) continue;
+    const int fits = f.fits;
+    f = kept;
+    f.fits = fits;
+    breaks = kept_breaks;
+    if (batch == 1) refused.emplace_back(cand[0].axis, cand[0].knot);
+    batch = std::max<std::size_t>(1, batch / 2);
+  }
+}
+
+template <std::size_t R>
+struct Result {
+  Fit<R> fit;
+  ApproximationReport report;
+};
+
+template <std::size_t R>
+Result<R> approximate(Data<R> d, const ApproximationOptions<R>& o, const char* what) {
+  // Exactly one of the three ways.
+  const int ways = (o.control_points ? 1 : 0) + (o.tolerance ? 1 : 0) + ((o.smoothing || o.auto_smoothing) ? 1 : 0);
+  if (ways != 1)
+    fail(errc::wrong_type, what, " approximation takes exactly one of control_points, tolerance and smoothing, got ",
+         ways);
+  if (o.smoothing && o.auto_smoothing) fail(errc::wrong_type, "smoothing is either a number or auto, not both");
+  if (o.tolerance && !(*o.tolerance > 0 && std::isfinite(*o.tolerance)))
+    fail(errc::wrong_type, "tolerance ", *o.tolerance, " is not a positive distance");
+  if (o.smoothing && !(*o.smoothing >= 0 && std::isfinite(*o.smoothing)))
+    fail(errc::wrong_type, "smoothing ", *o.smoothing, " is not a non-negative number");
+  for (std::size_t a = 0; a < R; ++a)
+    if (d.shape[a] < 2)
+      fail(errc::too_few_points, what, " approximation needs at least 2 points along ", axis_name(a), ", got ",
+           d.shape[a]);
+
+  // Missing points, weights.
+  const std::size_t total = d.points.size();
+  if (!o.weights.empty()) {
+    for (std::size_t a = 0; a < R; ++a)
+      if (o.weights.extent(a) != d.shape[a])
+        fail(errc::size_mismatch, "weights: ", o.weights.extent(a), " along ", axis_name(a), ", the points have ",
+             d.shape[a]);
+    d.weight.assign(o.weights.values().begin(), o.weights.values().end());
+    for (std::size_t i = 0; i < total; ++i) {
+      if (std::isnan(d.weight[i]) || std::isinf(d.weight[i]))
+        fail(errc::not_finite, "weight ", index_text<R>(i, d.shape), " is ", d.weight[i]);
+      if (d.weight[i] < 0)
+        fail(errc::invalid_weight, "weight ", index_text<R>(i, d.shape), " = ", d.weight[i], " is negative");
+    }
+  }
+  for (std::size_t i = 0; i < total; ++i) {
+    const Vec3& q = d.points.data()[i];
+    if (is_missing(q)) {
+      if (d.weight.empty()) d.weight.assign(total, 1.0);
+      d.weight[i] = 0;
+      ++d.missing;
+    } else if (!is_finite(q)) {
+      fail(errc::not_finite, "point ", index_text<R>(i, d.shape), " is ", q, " (NaN marks a missing point; infinity is refused)");
+    }
+  }
+  d.weight_sum = 0;
+  d.present = 0;
+  for (std::size_t i = 0; i < total; ++i)
+    if (d.w(i) > 0) {
+      d.weight_sum += d.w(i);
+      ++d.present;
+    }
+  if (d.present == 0)
+    fail(errc::too_few_points, "all ", total, " points are missing or have weight 0: there is nothing to approximate");
+  if (!d.weight.empty() && d.missing == 0 &&
+        std::all_of(d.weight.begin(), d.weight.end(), [&](double w) { return w == d.weight.front(); })) {
+    d.weight.clear();  // equal weights: the plain least-squares fit
+    d.weight_sum = static_cast<double>(total);
+  }
+
+  Result<R> res;
+  Fit<R>& f = res.fit;
+  for (std::size_t a = 0; a < R; ++a) {
+    Axis& ax = f.axes[a];
+    ax.n = d.shape[a];
+    ax.periodic = o.periodic[a];
+    const int p = o.degree[a] ? *o.degree[a] : std::min<int>(3, static_cast<int>(ax.n) - 1);
+    if (p < 1 || p > max_degree)
+      fail(errc::invalid_degree, "degree ", p, " along ", axis_name(a), " is outside 1..", max_degree);
+    if (ax.n < static_cast<std::size_t>(p) + 1)
+      fail(errc::too_few_points, "degree ", p, " along ", axis_name(a), " needs at least ", p + 1, " points, got ", ax.n);
+    ax.p = p;
+    ax.t = axis_parameters<R>(d, a, o.param, ax.periodic);
+  }
+  if (o.control_points)
+    for (std::size_t a = 0; a < R; ++a) {
+      const int c = (*o.control_points)[a];
+      const Axis& ax = f.axes[a];
+      if (c < ax.p + 1)
+        fail(errc::too_few_points, c, " control points along ", axis_name(a), " are fewer than degree ", ax.p,
+             " needs (", ax.p + 1, ")");
+      if (static_cast<std::size_t>(c) > ax.n)
+        fail(errc::too_few_points, c, " control points along ", axis_name(a), " are more than the ", ax.n,
+             " data points there: least squares needs at least as many data as control points");
+    }
+  if (o.progress) o.progress(0.0);
+
+  if (o.tolerance) {
+    solve_tolerance<R>(f, d, *o.tolerance, o.progress);
+  } else {
+    for (std::size_t a = 0; a < R; ++a) {
+      Axis& ax = f.axes[a];
+      int c = 0;
+      if (o.control_points) c = (*o.control_points)[a];
+      else c = std::max(ax.p + 1, std::min(static_cast<int>(ax.n), smoothing_max_control_points));
+      ax.set_knots(knots_from_breaks(ax, least_squares_breaks(ax, c)));
+    }
+    if (o.auto_smoothing) solve_gcv<R>(f, d);
+    else solve_once<R>(f, d, o.smoothing);
+  }
+
+  // The report.
+  const Residuals<R> r = residuals<R>(f.axes, d, f.cp);
+  ApproximationReport& rep = res.report;
+  rep.max_error = r.max;
+  rep.max_error_at = unflatten<R>(r.worst, d.shape);
+  rep.rms_error = std::sqrt(r.sum_sq / static_cast<double>(d.present));
+  for (std::size_t a = 0; a < R; ++a) rep.control_points.push_back(f.axes[a].c);
+  rep.lambda = f.lambda;
+  rep.missing = d.missing;
+  rep.fits = f.fits;
+  if (o.progress) o.progress(1.0);
+  return res;
+}
+
+template <std::size_t R>
+Grid<Vec3, R> control_net(const Fit<R>& f) {
+  typename Grid<Vec3, R>::shape_type shape{};
+  for (std::size_t a = 0; a < R; ++a) shape[a] = static_cast<std::size_t>(f.axes[a].c);
+  Grid<Vec3, R> g(shape, for_overwrite);
+  std::copy_n(f.cp.data(), f.cp.size(), &g.data()->x);
+  return g;
+}
+
+// A closed direction's last line, when it repeats the first (interpolation's rule),
+// is left out, with its weights.
+template <std::size_t R>
+Data<R> closed_data(Grid<Vec3, R> points, Grid<double, R>& weights, const std::array<bool, R>& periodic) {
+  Data<R> d;
+  for (std::size_t a = 0; a < R; ++a) {
+    if (!periodic[a] || points.extent(a) < 3) continue;
+    if (std::any_of(points.values().begin(), points.values().end(), is_missing)) break;
+    Closing c;
+    if constexpr (R == 1) c = closing_point(std::span<const Vec3>(points.data(), points.size()));
+    else c = grid_closing(points, static_cast<int>(a));
+    if (c.nearly)
+      fail(errc::closing_gap, "the last line of points along ", axis_name(a),
+           " nearly repeats the first: repeat the first line exactly, or leave the last one out");
+    if (!c.dropped) continue;
+    auto shape = points.shape();
+    std::size_t outer = 1, inner = 1;
+    for (std::size_t x = 0; x < a; ++x) outer *= shape[x];
+    for (std::size_t x = a + 1; x < R; ++x) inner *= shape[x];
+    const std::size_t n = shape[a];
+    shape[a] = n - 1;
+    Grid<Vec3, R> kept(shape, for_overwrite);
+    Grid<double, R> kept_w = weights.empty() ? Grid<double, R>() : Grid<double, R>(shape, 0.0);
+    for (std::size_t o = 0; o < outer; ++o) {
+      std::copy_n(points.data() + o * n * inner, (n - 1) * inner, kept.data() + o * (n - 1) * inner);
+      if (!weights.empty())
+        std::copy_n(weights.data() + o * n * inner, (n - 1) * inner, kept_w.data() + o * (n - 1) * inner);
+    }
+    points = std::move(kept);
+    if (!weights.empty()) weights = std::move(kept_w);
+  }
+  for (std::size_t a = 0; a < R; ++a) d.shape[a] = points.extent(a);
+  d.points = std::move(points);
+  return d;
+}
+
+template <std::size_t R>
+Result<R> run(Grid<Vec3, R> points, const ApproximationOptions<R>& options, const char* what) {
+  bool closed = std::any_of(options.periodic.begin(), options.periodic.end(), [](bool b) { return b; });
+  if (!closed) {
+    Data<R> d;
+    for (std::size_t a = 0; a < R; ++a) d.shape[a] = points.extent(a);
+    d.points = std::move(points);
+    return approximate<R>(std::move(d), options, what);
+  }
+  ApproximationOptions<R> o = options;
+  const auto given = points.shape();
+  Data<R> d = closed_data<R>(std::move(points), o.weights, o.periodic);
+  Result<R> r = approximate<R>(std::move(d), o, what);
+  // A closing line left out has the parameter one period after the first line's.
+  for (std::size_t a = 0; a < R; ++a)
+    if (r.fit.axes[a].n < given[a]) r.fit.axes[a].t.push_back(r.fit.axes[a].t.front() + 1.0);
+  return r;
+}
+
+}  // namespace
+
+CurveApproximation approximate_curve(std::span<const Vec3> points, const CurveApproximationOptions& options) {
+  Grid<Vec3, 1> g({points.size()}, std::vector<Vec3>(points.begin(), points.end()));
+  Result<1> r = run<1>(std::move(g), options, "curve");
+  Grid<Vec3, 1> net = control_net<1>(r.fit);
+  std::vector<Vec3> cp(net.values().begin(), net.values().end());
+  Axis& u = r.fit.axes[0];
+  return {BSplineCurve(u.knots, std::move(cp)), std::move(u.t), std::move(r.report)};
+}
+
+SurfaceApproximation approximate_surface(PointGrid points, const SurfaceApproximationOptions& options) {
+  Result<2> r = run<2>(std::move(points), options, "surface");
+  PointGrid net = control_net<2>(r.fit);
+  auto& ax = r.fit.axes;
+  return {BSplineSurface(ax[0].knots, ax[1].knots, std::move(net)), std::move(ax[0].t), std::move(ax[1].t),
+          std::move(r.report)};
+}
+
+VolumeApproximation approximate_volume(PointGrid3 points, const VolumeApproximationOptions& options) {
+  Result<3> r = run<3>(std::move(points), options, "volume");
+  PointGrid3 net = control_net<3>(r.fit);
+  auto& ax = r.fit.axes;
+  return {BSplineVolume(ax[0].knots, ax[1].knots, ax[2].knots, std::move(net)), std::move(ax[0].t), std::move(ax[1].t),
+          std::move(ax[2].t), std::move(r.report)};
+}
+
+}  // namespace interpatch
