@@ -1,0 +1,34 @@
+#pragma once
+// The files of the viewer page, embedded at build time (cmake/viewer.cmake): three.js
+// as viewer/package-lock.json pins it, its OrbitControls, and viewer/src.
+
+#include <initializer_list>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace interpatch::io::detail {
+
+struct ViewerAssets {
+  std::string three;           ///< three.module.min.js: the "three" module
+  std::string orbit_controls;  ///< examples/jsm/controls/OrbitControls.js, which imports "three"
+  std::string page;            ///< viewer/src/page.html, with its {{...}} slots
+  std::string style;           ///< viewer/src/viewer.css
+  std::string script;          ///< viewer/src/viewer.js, a module importing both
+  std::string_view three_version;
+};
+
+/// The assets, joined from their pieces on first use.
+const ViewerAssets& viewer_assets();
+
+/// The pieces of one file, in order, as one string.
+inline std::string joined(std::span<const std::string_view> pieces) {
+  std::string s;
+  std::size_t n = 0;
+  for (const std::string_view p : pieces) n += p.size();
+  s.reserve(n);
+  for (const std::string_view p : pieces) s += p;
+  return s;
+}
+
+}  // namespace interpatch::io::detail
