@@ -8,7 +8,6 @@ Shared by the browser tests (tools/check_viewer.py), the pictures of the README
 import json
 import os
 import shutil
-import time
 
 from selenium import webdriver
 from selenium.webdriver.chrome.options import Options
@@ -40,12 +39,12 @@ def chromium(width=1100, height=800):
 
 def open_page(driver, path, timeout=30):
     """Loads a page from file:// and waits until its script says it has drawn.
-    Returns the seconds from the navigation's start to that moment."""
-    start = time.monotonic()
+    Returns the seconds from the navigation's start to that moment, as the page
+    measured them (performance.now() once drawn)."""
     driver.get("file://" + os.path.abspath(path))
-    WebDriverWait(driver, timeout).until(
+    WebDriverWait(driver, timeout, poll_frequency=0.05).until(
         lambda d: d.execute_script("return document.body && document.body.dataset.ready === 'true'"))
-    return time.monotonic() - start
+    return float(driver.execute_script("return document.body.dataset.readyMs")) / 1000
 
 
 def console_errors(driver):
@@ -122,3 +121,8 @@ def info_panel(driver):
     rows = driver.execute_script(
         "return [...document.querySelectorAll('#info tr')].map(r => [r.dataset.key, r.cells[1].dataset.value])")
     return {k: json.loads(v) for k, v in rows}
+
+
+def view_element(driver):
+    """The element holding the 3D view (the canvas), for screenshots."""
+    return driver.find_element(By.ID, "view")

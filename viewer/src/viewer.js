@@ -401,4 +401,6 @@ controls.saveState();
 document.getElementById('reset').addEventListener('click', () => { controls.reset(); render(); });
 resize();
 repaint();
+// Drawn: the milliseconds since the page's navigation began (tools/bench_viewer.py).
+document.body.dataset.readyMs = String(performance.now());
 document.body.dataset.ready = 'true';
