@@ -58,8 +58,7 @@ function paletteAt(stops, t) {
 }
 
 // The range a colouring spans: all finite values, or for signed quantities
-// (curvatures) symmetric about zero and from the 2nd to the 98th percentile of
-// their sizes, so that a few extreme values (at a pole, a corner) do not wash out
+// (curvatures) symmetric about zero out to the 95th percentile of their sizes, so that a few extreme values (at a pole, a corner) do not wash out
 // the rest; values beyond it take the end colours.
 function rangeOf(values, signed) {
   const finite = [];
@@ -71,7 +70,7 @@ function rangeOf(values, signed) {
     return [lo, hi];
   }
   const sizes = finite.map(Math.abs).sort((a, b) => a - b);
-  const m = sizes[Math.min(sizes.length - 1, Math.floor(0.98 * sizes.length))];
+  const m = sizes[Math.min(sizes.length - 1, Math.floor(0.95 * sizes.length))];
   return [-m, m];
 }
 
@@ -296,7 +295,8 @@ function addData(sets) {
       for (let k = 0; k + 1 < p.length / 3; ++k) seg.push(...p.subarray(3 * k, 3 * k + 6));
       groups.data.add(lineSegments(new Float32Array(seg), colours.data));
     } else {
-      groups.data.add(points(p, colours.data, p.length / 3 > 5000 ? 2 : 6));
+      const n = p.length / 3;
+      groups.data.add(points(p, colours.data, n > 5000 ? 2 : n > 200 ? 3 : 6));
     }
     const full = d.full_shape.join(' × '), kept = d.shape.join(' × ');
     shown.push(`data ${d.pointer}: ${d.kind === 'curve' ? 'curve, ' : ''}${kept}${kept === full ? '' : ` of ${full}`} points`);
@@ -391,7 +391,8 @@ const box = new THREE.Box3().setFromObject(groups.model);
 const sphere = box.getBoundingSphere(new THREE.Sphere());
 const radius = Math.max(sphere.radius, 1e-9);
 const yaw = Math.PI / 4, pitch = 35 * Math.PI / 180;
-const distance = radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)) * 1.05;
+// The bounding sphere seen whole is a generous bound: most shapes fill little of it.
+const distance = radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)) * 0.8;
 camera.position.copy(sphere.center).add(new THREE.Vector3(Math.sin(yaw) * Math.cos(pitch), -Math.cos(yaw) * Math.cos(pitch), Math.sin(pitch)).multiplyScalar(distance));
 camera.near = distance / 100;
 camera.far = distance * 100;
