@@ -59,7 +59,7 @@ inline constexpr ViewLimits view_limits{};
 ///
 /// Example:
 /// @code
-///   interpatch::io::Construction c = interpatch::io::build_file("examples/coons.json");
+///   interpatch::io::Construction c = interpatch::io::build_file("coons.json");
 ///   interpatch::io::write_view("coons.html", c);  // open it in a browser
 /// @endcode
 /// @throws error file_unwritable, and what view_html throws.
