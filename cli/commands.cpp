@@ -269,8 +269,7 @@ void check_info_output(const fs::path& out) {
 }
 
 void check_view_output(const fs::path& out) {
-  const std::string ext = lower_extension(out);
-  if (ext == ".html" || ext == ".htm") return;
+  if (io::is_view_format(out.extension().string())) return;
   throw usage_error("cannot tell the output format of '" + out.string() + "': view writes .html (or .htm)");
 }
 

@@ -353,6 +353,16 @@ std::string view_html(const Construction& c, const ViewOptions& options) {
                        {"SCRIPT", a.script}});
 }
 
+bool is_view_format(std::string_view extension) noexcept {
+  if (extension.starts_with('.')) extension.remove_prefix(1);
+  const auto is = [&](std::string_view name) {
+    return extension.size() == name.size() &&
+           std::equal(name.begin(), name.end(), extension.begin(),
+                      [](char a, char b) { return a == (b >= 'A' && b <= 'Z' ? static_cast<char>(b - 'A' + 'a') : b); });
+  };
+  return is("html") || is("htm");
+}
+
 void write_view(const std::filesystem::path& path, const Construction& c, const ViewOptions& options) {
   const std::string page = view_html(c, options);
   write_atomically(path, [&](std::ostream& os) { os.write(page.data(), static_cast<std::streamsize>(page.size())); },

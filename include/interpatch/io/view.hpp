@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <string>
+#include <string_view>
 
 #include "interpatch/io/spec.hpp"
 
@@ -54,6 +55,10 @@ inline constexpr ViewLimits view_limits{};
 /// docs/spec-format.md describes the page.
 /// @throws error too_large, and what evaluation throws.
 [[nodiscard]] std::string view_html(const Construction& c, const ViewOptions& options = {});
+
+/// Whether an extension names a viewer page: .html or .htm, with or without the dot,
+/// in any case.
+[[nodiscard]] bool is_view_format(std::string_view extension) noexcept;
 
 /// Writes view_html() atomically to `path` (its extension is not checked).
 ///
