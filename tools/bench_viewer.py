@@ -1,5 +1,6 @@
 """make bench-viewer: a 1000 x 1000 surface's viewer page — its size, the time of the
-whole `interpatch view` command that writes it, beside `interpatch info` and
+whole `interpatch view` command that writes it and of the library call alone
+(io::write_view, through the Python module when it is built), beside `interpatch info` and
 `interpatch mesh` of the same grid (tools/time_in_turn.py, in turn), and the time
 headless Chromium takes to open and draw it (from the navigation's start until the
 page's script has drawn, as the page measures it, performance.now()).
@@ -48,17 +49,40 @@ def main():
                     f"info={ip} info {grid}",
                     f"mesh={ip} mesh {grid} --res 257x257 -o {os.path.join(a.work, 'grid1000.obj')}"], check=True)
 
+    # The library call alone (io::write_view through the Python module, whose build
+    # and page are those of the command), when the module is built beside INTERPATCH.
+    module_dir = os.path.join(os.path.dirname(ip), "python")
+    if os.path.isdir(os.path.join(module_dir, "interpatch")):
+        sys.path.insert(0, module_dir)
+        import time
+        import interpatch
+        surface = interpatch.build({"type": "interpolate", "points": {"npy": os.path.basename(grid)}}, base_dir=a.work)
+        library = []
+        for _ in range(a.rounds):
+            t0 = time.perf_counter()
+            surface.write(os.path.join(a.work, "library.html"))
+            library.append(time.perf_counter() - t0)
+        print("io::write_view alone (ms): " + ", ".join(f"{1000 * t:.1f}" for t in library) +
+              f"; median {1000 * statistics.median(library):.1f}")
+
+    # The most a surface's page holds: --res 1000x1000 is shown at 512 x 512.
+    largest = os.path.join(a.work, "grid1000_largest.html")
+    subprocess.run([ip, "view", grid, "-o", largest, "--res", "1000x1000"], check=True)
+    print(f"page with --res 1000x1000 (shown 512 x 512): {os.path.getsize(largest)} bytes "
+          f"({os.path.getsize(largest) / 1e6:.2f} MB)")
+
     driver = vb.chromium()
     try:
-        times = []
-        for _ in range(a.rounds):
-            driver.get("about:blank")
-            times.append(vb.open_page(driver, page, timeout=60))
-            errors = vb.console_errors(driver)
-            if errors:
-                sys.exit(f"the page reports errors: {errors}")
-        print("open and draw in Chromium (s): " + ", ".join(f"{t:.3f}" for t in times) +
-              f"; median {statistics.median(times):.3f}")
+        for label, path in (("default", page), ("--res 1000x1000", largest)):
+            times = []
+            for _ in range(a.rounds):
+                driver.get("about:blank")
+                times.append(vb.open_page(driver, path, timeout=60))
+                errors = vb.console_errors(driver)
+                if errors:
+                    sys.exit(f"the page reports errors: {errors}")
+            print(f"open and draw in Chromium, {label} (s): " + ", ".join(f"{t:.3f}" for t in times) +
+                  f"; median {statistics.median(times):.3f}")
     finally:
         driver.quit()
 

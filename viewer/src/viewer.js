@@ -45,9 +45,8 @@ function resize() {
   renderer.setSize(w, h);
   camera.aspect = w / Math.max(h, 1);
   camera.updateProjectionMatrix();
-  render();
 }
-window.addEventListener('resize', resize);
+window.addEventListener('resize', () => { resize(); render(); });
 
 // ---- colourings -------------------------------------------------------------------
 function paletteAt(stops, t) {
@@ -401,7 +400,7 @@ controls.update();
 controls.saveState();
 document.getElementById('reset').addEventListener('click', () => { controls.reset(); render(); });
 resize();
-repaint();
+repaint();  // draws the first picture
 // Drawn: the milliseconds since the page's navigation began (tools/bench_viewer.py).
 document.body.dataset.readyMs = String(performance.now());
 document.body.dataset.ready = 'true';
