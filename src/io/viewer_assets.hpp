@@ -2,7 +2,6 @@
 // The files of the viewer page, embedded at build time (cmake/viewer.cmake): three.js
 // as viewer/package-lock.json pins it, its OrbitControls, and viewer/src.
 
-#include <initializer_list>
 #include <span>
 #include <string>
 #include <string_view>
@@ -21,13 +20,10 @@ struct ViewerAssets {
 /// The assets, joined from their pieces on first use.
 const ViewerAssets& viewer_assets();
 
-/// The pieces of one file, in order, as one string.
-inline std::string joined(std::span<const std::string_view> pieces) {
+/// The pieces of one file (string literals), in order, as one string.
+inline std::string joined(std::span<const char* const> pieces) {
   std::string s;
-  std::size_t n = 0;
-  for (const std::string_view p : pieces) n += p.size();
-  s.reserve(n);
-  for (const std::string_view p : pieces) s += p;
+  for (const char* p : pieces) s += p;
   return s;
 }
 
