@@ -19,6 +19,7 @@
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/io/json_out.hpp"
 #include "interpatch/memory.hpp"
+#include "interpatch/volume.hpp"
 #include "io/viewer_assets.hpp"
 
 namespace interpatch::io {
@@ -235,18 +236,25 @@ ojson volume_json(const Volume& v, const std::array<std::size_t, 3>& res) {
   return {{"shape", {res[0], res[1], res[2]}}, {"positions", points.json()}, {"det_j", det.json()}};
 }
 
-// A Hermite patch's given corner derivatives are the surface's own there.
+// A Hermite patch's (volume's) given corner derivatives are its own there.
 ojson frames_json(const Construction& c) {
+  const auto vec = [](const Vec3& p) { return ojson::array({p.x, p.y, p.z}); };
   ojson frames = ojson::array();
-  if (c.type != "hermite_patch") return frames;
-  const Surface& s = evaluator(c);
-  const char* names[4] = {"p00", "p01", "p10", "p11"};
-  for (std::size_t k = 0; k < 4; ++k) {
-    const SurfaceDerivatives d = s.derivatives(static_cast<double>(k / 2), static_cast<double>(k % 2));
-    frames.push_back({{"at", cat("/corners/", names[k])},
-                      {"p", {d.s.x, d.s.y, d.s.z}},
-                      {"du", {d.su.x, d.su.y, d.su.z}},
-                      {"dv", {d.sv.x, d.sv.y, d.sv.z}}});
+  if (c.type == "hermite_patch") {
+    const Surface& s = evaluator(c);
+    const char* names[4] = {"p00", "p01", "p10", "p11"};
+    for (std::size_t k = 0; k < 4; ++k) {
+      const SurfaceDerivatives d = s.derivatives(static_cast<double>(k / 2), static_cast<double>(k % 2));
+      frames.push_back({{"at", cat("/corners/", names[k])}, {"p", vec(d.s)}, {"du", vec(d.su)}, {"dv", vec(d.sv)}});
+    }
+  } else if (c.type == "hermite_volume") {
+    const Volume& v = volume_evaluator(c);
+    for (std::size_t k = 0; k < 8; ++k) {  // corner (i, j, k) at index 4i + 2j + k, as the spec lists them
+      const VolumeDerivatives d =
+          v.derivatives(static_cast<double>(k / 4), static_cast<double>((k / 2) % 2), static_cast<double>(k % 2));
+      frames.push_back(
+          {{"at", cat("/corners/", k)}, {"p", vec(d.s)}, {"du", vec(d.su)}, {"dv", vec(d.sv)}, {"dw", vec(d.sw)}});
+    }
   }
   return frames;
 }
@@ -392,15 +400,12 @@ std::string view_thumbnail_svg(const Construction& c, std::size_t width, std::si
     patches.push_back({24, 24, std::vector<Vec3>(g.data(), g.data() + g.size())});
   }
   // The viewer's first view: from the side of -y and +x, 35 degrees above the xy plane.
-  double zmin = INFINITY, zmax = -INFINITY;
   Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
   for (const Patch& p : patches)
     for (const Vec3& x : p.points) {
       lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
       hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
     }
-  zmin = lo.z;
-  zmax = hi.z;
   const Vec3 centre = 0.5 * (lo + hi);
   const double yaw = -0.785398163397448, pitch = 0.610865238198015;  // -45 and 35 degrees
   const Vec3 right{std::cos(yaw), -std::sin(yaw), 0};
@@ -434,13 +439,15 @@ std::string view_thumbnail_svg(const Construction& c, std::size_t width, std::si
         const Vec3 n = cross(q[2] - q[0], q[3] - q[1]);
         const double len = norm(n);
         const double lit = len > 0 ? 0.35 + 0.65 * std::abs(dot(n, light)) / len : 0.35;
-        const auto rgb = palette_at(height_palette, zmax > zmin ? (z / 4 - zmin) / (zmax - zmin) : 0.5);
+        const auto rgb = palette_at(height_palette, hi.z > lo.z ? (z / 4 - lo.z) / (hi.z - lo.z) : 0.5);
         quad.rgb = {rgb[0] * lit, rgb[1] * lit, rgb[2] * lit};
         quads.push_back(quad);
       }
   // Farthest first.
   std::sort(quads.begin(), quads.end(), [](const Quad& a, const Quad& b) { return a.depth > b.depth; });
   const double w = static_cast<double>(width), h = static_cast<double>(height), margin = 6;
+  // One scale for both directions, fitting the wider one; a flat picture (a patch seen
+  // edge on) is not stretched to fill the other.
   const double extent = std::max({xmax - xmin, ymax - ymin, 1e-300});
   const double scale = std::min((w - 2 * margin) / std::max(xmax - xmin, extent * 1e-9),
                                 (h - 2 * margin) / std::max(ymax - ymin, extent * 1e-9));

@@ -158,17 +158,25 @@ TEST(ViewHtml, TheSummaryIsInfoAndEveryDataSetIsShown) {
     }
     EXPECT_EQ(d["frames"].size(), std::string(name) == "hermite_patch" ? 4u : 0u);
   }
+  EXPECT_EQ(page_data(io::view_html(example("hermite_volume")))["frames"].size(), 8u);
 }
 
 TEST(ViewHtml, HermiteFramesAreTheGivenCornerDerivatives) {
-  const json spec = json::parse(test::read_text(fs::path(INTERPATCH_EXAMPLES) / "hermite_patch.json"));
-  const json d = page_data(io::view_html(example("hermite_patch")));
-  for (const json& f : d["frames"]) {
-    const std::string corner = f["at"].get<std::string>().substr(std::string("/corners/").size());
-    for (const char* key : {"p", "du", "dv"})
-      for (std::size_t a = 0; a < 3; ++a)
-        // The patch reproduces its corner data to rounding (a few units of 1e-16 of these O(1) values).
-        EXPECT_NEAR(f[key][a].get<double>(), spec["corners"][corner][key][a].get<double>(), 1e-12) << corner << " " << key;
+  for (const char* name : {"hermite_patch", "hermite_volume"}) {
+    const json spec = json::parse(test::read_text(fs::path(INTERPATCH_EXAMPLES) / (std::string(name) + ".json")));
+    const json d = page_data(io::view_html(example(name)));
+    ASSERT_FALSE(d["frames"].empty()) << name;
+    for (const json& f : d["frames"]) {
+      const std::string at = f["at"];
+      const json& given = spec.at(json::json_pointer(at));
+      for (const char* key : {"p", "du", "dv", "dw"}) {
+        if (!given.contains(key)) continue;
+        for (std::size_t a = 0; a < 3; ++a)
+          // Hermite constructions reproduce their corner data to rounding (a few units
+          // of 1e-16 of these O(1) values).
+          EXPECT_NEAR(f[key][a].get<double>(), given[key][a].get<double>(), 1e-12) << at << " " << key;
+      }
+    }
   }
 }
 

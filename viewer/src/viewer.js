@@ -17,7 +17,7 @@ function floats(array) {
 
 const colours = {
   background: 0x20232a, data: 0xff8c1a, net: 0xc8c8d0, isolines: 0x15171c, inverted: 0xff1744,
-  du: 0xe53935, dv: 0x43a047, normal: 0x1e88e5,
+  du: 0xe53935, dv: 0x43a047, dw: 0x1e88e5,
 };
 
 // ---- scene, camera, controls ------------------------------------------------------
@@ -305,13 +305,14 @@ function addData(sets) {
 function addFrames(frames) {
   for (const f of frames) {
     const origin = new THREE.Vector3(...f.p);
-    for (const [key, colour] of [['du', colours.du], ['dv', colours.dv]]) {
+    for (const [key, colour] of [['du', colours.du], ['dv', colours.dv], ['dw', colours.dw]]) {
+      if (!f[key]) continue;
       const d = new THREE.Vector3(...f[key]);
-      const length = d.length() / 3;  // a third of the derivative: the Bézier handle of a cubic Hermite patch
+      const length = d.length() / 3;  // a third of the derivative: the Bézier handle of a cubic Hermite patch or volume
       if (length > 0) groups.data.add(new THREE.ArrowHelper(d.normalize(), origin, length, colour, 0.2 * length, 0.1 * length));
     }
   }
-  if (frames.length) shown.push(`corner frames: S_u (red) and S_v (green) at ${frames.map((f) => f.at).join(', ')}, a third of their length`);
+  if (frames.length) shown.push(`corner frames: S_u (red), S_v (green)${frames[0].dw ? ', S_w (blue)' : ''} at ${frames.map((f) => f.at).join(', ')}, a third of their length`);
 }
 
 // ---- the summary: the numbers `interpatch info` prints --------------------------------
