@@ -392,7 +392,7 @@ const sphere = box.getBoundingSphere(new THREE.Sphere());
 const radius = Math.max(sphere.radius, 1e-9);
 const yaw = Math.PI / 4, pitch = 35 * Math.PI / 180;
 // The bounding sphere seen whole is a generous bound: most shapes fill little of it.
-const distance = radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)) * 0.8;
+const distance = radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)) * 0.9;
 camera.position.copy(sphere.center).add(new THREE.Vector3(Math.sin(yaw) * Math.cos(pitch), -Math.cos(yaw) * Math.cos(pitch), Math.sin(pitch)).multiplyScalar(distance));
 camera.near = distance / 100;
 camera.far = distance * 100;
