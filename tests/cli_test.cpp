@@ -421,6 +421,21 @@ TEST_F(CliTest, MeshWritesEveryFormatAtTheRequestedResolution) {
   EXPECT_NE(read_file(at("d.ply")).find("element vertex 4096"), std::string::npos);
 }
 
+// The viewer page decimates what it cannot hold, never refuses it: counts too large
+// to represent and very elongated requests alike.
+TEST_F(CliTest, ViewDecimatesRatherThanRefuses) {
+  write_grid_spec("s.json", 3, 6, 9);
+  for (const char* res : {"100000000x3", "99999999999999999999999x99999999999999999999999", "700x700"}) {
+    const Result r = run({"view", "s.json", "-o", "page.html", "--res", res});
+    ASSERT_EQ(r.status, 0) << res << ": " << r.err;
+    const std::string page = read_file(at("page.html"));
+    const std::size_t a = page.find(R"("shown":[)") + 9;
+    const json shown = json::parse("[" + page.substr(a, page.find(']', a) - a) + "]");
+    EXPECT_LE(shown[0].get<std::size_t>() * shown[1].get<std::size_t>(), 512u * 512u) << res;
+    EXPECT_GE(shown[1].get<std::size_t>(), 2u) << res;
+  }
+}
+
 TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
   const Result r = run({"demo", "-o", "out"});
   ASSERT_EQ(r.status, 0) << r.err;

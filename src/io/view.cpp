@@ -315,13 +315,46 @@ std::array<std::size_t, 3> view_default_resolution(const Construction& c) noexce
 
 std::array<std::size_t, 3> view_resolution(std::array<std::size_t, 3> asked, std::size_t limit) noexcept {
   const std::size_t dims = asked[2] ? 3 : 2;
-  double product = 1;
-  for (std::size_t a = 0; a < dims; ++a) product *= static_cast<double>(asked[a]);
-  if (product <= static_cast<double>(limit)) return asked;
-  const double f = std::pow(static_cast<double>(limit) / product, 1.0 / static_cast<double>(dims));
-  for (std::size_t a = 0; a < dims; ++a)
-    asked[a] = std::max<std::size_t>(2, static_cast<std::size_t>(std::floor(static_cast<double>(asked[a]) * f)));
-  return asked;
+  const auto product = [&](const std::array<std::size_t, 3>& n) {
+    double p = 1;
+    for (std::size_t a = 0; a < dims; ++a) p *= static_cast<double>(n[a]);
+    return p;
+  };
+  if (product(asked) <= static_cast<double>(limit)) return asked;
+  // One factor for every direction; a direction it would take below 2 keeps 2, and
+  // the others share what is left (a 10^9 x 3 request is not 10^5 x 2 x ...).
+  std::array<std::size_t, 3> shown = asked;
+  std::array<bool, 3> at_two{false, false, false};
+  double budget = static_cast<double>(limit);
+  for (;;) {
+    double free_product = 1;
+    std::size_t free = 0;
+    for (std::size_t a = 0; a < dims; ++a)
+      if (!at_two[a]) {
+        free_product *= static_cast<double>(asked[a]);
+        ++free;
+      }
+    if (free == 0) break;
+    const double f = std::pow(budget / free_product, 1.0 / static_cast<double>(free));
+    bool clamped = false;
+    for (std::size_t a = 0; a < dims; ++a)
+      if (!at_two[a] && static_cast<double>(asked[a]) * f < 2) {
+        at_two[a] = clamped = true;
+        shown[a] = 2;
+        budget /= 2;
+      }
+    if (clamped) continue;  // the factor again, for the directions left
+    for (std::size_t a = 0; a < dims; ++a)
+      if (!at_two[a]) shown[a] = std::max<std::size_t>(2, static_cast<std::size_t>(static_cast<double>(asked[a]) * f));
+    break;
+  }
+  // Rounding in pow may leave the product a little over: the largest count gives way.
+  while (product(shown) > static_cast<double>(limit)) {
+    std::size_t* largest = std::max_element(shown.begin(), shown.begin() + static_cast<std::ptrdiff_t>(dims));
+    if (*largest <= 2) break;
+    --*largest;
+  }
+  return shown;
 }
 
 std::string view_html(const Construction& c, const ViewOptions& options) {

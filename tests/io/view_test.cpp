@@ -12,6 +12,7 @@
 #include <bit>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <regex>
 #include <string>
 #include <vector>
@@ -101,6 +102,24 @@ TEST(ViewResolution, WithinTheLimitAsAskedAndBeyondItScaledEvenly) {
       // As many as fit: one more in every direction would not.
       EXPECT_GT(product_next, limit);
     }
+  }
+  // Elongated requests, up to counts too large to represent (what --res passes on):
+  // still within the limit, the short directions at 2 or more, the long ones given the rest.
+  constexpr std::size_t huge = std::numeric_limits<std::size_t>::max();
+  for (const std::array<std::size_t, 3>& asked : {std::array<std::size_t, 3>{huge, 3, 0}, {2, huge, 0}, {huge, huge, 0},
+                                                  {3, 1000000000, 0}, {huge, 2, 2}, {2, 5, huge}, {huge, huge, huge}}) {
+    const bool volume = asked[2] != 0;
+    const std::size_t limit = volume ? io::view_limits.volume_samples : io::view_limits.surface_samples;
+    const auto shown = io::view_resolution(asked, limit);
+    const double product = static_cast<double>(shown[0]) * static_cast<double>(shown[1]) *
+                           static_cast<double>(volume ? shown[2] : 1);
+    EXPECT_LE(product, static_cast<double>(limit)) << asked[0] << " " << asked[1] << " " << asked[2];
+    for (std::size_t a = 0; a < (volume ? 3u : 2u); ++a) {
+      EXPECT_GE(shown[a], 2u);
+      EXPECT_LE(shown[a], asked[a]);
+    }
+    // The long directions get what the short ones leave: more than half of it.
+    EXPECT_GT(2 * product, static_cast<double>(limit)) << asked[0] << " " << asked[1] << " " << asked[2];
   }
 }
 

@@ -39,9 +39,10 @@ struct ViewLimits {
 };
 inline constexpr ViewLimits view_limits{};
 
-/// The resolution a page shows for `asked` samples (per direction, nw = 0 for a
-/// surface): each count scaled by the same factor until the product is within
-/// `limit`, at least 2 each; `asked` itself when already within.
+/// The resolution a page shows for `asked` samples (per direction, each at least 2;
+/// nw = 0 for a surface): `asked` itself when its product is within `limit`, otherwise
+/// each count scaled by one factor so that the product is within it — a count the
+/// factor would take below 2 stays 2, and the others share the rest.
 [[nodiscard]] std::array<std::size_t, 3> view_resolution(std::array<std::size_t, 3> asked, std::size_t limit) noexcept;
 
 /// The viewer page of a construction as text: the page of viewer/src (three.js and
