@@ -5,6 +5,7 @@ Shared by the browser tests (tools/check_viewer.py), the pictures of the README
 (tools/make_pictures.py) and the page benchmark (tools/bench_viewer.py).
 """
 
+import base64
 import json
 import os
 import shutil
@@ -38,13 +39,18 @@ def chromium(width=1100, height=800):
 
 
 def open_page(driver, path, timeout=30):
-    """Loads a page from file:// and waits until its script says it has drawn.
-    Returns the seconds from the navigation's start to that moment, as the page
-    measured them (performance.now() once drawn)."""
+    """Loads a page from file:// and waits until its script has run and its first
+    picture is complete (a pixel read back from the canvas waits for the rendering,
+    which SwiftShader does on the processor after the script returns). Returns the
+    seconds from the navigation's start to that moment, as the page measures them
+    (performance.now())."""
     driver.get("file://" + os.path.abspath(path))
     WebDriverWait(driver, timeout, poll_frequency=0.05).until(
         lambda d: d.execute_script("return document.body && document.body.dataset.ready === 'true'"))
-    return float(driver.execute_script("return document.body.dataset.readyMs")) / 1000
+    return float(driver.execute_script("""
+        const gl = document.querySelector('#view canvas').getContext('webgl2');
+        gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
+        return performance.now();""")) / 1000
 
 
 def console_errors(driver):
@@ -67,18 +73,19 @@ def requests(driver, page_path):
 
 
 def canvas_pixels(driver):
-    """The WebGL canvas as (width, height, rgb bytes), read in the page."""
+    """The WebGL canvas as (width, height, rgb bytes), read in the page (rows bottom
+    to top, as WebGL reads them)."""
     result = driver.execute_script("""
         const c = document.querySelector('#view canvas');
-        const t = document.createElement('canvas');
-        t.width = c.width; t.height = c.height;
-        const g = t.getContext('2d');
-        g.drawImage(c, 0, 0);
-        const d = g.getImageData(0, 0, t.width, t.height).data;
+        const gl = c.getContext('webgl2');
+        const w = gl.drawingBufferWidth, h = gl.drawingBufferHeight;
+        const d = new Uint8Array(4 * w * h);
+        gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, d);
+        const rgb = new Uint8Array(3 * w * h);
+        for (let k = 0, j = 0; k < d.length; k += 4, j += 3) { rgb[j] = d[k]; rgb[j + 1] = d[k + 1]; rgb[j + 2] = d[k + 2]; }
         let s = '';
-        for (let k = 0; k < d.length; k += 4) s += String.fromCharCode(d[k], d[k + 1], d[k + 2]);
-        return [t.width, t.height, btoa(s)];""")
-    import base64
+        for (let k = 0; k < rgb.length; k += 8192) s += String.fromCharCode.apply(null, rgb.subarray(k, k + 8192));
+        return [w, h, btoa(s)];""")
     return result[0], result[1], base64.b64decode(result[2])
 
 
