@@ -18,16 +18,21 @@ SHELL := /bin/bash
 #   libsisl-dev                      SISL races us in make bench
 #   clang libclang-rt-14-dev libomp-14-dev   libFuzzer (with its OpenMP) runs the fuzz targets of make test
 #   libeigen3-dev                    the sparse Cholesky decomposition of approximation's normal equations
+#   chromium chromium-driver python3-selenium   the viewer pages opened in a real browser (make test,
+#                                    make pictures, make bench-viewer)
+#   nodejs npm                       npm ci installs three.js for the viewer (viewer/package-lock.json);
+#                                    installed only when npm is not already on PATH
 DEBS := cmake ninja-build g++ pkg-config python3 libcli11-dev nlohmann-json3-dev \
         libgtest-dev libgmock-dev libbenchmark-dev python3-numpy python3-vtk9 python3-matplotlib \
         libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
         libocct-foundation-dev libsisl-dev python3-scipy clang libclang-rt-14-dev libomp-14-dev \
         pybind11-dev python3-pybind11 python3-dev python3-pytest \
-        libeigen3-dev
+        libeigen3-dev chromium chromium-driver python3-selenium $(if $(shell command -v npm),,nodejs npm)
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
-.PHONY: all deps build install demo test test-release test-asan test-fuzz fuzz fuzz-build bench clean
+.PHONY: all deps viewer-deps build install demo test test-release test-asan test-fuzz fuzz fuzz-build bench clean \
+        pictures bench-viewer
 
 all: build
 
@@ -41,7 +46,14 @@ deps:
 	  $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
 
-build: deps
+# three.js for the viewer page, as viewer/package-lock.json pins it (the build embeds
+# it and stops without it). Again whenever the lock file changes.
+viewer-deps: deps viewer/node_modules/.package-lock.json
+viewer/node_modules/.package-lock.json: viewer/package-lock.json viewer/package.json
+	npm ci --prefix viewer --no-audit --no-fund
+	touch $@
+
+build: viewer-deps
 	cmake --preset release
 	cmake --build --preset release -j $(JOBS)
 
@@ -57,7 +69,7 @@ demo: build
 test-release: build
 	ctest --preset release -j $(JOBS)
 
-test-asan: deps
+test-asan: viewer-deps
 	cmake --preset asan
 	cmake --build --preset asan -j $(JOBS)
 	ctest --preset asan -j $(JOBS)
@@ -68,7 +80,7 @@ test-asan: deps
 FUZZ_TEST_SECONDS ?= 20
 FUZZ_SECONDS ?= 600
 
-fuzz-build: deps
+fuzz-build: viewer-deps
 	cmake --preset fuzz
 	cmake --build --preset fuzz -j $(JOBS)
 
@@ -102,6 +114,16 @@ bench: deps
 	env $(BENCH_ENV) ./build/bench/bench/compare $(COMPARE_FLAGS) --json $(COMPARE_OUT) \
 	  --workdir build/bench/compare-work --commit "$$(git describe --always --dirty 2>/dev/null || echo unknown)"
 	/usr/bin/python3 tools/plot_bench.py $(COMPARE_OUT) -o docs/bench_interpolation.png
+
+# The README's pictures: viewer pages of the examples rendered to docs/images/*.png
+# by headless Chromium (tools/make_pictures.py).
+pictures: build
+	/usr/bin/python3 tools/make_pictures.py ./build/release/interpatch docs/images
+
+# A 1000 x 1000 surface's viewer page: its size, the time `interpatch view` takes to
+# write it and the time Chromium takes to open and draw it (docs/BENCHMARKS.md).
+bench-viewer: build
+	/usr/bin/python3 tools/bench_viewer.py ./build/release/interpatch build/bench-viewer
 
 clean:
 	rm -rf build demo-output

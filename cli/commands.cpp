@@ -24,6 +24,7 @@
 #include "interpatch/io/npy.hpp"
 #include "interpatch/io/npz.hpp"
 #include "interpatch/io/step.hpp"
+#include "interpatch/io/view.hpp"
 #include "interpatch/memory.hpp"
 #include "progress.hpp"
 
@@ -267,6 +268,11 @@ void check_info_output(const fs::path& out) {
   throw usage_error("cannot tell the output format of '" + out.string() + "': info writes .json");
 }
 
+void check_view_output(const fs::path& out) {
+  if (io::is_view_format(out.extension().string())) return;
+  throw usage_error("cannot tell the output format of '" + out.string() + "': view writes .html (or .htm)");
+}
+
 void require_eval_room(const Resolution& grid, const fs::path& out) {
   constexpr std::size_t beyond = std::numeric_limits<std::size_t>::max();  // parse_count's "too large to count"
   const bool uncountable = grid.nu == beyond || grid.nv == beyond || grid.nw == beyond;
@@ -429,6 +435,27 @@ int info_command(const Input& in, const std::optional<fs::path>& out) {
     std::cout << text << std::flush;
     if (!std::cout) throw error(errc::file_unwritable, "standard output: write failed");
   }
+  report_warnings(c);
+  return 0;
+}
+
+int view_command(const Input& in, const fs::path& out, std::string_view res_text) {
+  std::optional<Resolution> given;
+  if (!res_text.empty()) {
+    const std::vector<std::size_t> n = parse_counts(res_text, view_res_option);
+    given = Resolution{n[0], n[1], n.size() == 3 ? n[2] : 0};
+  }
+  check_view_output(out);
+  io::check_writable(out);
+  // The page holds what `info` prints, whose error at the data needs the data.
+  const io::Construction c = build_input(in);
+  io::ViewOptions options;
+  if (given) {
+    check_counts_kind(c, view_res_option, *given);
+    options.resolution = {given->nu, given->nv, given->nw};
+  }
+  options.title = in.path.stem().string();
+  io::write_view(out, c, options);
   report_warnings(c);
   return 0;
 }

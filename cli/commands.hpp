@@ -47,6 +47,7 @@ struct CountsOption {
 
 inline constexpr CountsOption res_option{"--res", "mesh", "vertices", "NUxNV", "NUxNVxNW", "64x64", "33x33x33"};
 inline constexpr CountsOption grid_option{"--grid", "grid", "points", "NUxNV", "NUxNVxNW", "100x50", "17x17x17", true};
+inline constexpr CountsOption view_res_option{"--res", "view", "samples", "NUxNV", "NUxNVxNW", "257x257", "33x33x33"};
 inline constexpr CountsOption shape_option{"--shape", "grid of data points", "points", "NxM", "NxMxL", "40x50", "10x12x14"};
 
 /// The one parser of counts on the command line: "NUxNV" or "NUxNVxNW" (also with
@@ -99,6 +100,7 @@ void check_build_output(const std::filesystem::path& out);
 void check_mesh_output(const std::filesystem::path& out);
 void check_eval_output(const std::filesystem::path& out);
 void check_info_output(const std::filesystem::path& out);
+void check_view_output(const std::filesystem::path& out);
 
 /// Refuse (error too_large) an evaluation grid whose .npy file cannot fit on the
 /// output's disk (it is written a block at a time, and a block must fit in memory)
@@ -135,6 +137,8 @@ int build_command(const Input& in, const std::filesystem::path& out);
 int mesh_command(const Input& in, const std::filesystem::path& out, std::string_view res);
 int eval_command(const Input& in, const std::filesystem::path& out, std::string_view grid);
 int info_command(const Input& in, const std::optional<std::filesystem::path>& out);
+/// The viewer page (io::write_view); `res` empty: io::view_default_resolution.
+int view_command(const Input& in, const std::filesystem::path& out, std::string_view res);
 int demo_command(const std::filesystem::path& dir);
 
 /// Prints the warnings of a construction (ignored fields) on stderr.

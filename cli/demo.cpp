@@ -25,6 +25,7 @@
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/io/json_out.hpp"
 #include "interpatch/io/npy.hpp"
+#include "interpatch/io/view.hpp"
 
 namespace interpatch::cli {
 
@@ -632,6 +633,48 @@ fs::path prepare(fs::path dir) {
   return dir;
 }
 
+// One example in the gallery.
+struct GalleryEntry {
+  std::string name, type, about, thumbnail_svg, summary;
+};
+
+std::string html_text(const std::string& text) {
+  std::string s;
+  for (const char ch : text) {
+    if (ch == '<') s += "&lt;";
+    else if (ch == '>') s += "&gt;";
+    else if (ch == '&') s += "&amp;";
+    else if (ch == '"') s += "&quot;";
+    else s += ch;
+  }
+  return s;
+}
+
+// DIR/index.html: a card per example, its picture (drawn by interpatch, no browser
+// needed to make it) linking to its viewer page.
+void write_gallery(const fs::path& path, const std::vector<GalleryEntry>& entries) {
+  std::string page =
+      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+      "<title>interpatch demo</title>\n<style>\n"
+      "body { margin: 0; padding: 16px 24px; background: #1b1d23; color: #e8e8e8; font: 14px/1.4 system-ui, sans-serif; }\n"
+      "h1 { font-size: 20px; } .cards { display: flex; flex-wrap: wrap; gap: 16px; }\n"
+      ".card { width: 240px; background: #2b2f38; border-radius: 6px; overflow: hidden; }\n"
+      ".card a { color: inherit; text-decoration: none; } .card svg { display: block; }\n"
+      ".card div { padding: 6px 10px 10px; } .card b { font-size: 15px; } .card small { color: #aab; display: block; }\n"
+      "</style>\n</head>\n<body>\n<h1>interpatch demo</h1>\n"
+      "<p>Every example of <code>interpatch demo</code>: click a picture to open its viewer page (3D, offline), "
+      "made by <code>interpatch view</code>. The other outputs of each example are beside this file.</p>\n"
+      "<div class=\"cards\">\n";
+  for (const GalleryEntry& e : entries) {
+    const std::string view = html_text(e.name) + ".view.html";
+    page += "<div class=\"card\"><a href=\"" + view + "\">" + e.thumbnail_svg + "<div><b>" + html_text(e.name) +
+            "</b> <small>" + html_text(e.type) + ": " + html_text(e.about) + "</small><small>" + html_text(e.summary) +
+            "</small></div></a></div>\n";
+  }
+  page += "</div>\n</body>\n</html>\n";
+  write_text(path, page);
+}
+
 std::string short_number(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.2g", v);
@@ -645,8 +688,12 @@ int demo_command(const fs::path& requested) {
   constexpr Resolution eval_grid{33, 33, 0}, volume_eval_grid{17, 17, 17};
   const Resolution res = default_surface_resolution, volume_res = default_volume_resolution;
 
+  // The viewer pages of the demo are lighter than the command's default (257 x 257).
+  constexpr std::array<std::size_t, 3> view_res{129, 129, 0}, volume_view_res{17, 17, 17};
+
   std::size_t files = 0;
   std::string summary;
+  std::vector<GalleryEntry> gallery;
   for (const Example& ex : examples()) {
     std::vector<std::string> written;
     fs::path spec_path;
@@ -690,6 +737,7 @@ int demo_command(const fs::path& requested) {
     }
     const ojson description = info(c);
     write_text(out(".info.json"), io::pretty_json(description));
+    io::write_view(out(".view.html"), c, {.resolution = volume ? volume_view_res : view_res, .title = ex.name});
     report_warnings(c);
 
     const auto& err = description["max_data_error"];
@@ -723,13 +771,15 @@ int demo_command(const fs::path& requested) {
               short_number(jac["min_determinant"].get<double>()) + " to " +
               short_number(jac["max_determinant"].get<double>()) + ")";
     }
+    gallery.push_back({ex.name, c.type, ex.about, io::view_thumbnail_svg(c), line.substr(line.rfind("\n      ") + 7)});
     line += "\n      ";
     for (std::size_t i = 0; i < written.size(); ++i) line += (i ? " " : "") + written[i];
     summary += line + "\n";
     files += written.size();
   }
-  std::printf("interpatch demo: %zu examples\n%soutputs in %s: %zu files\n", examples().size(), summary.c_str(),
-              dir.string().c_str(), files);
+  write_gallery(dir / "index.html", gallery);
+  std::printf("interpatch demo: %zu examples\n%soutputs in %s: %zu files\nopen %s in a web browser to see every example\n",
+              examples().size(), summary.c_str(), dir.string().c_str(), files + 1, (dir / "index.html").string().c_str());
   return 0;
 }
 

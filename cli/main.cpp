@@ -1,4 +1,4 @@
-// The interpatch command: build, mesh, eval, info, demo.
+// The interpatch command: build, mesh, eval, info, view, demo.
 // Exit status: 0 ok, 2 bad usage, 3 invalid input, 4 files, 5 too large, 1 else;
 // every failure prints exactly one line on stderr, "interpatch: <message>".
 
@@ -101,6 +101,14 @@ int main(int argc, char** argv) {
   std::optional<std::string> info_out;
   info->add_option("-o,--output", info_out, "Write the object to this .json file instead of stdout");
 
+  CLI::App* view = app.add_subcommand("view", "Write a viewer page: one self-contained .html file showing it in 3D in a browser");
+  add_input(view);
+  view->add_option("-o,--output", out, "Output file: .html (or .htm), which loads nothing from a network or another file")
+      ->required();
+  view->add_option("--res", res,
+                   "Samples along u and v, NUxNV (default 257x257); for a volume NUxNVxNW (default 33x33x33);\n"
+                   "more than the page holds (512x512, 65x65x65) are decimated for display");
+
   CLI::App* demo = app.add_subcommand("demo", "Run every construction on built-in examples");
   demo->add_option("-o,--output", demo_dir, "Directory for the outputs (created if missing; its parent must exist)")
       ->capture_default_str();
@@ -108,8 +116,9 @@ int main(int argc, char** argv) {
   // CLI11 would call an unknown command an extra argument after a missing one.
   if (argc > 1 && argv[1][0] != '-') {
     const std::string first = argv[1];
-    if (first != "build" && first != "mesh" && first != "eval" && first != "info" && first != "demo")
-      return fail_with(2, "unknown command '" + first + "'; the commands are build, mesh, eval, info, demo (see interpatch --help)");
+    if (first != "build" && first != "mesh" && first != "eval" && first != "info" && first != "view" &&
+        first != "demo")
+      return fail_with(2, "unknown command '" + first + "'; the commands are build, mesh, eval, info, view, demo (see interpatch --help)");
   }
 
   try {
@@ -131,6 +140,7 @@ int main(int argc, char** argv) {
     if (*build) return cli::build_command(input, out);
     if (*mesh) return cli::mesh_command(input, out, res);
     if (*eval) return cli::eval_command(input, out, grid);
+    if (*view) return cli::view_command(input, out, res);
     if (*info) {
       std::optional<std::filesystem::path> o;
       if (info_out) o = *info_out;

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <span>
 #include <sstream>
 #include <string>
@@ -420,10 +421,37 @@ TEST_F(CliTest, MeshWritesEveryFormatAtTheRequestedResolution) {
   EXPECT_NE(read_file(at("d.ply")).find("element vertex 4096"), std::string::npos);
 }
 
+// The viewer page decimates what it cannot hold, never refuses it: counts too large
+// to represent and very elongated requests alike.
+TEST_F(CliTest, ViewDecimatesRatherThanRefuses) {
+  write_grid_spec("s.json", 3, 6, 9);
+  for (const char* res : {"100000000x3", "99999999999999999999999x99999999999999999999999", "700x700"}) {
+    const Result r = run({"view", "s.json", "-o", "page.html", "--res", res});
+    ASSERT_EQ(r.status, 0) << res << ": " << r.err;
+    const std::string page = read_file(at("page.html"));
+    const std::size_t a = page.find(R"("shown":[)") + 9;
+    const json shown = json::parse("[" + page.substr(a, page.find(']', a) - a) + "]");
+    EXPECT_LE(shown[0].get<std::size_t>() * shown[1].get<std::size_t>(), 512u * 512u) << res;
+    EXPECT_GE(shown[1].get<std::size_t>(), 2u) << res;
+  }
+}
+
 TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
   const Result r = run({"demo", "-o", "out"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("outputs in out"), std::string::npos) << r.out;
+  // The gallery: for every example a picture linking to its viewer page; the last line
+  // says to open it.
+  const std::string last_line = "open " + (fs::path("out") / "index.html").string() + " in a web browser to see every example\n";
+  ASSERT_GE(r.out.size(), last_line.size());
+  EXPECT_EQ(r.out.substr(r.out.size() - last_line.size()), last_line);
+  const std::size_t example_count = std::stoul(r.out.substr(r.out.find(": ") + 2));
+  const std::string gallery = read_file(at("out") / "index.html");
+  const std::regex card(R"re(<a href="([a-z_0-9]+\.view\.html)"><svg )re");
+  std::size_t cards = 0;
+  for (auto it = std::sregex_iterator(gallery.begin(), gallery.end(), card); it != std::sregex_iterator(); ++it, ++cards)
+    EXPECT_TRUE(fs::exists(at("out") / (*it)[1].str())) << (*it)[1];
+  EXPECT_EQ(cards, example_count);
   for (const char* name : {"hemisphere", "terrain", "wave", "saddle", "pipe", "half_cylinder", "twisted_strip"}) {
     for (const char* suffix :
          {".spec.json", ".bspline.json", ".bspline.npz", ".step", ".igs", ".eval.npy", ".eval.csv", ".obj", ".vtk",

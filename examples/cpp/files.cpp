@@ -1,6 +1,6 @@
 // Files: atomic output (io/atomic_file.hpp), points as CSV (io/csv.hpp) and NumPy
 // .npy (io/npy.hpp), meshes (io/mesh.hpp), and the exact form as STEP (io/step.hpp)
-// and IGES (io/iges.hpp) and NumPy .npz (io/npz.hpp), each example run and what it writes read back. The
+// and IGES (io/iges.hpp) and NumPy .npz (io/npz.hpp), the viewer page (io/view.hpp), each example run and what it writes read back. The
 // examples name files relative to the working directory, so the program works in a
 // scratch directory of its own, removed at the end. Links interpatch::interpatch.
 
@@ -218,6 +218,20 @@ void iges_files(const fs::path& examples) {
   std::printf("terrain as IGES: %zu lines of 80 columns\n", lines.size());
 }
 
+// The viewer page (io/view.hpp): one HTML file holding everything it shows.
+void view_pages(const fs::path& examples) {
+  fs::copy_file(examples / "coons.json", "coons.json");
+  interpatch::io::Construction c = interpatch::io::build_file("coons.json");
+  interpatch::io::write_view("coons.html", c);  // open it in a browser
+  const std::string page = read_text("coons.html");
+  example::expect(page.starts_with("<!DOCTYPE html>"), "coons.html is an HTML page");
+  example::expect(page.find(R"(id="interpatch-data")") != std::string::npos, "with the construction's data inside");
+  example::expect(page.find(" src=") == std::string::npos, "and no script loaded from elsewhere");
+  const std::string svg = interpatch::io::view_thumbnail_svg(c);
+  example::expect(svg.starts_with("<svg") && svg.find("<polygon") != std::string::npos, "the thumbnail is an SVG picture");
+  std::printf("coons.html: a viewer page of %zu bytes\n", page.size());
+}
+
 // The exact form as a NumPy archive (io/npz.hpp): written, read back from the file
 // and from bytes in memory, the same surface each time. Runs after iges_files, which
 // put terrain.json here.
@@ -263,5 +277,6 @@ int main() {
     step_files(INTERPATCH_EXAMPLES_DIR);
     iges_files(INTERPATCH_EXAMPLES_DIR);
     npz_files();
+    view_pages(INTERPATCH_EXAMPLES_DIR);
   });
 }

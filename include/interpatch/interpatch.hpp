@@ -13,3 +13,4 @@
 #include "interpatch/io/npz.hpp"
 #include "interpatch/io/spec.hpp"
 #include "interpatch/io/step.hpp"
+#include "interpatch/io/view.hpp"

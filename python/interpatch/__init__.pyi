@@ -25,7 +25,8 @@ class Construction:
     def info(self) -> dict[str, Any]:
         """The dict `interpatch info` prints."""
     def write(self, path: _Path, res: Optional[Sequence[int]] = None) -> None:
-        """.json .npz .step .igs (the exact form) or .obj .ply .stl .vtk .vts .xyz (a mesh of res vertices)."""
+        """.json .npz .step .igs (the exact form), .obj .ply .stl .vtk .vts .xyz (a mesh of res vertices)
+        or .html (a viewer page of res samples, as `interpatch view` writes it)."""
     @property
     def params_u(self) -> Optional[_Array]: ...
     @property

@@ -22,6 +22,7 @@
 #include "interpatch/io/json_out.hpp"
 #include "interpatch/io/mesh.hpp"
 #include "interpatch/io/spec.hpp"
+#include "interpatch/io/view.hpp"
 
 namespace py = pybind11;
 namespace ip = interpatch;
@@ -96,27 +97,35 @@ class PyBuilt {
 
   [[nodiscard]] const std::string& type() const { return b_->c.type; }
 
-  // Written as the commands write: .json .npz .step/.stp .igs/.iges (the exact form) or
-  // a mesh (.obj .ply .stl .vtk .vts .xyz) of `res` vertices.
+  // Written as the commands write: .json .npz .step/.stp .igs/.iges (the exact form),
+  // a mesh (.obj .ply .stl .vtk .vts .xyz) of `res` vertices, or a viewer page (.html)
+  // of `res` samples.
   void write(const std::filesystem::path& path, const std::optional<std::vector<std::size_t>>& res) const {
     namespace cli = ip::cli;
     py::gil_scoped_release free;
     std::lock_guard<std::mutex> hold(b_->lock);
+    const bool volume = ip::io::is_volume(b_->c);
+    // res as given, or `fallback`: (nu, nv) for a surface, (nu, nv, nw) for a volume.
+    const auto resolution = [&](const cli::Resolution& fallback) {
+      if (!res) return fallback;
+      if (res->size() != (volume ? 3u : 2u))
+        throw ip::error(ip::errc::size_mismatch, std::string("res: ") + (volume ? "(nu, nv, nw)" : "(nu, nv)") +
+                                                     " vertices, got " + std::to_string(res->size()) + " counts");
+      return cli::Resolution{(*res)[0], (*res)[1], volume ? (*res)[2] : 0};
+    };
     try {
       if (ip::io::is_mesh_format(path.extension().string())) {
-        const bool volume = ip::io::is_volume(b_->c);
-        cli::Resolution r = volume ? cli::default_volume_resolution : cli::default_surface_resolution;
-        if (res) {
-          if (res->size() != (volume ? 3u : 2u))
-            throw ip::error(ip::errc::size_mismatch, std::string("res: ") + (volume ? "(nu, nv, nw)" : "(nu, nv)") +
-                                                         " vertices, got " + std::to_string(res->size()) + " counts");
-          r = {(*res)[0], (*res)[1], volume ? (*res)[2] : 0};
-        }
-        cli::write_mesh(b_->c, path, r);
+        cli::write_mesh(b_->c, path, resolution(volume ? cli::default_volume_resolution : cli::default_surface_resolution));
+        return;
+      }
+      if (ip::io::has_exact_form(b_->c)) (void)ip::io::exact_form(b_->c);  // the page shows it, as the command does
+      if (ip::io::is_view_format(path.extension().string())) {
+        const auto d = ip::io::view_default_resolution(b_->c);
+        const cli::Resolution r = resolution({d[0], d[1], d[2]});
+        ip::io::write_view(path, b_->c, {.resolution = {r.nu, r.nv, r.nw}, .title = path.stem().string()});
         return;
       }
       cli::check_build_output(path);
-      if (ip::io::has_exact_form(b_->c)) (void)ip::io::exact_form(b_->c);
       cli::write_build(b_->c, path);
     } catch (const cli::usage_error& e) {
       throw ip::error(ip::errc::wrong_type, e.what());
@@ -345,9 +354,10 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("type", &PyBuilt::type, "The spec's \"type\".")
       .def("info", &PyBuilt::info, "The dict `interpatch info` prints for this construction.")
       .def("write", &PyBuilt::write, py::arg("path"), py::arg("res") = py::none(),
-           "Write as `interpatch build` (.json .npz .step .igs: the exact form) or `interpatch mesh` "
+           "Write as `interpatch build` (.json .npz .step .igs: the exact form), `interpatch mesh` "
            "(.obj .ply .stl .vtk .vts .xyz: res = (nu, nv) vertices, 64 x 64 by default; a volume's "
-           "(nu, nv, nw), 33 x 33 x 33) would.")
+           "(nu, nv, nw), 33 x 33 x 33) or `interpatch view` (.html: a viewer page of res samples, "
+           "257 x 257 by default, a volume's 33 x 33 x 33) would.")
       .def_property_readonly("params_u", [](const PyBuilt& s) { return s.data_params(0); },
                              "Parameters of the data along u (None without data).")
       .def_property_readonly("params_v", [](const PyBuilt& s) { return s.data_params(1); },

@@ -439,3 +439,29 @@ def test_approximate_options_and_errors():
     with pytest.raises(interpatch.Error) as e:
         interpatch.interpolate_surface(holed)
     assert e.value.code == "not_finite" and "approximate" in str(e.value)
+
+
+def _page_data(path):
+    """The data a viewer page embeds, without the summary's timings (they differ from run to run)."""
+    import json
+    import re
+    text = open(path, encoding="utf-8").read()
+    data = json.loads(re.search(r'<script type="application/json" id="interpatch-data">(.*?)</script>', text, re.S).group(1))
+    del data["info"]["timings"]
+    return data
+
+
+def test_write_html_gives_the_command_lines_viewer_page(tmp_path):
+    for name, res in (("coons", (9, 7)), ("trilinear", (3, 4, 5))):
+        path = os.path.join(EXAMPLES, name + ".json")
+        s = interpatch.build(path)
+        mine, theirs = tmp_path / (name + ".html"), tmp_path / "cli" / (name + ".html")
+        theirs.parent.mkdir(exist_ok=True)
+        s.write(str(mine), res=res)
+        subprocess.run([CLI, "view", path, "-o", str(theirs), "--res", "x".join(map(str, res))], check=True,
+                       capture_output=True)
+        assert _page_data(mine) == _page_data(theirs), name
+        assert _page_data(mine)["resolution"]["shown"][:len(res)] == list(res)
+    with pytest.raises(interpatch.Error) as e:
+        interpatch.build(os.path.join(EXAMPLES, "coons.json")).write(str(tmp_path / "x.html"), res=(4, 4, 4))
+    assert e.value.code == "size_mismatch"
