@@ -18,6 +18,9 @@
 #include "interpatch/error.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/threads.hpp"
+#ifdef INTERPATCH_MPI
+#include "mpi_command.hpp"
+#endif
 
 #ifndef INTERPATCH_VERSION
 #error "INTERPATCH_VERSION (the CMake project version) is defined by CMakeLists.txt"
@@ -125,6 +128,9 @@ int main(int argc, char** argv) {
   if (const char* sync = std::getenv("INTERPATCH_SYNC"); sync && std::string_view(sync) == "1")
     interpatch::io::set_durable_writes(true);
 
+  // The command as one process runs it; under an MPI launcher, eval and build are
+  // split between the processes (docs/mpi.md) and the other commands run on rank 0.
+  const auto run = [&]() -> int {
   try {
     if (*demo) return cli::demo_command(demo_dir);
     const cli::Input input = cli::parse_input(spec, shape);
@@ -146,4 +152,12 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     return fail_with(1, e.what());
   }
+  };
+#ifdef INTERPATCH_MPI
+  if (cli::mpi_launched()) {
+    if (*eval || *build) return cli::mpi_command({static_cast<bool>(*build), spec, shape, out, grid}, run);
+    if (cli::mpi_launched_rank() != 0) return 0;
+  }
+#endif
+  return run();
 }
