@@ -17,11 +17,13 @@ SHELL := /bin/bash
 #   libocct-*-dev                    OpenCASCADE reads back the STEP and IGES files (tests) and races us (make bench)
 #   libsisl-dev                      SISL races us in make bench
 #   clang libclang-rt-14-dev libomp-14-dev   libFuzzer (with its OpenMP) runs the fuzz targets of make test
+#   libopenmpi-dev openmpi-bin       MPI: eval and build split between processes (mpirun; docs/mpi.md) and their tests
 DEBS := cmake ninja-build g++ pkg-config python3 libcli11-dev nlohmann-json3-dev \
         libgtest-dev libgmock-dev libbenchmark-dev python3-numpy python3-vtk9 python3-matplotlib \
         libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
         libocct-foundation-dev libsisl-dev python3-scipy clang libclang-rt-14-dev libomp-14-dev \
-        pybind11-dev python3-pybind11 python3-dev python3-pytest
+        pybind11-dev python3-pybind11 python3-dev python3-pytest \
+        libopenmpi-dev openmpi-bin
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 

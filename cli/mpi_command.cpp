@@ -83,6 +83,7 @@ struct Plan {
   std::size_t dims = 0;
   nlohmann::json spec;
   fs::path base, points;
+  std::string file;  // as the spec names it
   std::vector<std::size_t> counts;  // --grid
   io::internal::NpyHeader header;
   io::internal::NpyDtype dtype;
@@ -110,16 +111,21 @@ Plan plan_of(const MpiRequest& r, const mpi::Team& team) {
   if (plan.dims == 0 || !s.contains("points") || !s["points"].is_object() || !s["points"].contains("npy")) return plan;
   io::reader::Context ctx;
   ctx.base_dir = plan.base;
-  plan.points = ctx.resolve(io::reader::file_name(s["points"], "npy", "/points"));
+  plan.file = io::reader::file_name(s["points"], "npy", "/points");
+  plan.points = ctx.resolve(plan.file);
   // The header, read by every process; anything the split run does not read (other
   // dtypes, Fortran order, a shape that is not a grid, short data) is left to the
   // single process, which says what is wrong.
-  const mpi::InputFile file(plan.points, team);
-  std::string head(static_cast<std::size_t>(std::min<std::uint64_t>(file.size(), 1 << 20)), '\0');
-  file.read(head.data(), head.size(), 0);
+  std::string head;
+  const std::uint64_t size = io::reader::at("/points", [&] {
+    const mpi::InputFile file(plan.points, team);
+    head.resize(static_cast<std::size_t>(std::min<std::uint64_t>(file.size(), 1 << 20)));
+    file.read(head.data(), head.size(), 0);
+    return file.size();
+  });
   std::istringstream is(head);
   try {
-    plan.header = io::internal::read_npy_header(is, file.size(), plan.points.string());
+    plan.header = io::internal::read_npy_header(is, size, plan.points.string());
   } catch (const error&) {
     return plan;
   }
@@ -133,7 +139,7 @@ Plan plan_of(const MpiRequest& r, const mpi::Team& team) {
     if (e != 0 && count > (std::uint64_t{1} << 62) / e) return plan;
     count *= e;
   }
-  if (count == 0 || plan.header.data_offset + count * dt->size != file.size()) return plan;
+  if (count == 0 || plan.header.data_offset + count * dt->size != size) return plan;
   plan.split = true;
   return plan;
 }
@@ -191,14 +197,20 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
   team.run([&] {
     require_memory(count * M, sizeof(Vec3), cat("/points: this process's ", count, " rows of the grid"));
     rows = rows_grid<D>(n, count);
-    const mpi::InputFile file(plan.points, team);
-    read_rows(file, plan, 3 * M, first, count, &rows.data()->x);
-    const std::size_t at[5] = {first > 0 ? first - 1 : 0, 0, std::min<std::size_t>(1, n[0] - 1), n[0] < 2 ? 0 : n[0] - 2,
-                               n[0] - 1};
-    for (std::size_t h = 0; h < 5; ++h) {
-      halo[h] = rows_grid<D>(n, 1);
-      read_rows(file, plan, 3 * M, at[h], 1, &halo[h].data()->x);
-    }
+    io::reader::at("/points", [&] {
+      const mpi::InputFile file(plan.points, team);
+      read_rows(file, plan, 3 * M, first, count, &rows.data()->x);
+      const std::size_t at[5] = {first > 0 ? first - 1 : 0, 0, std::min<std::size_t>(1, n[0] - 1), n[0] < 2 ? 0 : n[0] - 2,
+                                 n[0] - 1};
+      for (std::size_t h = 0; h < 5; ++h) {
+        halo[h] = rows_grid<D>(n, 1);
+        read_rows(file, plan, 3 * M, at[h], 1, &halo[h].data()->x);
+      }
+    });
+  });
+  // As the reader does: the first point that is not finite, named in the whole grid.
+  team.run([&] {
+    io::reader::check_finite_block({n.begin(), n.begin() + D}, {rows.data(), rows.size()}, first * M, "/points", plan.file);
   });
 
   // The spec's options, then the checks and warnings of the single process.

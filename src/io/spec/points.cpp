@@ -114,19 +114,7 @@ std::string expected_shape(std::size_t rank) {
 // below `ptr` (`/points/3/7/2`) and the file it came from.
 void check_finite_points(const std::vector<std::size_t>& shape, const PointStorage& points, std::string_view ptr,
                          const std::string& file) {
-  if (const std::size_t i = interpatch::detail::first_non_finite(points.data(), points.size()); i < points.size()) {
-    const Vec3& p = points[i];
-    std::vector<std::size_t> idx(shape.size() + 1);
-    std::size_t r = i;
-    for (std::size_t a = shape.size(); a-- > 0;) {
-      idx[a] = r % shape[a];
-      r /= shape[a];
-    }
-    const int k = std::isfinite(p.x) ? (std::isfinite(p.y) ? 2 : 1) : 0;
-    idx[shape.size()] = static_cast<std::size_t>(k);
-    fail(errc::not_finite, place(index_pointer(ptr, idx, idx.size())), ": coordinate ", coord_name(k), " is ", p[k], " (in ",
-         file, ")");
-  }
+  check_finite_block(shape, points, 0, ptr, file);
 }
 
 PointArray npy_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx) {
@@ -231,5 +219,22 @@ Grid<double, Rank> inline_number_grid(const json& j, std::string_view ptr) {
 
 template Grid<double, 2> inline_number_grid<2>(const json& j, std::string_view ptr);
 template Grid<double, 3> inline_number_grid<3>(const json& j, std::string_view ptr);
+
+void check_finite_block(const std::vector<std::size_t>& shape, std::span<const Vec3> points, std::size_t first,
+                        std::string_view ptr, const std::string& file) {
+  if (const std::size_t i = interpatch::detail::first_non_finite(points.data(), points.size()); i < points.size()) {
+    const Vec3& p = points[i];
+    std::vector<std::size_t> idx(shape.size() + 1);
+    std::size_t r = first + i;
+    for (std::size_t a = shape.size(); a-- > 0;) {
+      idx[a] = r % shape[a];
+      r /= shape[a];
+    }
+    const int k = std::isfinite(p.x) ? (std::isfinite(p.y) ? 2 : 1) : 0;
+    idx[shape.size()] = static_cast<std::size_t>(k);
+    fail(errc::not_finite, place(index_pointer(ptr, idx, idx.size())), ": coordinate ", coord_name(k), " is ", p[k], " (in ",
+         file, ")");
+  }
+}
 
 }  // namespace interpatch::io::reader

@@ -170,6 +170,11 @@ Construction build_ruled(const json& spec, Context& ctx);
 Construction build_coons(const json& spec, Context& ctx);
 Construction build_network(const json& spec, Context& ctx);
 Construction build_hermite_patch(const json& spec, Context& ctx);
+/// Refuses the first point with a NaN or Inf coordinate among `points`, which are
+/// the points from index `first` on of a grid of `shape` read from `file`, naming
+/// it as a JSON Pointer below `ptr` (`/points/3/7/2`) and the file.
+void check_finite_block(const std::vector<std::size_t>& shape, std::span<const Vec3> points, std::size_t first,
+                        std::string_view ptr, const std::string& file);
 /// build_interpolate's checks of a grid of `shape` before it is solved (at least 2
 /// points along each axis, enough distinct lines for each degree), its warnings
 /// (data closed along an axis not declared periodic) into ctx and its notes as
