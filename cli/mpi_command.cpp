@@ -10,6 +10,8 @@
 
 #include <algorithm>
 #include <bit>
+#include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -171,6 +173,42 @@ void read_rows(const mpi::InputFile& file, const Plan& plan, std::size_t row, st
   }
 }
 
+// INTERPATCH_MPI_TIMINGS=1: each process prints one line, after the output is in
+// place, of the seconds each stage took and the bytes it sent to other processes
+// (docs/BENCHMARKS.md, "Split between MPI processes").
+class Stages {
+ public:
+  explicit Stages(int rank) : rank_(rank), on_(std::getenv("INTERPATCH_MPI_TIMINGS") != nullptr), t_(clock()) {}
+  void done(const char* stage, std::uint64_t sent = 0) {
+    if (!on_) return;
+    const double now = clock();
+    text_ += cat(text_.empty() ? "" : ", ", "\"", stage, "\": [", now - t_, ", ", sent, ", ", peak_mib(), "]");
+    t_ = now;
+  }
+  void print() const {
+    if (on_) std::fprintf(stderr, "interpatch: rank %d stages (seconds, bytes sent, peak MiB so far): {%s}\n", rank_, text_.c_str());
+  }
+
+ private:
+  // The process's peak resident memory so far (VmHWM), MiB.
+  static long peak_mib() {
+    std::ifstream status("/proc/self/status");
+    for (std::string line; std::getline(status, line);)
+      if (line.rfind("VmHWM:", 0) == 0) return std::atol(line.c_str() + 6) / 1024;
+    return -1;
+  }
+  static double clock() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  }
+  int rank_;
+  bool on_;
+  double t_;
+  std::string text_;
+};
+
+// Gives a buffer's memory back now (v = {} would keep its capacity).
+void release(std::vector<Vec3>& v) { std::vector<Vec3>().swap(v); }
+
 // A grid of D dimensions with every extent but the first from `n`.
 template <std::size_t D>
 Grid<Vec3, D> rows_grid(const std::array<std::size_t, 3>& n, std::size_t rows) {
@@ -183,6 +221,7 @@ Grid<Vec3, D> rows_grid(const std::array<std::size_t, 3>& n, std::size_t rows) {
 template <std::size_t D>
 int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
   const int P = team.size();
+  Stages stages(team.rank());
   io::reader::Context ctx;
   ctx.base_dir = plan.base;
   std::array<std::size_t, 3> n{};
@@ -192,11 +231,15 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
 
   // Each process's rows and the few rows of the others it looks at.
   const auto [first, count] = mpi::chunk_block(n[0], team.rank(), P);
-  Grid<Vec3, D> rows;
+  // This process's rows, C order. Not a Grid: a Grid's buffer, freed, is kept for
+  // reuse (detail/pages.cpp), which would hold a second share of the data here.
+  std::vector<Vec3> rows;
+  std::size_t nrows = 0;
   std::array<Grid<Vec3, D>, 5> halo;  // the row before the block; rows 0, 1, n−2, n−1
   team.run([&] {
     require_memory(count * M, sizeof(Vec3), cat("/points: this process's ", count, " rows of the grid"));
-    rows = rows_grid<D>(n, count);
+    rows.resize(count * M);
+    nrows = count;
     io::reader::at("/points", [&] {
       const mpi::InputFile file(plan.points, team);
       read_rows(file, plan, 3 * M, first, count, &rows.data()->x);
@@ -213,6 +256,7 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
     io::reader::check_finite_block({n.begin(), n.begin() + D}, {rows.data(), rows.size()}, first * M, "/points", plan.file);
   });
 
+  stages.done("read");
   // The spec's options, then the checks and warnings of the single process.
   std::vector<std::optional<int>> degree;
   Parametrization param{};
@@ -228,7 +272,7 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
     b.n = n;
     b.data = rows.data();
     b.first = first;
-    b.count = rows.extent(0);
+    b.count = nrows;
     b.before = halo[0].data();
     b.row0 = halo[1].data();
     b.last = halo[4].data();
@@ -253,13 +297,16 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
     if (a == 0) {
       --n[0];
       halo[4] = halo[3];  // the new last row
-      if (first + rows.extent(0) > n[0]) {
-        auto s = rows.shape();
-        s[0] = n[0] - first;
-        rows = Grid<Vec3, D>(s, std::vector<Vec3>(rows.data(), rows.data() + s[0] * M));
+      if (first + nrows > n[0]) {
+        nrows = n[0] - first;
+        rows.resize(nrows * M);
       }
     } else {
-      detail::drop_last_line(rows, a);
+      Grid<Vec3, D> g = rows_grid<D>(n, nrows);
+      std::copy(rows.begin(), rows.end(), g.data());
+      release(rows);
+      detail::drop_last_line(g, a);
+      rows.assign(g.data(), g.data() + g.size());
       for (auto& h : halo) detail::drop_last_line(h, a);
       --n[a];
       M = M / (n[a] + 1) * n[a];
@@ -281,7 +328,9 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
   }
   const std::vector<bool> closed(periodic.begin(), periodic.begin() + D);
   std::array<bool, 3> closed_arr = periodic;
+  stages.done("checks");
   detail::RowSolution rs = detail::solve_rows(b, p, param, std::span<const bool>(closed_arr.data(), D), team);
+  stages.done("rows");
   (void)closed;
   for (auto& h : halo) h = {};
 
@@ -289,7 +338,7 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
   std::vector<std::size_t> col_first(static_cast<std::size_t>(P)), col_count(static_cast<std::size_t>(P));
   for (int s = 0; s < P; ++s) std::tie(col_first[static_cast<std::size_t>(s)], col_count[static_cast<std::size_t>(s)]) = mpi::even_block(M, s, P);
   const std::size_t C = col_count[static_cast<std::size_t>(team.rank())];
-  const std::vector<std::uint64_t> row_counts = team.all(rows.extent(0));
+  const std::vector<std::uint64_t> row_counts = team.all(nrows);
   std::vector<Vec3> columns;
   {
     std::vector<Vec3> send;
@@ -300,18 +349,19 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
     });
     std::size_t at = 0;
     for (std::size_t s = 0; s < static_cast<std::size_t>(P); ++s) {
-      for (std::size_t i = 0; i < rows.extent(0); ++i)
+      for (std::size_t i = 0; i < nrows; ++i)
         std::copy_n(rows.data() + i * M + col_first[s], col_count[s], send.data() + at + i * col_count[s]);
-      sc[s] = rows.extent(0) * col_count[s];
+      sc[s] = nrows * col_count[s];
       rc[s] = row_counts[s] * C;
       at += sc[s];
     }
-    rows = {};
+    release(rows);
     team.run([&] {
       require_memory(n[0] * C, sizeof(Vec3), "this process's columns of the grid");
       columns.resize(n[0] * C);
     });
     team.exchange(send.data(), sc, columns.data(), rc);
+    stages.done("to_columns", (send.size() - sc[static_cast<std::size_t>(team.rank())]) * sizeof(Vec3));
   }
 
   // Along u, on whole columns.
@@ -319,11 +369,15 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
   team.run([&] { lu0 = detail::factor_axis(rs.knots[0], rs.params[0], 0); });
   detail::solve_columns(lu0, &columns.data()->x, n[0], 3 * C);
   if (shift != 0) detail::scale_points(columns.data(), columns.size(), shift);
-  Grid<Vec3, 2> net({n[0], C}, std::move(columns));
+  stages.done("solve_u");
   team.run([&] {
-    if (periodic[0] && p[0] % 2 == 0) detail::insert_seam(net, 0, rs.knots[0], rs.params[0].front());
+    if (!periodic[0] || p[0] % 2 != 0) return;
+    Grid<Vec3, 2> g({n[0], C}, columns);
+    release(columns);
+    detail::insert_seam(g, 0, rs.knots[0], rs.params[0].front());
+    columns.assign(g.data(), g.data() + g.size());
   });
-  const std::size_t N = net.extent(0);
+  const std::size_t N = n[0] + (periodic[0] && p[0] % 2 == 0 ? 1 : 0);
   // The other axes' seams need their knots on every process, rows or none.
   std::array<std::size_t, 3> cn = n;  // extents of the control net
   cn[0] = N;
@@ -386,7 +440,7 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
 
   // Columns back to rows: process s gets the rows of its window, from each column.
   const std::vector<std::uint64_t> los = team.all(static_cast<std::uint64_t>(lo)), counts = team.all(window);
-  Grid<Vec3, D> cp;
+  std::vector<Vec3> cp;
   {
     std::vector<std::size_t> sc(static_cast<std::size_t>(P)), rc(static_cast<std::size_t>(P));
     std::size_t send_total = 0;
@@ -403,18 +457,19 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
     std::size_t at = 0;
     for (std::size_t s = 0; s < static_cast<std::size_t>(P); ++s)
       for (std::size_t v = 0; v < counts[s]; ++v, at += C)
-        std::copy_n(net.data() + ((static_cast<long long>(los[s]) + static_cast<long long>(v)) % static_cast<long long>(N)) * C, C,
+        std::copy_n(columns.data() + ((static_cast<long long>(los[s]) + static_cast<long long>(v)) % static_cast<long long>(N)) * C, C,
                     send.data() + at);
-    net = {};
+    release(columns);
     team.run([&] {
       require_memory(window * M, sizeof(Vec3), "this process's rows of the control points");
       recv.resize(window * M);
     });
     team.exchange(send.data(), sc, recv.data(), rc);
-    send = {};
+    stages.done("to_rows", (send.size() - sc[static_cast<std::size_t>(team.rank())]) * sizeof(Vec3));
+    release(send);
     team.run([&] {
       require_memory(window * M, sizeof(Vec3), "this process's rows of the control points");
-      cp = rows_grid<D>(n, window);
+      cp.resize(window * M);
     });
     at = 0;
     for (std::size_t s = 0; s < static_cast<std::size_t>(P); ++s)
@@ -422,10 +477,16 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
         std::copy_n(recv.data() + at, col_count[s], cp.data() + v * M + col_first[s]);
   }
   team.run([&] {
+    std::array<std::size_t, 3> extents = n;
     for (std::size_t a = 1; a < D; ++a)
       if (seam[a]) {
+        Grid<Vec3, D> g = rows_grid<D>(extents, window);
+        std::copy(cp.begin(), cp.end(), g.data());
+        release(cp);
         KnotVector k = rs.knots[a];
-        detail::insert_seam(cp, a, k, rs.params[a].front());
+        detail::insert_seam(g, a, k, rs.params[a].front());
+        extents[a] = g.extent(a);
+        cp.assign(g.data(), g.data() + g.size());
       }
   });
   const std::size_t row_points = cp.size() / std::max<std::size_t>(window, 1);
@@ -477,6 +538,8 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
     });
   }
   file.commit();
+  stages.done(r.build ? "write" : "evaluate_write");
+  stages.print();
   if (team.rank() == 0)
     for (const std::string& w : ctx.warnings) std::fprintf(stderr, "interpatch: warning: %s\n", w.c_str());
   return 0;
