@@ -547,9 +547,6 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
 
 }  // namespace
 
-bool mpi_launched() noexcept { return mpi::launched(); }
-int mpi_launched_rank() noexcept { return mpi::launched_rank(); }
-
 int mpi_command(const MpiRequest& request, const std::function<int()>& single) {
   const mpi::Session session;
   const mpi::Team team(status_of);
@@ -576,3 +573,7 @@ int mpi_command(const MpiRequest& request, const std::function<int()>& single) {
 }
 
 }  // namespace interpatch::cli
+
+extern "C" int interpatch_mpi_command(const interpatch::cli::MpiRequest* request, const std::function<int()>* single) {
+  return interpatch::cli::mpi_command(*request, *single);
+}

@@ -21,8 +21,6 @@ using detail::fail;
 
 namespace {
 
-const char* env(const char* name) noexcept { return std::getenv(name); }
-
 // A count MPI takes as an int.
 int as_int(std::size_t n, const char* what) {
   if (n > static_cast<std::size_t>(INT_MAX))
@@ -49,16 +47,6 @@ MPI_Datatype point_type() {
 }
 
 }  // namespace
-
-bool launched() noexcept {
-  return env("OMPI_COMM_WORLD_SIZE") != nullptr || env("PMIX_RANK") != nullptr || env("PMI_RANK") != nullptr;
-}
-
-int launched_rank() noexcept {
-  for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"})
-    if (const char* v = env(name)) return std::atoi(v);
-  return 0;
-}
 
 Session::Session() {
   int provided = 0;

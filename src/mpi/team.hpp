@@ -18,12 +18,6 @@
 
 namespace interpatch::mpi {
 
-/// Whether this process was started by an MPI launcher (mpirun, mpiexec, srun with
-/// PMI or PMIx): only then is MPI initialized, so that a plain run costs nothing.
-[[nodiscard]] bool launched() noexcept;
-/// This process's rank as the launcher's environment gives it (0 when not launched).
-[[nodiscard]] int launched_rank() noexcept;
-
 /// The exit status a failure maps to (the command's rule).
 using Classify = std::function<int(const std::exception_ptr&)>;
 
