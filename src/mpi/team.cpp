@@ -167,6 +167,8 @@ std::pair<std::size_t, std::size_t> even_block(std::size_t n, int r, int size) {
 
 InputFile::InputFile(const fs::path& path, const Team& team) : path_(path) {
   (void)team;
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) fail(errc::file_unreadable, "cannot read '", path.string(), "': it is a directory");
   MPI_File f = MPI_FILE_NULL;
   // Each process opens the file on its own: a process that cannot read it fails
   // alone, and the team agrees on the failure (Team::run) without a hang.

@@ -108,6 +108,30 @@ def same_failure(d, name, args, status):
         check(open(good, "rb").read() == b"good", f"{name}: the existing output was changed")
 
 
+def a_rank_cannot_read(d, rng):
+    """Ranks 1 and 2 run in a directory where the points file cannot be read (it is a
+    directory there): the first of them reports, all three end with status 4, and no
+    output appears."""
+    a, b = os.path.join(d, "a"), os.path.join(d, "b")
+    os.makedirs(a)
+    os.makedirs(os.path.join(b, "points.npy"))
+    np.save(os.path.join(a, "points.npy"), grid((50, 20), rng))
+    for w in (a, b):
+        with open(os.path.join(w, "spec.json"), "w") as f:
+            json.dump({"type": "interpolate", "points": {"npy": "points.npy"}}, f)
+    out = os.path.join(d, "split.npz")
+    args = ["build", "spec.json", "-o", out]
+    cmd = [MPIRUN, "--oversubscribe", "-q", "--mca", "btl", "self,vader", "-np", "1", "--wdir", a, EXE] + args + \
+          [":", "-np", "2", "--wdir", b, EXE] + args
+    r = subprocess.run(cmd, env=ENV, capture_output=True, text=True, timeout=120)
+    lines = r.stderr.splitlines()
+    check(r.returncode == 4, f"a rank cannot read: status {r.returncode}, expected 4: {r.stderr}")
+    check(len(lines) == 1 and "cannot" in r.stderr and "points.npy" in r.stderr,
+          f"a rank cannot read: stderr {r.stderr!r}")
+    check(not os.path.exists(out) and not [f for f in os.listdir(d) if "interpatch" in f],
+          f"a rank cannot read: files left: {os.listdir(d)}")
+
+
 def main():
     rng = np.random.default_rng(19)
     for name, points, options, eval_grid in cases(rng):
@@ -134,6 +158,7 @@ def main():
         same_failure(d, "degree too high", ["build", "spec.json", "-o", "good.npz"], 3)
         same_failure(d, "bad --grid", ["eval", "spec.json", "--grid", "1", "-o", "good.npy"], 2)
         same_failure(d, "output in a missing directory", ["eval", "spec.json", "--grid", "5", "-o", "no/dir/x.npy"], 4)
+        a_rank_cannot_read(d, rng)
         print("ok: failures", flush=True)
     if failures:
         print(f"{len(failures)} failures")
