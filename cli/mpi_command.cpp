@@ -230,7 +230,9 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
   for (std::size_t a = 1; a < D; ++a) M *= n[a];
 
   // Each process's rows and the few rows of the others it looks at.
-  const auto [first, count] = mpi::chunk_block(n[0], team.rank(), P);
+  // Plain variables, not a structured binding: lambdas capture them (clang 14 refuses bindings).
+  const std::pair<std::size_t, std::size_t> block = mpi::chunk_block(n[0], team.rank(), P);
+  const std::size_t first = block.first, count = block.second;
   // This process's rows, C order. Not a Grid: a Grid's buffer, freed, is kept for
   // reuse (detail/pages.cpp), which would hold a second share of the data here.
   std::vector<Vec3> rows;
@@ -559,11 +561,7 @@ int mpi_command(const MpiRequest& request, const std::function<int()>& single) {
       team.min(s);
       split[0] = static_cast<int>(s[0]);
     }
-    if (split[0] == 0) {
-      double status[1] = {team.rank() == 0 ? static_cast<double>(single()) : 0.0};
-      team.max(status);
-      return static_cast<int>(status[0]);
-    }
+    if (split[0] == 0) return team.await(team.rank() == 0 ? single() : 0);
     return plan.dims == 3 ? split_run<3>(request, plan, team) : split_run<2>(request, plan, team);
   } catch (const detail::peer_failure& p) {
     return p.status;

@@ -4,11 +4,13 @@
 #include <mpi.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <climits>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <random>
+#include <thread>
 
 #include "detail/text.hpp"
 #include "interpatch/error.hpp"
@@ -123,6 +125,16 @@ std::vector<std::uint64_t> Team::all(std::uint64_t mine) const {
   std::vector<std::uint64_t> out(static_cast<std::size_t>(size_));
   MPI_Allgather(&mine, 1, MPI_UINT64_T, out.data(), 1, MPI_UINT64_T, MPI_COMM_WORLD);
   return out;
+}
+
+int Team::await(int value) const {
+  MPI_Request request;
+  MPI_Ibcast(&value, 1, MPI_INT, 0, MPI_COMM_WORLD, &request);
+  for (int done = 0;;) {
+    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+    if (done) return value;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
 }
 
 std::string Team::broadcast(std::string text) const {

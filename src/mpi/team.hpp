@@ -45,6 +45,9 @@ class Team final : public detail::RowTeam {
 
   /// Sizes (any type of 8 bytes or less, as 64-bit) from every process, in order.
   [[nodiscard]] std::vector<std::uint64_t> all(std::uint64_t mine) const;
+  /// Rank 0's value, on every process; the others wait asleep (not spinning, as a
+  /// blocking collective would, on cores rank 0 may need).
+  [[nodiscard]] int await(int value) const;
   /// Rank 0's string, on every process.
   [[nodiscard]] std::string broadcast(std::string text) const;
 
