@@ -206,6 +206,11 @@ class Stages {
   std::string text_;
 };
 
+// The coordinates of points as doubles (Vec3 is three doubles); null for none, where
+// &p->x would dereference nothing.
+static_assert(sizeof(Vec3) == 3 * sizeof(double), "points are read and moved as triples of doubles");
+double* doubles(Vec3* p) { return reinterpret_cast<double*>(p); }
+
 // Gives a buffer's memory back now (v = {} would keep its capacity).
 void release(std::vector<Vec3>& v) { std::vector<Vec3>().swap(v); }
 
@@ -244,12 +249,12 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
     nrows = count;
     io::reader::at("/points", [&] {
       const mpi::InputFile file(plan.points, team);
-      read_rows(file, plan, 3 * M, first, count, &rows.data()->x);
+      read_rows(file, plan, 3 * M, first, count, doubles(rows.data()));
       const std::size_t at[5] = {first > 0 ? first - 1 : 0, 0, std::min<std::size_t>(1, n[0] - 1), n[0] < 2 ? 0 : n[0] - 2,
                                  n[0] - 1};
       for (std::size_t h = 0; h < 5; ++h) {
         halo[h] = rows_grid<D>(n, 1);
-        read_rows(file, plan, 3 * M, at[h], 1, &halo[h].data()->x);
+        read_rows(file, plan, 3 * M, at[h], 1, doubles(halo[h].data()));
       }
     });
   });
@@ -369,7 +374,7 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
   // Along u, on whole columns.
   detail::AxisSolver lu0 = detail::BandedLU(0, 0, 0);
   team.run([&] { lu0 = detail::factor_axis(rs.knots[0], rs.params[0], 0); });
-  detail::solve_columns(lu0, &columns.data()->x, n[0], 3 * C);
+  detail::solve_columns(lu0, doubles(columns.data()), n[0], 3 * C);
   if (shift != 0) detail::scale_points(columns.data(), columns.size(), shift);
   stages.done("solve_u");
   team.run([&] {
