@@ -22,12 +22,14 @@ SHELL := /bin/bash
 #                                    make pictures, make bench-viewer)
 #   nodejs npm                       npm ci installs three.js for the viewer (viewer/package-lock.json);
 #                                    installed only when npm is not already on PATH
+#   libopenmpi-dev openmpi-bin       MPI: eval and build split between processes (mpirun; docs/mpi.md) and their tests
 DEBS := cmake ninja-build g++ pkg-config python3 libcli11-dev nlohmann-json3-dev \
         libgtest-dev libgmock-dev libbenchmark-dev python3-numpy python3-vtk9 python3-matplotlib \
         libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
         libocct-foundation-dev libsisl-dev python3-scipy clang libclang-rt-14-dev libomp-14-dev \
         pybind11-dev python3-pybind11 python3-dev python3-pytest \
-        libeigen3-dev chromium chromium-driver python3-selenium $(if $(shell command -v npm),,nodejs npm)
+        libeigen3-dev chromium chromium-driver python3-selenium $(if $(shell command -v npm),,nodejs npm) \
+        libopenmpi-dev openmpi-bin
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 

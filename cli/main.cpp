@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <new>
 #include <optional>
 #include <string>
@@ -18,6 +19,13 @@
 #include "interpatch/error.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/threads.hpp"
+#ifdef INTERPATCH_MPI
+#include <dlfcn.h>
+
+#include <cstring>
+
+#include "mpi_command.hpp"
+#endif
 
 #ifndef INTERPATCH_VERSION
 #error "INTERPATCH_VERSION (the CMake project version) is defined by CMakeLists.txt"
@@ -32,6 +40,34 @@ int fail_with(int status, std::string message) {
   std::fprintf(stderr, "interpatch: %s\n", message.c_str());
   return status;
 }
+
+#ifdef INTERPATCH_MPI
+// eval or build under an MPI launcher: through the module interpatch-mpi.so, beside
+// the command or where it is installed. Without it, rank 0 runs the command alone.
+int mpi_run(const interpatch::cli::MpiRequest& request, const std::function<int()>& single) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path dir = fs::read_symlink("/proc/self/exe", ec).parent_path();
+  std::string why = "no path to the command";
+  for (const fs::path& d : {dir, dir / INTERPATCH_MPI_MODULE_DIR}) {
+    void* module = ::dlopen((d / "interpatch-mpi.so").c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (module == nullptr) {
+      why = ::dlerror();
+      continue;
+    }
+    void* symbol = ::dlsym(module, "interpatch_mpi_command");
+    int (*entry)(const interpatch::cli::MpiRequest*, const std::function<int()>*) = nullptr;
+    static_assert(sizeof entry == sizeof symbol);
+    std::memcpy(&entry, &symbol, sizeof entry);
+    if (entry != nullptr) return entry(&request, &single);
+    why = "interpatch-mpi.so has no entry point interpatch_mpi_command";
+  }
+  if (interpatch::cli::mpi_launched_rank() != 0) return 0;
+  std::fprintf(stderr, "interpatch: warning: started by an MPI launcher, but its MPI part cannot be loaded (%s): rank 0 runs the command alone\n",
+               why.c_str());
+  return single();
+}
+#endif
 
 }  // namespace
 
@@ -134,6 +170,9 @@ int main(int argc, char** argv) {
   if (const char* sync = std::getenv("INTERPATCH_SYNC"); sync && std::string_view(sync) == "1")
     interpatch::io::set_durable_writes(true);
 
+  // The command as one process runs it; under an MPI launcher, eval and build are
+  // split between the processes (docs/mpi.md) and the other commands run on rank 0.
+  const auto run = [&]() -> int {
   try {
     if (*demo) return cli::demo_command(demo_dir);
     const cli::Input input = cli::parse_input(spec, shape);
@@ -156,4 +195,12 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     return fail_with(1, e.what());
   }
+  };
+#ifdef INTERPATCH_MPI
+  if (cli::mpi_launched()) {
+    if (*eval || *build) return mpi_run({static_cast<bool>(*build), spec, shape, out, grid}, run);
+    if (cli::mpi_launched_rank() != 0) return 0;
+  }
+#endif
+  return run();
 }

@@ -9,6 +9,7 @@
 #include "detail/basis_table.hpp"
 #include "detail/kernel.hpp"
 #include "detail/parallel.hpp"
+#include "detail/row_window.hpp"
 #include "detail/text.hpp"
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/memory.hpp"
@@ -205,22 +206,24 @@ SurfaceDerivatives BSplineSurface::derivatives(double u, double v) const {
           derivative(u, v, 2, 0), derivative(u, v, 1, 1), derivative(u, v, 0, 2)};
 }
 
-void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
-                                   const progress_callback& progress) const {
-  detail::check_output_size(out.size(), {us.size(), vs.size()}, "surface evaluation");
+namespace detail {
+
+// The points of a polynomial surface over a grid, its control rows taken from a
+// window (the whole net, or the rows one process of a split run holds).
+void evaluate_surface_rows(const KnotVector& ku_, const KnotVector& kv_, const RowWindow& net, std::span<const double> us,
+                           std::span<const double> vs, std::span<Vec3> out, const progress_callback& progress) {
   const auto bu = bases(ku_, us, 0, "u");
   const auto bv = bases(kv_, vs, 0, "v");
-  const int p = degree_u(), q = degree_v();
-  const std::size_t ncv = cp_.extent(1);
+  const int p = ku_.degree(), q = kv_.degree();
+  const std::size_t ncv = net.row_size;
   const std::size_t nv = vs.size();
-  const bool rat = rational();
   // One parallel region: opening one costs microseconds with pinned threads but up
   // to milliseconds on a loaded machine, where the idle thread spins. Progress is
   // reported by the calling thread (thread 0) from a shared row count.
-  [[maybe_unused]] const bool threads = us.size() * (nv + ncv) >= detail::parallel_min_work;
+  [[maybe_unused]] const bool threads = us.size() * (nv + ncv) >= parallel_min_work;
   std::atomic<std::size_t> done{0};
   const auto nu = static_cast<long long>(us.size());
-  if (!rat) {
+  {
     // The control net as rows of doubles, the v bases packed: both loops run along memory.
     std::vector<int> spans(nv);
     std::vector<double> weights(nv * static_cast<std::size_t>(q + 1));
@@ -241,7 +244,7 @@ void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const d
       for (long long ri = 0; ri < nu; ++ri) {
         const auto i = static_cast<std::size_t>(ri);
         const Basis& b = bu[i];
-        for (int a = 0; a <= p; ++a) rows[a] = &cp_(static_cast<std::size_t>(ku_.wrap_index(b.span - p + a)), 0).x;
+        for (int a = 0; a <= p; ++a) rows[a] = &net.row(static_cast<std::size_t>(ku_.wrap_index(b.span - p + a)))->x;
         weighted_rows(b.d, p + 1, rows, row_doubles, row.data());
         std::copy_n(row.data(), wrap_doubles, row.data() + row_doubles);
         // Not &out[i * nv].x: with no v values there is no element to index.
@@ -251,8 +254,26 @@ void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const d
       }
     }
     if (progress) progress(1.0);
-    return;
   }
+}
+
+}  // namespace detail
+
+void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
+                                   const progress_callback& progress) const {
+  detail::check_output_size(out.size(), {us.size(), vs.size()}, "surface evaluation");
+  const bool rat = rational();
+  const std::size_t ncv = cp_.extent(1);
+  if (!rat)
+    return detail::evaluate_surface_rows(ku_, kv_, {cp_.data(), 0, cp_.extent(0), cp_.extent(0), ncv}, us, vs, out,
+                                         progress);
+  const auto bu = bases(ku_, us, 0, "u");
+  const auto bv = bases(kv_, vs, 0, "v");
+  const int p = degree_u(), q = degree_v();
+  const std::size_t nv = vs.size();
+  [[maybe_unused]] const bool threads = us.size() * (nv + ncv) >= detail::parallel_min_work;
+  std::atomic<std::size_t> done{0};
+  const auto nu = static_cast<long long>(us.size());
 #pragma omp parallel if (threads)
   {
     // One contracted row of homogeneous points per thread, reused for every u.

@@ -7,6 +7,7 @@
 
 #include "detail/parallel.hpp"
 #include "detail/basis_table.hpp"
+#include "detail/row_window.hpp"
 #include "detail/text.hpp"
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/memory.hpp"
@@ -46,14 +47,31 @@ std::size_t grid_items(std::size_t nu, std::size_t nv, std::size_t nw, std::size
 // point and, with Partials, the three first partials, handed to sink(i, j, m, d).
 // Rows of u are split over the threads; every number is computed by the same
 // operations whatever their count.
-template <bool Partials, class Sink>
-void contract(const BSplineVolume& b, const std::vector<Basis>& bu, const std::vector<Basis>& bv,
-              const std::vector<Basis>& bw, std::size_t r0, std::size_t r1, [[maybe_unused]] bool threads, const Sink& sink) {
-  const int p = b.degree_u(), q = b.degree_v(), r = b.degree_w();
+// What the contraction reads: knots, the control planes (the whole net, or a window
+// of it) and the weights of a rational volume (empty for a polynomial one, which
+// is all a window holds).
+struct Net {
+  const KnotVector& ku;
+  const KnotVector& kv;
+  const KnotVector& kw;
+  detail::RowWindow planes;
+  const Grid<double, 3>& weights;
+  std::size_t ncv, ncw;
+};
+
+Net net_of(const BSplineVolume& b) {
   const PointGrid3& cp = b.control_points();
-  const Grid<double, 3>& wt = b.weights();
-  const bool rat = b.rational();
-  const std::size_t ncv = cp.extent(1), ncw = cp.extent(2), plane = ncv * ncw;
+  return {b.knots_u(), b.knots_v(), b.knots_w(), {cp.data(), 0, cp.extent(0), cp.extent(0), cp.extent(1) * cp.extent(2)},
+          b.weights(), cp.extent(1), cp.extent(2)};
+}
+
+template <bool Partials, class Sink>
+void contract(const Net& b, const std::vector<Basis>& bu, const std::vector<Basis>& bv,
+              const std::vector<Basis>& bw, std::size_t r0, std::size_t r1, [[maybe_unused]] bool threads, const Sink& sink) {
+  const int p = b.ku.degree(), q = b.kv.degree(), r = b.kw.degree();
+  const Grid<double, 3>& wt = b.weights;
+  const bool rat = !wt.empty();
+  const std::size_t ncv = b.ncv, ncw = b.ncw, plane = ncv * ncw;
   const std::size_t nv = bv.size(), nw = bw.size();
   constexpr int nu_terms = Partials ? 2 : 1;  // u-derivative orders 0..1
   constexpr int nv_terms = Partials ? 3 : 1;  // (k, l) = (0,0), (1,0), (0,1)
@@ -75,8 +93,8 @@ void contract(const BSplineVolume& b, const std::vector<Basis>& bu, const std::v
         std::fill(out, out + plane, H{0, 0, 0, 0});
         for (int e = 0; e <= p; ++e) {
           const double c = a.d[k * (p + 1) + e];
-          const auto ii = static_cast<std::size_t>(b.knots_u().wrap_index(a.span - p + e));
-          const Vec3* P = &cp(ii, 0, 0);
+          const auto ii = static_cast<std::size_t>(b.ku.wrap_index(a.span - p + e));
+          const Vec3* P = b.planes.row(ii);
           if (rat) {
             const double* wp = &wt(ii, 0, 0);
             for (std::size_t x = 0; x < plane; ++x) {
@@ -103,7 +121,7 @@ void contract(const BSplineVolume& b, const std::vector<Basis>& bu, const std::v
           std::fill(out, out + ncw, H{0, 0, 0, 0});
           for (int e = 0; e <= q; ++e) {
             const double c = bj.d[ll[t] * (q + 1) + e];
-            const H* in = U[kk[t]].data() + static_cast<std::size_t>(b.knots_v().wrap_index(bj.span - q + e)) * ncw;
+            const H* in = U[kk[t]].data() + static_cast<std::size_t>(b.kv.wrap_index(bj.span - q + e)) * ncw;
             for (std::size_t x = 0; x < ncw; ++x)
               for (std::size_t y = 0; y < 4; ++y) out[x][y] += c * in[x][y];
           }
@@ -114,7 +132,7 @@ void contract(const BSplineVolume& b, const std::vector<Basis>& bu, const std::v
           H h[4]{};
           for (int e = 0; e <= r; ++e) {
             const double c0 = bm.d[e];
-            const auto x = static_cast<std::size_t>(b.knots_w().wrap_index(bm.span - r + e));
+            const auto x = static_cast<std::size_t>(b.kw.wrap_index(bm.span - r + e));
             for (std::size_t y = 0; y < 4; ++y) h[0][y] += c0 * V[0][x][y];
             if constexpr (Partials) {
               const double c1 = bm.d[(r + 1) + e];
@@ -148,13 +166,13 @@ void contract(const BSplineVolume& b, const std::vector<Basis>& bu, const std::v
 // Runs `contract` over all u rows in chunks, reporting progress between chunks from
 // the calling thread.
 template <bool Partials, class Sink>
-void contract_all(const BSplineVolume& b, std::span<const double> us, std::span<const double> vs,
+void contract_all(const Net& b, std::span<const double> us, std::span<const double> vs,
                   std::span<const double> ws, const progress_callback& progress, const Sink& sink) {
   const int nd = Partials ? 1 : 0;
-  const auto bu = bases(b.knots_u(), us, nd, "u");
-  const auto bv = bases(b.knots_v(), vs, nd, "v");
-  const auto bw = bases(b.knots_w(), ws, nd, "w");
-  const std::size_t ncv = b.control_points().extent(1), ncw = b.control_points().extent(2);
+  const auto bu = bases(b.ku, us, nd, "u");
+  const auto bv = bases(b.kv, vs, nd, "v");
+  const auto bw = bases(b.kw, ws, nd, "w");
+  const std::size_t ncv = b.ncv, ncw = b.ncw;
   // Starting the second thread costs milliseconds: small grids stay on one.
   [[maybe_unused]] const bool threads = us.size() * (vs.size() * ws.size() + ncv * ncw) >= detail::parallel_min_work;
   constexpr std::size_t chunk = 16;
@@ -361,17 +379,32 @@ void BSplineVolume::evaluate_into(std::span<const double> us, std::span<const do
                                   std::span<Vec3> out, const progress_callback& progress) const {
   detail::check_output_size(out.size(), {us.size(), vs.size(), ws.size()}, "volume evaluation");
   const std::size_t nv = vs.size(), nw = ws.size();
-  contract_all<false>(*this, us, vs, ws, progress,
+  contract_all<false>(net_of(*this), us, vs, ws, progress,
                       [&](std::size_t i, std::size_t j, std::size_t k, const VolumeDerivatives& d) {
                         out[(i * nv + j) * nw + k] = d.s;
                       });
 }
 
+namespace detail {
+
+void evaluate_volume_rows(const KnotVector& ku, const KnotVector& kv, const KnotVector& kw, const RowWindow& net,
+                          std::span<const double> us, std::span<const double> vs, std::span<const double> ws,
+                          std::span<Vec3> out, const progress_callback& progress) {
+  const Grid<double, 3> polynomial;
+  const std::size_t nv = vs.size(), nw = ws.size();
+  contract_all<false>(Net{ku, kv, kw, net, polynomial, static_cast<std::size_t>(kv.count()), static_cast<std::size_t>(kw.count())},
+                      us, vs, ws, progress, [&](std::size_t i, std::size_t j, std::size_t k, const VolumeDerivatives& d) {
+                        out[(i * nv + j) * nw + k] = d.s;
+                      });
+}
+
+}  // namespace detail
+
 Grid<VolumeDerivatives, 3> BSplineVolume::evaluate_derivatives(std::span<const double> us, std::span<const double> vs,
                                                                std::span<const double> ws) const {
   grid_items(us.size(), vs.size(), ws.size(), sizeof(VolumeDerivatives), "volume derivative grid");
   Grid<VolumeDerivatives, 3> out({us.size(), vs.size(), ws.size()}, for_overwrite);
-  contract_all<true>(*this, us, vs, ws, {},
+  contract_all<true>(net_of(*this), us, vs, ws, {},
                      [&out](std::size_t i, std::size_t j, std::size_t k, const VolumeDerivatives& d) { out(i, j, k) = d; });
   return out;
 }
@@ -380,7 +413,7 @@ VolumeJacobians BSplineVolume::evaluate_jacobians(std::span<const double> us, st
                                                   std::span<const double> ws, const progress_callback& progress) const {
   grid_items(us.size(), vs.size(), ws.size(), sizeof(Vec3) + sizeof(double), "volume Jacobian grid");
   VolumeJacobians out{PointGrid3({us.size(), vs.size(), ws.size()}), Grid<double, 3>({us.size(), vs.size(), ws.size()})};
-  contract_all<true>(*this, us, vs, ws, progress,
+  contract_all<true>(net_of(*this), us, vs, ws, progress,
                      [&out](std::size_t i, std::size_t j, std::size_t k, const VolumeDerivatives& d) {
                        out.points(i, j, k) = d.s;
                        out.determinants(i, j, k) = triple(d.su, d.sv, d.sw);

@@ -8,6 +8,7 @@
 
 #include "detail/banded.hpp"
 #include "detail/collocation.hpp"
+#include "detail/grid_rows.hpp"
 #include "detail/kernel.hpp"
 #include "detail/parallel.hpp"
 #include "detail/text.hpp"
@@ -16,6 +17,8 @@
 namespace interpatch {
 
 using detail::fail;
+using detail::GridBlock;
+using detail::RowTeam;
 
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 grids are solved as arrays of doubles");
 
@@ -189,15 +192,21 @@ double box_diagonal(std::size_t count, const PointAt& point) {
 // first (closing_point; the rule is the same for every line of a grid, and all must
 // repeat for the last line to be left out). point(l, k) is point k of line l;
 // diagonal() the data's bounding-box diagonal, computed only when a gap is small.
-// With a near miss, `line` is the first line that misses.
+// With a near miss, `line` is the first line that misses. A grid split between the
+// processes of `team`: each passes its own lines, the first being line `first_line`
+// of the grid, and all agree; `mine` says whether the near miss is among them.
 struct LineEnding {
   Closing closing;
   std::size_t line = 0;
   double gap = 0, adjacent = 0, tol = 0;
+  bool mine = true;
 };
 
+const RowTeam solo;  // the single process
+
 template <class PointAt, class Diagonal>
-LineEnding line_ending(std::size_t lines, std::size_t n, const PointAt& point, const Diagonal& diagonal) {
+LineEnding line_ending(std::size_t lines, std::size_t n, const PointAt& point, const Diagonal& diagonal,
+                       const RowTeam& team = solo, std::size_t first_line = 0) {
   if (n < 3) return {{n, false, false}};
   bool all_zero = true, near = false;
   for (std::size_t l = 0; l < lines; ++l) {
@@ -207,31 +216,53 @@ LineEnding line_ending(std::size_t lines, std::size_t n, const PointAt& point, c
     const double adjacent = std::min(distance(point(l, 1), point(l, 0)), distance(point(l, n - 1), point(l, n - 2)));
     near = near || gap < 1e-3 * adjacent;
   }
-  if (all_zero) return {{n - 1, true, false}};
-  if (!near) return {{n, false, false}};
+  std::size_t flags[2] = {all_zero ? 0u : 1u, near ? 1u : 0u};  // lines with a gap, processes with a near one
+  team.sum(flags);
+  if (flags[0] == 0) return {{n - 1, true, false}};
+  if (flags[1] == 0) return {{n, false, false}};
   const double tol = 1e-12 * diagonal();
   bool all_close = true;
   for (std::size_t l = 0; l < lines && all_close; ++l) all_close = distance(point(l, n - 1), point(l, 0)) <= tol;
-  if (all_close) return {{n - 1, true, false}};
+  std::size_t open[1] = {all_close ? 0u : 1u};
+  team.sum(open);
+  if (open[0] == 0) return {{n - 1, true, false}};
+  constexpr std::size_t none = static_cast<std::size_t>(-1);
+  LineEnding found{{n, false, false}};
+  std::size_t first[1] = {none};
   for (std::size_t l = 0; l < lines; ++l) {
     const double gap = distance(point(l, n - 1), point(l, 0));
     const double adjacent = std::min(distance(point(l, 1), point(l, 0)), distance(point(l, n - 1), point(l, n - 2)));
-    if (gap > tol && gap < 1e-3 * adjacent) return {{n, false, true}, l, gap, adjacent, tol};
+    if (gap > tol && gap < 1e-3 * adjacent) {
+      found = {{n, false, true}, first_line + l, gap, adjacent, tol};
+      first[0] = found.line;
+      break;
+    }
   }
-  return {{n, false, false}};
+  team.min(first);
+  if (first[0] == none) return {{n, false, false}};
+  if (found.closing.nearly && found.line == first[0]) return found;
+  LineEnding other{{n, false, true}, first[0]};
+  other.mine = false;
+  return other;
 }
 
-// line_ending, a near miss refused; where(l) names line l's last point.
+// line_ending, a near miss refused (by the process whose line it is); where(l) names
+// line l's last point.
 template <class PointAt, class Diagonal, class Where>
 Closing find_closing(std::size_t lines, std::size_t n, const PointAt& point, const Diagonal& diagonal,
-                     const Where& where) {
-  const LineEnding e = line_ending(lines, n, point, diagonal);
+                     const Where& where, const RowTeam& team = solo, std::size_t first_line = 0) {
+  const LineEnding e = line_ending(lines, n, point, diagonal, team, first_line);
   if (e.closing.nearly)
-    fail(errc::closing_gap, where(e.line), " = ", point(e.line, n - 1), " nearly repeats the first point ",
-         point(e.line, 0), ": gap ", e.gap, ", more than the ", e.tol,
-         " (1e-12 of the bounding-box diagonal) that makes it the closing point and less than ",
-         "1e-3 of the chords next to it (", e.adjacent, "), which would leave a kink at the seam; repeat the first point "
-         "exactly, or leave the last one out");
+    team.run([&] {
+      if (!e.mine) return;
+      const std::size_t l = e.line - first_line;
+      fail(errc::closing_gap, where(l), " = ", point(l, n - 1), " nearly repeats the first point ", point(l, 0),
+           ": gap ", e.gap, ", more than the ", e.tol,
+           " (1e-12 of the bounding-box diagonal) that makes it the closing point and less than ",
+           "1e-3 of the chords next to it (", e.adjacent,
+           "), which would leave a kink at the seam; repeat the first point "
+           "exactly, or leave the last one out");
+    });
   return e.closing;
 }
 
@@ -391,7 +422,7 @@ namespace {
 // Partial sums are formed in chunks of a fixed number of rows and added in chunk
 // order, so the result does not depend on the number of threads.
 
-constexpr std::size_t rows_per_chunk = 16;
+using detail::rows_per_chunk;
 constexpr std::size_t rows_per_group = 8;
 // A line shorter than 1e-14 of the longest along its axis is a collapsed row (a
 // pole) within rounding: it is left out of the averaging.
@@ -492,30 +523,65 @@ GridShape grid_shape(const std::array<std::size_t, Rank>& shape) {
   return g;
 }
 
-[[noreturn]] void fail_not_finite(const Vec3* q, const GridShape& g, std::size_t k) {
+GridShape grid_shape(const GridBlock& b) {
+  GridShape g;
+  g.rank = b.rank;
+  g.n = b.n;
+  g.row = b.row_size();
+  return g;
+}
+
+// Point k of the whole grid (in C order) is q.
+[[noreturn]] void fail_not_finite(const Vec3& q, const GridShape& g, std::size_t k) {
   std::string at;
   for (std::size_t a = g.rank, rest = k; a-- > 0; rest /= g.n[a]) at = detail::cat("[", rest % g.n[a], "]", at);
-  const bool missing = std::isnan(q[k].x) || std::isnan(q[k].y) || std::isnan(q[k].z);
-  fail(errc::not_finite, "point ", at, " is ", q[k],
+  const bool missing = std::isnan(q.x) || std::isnan(q.y) || std::isnan(q.z);
+  fail(errc::not_finite, "point ", at, " is ", q,
        missing ? " (interpolation needs every point; approximation takes missing points, marked by NaN)" : "");
 }
 
 void check_grid_finite(const Vec3* q, const GridShape& g) {
   const std::size_t total = g.n[0] * g.row;
-  if (const std::size_t k = detail::first_non_finite(q, total); k < total) fail_not_finite(q, g, k);
+  if (const std::size_t k = detail::first_non_finite(q, total); k < total) fail_not_finite(q[k], g, k);
+}
+
+// The same for a block of rows.
+void check_block_finite(const GridBlock& b) {
+  const std::size_t M = b.row_size(), total = b.count * M;
+  if (const std::size_t k = detail::first_non_finite(b.data, total); k < total)
+    fail_not_finite(b.data[k], grid_shape(b), b.first * M + k);
+}
+
+// The block of every row of a grid, for the single process.
+template <std::size_t Rank>
+GridBlock whole_grid(const Grid<Vec3, Rank>& q) {
+  GridBlock b;
+  b.rank = Rank;
+  for (std::size_t a = 0; a < Rank; ++a) b.n[a] = q.extent(a);
+  b.data = const_cast<Vec3*>(q.data());  // NOLINT: read only where the grid is const (the parameters)
+  b.count = b.n[0];
+  const std::size_t M = b.row_size();
+  b.row0 = b.data;
+  b.last = b.data + (b.n[0] - 1) * M;
+  return b;
 }
 
 // The exponent of the grid's scale: of the largest coordinate in its first and last
 // rows (in every row when those are all zero), a few thousand points read at most.
 // It follows the scale of the data exactly, which is all it is for.
-int grid_exponent(const Vec3* q, const GridShape& g) {
-  auto largest = [&](std::size_t r0, std::size_t r1) {
+int grid_exponent(const GridBlock& b, const RowTeam& team) {
+  const std::size_t M = b.row_size();
+  auto largest = [&](const Vec3* q, std::size_t count) {
     double m = 0;
-    for (std::size_t k = r0 * g.row; k < r1 * g.row; ++k) m = std::max(m, max_abs(q[k]));
+    for (std::size_t k = 0; k < count; ++k) m = std::max(m, max_abs(q[k]));
     return m;
   };
-  double m = std::max(largest(0, 1), largest(g.n[0] - 1, g.n[0]));
-  if (m == 0) m = largest(0, g.n[0]);
+  double m = std::max(largest(b.row0, M), largest(b.last, M));
+  if (m == 0) {
+    double all[1] = {largest(b.data, b.count * M)};
+    team.max(all);
+    m = all[0];
+  }
   return scale_exponent(m);
 }
 
@@ -527,40 +593,42 @@ int grid_exponent(const Vec3* q, const GridShape& g) {
 // they are, in the range where the arithmetic has no limits.
 constexpr int extreme_exponent = 400;
 
-int extreme_shift(const Vec3* q, const GridShape& g) {
-  const int e = grid_exponent(q, g);
+int extreme_shift(const GridBlock& b, const RowTeam& team) {
+  const int e = grid_exponent(b, team);
   return e > extreme_exponent || e < -extreme_exponent ? e : 0;
 }
 
-// p[i] * 2^k for i < count, exactly (one rounding where the result is subnormal).
-void scale_points(Vec3* p, std::size_t count, int k) {
-  const auto n = static_cast<long long>(count);
-#pragma omp parallel for schedule(static) if (count >= detail::parallel_min_work)
-  for (long long i = 0; i < n; ++i) p[i] = ldexp(p[i], k);
-}
+using detail::scale_points;
 
 // Pass 1 and what the averaged parameters need from it.
 class GridChords {
  public:
-  GridChords(const Vec3* q, const GridShape& g, Parametrization param, std::array<bool, 3> periodic = {})
-      : g_(g), param_(param), root_(root_scale(grid_exponent(q, g))), periodic_(periodic) {
+  // The chords of a block of rows; every process of `team` builds its own, and
+  // they agree on what is summed over the whole grid.
+  GridChords(const GridBlock& b, Parametrization param, std::array<bool, 3> periodic, const RowTeam& team)
+      : g_(grid_shape(b)), param_(param), root_(root_scale(grid_exponent(b, team))), periodic_(periodic) {
+    const GridShape& g = g_;
     const std::size_t n0 = g.n[0], M = g.row, R = g.rank;
     if (param == Parametrization::uniform) {
-      check_grid_finite(q, g);
+      team.run([&] { check_block_finite(b); });
       return;
     }
-    const std::size_t chunks = (n0 + rows_per_chunk - 1) / rows_per_chunk;
-    std::size_t sums = chunks * M;
-    for (std::size_t a = 1; a < R; ++a) sums += n0 * g.lines(a) + chunks * g.n[a];
-    require_memory(sums, sizeof(double), "chord sums of the grid");
+    INTERPATCH_ASSERT(b.first % rows_per_chunk == 0);
+    const Vec3* q = b.data;
+    const std::size_t chunks = (b.count + rows_per_chunk - 1) / rows_per_chunk;
+    team.run([&] {
+      std::size_t sums = chunks * M;
+      for (std::size_t a = 1; a < R; ++a) sums += b.count * g.lines(a) + chunks * g.n[a];
+      require_memory(sums, sizeof(double), "chord sums of the grid");
+    });
     // part[c][a]: chunk c's sums; a = 0: the lengths of the lines along u (one per
     // point of a row); a ≥ 1: normalized running lengths along axis a.
     std::vector<std::vector<double>> part(chunks * R);
     line_length_.assign(R, {});
-    for (std::size_t a = 1; a < R; ++a) line_length_[a].assign(n0 * g.lines(a), 0.0);
+    for (std::size_t a = 1; a < R; ++a) line_length_[a].assign(b.count * g.lines(a), 0.0);
     std::vector<std::size_t> bad(chunks, no_point);
     const auto nchunks = static_cast<long long>(chunks);
-#pragma omp parallel if (n0 * M >= detail::parallel_min_work / 4)
+#pragma omp parallel if (b.count * M >= detail::parallel_min_work / 4)
     {
       std::vector<double> scratch(scratch_size());
 #pragma omp for schedule(static)
@@ -568,15 +636,15 @@ class GridChords {
         const auto c = static_cast<std::size_t>(ci);
         part[c * R].assign(M, 0.0);
         for (std::size_t a = 1; a < R; ++a) part[c * R + a].assign(g.n[a], 0.0);
-        const std::size_t r1 = std::min(n0, (c + 1) * rows_per_chunk);
-        for (std::size_t r = c * rows_per_chunk; r < r1; ++r) {
+        const std::size_t r1 = std::min(b.count, (c + 1) * rows_per_chunk);
+        for (std::size_t r = c * rows_per_chunk; r < r1; ++r) {  // local rows; b.first + r in the grid
           const Vec3* row = q + r * M;
           if (const std::size_t m = detail::first_non_finite(row, M); m < M) {
             bad[c] = r * M + m;
             break;
           }
-          if (r > 0) {
-            chord_lengths(row - M, row, M, scratch.data(), param, root_);
+          if (b.first + r > 0) {
+            chord_lengths(r == 0 ? b.before : row - M, row, M, scratch.data(), param, root_);
             double* t0 = part[c * R].data();
             for (std::size_t m = 0; m < M; ++m) t0[m] += scratch[m];
           }
@@ -586,32 +654,44 @@ class GridChords {
         }
       }
     }
-    for (std::size_t c = 0; c < chunks; ++c)
-      if (bad[c] != no_point) fail_not_finite(q, g, bad[c]);
-    for (std::size_t a = 1; a < R; ++a) check_lengths(line_length_[a], a);
+    team.run([&] {
+      for (std::size_t c = 0; c < chunks; ++c)
+        if (bad[c] != no_point) fail_not_finite(q[bad[c]], g, b.first * M + bad[c]);
+    });
+    team.run([&] {
+      for (std::size_t a = 1; a < R; ++a) check_lengths(line_length_[a], a);
+    });
     // Nearly collapsed lines were summed like the others: take them out again.
+    std::vector<double> longest(R, 0.0);
+    for (std::size_t a = 1; a < R; ++a)
+      for (const double l : line_length_[a]) longest[a] = std::max(longest[a], l);
+    team.max(longest);
     used_.assign(R, 0);
     for (std::size_t a = 1; a < R; ++a) {
       const auto& len = line_length_[a];
-      const double cut = pole_ratio * *std::max_element(len.begin(), len.end());
+      const double cut = pole_ratio * longest[a];
       const std::size_t per_row = g.lines(a);
       for (std::size_t l = 0; l < len.size(); ++l) {
         if (len[l] > cut && line_weight(len[l]) > 0) ++used_[a];
         else if (line_weight(len[l]) > 0) remove_line(q, a, l / per_row, l % per_row, part[(l / per_row / rows_per_chunk) * R + a]);
       }
     }
+    team.sum(used_);
     sums_.assign(R, {});
     for (std::size_t a = 0; a < R; ++a) {
       sums_[a].assign(a == 0 ? M : g.n[a], 0.0);
-      for (std::size_t c = 0; c < chunks; ++c)
-        for (std::size_t k = 0; k < sums_[a].size(); ++k) sums_[a][k] += part[c * R + a][k];
+      team.fold(sums_[a], [&](std::span<double> acc) {
+        for (std::size_t c = 0; c < chunks; ++c)
+          for (std::size_t k = 0; k < acc.size(); ++k) acc[k] += part[c * R + a][k];
+      });
     }
     if (periodic_[0]) {  // the closing chords of the lines along u: last row back to the first
       std::vector<double> closing(M);
-      chord_lengths(q + (n0 - 1) * M, q, M, closing.data(), param, root_);
+      chord_lengths(b.last, b.row0, M, closing.data(), param, root_);
       for (std::size_t m = 0; m < M; ++m) sums_[0][m] += closing[m];
     }
-    check_lengths(sums_[0], 0);
+    (void)n0;
+    team.run([&] { check_lengths(sums_[0], 0); });
     // Along u: the weight of each line is 1 / its length, 0 for a collapsed line.
     const double cut0 = pole_ratio * *std::max_element(sums_[0].begin(), sums_[0].end());
     inv_length_.assign(M, 0.0);
@@ -781,18 +861,19 @@ std::vector<double> grid_parameters_of(const Grid<Vec3, Rank>& q, int axis, Para
   const auto a = static_cast<std::size_t>(axis);
   if (q.extent(a) < 2) fail(errc::too_few_points, "a grid needs at least 2 points along ", axis_name(axis), ", got ", q.extent(a));
   const GridShape g = grid_shape(q.shape());
-  auto parameters = [&](const Vec3* data) {
-    const GridChords chords(data, g, param);
+  const RowTeam alone;
+  auto parameters = [&](const Grid<Vec3, Rank>& data) {
+    const GridChords chords(whole_grid(data), param, {}, alone);
     if (a > 0) return chords.in_row_parameters(a);
-    return chords.u_parameters(chords.uses_chords() ? row_steps(data, g, chords) : std::vector<double>(g.n[0], 0.0));
+    return chords.u_parameters(chords.uses_chords() ? row_steps(data.data(), g, chords) : std::vector<double>(g.n[0], 0.0));
   };
-  const int shift = param == Parametrization::uniform ? 0 : extreme_shift(q.data(), g);
-  if (shift == 0) return parameters(q.data());
+  const int shift = param == Parametrization::uniform ? 0 : extreme_shift(whole_grid(q), alone);
+  if (shift == 0) return parameters(q);
   check_grid_finite(q.data(), g);  // before scaling: the message shows the point as given
   require_memory(q.size(), sizeof(Vec3), "a scaled copy of the grid");
   Grid<Vec3, Rank> scaled = q;
   scale_points(scaled.data(), scaled.size(), -shift);
-  return parameters(scaled.data());
+  return parameters(scaled);
 }
 
 }  // namespace
@@ -812,18 +893,7 @@ struct GridSolution {
   std::vector<std::vector<double>> params;  // one per axis
 };
 
-// The factored system of one axis: banded for an open direction, cyclic banded for
-// a closed one.
-using AxisSolver = std::variant<detail::BandedLU, detail::CyclicLU>;
-
-AxisSolver factor_axis(const KnotVector& knots, std::span<const double> params, std::size_t a) {
-  try {
-    if (knots.periodic()) return detail::factor_periodic_collocation(knots, params);
-    return detail::factor_collocation(knots, params);
-  } catch (const error& e) {
-    fail(e.code(), "along ", axis_name(static_cast<int>(a)), ": ", e.what());
-  }
-}
+using detail::AxisSolver;
 
 void solve_axis(const AxisSolver& lu, double* data, const std::size_t* shape, std::size_t rank, std::size_t axis,
                 std::size_t components, bool parallel = true) {
@@ -832,6 +902,160 @@ void solve_axis(const AxisSolver& lu, double* data, const std::size_t* shape, st
 
 KnotVector axis_knots(std::span<const double> params, int degree, bool closed) {
   return closed ? periodic_knots(params, degree) : averaged_knots(params, degree);
+}
+
+// Rows 0, 1, n − 2 and n − 1 of a whole grid: what the closing along u looks at.
+template <std::size_t Rank>
+std::array<const Vec3*, 4> end_rows(const Grid<Vec3, Rank>& points) {
+  const std::size_t n = points.extent(0), M = points.size() / n;
+  auto row = [&](std::size_t r) { return points.data() + std::min(r, n - 1) * M; };
+  return {row(0), row(1), row(n < 2 ? 0 : n - 2), row(n - 1)};
+}
+
+template <std::size_t Rank>
+Closing grid_closing_of(const Grid<Vec3, Rank>& points, int axis) {
+  if (axis < 0 || axis >= static_cast<int>(Rank))
+    fail(errc::out_of_domain, "axis ", axis, " is outside 0..", Rank - 1, " for a grid of rank ", Rank);
+  return detail::block_closing(whole_grid(points), static_cast<std::size_t>(axis), end_rows(points), false, solo);
+}
+
+}  // namespace
+
+namespace detail {
+
+void scale_points(Vec3* p, std::size_t count, int k) {
+  const auto n = static_cast<long long>(count);
+#pragma omp parallel for schedule(static) if (count >= parallel_min_work)
+  for (long long i = 0; i < n; ++i) p[i] = ldexp(p[i], k);
+}
+
+int grid_degree(const std::optional<int>& degree, std::size_t count, const char* where) {
+  return resolve_degree(degree, count, 0, where);
+}
+
+int block_shift(const GridBlock& b, const RowTeam& team) { return extreme_shift(b, team); }
+
+void check_finite(const GridBlock& b) { check_block_finite(b); }
+
+AxisSolver factor_axis(const KnotVector& knots, std::span<const double> params, std::size_t a) {
+  try {
+    if (knots.periodic()) return factor_periodic_collocation(knots, params);
+    return factor_collocation(knots, params);
+  } catch (const error& e) {
+    fail(e.code(), "along ", axis_name(static_cast<int>(a)), ": ", e.what());
+  }
+}
+
+void solve_columns(const AxisSolver& lu, double* data, std::size_t n, std::size_t width) {
+  const std::size_t shape[2] = {n, width};
+  solve_axis(lu, data, shape, 2, 0, 1);
+}
+
+Closing block_closing(const GridBlock& b, std::size_t axis, std::span<const Vec3* const> ends, bool refuse,
+                      const RowTeam& team) {
+  const GridShape g = grid_shape(b);
+  const std::size_t M = g.row, n = g.n[axis];
+  // The bounding-box diagonal of the whole grid; -max(-x) is min(x), bit for bit.
+  auto diagonal = [&] {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    double box[6] = {-inf, -inf, -inf, -inf, -inf, -inf};  // -lo, hi
+    for (std::size_t i = 0; i < b.count * M; ++i)
+      for (int k = 0; k < 3; ++k) {
+        box[k] = std::max(box[k], -b.data[i][k]);
+        box[3 + k] = std::max(box[3 + k], b.data[i][k]);
+      }
+    team.max(box);
+    return norm(Vec3{box[3], box[4], box[5]} - Vec3{-box[0], -box[1], -box[2]});
+  };
+  auto where_flat = [&](std::size_t flat) {
+    std::string idx;
+    for (std::size_t a = g.rank, rest = flat; a-- > 0; rest /= g.n[a]) idx = cat("[", rest % g.n[a], "]", idx);
+    return cat("point ", idx, ", the last along ", axis_name(static_cast<int>(axis)), ",");
+  };
+  if (axis == 0) {  // every process has the rows it looks at: each finds the same
+    auto point = [&](std::size_t l, std::size_t k) -> const Vec3& {
+      return (k == 0 ? ends[0] : k == 1 ? ends[1] : k + 2 == n ? ends[2] : ends[3])[l];
+    };
+    auto where = [&](std::size_t l) { return where_flat((n - 1) * M + l); };
+    Closing c;
+    team.run([&] {
+      c = refuse ? find_closing(M, n, point, diagonal, where) : line_ending(M, n, point, diagonal).closing;
+    });
+    return c;
+  }
+  std::size_t inner = 1;
+  for (std::size_t a = axis + 1; a < g.rank; ++a) inner *= g.n[a];
+  auto index = [&](std::size_t l, std::size_t k) { return (l / inner) * n * inner + k * inner + l % inner; };
+  auto point = [&](std::size_t l, std::size_t k) -> const Vec3& { return b.data[index(l, k)]; };
+  auto where = [&](std::size_t l) { return where_flat(b.first * M + index(l, n - 1)); };
+  const std::size_t lines = b.count * M / n, first_line = b.first * M / n;
+  if (!refuse) return line_ending(lines, n, point, diagonal, team, first_line).closing;
+  return find_closing(lines, n, point, diagonal, where, team, first_line);
+}
+
+RowSolution solve_rows(const GridBlock& b, std::span<const int> p, Parametrization param, std::span<const bool> periodic,
+                       const RowTeam& team) {
+  const std::size_t R = b.rank, M = b.row_size();
+  std::array<bool, 3> closed{};
+  for (std::size_t a = 0; a < R; ++a) closed[a] = periodic[a];
+  const GridChords chords(b, param, closed, team);
+  team.run([&] { chords.check_lines(); });
+
+  RowSolution r;
+  r.params.resize(R);
+  std::vector<AxisSolver> lu;
+  std::vector<KnotVector> row_knots;
+  team.run([&] {  // the same on every process
+    for (std::size_t a = 1; a < R; ++a) {
+      r.params[a] = chords.in_row_parameters(a);
+      row_knots.push_back(axis_knots(r.params[a], p[a], periodic[a]));
+      lu.push_back(factor_axis(row_knots.back(), r.params[a], a));
+    }
+  });
+
+  // Pass 2: groups of rows, each thread a contiguous run of them. A row's step along
+  // u needs the row before it as it was, so each thread keeps a copy of the last
+  // row it has read before solving it (the block's first row: the row before the
+  // block).
+  std::vector<double> steps(b.count, 0.0);
+  Vec3* data = b.data;
+  const std::size_t groups = (b.count + rows_per_group - 1) / rows_per_group;
+  std::array<std::size_t, 4> group_shape{};
+  for (std::size_t a = 1; a < R; ++a) group_shape[a] = b.n[a];
+  group_shape[R] = 3;
+  const bool uses_chords = chords.uses_chords();
+#pragma omp parallel if (b.count * M >= parallel_min_work / 8)
+  {
+    const std::size_t nt = thread_count(), t = static_cast<std::size_t>(thread_index());
+    const std::size_t g0 = groups * t / nt, g1 = groups * (t + 1) / nt;
+    std::vector<Vec3> prev(uses_chords ? M : 0);
+    std::vector<double> scratch(uses_chords ? M : 0);
+    if (uses_chords && g0 < g1) {
+      if (g0 > 0) std::copy_n(data + (g0 * rows_per_group - 1) * M, M, prev.data());
+      else if (b.first > 0) std::copy_n(b.before, M, prev.data());
+    }
+#pragma omp barrier
+    auto gs = group_shape;
+    for (std::size_t gi = g0; gi < g1; ++gi) {
+      const std::size_t r0 = gi * rows_per_group, r1 = std::min(b.count, r0 + rows_per_group);
+      if (uses_chords) {
+        for (std::size_t k = b.first + r0 == 0 ? 1 : r0; k < r1; ++k)
+          steps[k] = chords.row_step(k == r0 ? prev.data() : data + (k - 1) * M, data + k * M, scratch.data());
+        std::copy_n(data + (r1 - 1) * M, M, prev.data());
+      }
+      gs[0] = r1 - r0;
+      for (std::size_t a = 1; a < R; ++a) solve_axis(lu[a - 1], &data[r0 * M].x, gs.data(), R + 1, a, 1, false);
+    }
+  }
+
+  // Along u: every row's step, in row order.
+  const std::vector<double> all_steps = team.gather(steps);
+  team.run([&] {
+    r.params[0] = chords.u_parameters(all_steps);
+    r.knots.push_back(axis_knots(r.params[0], p[0], periodic[0]));
+  });
+  for (auto& k : row_knots) r.knots.push_back(std::move(k));
+  return r;
 }
 
 // Leaves out the last line along `axis` of a grid (a closing line equal to the
@@ -867,48 +1091,6 @@ void drop_last_line(Grid<Vec3, Rank>& points, std::size_t axis) {
   points = Grid<Vec3, Rank>(shape, std::move(values));
 }
 
-// The lines of a grid along `axis`: at(l, k) is point k of line l.
-template <std::size_t Rank>
-struct GridLines {
-  GridLines(const Grid<Vec3, Rank>& g, std::size_t axis) : points(g), n(g.shape()[axis]) {
-    for (std::size_t a = axis + 1; a < Rank; ++a) inner *= g.shape()[a];
-  }
-  [[nodiscard]] std::size_t count() const { return points.size() / n; }
-  [[nodiscard]] std::size_t index(std::size_t l, std::size_t k) const { return (l / inner) * n * inner + k * inner + l % inner; }
-  [[nodiscard]] const Vec3& at(std::size_t l, std::size_t k) const { return points.data()[index(l, k)]; }
-  [[nodiscard]] double diagonal() const {
-    return box_diagonal(points.size(), [&](std::size_t i) -> const Vec3& { return points.data()[i]; });
-  }
-  const Grid<Vec3, Rank>& points;
-  std::size_t n, inner = 1;
-};
-
-// The closing line along `axis`, if any (find_closing over the grid's lines).
-template <std::size_t Rank>
-Closing closing_line(const Grid<Vec3, Rank>& points, std::size_t axis) {
-  const GridLines<Rank> g(points, axis);
-  const auto& shape = points.shape();
-  auto where = [&](std::size_t l) {
-    std::string idx;
-    for (std::size_t a = Rank, rest = g.index(l, g.n - 1); a-- > 0; rest /= shape[a])
-      idx = detail::cat("[", rest % shape[a], "]", idx);
-    return detail::cat("point ", idx, ", the last along ", axis_name(static_cast<int>(axis)), ",");
-  };
-  return find_closing(
-      g.count(), g.n, [&](std::size_t l, std::size_t k) -> const Vec3& { return g.at(l, k); }, [&] { return g.diagonal(); },
-      where);
-}
-
-template <std::size_t Rank>
-Closing grid_closing_of(const Grid<Vec3, Rank>& points, int axis) {
-  if (axis < 0 || axis >= static_cast<int>(Rank))
-    fail(errc::out_of_domain, "axis ", axis, " is outside 0..", Rank - 1, " for a grid of rank ", Rank);
-  const GridLines<Rank> g(points, static_cast<std::size_t>(axis));
-  return line_ending(g.count(), g.n, [&](std::size_t l, std::size_t k) -> const Vec3& { return g.at(l, k); },
-                     [&] { return g.diagonal(); })
-      .closing;
-}
-
 // Re-anchors a closed axis of even degree at its first parameter (seam_insertion on
 // every line along it): one more control point along the axis.
 template <std::size_t Rank>
@@ -940,6 +1122,15 @@ void insert_seam(Grid<Vec3, Rank>& points, std::size_t axis, KnotVector& knots, 
   knots = std::move(seam.knots);
 }
 
+template void drop_last_line<2>(Grid<Vec3, 2>&, std::size_t);
+template void drop_last_line<3>(Grid<Vec3, 3>&, std::size_t);
+template void insert_seam<2>(Grid<Vec3, 2>&, std::size_t, KnotVector&, double);
+template void insert_seam<3>(Grid<Vec3, 3>&, std::size_t, KnotVector&, double);
+
+}  // namespace detail
+
+namespace {
+
 // The tensor-product interpolation behind surfaces and volumes, in the
 // three passes described above. The data become the control points.
 template <std::size_t Rank>
@@ -957,8 +1148,8 @@ GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional
   std::array<bool, Rank> dropped{};
   for (std::size_t a = 0; a < Rank; ++a)
     if (periodic[a])
-      if (const Closing c = closing_line(points, a); c.dropped) {
-        drop_last_line(points, a);
+      if (const Closing c = detail::block_closing(whole_grid(points), a, end_rows(points), true, solo); c.dropped) {
+        detail::drop_last_line(points, a);
         dropped[a] = true;
       }
   const auto& shape = points.shape();
@@ -968,71 +1159,26 @@ GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional
   for (std::size_t a = 0; a < Rank; ++a) p[a] = resolve_degree(degree[a], shape[a], 0, periodic[a] ? around_axis[a] : in_axis[a]);
   if (progress) progress(0.0);
 
-  // Pass 1, then the knots and factorizations of the axes inside the rows.
+  // Passes 1 and 2, the knots and factorizations of the axes inside the rows.
   const GridShape g = grid_shape(shape);
-  const int shift = param == Parametrization::uniform ? 0 : extreme_shift(points.data(), g);
+  const GridBlock block = whole_grid(points);
+  const int shift = param == Parametrization::uniform ? 0 : extreme_shift(block, solo);
   if (shift != 0) {
     check_grid_finite(points.data(), g);  // before scaling: the message shows the point as given
     scale_points(points.data(), points.size(), -shift);
   }
-  std::array<bool, 3> closed{};
-  for (std::size_t a = 0; a < Rank; ++a) closed[a] = periodic[a];
-  const GridChords chords(points.data(), g, param, closed);
-  chords.check_lines();
-
-  GridSolution r;
-  r.params.resize(Rank);
-  r.knots.reserve(Rank);
-  std::vector<AxisSolver> lu;
-  std::vector<KnotVector> row_knots;
-  for (std::size_t a = 1; a < Rank; ++a) {
-    r.params[a] = chords.in_row_parameters(a);
-    row_knots.push_back(axis_knots(r.params[a], p[a], periodic[a]));
-    lu.push_back(factor_axis(row_knots.back(), r.params[a], a));
-  }
-  if (progress) progress(0.2);
-
-  // Pass 2: groups of rows, each thread a contiguous run of them. A row's step along
-  // u needs the row before it as it was, so each thread keeps a copy of the last
-  // row it has read before solving it.
-  std::vector<double> steps(g.n[0], 0.0);
-  Vec3* data = points.data();
-  const std::size_t M = g.row, groups = (g.n[0] + rows_per_group - 1) / rows_per_group;
-  std::array<std::size_t, Rank + 1> group_shape{};
-  for (std::size_t a = 1; a < Rank; ++a) group_shape[a] = shape[a];
-  group_shape[Rank] = 3;
-#pragma omp parallel if (points.size() >= detail::parallel_min_work / 8)
-  {
-    const std::size_t nt = detail::thread_count(), t = static_cast<std::size_t>(detail::thread_index());
-    const std::size_t g0 = groups * t / nt, g1 = groups * (t + 1) / nt;
-    std::vector<Vec3> prev(chords.uses_chords() ? M : 0);
-    std::vector<double> scratch(chords.uses_chords() ? M : 0);
-    if (chords.uses_chords() && g0 < g1 && g0 > 0) std::copy_n(data + (g0 * rows_per_group - 1) * M, M, prev.data());
-#pragma omp barrier
-    auto gs = group_shape;
-    for (std::size_t gi = g0; gi < g1; ++gi) {
-      const std::size_t r0 = gi * rows_per_group, r1 = std::min(g.n[0], r0 + rows_per_group);
-      if (chords.uses_chords()) {
-        for (std::size_t k = std::max<std::size_t>(r0, 1); k < r1; ++k)
-          steps[k] = chords.row_step(k == r0 ? prev.data() : data + (k - 1) * M, data + k * M, scratch.data());
-        std::copy_n(data + (r1 - 1) * M, M, prev.data());
-      }
-      gs[0] = r1 - r0;
-      for (std::size_t a = 1; a < Rank; ++a) solve_axis(lu[a - 1], &data[r0 * M].x, gs.data(), Rank + 1, a, 1, false);
-    }
-  }
+  detail::RowSolution rows = detail::solve_rows(block, p, param, periodic, solo);
   if (progress) progress(0.6);
 
   // Pass 3: along u.
-  r.params[0] = chords.u_parameters(steps);
-  r.knots.push_back(axis_knots(r.params[0], p[0], periodic[0]));
-  for (auto& k : row_knots) r.knots.push_back(std::move(k));
-  const AxisSolver lu0 = factor_axis(r.knots[0], r.params[0], 0);
-  solve_axis(lu0, &data->x, shape.data(), Rank, 0, 3);
+  GridSolution r{std::move(rows.knots), std::move(rows.params)};
+  const AxisSolver lu0 = detail::factor_axis(r.knots[0], r.params[0], 0);
+  Vec3* data = points.data();
+  detail::solve_columns(lu0, &data->x, g.n[0], 3 * g.row);
   if (shift != 0) scale_points(data, points.size(), shift);
   // Closed axes of even degree start their period at their first parameter.
   for (std::size_t a = 0; a < Rank; ++a)
-    if (periodic[a] && p[a] % 2 == 0) insert_seam(points, a, r.knots[a], r.params[a].front());
+    if (periodic[a] && p[a] % 2 == 0) detail::insert_seam(points, a, r.knots[a], r.params[a].front());
   for (std::size_t a = 0; a < Rank; ++a)
     if (dropped[a]) r.params[a].push_back(r.params[a].front() + 1.0);
   if (progress) progress(1.0);

@@ -19,6 +19,7 @@
 #include <cstring>
 #include <istream>
 #include <optional>
+#include <sstream>
 #include <span>
 #include <streambuf>
 #include <string>
@@ -119,11 +120,14 @@ struct OutMember {
   std::string head;                // the .npy preamble and header
   std::string bytes;               // the data of a small int64 or bool array, little-endian
   std::span<const double> values;  // or the data, in the form's own memory
+  std::uint64_t elsewhere = 0;     // or bytes of data another writer puts in place (exact_npz_frame)
   std::uint64_t offset = 0;        // of the local header
   std::uint32_t crc = 0;
   bool zip64_size = false, zip64_offset = false;
 
-  [[nodiscard]] std::uint64_t size() const { return head.size() + bytes.size() + values.size() * sizeof(double); }
+  [[nodiscard]] std::uint64_t size() const {
+    return head.size() + bytes.size() + values.size() * sizeof(double) + elsewhere;
+  }
   [[nodiscard]] std::uint16_t version() const { return zip64_size || zip64_offset ? version_zip64 : version_plain; }
 };
 
@@ -144,7 +148,9 @@ std::vector<OutMember> members_of(const FormView& f) {
   for (const std::size_t e : f.shape) count *= e;
   std::vector<std::size_t> points_shape = f.shape;
   points_shape.push_back(3);
-  m.push_back({member_names[4], internal::npy_header("<f8", points_shape), {}, {&f.points->x, 3 * count}});
+  m.push_back({member_names[4], internal::npy_header("<f8", points_shape), {}, {}});
+  if (f.points) m.back().values = {&f.points->x, 3 * count};
+  else m.back().elsewhere = 3 * count * sizeof(double);
   if (f.weights) m.push_back({member_names[5], internal::npy_header("<f8", f.shape), {}, {f.weights, count}});
   std::string periodic;
   for (const KnotVector* k : f.knots) periodic += k->periodic() ? '\1' : '\0';
@@ -235,8 +241,13 @@ std::string end_records(std::size_t entries, std::uint64_t directory_offset, std
   return e;
 }
 
-void write_archive(const fs::path& path, const FormView& f, bool force_zip64) {
-  std::vector<OutMember> members = members_of(f);
+// Where the members and the directory go: each member's offset and ZIP64 flags.
+struct Layout {
+  std::uint64_t directory_offset = 0, directory_size = 0, total = 0;
+  bool zip64_end = false;
+};
+
+Layout lay_out(std::vector<OutMember>& members, bool force_zip64) {
   std::uint64_t at = 0;
   for (OutMember& m : members) {
     m.offset = at;
@@ -244,12 +255,20 @@ void write_archive(const fs::path& path, const FormView& f, bool force_zip64) {
     m.zip64_offset = force_zip64 || m.offset >= escape32;
     at += local_header(m).size() + m.size();
   }
-  const std::uint64_t directory_offset = at;
-  std::uint64_t directory_size = 0;
-  for (const OutMember& m : members) directory_size += central_header(m).size();
-  const bool zip64_end = force_zip64 || directory_offset + directory_size >= escape32 || members.size() >= escape16;
-  const std::uint64_t total =
-      directory_offset + directory_size + end_records(members.size(), 0, 0, zip64_end, force_zip64).size();
+  Layout l;
+  l.directory_offset = at;
+  for (const OutMember& m : members) l.directory_size += central_header(m).size();
+  l.zip64_end = force_zip64 || l.directory_offset + l.directory_size >= escape32 || members.size() >= escape16;
+  l.total = l.directory_offset + l.directory_size + end_records(members.size(), 0, 0, l.zip64_end, force_zip64).size();
+  return l;
+}
+
+void write_archive(const fs::path& path, const FormView& f, bool force_zip64) {
+  std::vector<OutMember> members = members_of(f);
+  const Layout layout = lay_out(members, force_zip64);
+  const std::uint64_t directory_offset = layout.directory_offset, directory_size = layout.directory_size;
+  const bool zip64_end = layout.zip64_end;
+  const std::uint64_t total = layout.total;
 
   check_disk_space(path, total, cat("the archive '", path.string(), "'"));
   write_atomically(path, [&](std::ostream& os) {
@@ -732,6 +751,31 @@ class Reader {
 }  // namespace
 
 namespace internal {
+
+NpzFrame exact_npz_frame(std::span<const int> degrees, std::span<const KnotVector* const> knots,
+                         std::span<const std::size_t> shape, std::uint32_t points_crc) {
+  FormView f{{degrees.begin(), degrees.end()}, {knots.begin(), knots.end()}, {shape.begin(), shape.end()}, nullptr, nullptr};
+  std::vector<OutMember> members = members_of(f);
+  const Layout layout = lay_out(members, false);
+  NpzFrame frame;
+  std::string* to = &frame.head;
+  for (OutMember& m : members) {
+    m.crc = crc32(m.head.data(), m.head.size());
+    m.crc = crc32(m.bytes.data(), m.bytes.size(), m.crc);
+    std::ostringstream values;
+    internal::write_values(values, m.values.data(), m.values.size(), &m.crc);
+    if (m.elsewhere) m.crc = internal::crc32_combine(m.crc, points_crc, m.elsewhere);
+    *to += local_header(m) + m.head + m.bytes + values.str();
+    if (m.elsewhere) {
+      frame.points_offset = to->size();
+      to = &frame.tail;
+    }
+  }
+  for (const OutMember& m : members) frame.tail += central_header(m);
+  frame.tail += end_records(members.size(), layout.directory_offset, layout.directory_size, layout.zip64_end, false);
+  frame.total = layout.total;
+  return frame;
+}
 
 void write_exact_npz(const fs::path& path, const ExactForm& exact, bool zip64) {
   std::visit([&](const auto& form) { write_archive(path, view(form), zip64); }, exact);

@@ -3,7 +3,10 @@
 // io/npz.hpp.
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
+#include <span>
+#include <string>
 
 #include "interpatch/io/spec.hpp"
 
@@ -18,5 +21,19 @@ namespace interpatch::io::internal {
 /// their sizes (`zip64`), or only where a size or an offset passes 4 GiB: the
 /// tests' way to the ZIP64 records without writing 4 GiB.
 void write_exact_npz(const std::filesystem::path& path, const ExactForm& exact, bool zip64);
+
+/// The bytes of an .npz archive of a polynomial exact form (degrees, knots, a
+/// control net of `shape` without its 3 coordinates) other than the control points'
+/// data, for a writer that puts those in place itself (a run split between
+/// processes, src/mpi/): `head` is every byte before them, `tail` every byte after,
+/// and the data go at points_offset (head.size()); total is the archive's size.
+/// `points_crc` is the CRC-32 of the data alone (crc32_combine of the pieces). The
+/// archive is write_exact_npz's, byte for byte.
+struct NpzFrame {
+  std::string head, tail;
+  std::uint64_t points_offset = 0, total = 0;
+};
+[[nodiscard]] NpzFrame exact_npz_frame(std::span<const int> degrees, std::span<const KnotVector* const> knots,
+                                       std::span<const std::size_t> shape, std::uint32_t points_crc);
 
 }  // namespace interpatch::io::internal

@@ -135,26 +135,23 @@ Construction bspline_from_npz(const json& spec, Context& ctx) {
 
 }  // namespace
 
-template <std::size_t D>
-Construction build_interpolate(const json& spec, Context& ctx) {
-  using T = Tensor<D>;
-  PointArray pts = interpolation_points(member(spec, "points", "", cat("a grid of points, ", T::grid_form)), D, "/points", ctx);
-  const auto degree = degrees(spec, "", D);
-  const Parametrization param = parametrization(spec, "");
-  const std::array<bool, 3> periodic = periodic_flags(spec, "", D);
-  const std::string shape = extents_text(pts.shape);
+nlohmann::ordered_json check_grid_axes(const json& spec, const std::vector<std::optional<int>>& degree,
+                                       const std::array<bool, 3>& periodic, std::span<const std::size_t> shape,
+                                       const char* kind, const std::function<Closing(std::size_t)>& closing,
+                                       Context& ctx) {
+  const std::size_t D = degree.size();
+  const std::string shape_text = extents_text(shape);
   nlohmann::ordered_json notes = nlohmann::ordered_json::array();
   for (std::size_t a = 0; a < D; ++a) {
-    const std::size_t count = pts.shape[a];
+    const std::size_t count = shape[a];
     if (count < 2)
       fail(errc::too_few_points, "/points: the grid has ", count, " point", count == 1 ? "" : "s", " along ", axis_name(a),
-           " (shape ", shape, "); interpolation needs at least 2");
+           " (shape ", shape_text, "); interpolation needs at least 2");
   }
-  typename T::Points grid(grid_shape<D>(pts.shape), std::move(pts.points));
   for (std::size_t a = 0; a < D; ++a) {
-    const std::size_t count = pts.shape[a];
+    const std::size_t count = shape[a];
     // Interpolation's own rule (grid_closing): whether the last line repeats the first.
-    const Closing ending = grid_closing(grid, static_cast<int>(a));
+    const Closing ending = closing(a);
     // A closed direction is made of its distinct lines: a closing line is left out.
     const bool dropped = periodic[a] && ending.dropped;
     const std::size_t lines = dropped ? count - 1 : count;
@@ -163,7 +160,7 @@ Construction build_interpolate(const json& spec, Context& ctx) {
     if (degree[a] && static_cast<std::size_t>(*degree[a]) >= lines && !refused)
       fail(errc::too_few_points, degree_pointer(spec, "", a), ": degree ", *degree[a], periodic[a] ? " around " : " along ",
            axis_name(a), periodic[a] ? " (closed)" : "", " needs at least ", *degree[a] + 1,
-           periodic[a] ? " distinct points" : " points", ", /points has ", count, " (shape ", shape, ")",
+           periodic[a] ? " distinct points" : " points", ", /points has ", count, " (shape ", shape_text, ")",
            dropped ? ", the last repeating the first" : "");
     if (dropped)
       notes.push_back(cat("the last line of points along ", axis_name(a), " repeats the first and is left out: ", lines,
@@ -172,16 +169,29 @@ Construction build_interpolate(const json& spec, Context& ctx) {
       std::array<bool, 3> suggested = periodic;
       suggested[a] = true;
       const std::string what = cat("the data close along ", axis_name(a), " (the last line of points repeats the first), but ",
-                                   axis_name(a), " is not periodic: the ", T::kind, " meets itself there with a crease; \"periodic\": ",
+                                   axis_name(a), " is not periodic: the ", kind, " meets itself there with a crease; \"periodic\": ",
                                    periodic_text(suggested, D), " makes it smooth across the seam");
       ctx.warn(cat("/points: ", what));
       notes.push_back(what);
     }
   }
+  return notes;
+}
+
+template <std::size_t D>
+Construction build_interpolate(const json& spec, Context& ctx) {
+  using T = Tensor<D>;
+  PointArray pts = interpolation_points(member(spec, "points", "", cat("a grid of points, ", T::grid_form)), D, "/points", ctx);
+  const auto degree = degrees(spec, "", D);
+  const Parametrization param = parametrization(spec, "");
+  const std::array<bool, 3> periodic = periodic_flags(spec, "", D);
+  typename T::Points grid(grid_shape<D>(pts.shape), std::move(pts.points));
+  nlohmann::ordered_json notes = check_grid_axes(spec, degree, periodic, pts.shape, T::kind,
+                                                 [&](std::size_t a) { return grid_closing(grid, static_cast<int>(a)); }, ctx);
   DataSet data;
   data.pointer = "/points";
   if (ctx.keep_data) {
-    require_memory(grid.size(), sizeof(Vec3), cat("/points: a copy of the ", shape, " data points for the error check"));
+    require_memory(grid.size(), sizeof(Vec3), cat("/points: a copy of the ", extents_text(pts.shape), " data points for the error check"));
     data.points.assign(grid.values().begin(), grid.values().end());
   }
   ctx.parsed();

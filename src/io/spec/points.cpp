@@ -120,24 +120,7 @@ std::string expected_shape(std::size_t rank) {
 // below `ptr` (`/points/3/7/2`) and the file it came from.
 void check_finite_points(const std::vector<std::size_t>& shape, const PointStorage& points, std::string_view ptr,
                          const std::string& file, bool missing_allowed) {
-  std::size_t i = interpatch::detail::first_non_finite(points.data(), points.size());
-  if (missing_allowed)  // NaN marks a missing point; infinities are still refused
-    for (; i < points.size(); ++i)
-      if (std::isinf(points[i].x) || std::isinf(points[i].y) || std::isinf(points[i].z)) break;
-  if (i < points.size()) {
-    const Vec3& p = points[i];
-    std::vector<std::size_t> idx(shape.size() + 1);
-    std::size_t r = i;
-    for (std::size_t a = shape.size(); a-- > 0;) {
-      idx[a] = r % shape[a];
-      r /= shape[a];
-    }
-    auto bad = [&](double x) { return missing_allowed ? std::isinf(x) : !std::isfinite(x); };
-    const int k = !bad(p.x) ? (!bad(p.y) ? 2 : 1) : 0;
-    idx[shape.size()] = static_cast<std::size_t>(k);
-    fail(errc::not_finite, place(index_pointer(ptr, idx, idx.size())), ": coordinate ", coord_name(k), " is ", p[k], " (in ",
-         file, ")");
-  }
+  check_finite_block(shape, points, 0, ptr, file, missing_allowed);
 }
 
 PointArray npy_points(const json& obj, std::size_t rank, std::string_view ptr, Context& ctx, bool missing_allowed) {
@@ -233,14 +216,18 @@ PointArray interpolation_points(const json& j, std::size_t rank, std::string_vie
   try {
     return points_impl(j, rank, ptr, ctx);
   } catch (const error& e) {
-    const std::string_view m = e.what();
-    const bool nan = e.code() == errc::not_finite && (m.find(" is nan") != m.npos || m.find(" is -nan") != m.npos ||
-                                                      m.find("nan,") != m.npos || m.find("'nan'") != m.npos);
-    const bool null = e.code() == errc::wrong_type && m.ends_with("got null");
-    if (!nan && !null) throw;
-    throw error(e.code(), cat(m, " (interpolation needs every point; \"type\": \"approximate\" takes missing points, ",
-                              "NaN in a file or null in a list)"));
+    rethrow_for_interpolation(e);
   }
+}
+
+void rethrow_for_interpolation(const error& e) {
+  const std::string_view m = e.what();
+  const bool nan = e.code() == errc::not_finite && (m.find(" is nan") != m.npos || m.find(" is -nan") != m.npos ||
+                                                    m.find("nan,") != m.npos || m.find("'nan'") != m.npos);
+  const bool null = e.code() == errc::wrong_type && m.ends_with("got null");
+  if (!nan && !null) throw e;
+  throw error(e.code(), cat(m, " (interpolation needs every point; \"type\": \"approximate\" takes missing points, ",
+                            "NaN in a file or null in a list)"));
 }
 
 template <std::size_t Rank>
@@ -260,5 +247,27 @@ Grid<double, Rank> inline_number_grid(const json& j, std::string_view ptr) {
 
 template Grid<double, 2> inline_number_grid<2>(const json& j, std::string_view ptr);
 template Grid<double, 3> inline_number_grid<3>(const json& j, std::string_view ptr);
+
+void check_finite_block(const std::vector<std::size_t>& shape, std::span<const Vec3> points, std::size_t first,
+                        std::string_view ptr, const std::string& file, bool missing_allowed) {
+  std::size_t i = interpatch::detail::first_non_finite(points.data(), points.size());
+  if (missing_allowed)  // NaN marks a missing point; infinities are still refused
+    for (; i < points.size(); ++i)
+      if (std::isinf(points[i].x) || std::isinf(points[i].y) || std::isinf(points[i].z)) break;
+  if (i < points.size()) {
+    const Vec3& p = points[i];
+    std::vector<std::size_t> idx(shape.size() + 1);
+    std::size_t r = first + i;
+    for (std::size_t a = shape.size(); a-- > 0;) {
+      idx[a] = r % shape[a];
+      r /= shape[a];
+    }
+    const auto bad = [&](double x) { return missing_allowed ? std::isinf(x) : !std::isfinite(x); };
+    const int k = !bad(p.x) ? (!bad(p.y) ? 2 : 1) : 0;
+    idx[shape.size()] = static_cast<std::size_t>(k);
+    fail(errc::not_finite, place(index_pointer(ptr, idx, idx.size())), ": coordinate ", coord_name(k), " is ", p[k], " (in ",
+         file, ")");
+  }
+}
 
 }  // namespace interpatch::io::reader

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <initializer_list>
 #include <optional>
 #include <span>
@@ -175,6 +176,26 @@ Construction build_ruled(const json& spec, Context& ctx);
 Construction build_coons(const json& spec, Context& ctx);
 Construction build_network(const json& spec, Context& ctx);
 Construction build_hermite_patch(const json& spec, Context& ctx);
+/// Refuses the first point with a NaN or Inf coordinate among `points`, which are
+/// the points from index `first` on of a grid of `shape` read from `file`, naming
+/// it as a JSON Pointer below `ptr` (`/points/3/7/2`) and the file.
+/// With `missing_allowed` (approximation) NaN marks a missing point and only
+/// infinities are refused.
+void check_finite_block(const std::vector<std::size_t>& shape, std::span<const Vec3> points, std::size_t first,
+                        std::string_view ptr, const std::string& file, bool missing_allowed = false);
+/// `e` thrown again, with the note that approximation takes missing points when it is
+/// about a NaN (or null) point: what interpolation_points says, for readers of grids
+/// that do not go through it (the run split between processes).
+[[noreturn]] void rethrow_for_interpolation(const error& e);
+/// build_interpolate's checks of a grid of `shape` before it is solved (at least 2
+/// points along each axis, enough distinct lines for each degree), its warnings
+/// (data closed along an axis not declared periodic) into ctx and its notes as
+/// returned; closing(a) is the grid's closing along axis a (grid_closing). Shared
+/// with the run split between processes (src/mpi/), which has no grid in one piece.
+nlohmann::ordered_json check_grid_axes(const json& spec, const std::vector<std::optional<int>>& degree,
+                                       const std::array<bool, 3>& periodic, std::span<const std::size_t> shape,
+                                       const char* kind, const std::function<Closing(std::size_t)>& closing,
+                                       Context& ctx);
 template <std::size_t Dims>
 Construction build_interpolate(const json& spec, Context& ctx);
 template <std::size_t Dims>

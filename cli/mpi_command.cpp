@@ -1,0 +1,586 @@
+// eval and build of a grid interpolation split between MPI processes. Each process
+// reads its block of rows of the .npy points (MPI-IO), the passes along the axes
+// inside the rows run on the blocks (src/detail/grid_rows.hpp, the very functions
+// the single process runs), one all-to-all turns the rows into columns for the
+// solve along u and another turns the control points back into rows (with the
+// halo each process's output rows need), and every process writes its part of the
+// output in place; rank 0 renames the file into place when all have succeeded.
+
+#include "mpi_command.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cstdlib>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <fstream>
+#include <new>
+#include <sstream>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "commands.hpp"
+#include "detail/grid_rows.hpp"
+#include "detail/row_window.hpp"
+#include "exit_status.hpp"
+#include "interpatch/error.hpp"
+#include "interpatch/evaluate.hpp"
+#include "interpatch/io/atomic_file.hpp"
+#include "interpatch/memory.hpp"
+#include "io/crc32.hpp"
+#include "io/npy_format.hpp"
+#include "io/npz_internal.hpp"
+#include "io/spec/reader.hpp"
+#include "mpi/team.hpp"
+
+namespace interpatch::cli {
+
+namespace fs = std::filesystem;
+using detail::cat;
+using detail::fail;
+
+namespace {
+
+int status_of(const std::exception_ptr& e) {
+  try {
+    std::rethrow_exception(e);
+  } catch (const error& x) {
+    return exit_status(x.code());
+  } catch (const usage_error&) {
+    return 2;
+  } catch (const std::bad_alloc&) {
+    return 5;
+  } catch (const detail::peer_failure& p) {
+    return p.status;
+  } catch (...) {
+    return 1;
+  }
+}
+
+// The one error line, as the single process prints it.
+int report(const std::exception_ptr& e) {
+  std::string message;
+  try {
+    std::rethrow_exception(e);
+  } catch (const std::bad_alloc&) {
+    message = "out of memory";
+  } catch (const std::exception& x) {
+    message = x.what();
+  } catch (...) {
+    message = "unknown failure";
+  }
+  for (char& c : message)
+    if (c == '\n' || c == '\r') c = ' ';
+  std::fprintf(stderr, "interpatch: %s\n", message.c_str());
+  return status_of(e);
+}
+
+// What the split run needs to know before it reads a point; `split` false: the
+// request runs on rank 0 alone.
+struct Plan {
+  bool split = false;
+  std::size_t dims = 0;
+  nlohmann::json spec;
+  fs::path base, points;
+  std::string file;  // as the spec names it
+  std::vector<std::size_t> counts;  // --grid
+  io::internal::NpyHeader header;
+  io::internal::NpyDtype dtype;
+};
+
+Plan plan_of(const MpiRequest& r, const mpi::Team& team) {
+  Plan plan;
+  const Input in = parse_input(r.spec, r.shape);
+  const fs::path out = r.out;
+  if (r.build) check_build_output(out);
+  else {
+    plan.counts = parse_grid(r.grid);
+    check_eval_output(out);
+  }
+  io::check_writable(out);
+  std::string ext = out.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext != (r.build ? ".npz" : ".npy") || in.kind == Input::Kind::csv) return plan;
+  plan.spec = in.kind == Input::Kind::npy ? data_file_spec(in) : io::read_json_file(in.path);
+  plan.base = in.path.parent_path();
+  const nlohmann::json& s = plan.spec;
+  if (!s.is_object() || !s.contains("type") || !s["type"].is_string()) return plan;
+  const std::string type = s["type"].get<std::string>();
+  plan.dims = type == "interpolate" ? 2 : type == "interpolate_volume" ? 3 : 0;
+  if (plan.dims == 0 || !s.contains("points") || !s["points"].is_object() || !s["points"].contains("npy")) return plan;
+  io::reader::Context ctx;
+  ctx.base_dir = plan.base;
+  plan.file = io::reader::file_name(s["points"], "npy", "/points");
+  plan.points = ctx.resolve(plan.file);
+  // The header, read by every process; anything the split run does not read (other
+  // dtypes, Fortran order, a shape that is not a grid, short data) is left to the
+  // single process, which says what is wrong.
+  std::string head;
+  const std::uint64_t size = io::reader::at("/points", [&] {
+    const mpi::InputFile file(plan.points, team);
+    head.resize(static_cast<std::size_t>(std::min<std::uint64_t>(file.size(), 1 << 20)));
+    file.read(head.data(), head.size(), 0);
+    return file.size();
+  });
+  std::istringstream is(head);
+  try {
+    plan.header = io::internal::read_npy_header(is, size, plan.points.string());
+  } catch (const error&) {
+    return plan;
+  }
+  const auto dt = io::internal::parse_npy_dtype(plan.header.descr);
+  const auto& shape = plan.header.shape;
+  if (!dt || dt->kind != 'f' || plan.header.fortran_order || shape.size() != plan.dims + 1 || shape.back() != 3)
+    return plan;
+  plan.dtype = *dt;
+  std::uint64_t count = 1;
+  for (const std::size_t e : shape) {
+    if (e != 0 && count > (std::uint64_t{1} << 62) / e) return plan;
+    count *= e;
+  }
+  if (count == 0 || plan.header.data_offset + count * dt->size != size) return plan;
+  plan.split = true;
+  return plan;
+}
+
+// Rows of the .npy file as doubles: rows [r, r + n) of `row` values each.
+void read_rows(const mpi::InputFile& file, const Plan& plan, std::size_t row, std::size_t r, std::size_t n, double* dst) {
+  const std::size_t es = plan.dtype.size, total = row * n;
+  const std::uint64_t at = plan.header.data_offset + std::uint64_t{r} * row * es;
+  if (es == 8 && !plan.dtype.big_endian && std::endian::native == std::endian::little) {
+    file.read(reinterpret_cast<char*>(dst), total * 8, at);
+    return;
+  }
+  constexpr std::size_t piece = std::size_t{1} << 20;
+  std::vector<unsigned char> raw(std::min(total, piece) * es);
+  for (std::size_t done = 0; done < total; done += piece) {
+    const std::size_t k = std::min(piece, total - done);
+    file.read(reinterpret_cast<char*>(raw.data()), k * es, at + done * es);
+    for (std::size_t i = 0; i < k; ++i) {
+      unsigned char b[8];
+      std::memcpy(b, raw.data() + i * es, es);
+      if (plan.dtype.big_endian != (std::endian::native == std::endian::big)) std::reverse(b, b + es);
+      if (es == 8) dst[done + i] = std::bit_cast<double>(b);
+      else {
+        float f;
+        std::memcpy(&f, b, 4);
+        dst[done + i] = static_cast<double>(f);
+      }
+    }
+  }
+}
+
+// INTERPATCH_MPI_TIMINGS=1: each process prints one line, after the output is in
+// place, of the seconds each stage took and the bytes it sent to other processes
+// (docs/BENCHMARKS.md, "Split between MPI processes").
+class Stages {
+ public:
+  explicit Stages(int rank) : rank_(rank), on_(std::getenv("INTERPATCH_MPI_TIMINGS") != nullptr), t_(clock()) {}
+  void done(const char* stage, std::uint64_t sent = 0) {
+    if (!on_) return;
+    const double now = clock();
+    text_ += cat(text_.empty() ? "" : ", ", "\"", stage, "\": [", now - t_, ", ", sent, ", ", peak_mib(), "]");
+    t_ = now;
+  }
+  void print() const {
+    if (on_) std::fprintf(stderr, "interpatch: rank %d stages (seconds, bytes sent, peak MiB so far): {%s}\n", rank_, text_.c_str());
+  }
+
+ private:
+  // The process's peak resident memory so far (VmHWM), MiB.
+  static long peak_mib() {
+    std::ifstream status("/proc/self/status");
+    for (std::string line; std::getline(status, line);)
+      if (line.rfind("VmHWM:", 0) == 0) return std::atol(line.c_str() + 6) / 1024;
+    return -1;
+  }
+  static double clock() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  }
+  int rank_;
+  bool on_;
+  double t_;
+  std::string text_;
+};
+
+// The coordinates of points as doubles (Vec3 is three doubles); null for none, where
+// &p->x would dereference nothing.
+static_assert(sizeof(Vec3) == 3 * sizeof(double), "points are read and moved as triples of doubles");
+double* doubles(Vec3* p) { return reinterpret_cast<double*>(p); }
+
+// Gives a buffer's memory back now (v = {} would keep its capacity).
+void release(std::vector<Vec3>& v) { std::vector<Vec3>().swap(v); }
+
+// A grid of D dimensions with every extent but the first from `n`.
+template <std::size_t D>
+Grid<Vec3, D> rows_grid(const std::array<std::size_t, 3>& n, std::size_t rows) {
+  typename Grid<Vec3, D>::shape_type s{};
+  s[0] = rows;
+  for (std::size_t a = 1; a < D; ++a) s[a] = n[a];
+  return Grid<Vec3, D>(s, for_overwrite);
+}
+
+template <std::size_t D>
+int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
+  const int P = team.size();
+  Stages stages(team.rank());
+  io::reader::Context ctx;
+  ctx.base_dir = plan.base;
+  std::array<std::size_t, 3> n{};
+  for (std::size_t a = 0; a < D; ++a) n[a] = plan.header.shape[a];
+  std::size_t M = 1;
+  for (std::size_t a = 1; a < D; ++a) M *= n[a];
+
+  // Each process's rows and the few rows of the others it looks at.
+  // Plain variables, not a structured binding: lambdas capture them (clang 14 refuses bindings).
+  const std::pair<std::size_t, std::size_t> block = mpi::chunk_block(n[0], team.rank(), P);
+  const std::size_t first = block.first, count = block.second;
+  // This process's rows, C order. Not a Grid: a Grid's buffer, freed, is kept for
+  // reuse (detail/pages.cpp), which would hold a second share of the data here.
+  std::vector<Vec3> rows;
+  std::size_t nrows = 0;
+  std::array<Grid<Vec3, D>, 5> halo;  // the row before the block; rows 0, 1, n−2, n−1
+  team.run([&] {
+    require_memory(count * M, sizeof(Vec3), cat("/points: this process's ", count, " rows of the grid"));
+    rows.resize(count * M);
+    nrows = count;
+    io::reader::at("/points", [&] {
+      const mpi::InputFile file(plan.points, team);
+      read_rows(file, plan, 3 * M, first, count, doubles(rows.data()));
+      const std::size_t at[5] = {first > 0 ? first - 1 : 0, 0, std::min<std::size_t>(1, n[0] - 1), n[0] < 2 ? 0 : n[0] - 2,
+                                 n[0] - 1};
+      for (std::size_t h = 0; h < 5; ++h) {
+        halo[h] = rows_grid<D>(n, 1);
+        read_rows(file, plan, 3 * M, at[h], 1, doubles(halo[h].data()));
+      }
+    });
+  });
+  // As the reader does: the first point that is not finite, named in the whole grid.
+  team.run([&] {
+    try {
+      io::reader::check_finite_block({n.begin(), n.begin() + D}, {rows.data(), rows.size()}, first * M, "/points", plan.file);
+    } catch (const error& e) {
+      io::reader::rethrow_for_interpolation(e);
+    }
+  });
+
+  stages.done("read");
+  // The spec's options, then the checks and warnings of the single process.
+  std::vector<std::optional<int>> degree;
+  Parametrization param{};
+  std::array<bool, 3> periodic{};
+  team.run([&] {
+    degree = io::reader::degrees(plan.spec, "", D);
+    param = io::reader::parametrization(plan.spec, "");
+    periodic = io::reader::periodic_flags(plan.spec, "", D);
+  });
+  detail::GridBlock b;
+  auto set_block = [&] {
+    b.rank = D;
+    b.n = n;
+    b.data = rows.data();
+    b.first = first;
+    b.count = nrows;
+    b.before = halo[0].data();
+    b.row0 = halo[1].data();
+    b.last = halo[4].data();
+  };
+  set_block();
+  const std::array<const Vec3*, 4> ends{halo[1].data(), halo[2].data(), halo[3].data(), halo[4].data()};
+  team.run([&] {
+    if (team.rank() == 0) (void)io::reader::check_fields(plan.spec, "", io::reader::find_type(D == 2 ? "interpolate" : "interpolate_volume")->fields, ctx);
+  });
+  const std::vector<std::size_t> shape(plan.header.shape.begin(), plan.header.shape.begin() + D);
+  // check_grid_axes throws on every process alike (it sees what all see).
+  team.run([&] {
+    (void)io::reader::check_grid_axes(plan.spec, degree, periodic, shape, D == 2 ? "surface" : "volume",
+                                      [&](std::size_t a) { return detail::block_closing(b, a, ends, false, team); }, ctx);
+  });
+
+  // Closed directions: a last line repeating the first is left out.
+  std::array<bool, 3> dropped{};
+  for (std::size_t a = 0; a < D; ++a) {
+    if (!periodic[a] || !detail::block_closing(b, a, ends, true, team).dropped) continue;
+    dropped[a] = true;
+    if (a == 0) {
+      --n[0];
+      halo[4] = halo[3];  // the new last row
+      if (first + nrows > n[0]) {
+        nrows = n[0] - first;
+        rows.resize(nrows * M);
+      }
+    } else {
+      Grid<Vec3, D> g = rows_grid<D>(n, nrows);
+      std::copy(rows.begin(), rows.end(), g.data());
+      release(rows);
+      detail::drop_last_line(g, a);
+      rows.assign(g.data(), g.data() + g.size());
+      for (auto& h : halo) detail::drop_last_line(h, a);
+      --n[a];
+      M = M / (n[a] + 1) * n[a];
+    }
+    set_block();
+  }
+  std::vector<int> p(D);
+  static constexpr const char* in_axis[3] = {" in u", " in v", " in w"};
+  static constexpr const char* around_axis[3] = {" around u (closed)", " around v (closed)", " around w (closed)"};
+  team.run([&] {
+    for (std::size_t a = 0; a < D; ++a) p[a] = detail::grid_degree(degree[a], n[a], periodic[a] ? around_axis[a] : in_axis[a]);
+  });
+
+  const int shift = param == Parametrization::uniform ? 0 : detail::block_shift(b, team);
+  if (shift != 0) {
+    team.run([&] { detail::check_finite(b); });
+    detail::scale_points(rows.data(), rows.size(), -shift);
+    for (auto& h : halo) detail::scale_points(h.data(), h.size(), -shift);
+  }
+  const std::vector<bool> closed(periodic.begin(), periodic.begin() + D);
+  std::array<bool, 3> closed_arr = periodic;
+  stages.done("checks");
+  detail::RowSolution rs = detail::solve_rows(b, p, param, std::span<const bool>(closed_arr.data(), D), team);
+  stages.done("rows");
+  (void)closed;
+  for (auto& h : halo) h = {};
+
+  // Rows to columns: process s gets columns cols[s] of every row.
+  std::vector<std::size_t> col_first(static_cast<std::size_t>(P)), col_count(static_cast<std::size_t>(P));
+  for (int s = 0; s < P; ++s) std::tie(col_first[static_cast<std::size_t>(s)], col_count[static_cast<std::size_t>(s)]) = mpi::even_block(M, s, P);
+  const std::size_t C = col_count[static_cast<std::size_t>(team.rank())];
+  const std::vector<std::uint64_t> row_counts = team.all(nrows);
+  std::vector<Vec3> columns;
+  {
+    std::vector<Vec3> send;
+    std::vector<std::size_t> sc(static_cast<std::size_t>(P)), rc(static_cast<std::size_t>(P));
+    team.run([&] {
+      require_memory(rows.size(), sizeof(Vec3), "the transpose of this process's rows");
+      send.resize(rows.size());
+    });
+    std::size_t at = 0;
+    for (std::size_t s = 0; s < static_cast<std::size_t>(P); ++s) {
+      for (std::size_t i = 0; i < nrows; ++i)
+        std::copy_n(rows.data() + i * M + col_first[s], col_count[s], send.data() + at + i * col_count[s]);
+      sc[s] = nrows * col_count[s];
+      rc[s] = row_counts[s] * C;
+      at += sc[s];
+    }
+    release(rows);
+    team.run([&] {
+      require_memory(n[0] * C, sizeof(Vec3), "this process's columns of the grid");
+      columns.resize(n[0] * C);
+    });
+    team.exchange(send.data(), sc, columns.data(), rc);
+    stages.done("to_columns", (send.size() - sc[static_cast<std::size_t>(team.rank())]) * sizeof(Vec3));
+  }
+
+  // Along u, on whole columns.
+  detail::AxisSolver lu0 = detail::BandedLU(0, 0, 0);
+  team.run([&] { lu0 = detail::factor_axis(rs.knots[0], rs.params[0], 0); });
+  detail::solve_columns(lu0, doubles(columns.data()), n[0], 3 * C);
+  if (shift != 0) detail::scale_points(columns.data(), columns.size(), shift);
+  stages.done("solve_u");
+  team.run([&] {
+    if (!periodic[0] || p[0] % 2 != 0) return;
+    Grid<Vec3, 2> g({n[0], C}, columns);
+    release(columns);
+    detail::insert_seam(g, 0, rs.knots[0], rs.params[0].front());
+    columns.assign(g.data(), g.data() + g.size());
+  });
+  const std::size_t N = n[0] + (periodic[0] && p[0] % 2 == 0 ? 1 : 0);
+  // The other axes' seams need their knots on every process, rows or none.
+  std::array<std::size_t, 3> cn = n;  // extents of the control net
+  cn[0] = N;
+
+  // Which control rows each process needs: its share (build), or the window its
+  // output rows' basis functions reach (eval), around a periodic u past the end.
+  std::vector<double> us;
+  Resolution grid{};
+  std::size_t out_first = 0, out_count = 0;
+  long long lo = 0, hi = -1;
+  std::vector<KnotVector> knots = rs.knots;
+  std::array<bool, 3> seam{};
+  for (std::size_t a = 1; a < D; ++a) seam[a] = periodic[a] && p[a] % 2 == 0;
+  // The knots after the seams along the rows (computed here, applied to the rows below).
+  team.run([&] {
+    for (std::size_t a = 1; a < D; ++a)
+      if (seam[a]) {
+        Grid<Vec3, D> none = rows_grid<D>(cn, 0);
+        detail::insert_seam(none, a, knots[a], rs.params[a].front());
+        cn[a] = static_cast<std::size_t>(knots[a].count());
+      }
+    bool unit = true;
+    for (const KnotVector& k : knots) unit = unit && k.front() == 0.0 && k.back() == 1.0;
+    if (!unit)
+      for (KnotVector& k : knots) k = k.mapped(0.0, 1.0);
+  });
+  if (r.build) {
+    std::tie(out_first, out_count) = mpi::even_block(N, team.rank(), P);
+    lo = static_cast<long long>(out_first);
+    hi = lo + static_cast<long long>(out_count) - 1;
+  } else {
+    team.run([&] {
+      grid = plan.counts.size() == 1 ? Resolution{plan.counts[0], plan.counts[0], D == 3 ? plan.counts[0] : 0}
+                                     : Resolution{plan.counts[0], plan.counts[1], plan.counts.size() > 2 ? plan.counts[2] : 0};
+      if (plan.counts.size() > 1 && (plan.counts.size() == 3) != (D == 3)) {
+        io::Construction c;
+        c.type = D == 2 ? "interpolate" : "interpolate_volume";
+        if constexpr (D == 3) c.exact = BSplineVolume(KnotVector::bezier(1), KnotVector::bezier(1), KnotVector::bezier(1), PointGrid3({2, 2, 2}));
+        else c.exact = BSplineSurface(KnotVector::bezier(1), KnotVector::bezier(1), PointGrid({2, 2}));
+        check_counts_kind(c, grid_option, grid);
+      }
+      require_eval_room(grid, r.out);
+    });
+    std::tie(out_first, out_count) = mpi::even_block(grid.nu, team.rank(), P);
+    const std::vector<double> all_us = linspace(0, 1, grid.nu);
+    us.assign(all_us.begin() + static_cast<std::ptrdiff_t>(out_first),
+              all_us.begin() + static_cast<std::ptrdiff_t>(out_first + out_count));
+    const KnotVector& ku = knots[0];
+    long long prev = -1;
+    for (const double u : us) {
+      const double t = ku.periodic() ? ku.wrap(u) : std::clamp(u, ku.front(), ku.back());
+      long long s = ku.find_span(t);
+      if (s < prev) s += static_cast<long long>(N);  // wrapped past the end of a periodic u
+      prev = s;
+      if (hi < lo) lo = s - ku.degree();
+      hi = s;
+    }
+  }
+  const std::size_t window = hi >= lo ? static_cast<std::size_t>(hi - lo + 1) : 0;
+
+  // Columns back to rows: process s gets the rows of its window, from each column.
+  const std::vector<std::uint64_t> los = team.all(static_cast<std::uint64_t>(lo)), counts = team.all(window);
+  std::vector<Vec3> cp;
+  {
+    std::vector<std::size_t> sc(static_cast<std::size_t>(P)), rc(static_cast<std::size_t>(P));
+    std::size_t send_total = 0;
+    for (std::size_t s = 0; s < static_cast<std::size_t>(P); ++s) {
+      sc[s] = counts[s] * C;
+      rc[s] = window * col_count[s];
+      send_total += sc[s];
+    }
+    std::vector<Vec3> send, recv;
+    team.run([&] {
+      require_memory(send_total, sizeof(Vec3), "the transpose of the control points");
+      send.resize(send_total);
+    });
+    std::size_t at = 0;
+    for (std::size_t s = 0; s < static_cast<std::size_t>(P); ++s)
+      for (std::size_t v = 0; v < counts[s]; ++v, at += C)
+        std::copy_n(columns.data() + ((static_cast<long long>(los[s]) + static_cast<long long>(v)) % static_cast<long long>(N)) * C, C,
+                    send.data() + at);
+    release(columns);
+    team.run([&] {
+      require_memory(window * M, sizeof(Vec3), "this process's rows of the control points");
+      recv.resize(window * M);
+    });
+    team.exchange(send.data(), sc, recv.data(), rc);
+    stages.done("to_rows", (send.size() - sc[static_cast<std::size_t>(team.rank())]) * sizeof(Vec3));
+    release(send);
+    team.run([&] {
+      require_memory(window * M, sizeof(Vec3), "this process's rows of the control points");
+      cp.resize(window * M);
+    });
+    at = 0;
+    for (std::size_t s = 0; s < static_cast<std::size_t>(P); ++s)
+      for (std::size_t v = 0; v < window; ++v, at += col_count[s])
+        std::copy_n(recv.data() + at, col_count[s], cp.data() + v * M + col_first[s]);
+  }
+  team.run([&] {
+    std::array<std::size_t, 3> extents = n;
+    for (std::size_t a = 1; a < D; ++a)
+      if (seam[a]) {
+        Grid<Vec3, D> g = rows_grid<D>(extents, window);
+        std::copy(cp.begin(), cp.end(), g.data());
+        release(cp);
+        KnotVector k = rs.knots[a];
+        detail::insert_seam(g, a, k, rs.params[a].front());
+        extents[a] = g.extent(a);
+        cp.assign(g.data(), g.data() + g.size());
+      }
+  });
+  const std::size_t row_points = cp.size() / std::max<std::size_t>(window, 1);
+  const std::size_t row_size = window ? row_points : [&] {
+    std::size_t m = 1;
+    for (std::size_t a = 1; a < D; ++a) m *= cn[a];
+    return m;
+  }();
+
+  mpi::OutputFile file(r.out, team);
+  if (r.build) {
+    std::vector<int> degrees(p.begin(), p.end());
+    std::vector<const KnotVector*> kp;
+    for (const KnotVector& k : knots) kp.push_back(&k);
+    std::vector<std::size_t> net_shape{N};
+    for (std::size_t a = 1; a < D; ++a) net_shape.push_back(cn[a]);
+    const std::size_t bytes = cp.size() * sizeof(Vec3);
+    const std::vector<std::uint64_t> crcs = team.all(io::internal::crc32(cp.data(), bytes));
+    const std::vector<std::uint64_t> lens = team.all(bytes);
+    std::uint32_t crc = 0;
+    for (std::size_t s = 0; s < crcs.size(); ++s)
+      if (lens[s]) crc = io::internal::crc32_combine(crc, static_cast<std::uint32_t>(crcs[s]), lens[s]);
+    const io::internal::NpzFrame frame = io::internal::exact_npz_frame(degrees, kp, net_shape, crc);
+    team.run([&] {
+      if (team.rank() == 0) {
+        io::check_disk_space(r.out, frame.total, cat("the archive '", r.out, "'"));
+        file.write(frame.head.data(), frame.head.size(), 0);
+        file.write(frame.tail.data(), frame.tail.size(), frame.points_offset + std::uint64_t{N} * row_size * sizeof(Vec3));
+      }
+      file.write(cp.data(), bytes, frame.points_offset + std::uint64_t{out_first} * row_size * sizeof(Vec3));
+    });
+  } else {
+    const std::vector<double> vs = linspace(0, 1, grid.nv), ws = D == 3 ? linspace(0, 1, grid.nw) : std::vector<double>{};
+    const std::size_t per_row = grid.nv * (D == 3 ? grid.nw : 1);
+    std::vector<std::size_t> out_shape{grid.nu, grid.nv};
+    if (D == 3) out_shape.push_back(grid.nw);
+    out_shape.push_back(3);
+    const std::string header = io::internal::npy_header("<f8", out_shape);
+    team.run([&] {
+      require_memory(out_count * per_row, sizeof(Vec3), "this process's rows of the evaluation grid");
+      std::vector<Vec3> out(out_count * per_row);
+      const detail::RowWindow w{cp.data(), lo, window, N, row_size};
+      if (out_count > 0) {
+        if constexpr (D == 2) detail::evaluate_surface_rows(knots[0], knots[1], w, us, vs, out);
+        else detail::evaluate_volume_rows(knots[0], knots[1], knots[2], w, us, vs, ws, out);
+      }
+      if (team.rank() == 0) file.write(header.data(), header.size(), 0);
+      file.write(out.data(), out.size() * sizeof(Vec3), header.size() + std::uint64_t{out_first} * per_row * sizeof(Vec3));
+    });
+  }
+  file.commit();
+  stages.done(r.build ? "write" : "evaluate_write");
+  stages.print();
+  if (team.rank() == 0)
+    for (const std::string& w : ctx.warnings) std::fprintf(stderr, "interpatch: warning: %s\n", w.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int mpi_command(const MpiRequest& request, const std::function<int()>& single) {
+  const mpi::Session session;
+  const mpi::Team team(status_of);
+  try {
+    Plan plan;
+    team.run([&] { plan = plan_of(request, team); });
+    int split[1] = {plan.split ? 1 : 0};
+    {
+      std::size_t s[1] = {static_cast<std::size_t>(split[0])};
+      team.min(s);
+      split[0] = static_cast<int>(s[0]);
+    }
+    if (split[0] == 0) return team.await(team.rank() == 0 ? single() : 0);
+    return plan.dims == 3 ? split_run<3>(request, plan, team) : split_run<2>(request, plan, team);
+  } catch (const detail::peer_failure& p) {
+    return p.status;
+  } catch (...) {
+    return report(std::current_exception());
+  }
+}
+
+}  // namespace interpatch::cli
+
+extern "C" int interpatch_mpi_command(const interpatch::cli::MpiRequest* request, const std::function<int()>* single) {
+  return interpatch::cli::mpi_command(*request, *single);
+}

@@ -1,0 +1,171 @@
+#!/usr/bin/env python3
+"""interpatch under mpirun, compared byte for byte with the single process.
+
+Runs `interpatch eval` and `interpatch build` on grids whose rows split unevenly
+between 1..4 processes (chunks of 16 rows), closed directions of odd and even
+degree, collapsed rows (poles), every parametrization, float32 and big-endian
+input, surfaces and volumes; every output must equal the single process's, byte for
+byte. Then the failures: a missing points file, a NaN in the last process's rows,
+bad options, an output in a missing directory; each must end every process with
+the single process's exit status and error line, exactly one line on stderr, no
+output file and no temporary file left, and an existing output untouched.
+
+Usage: mpi_runs.py INTERPATCH [MPIRUN]
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+EXE = sys.argv[1]
+MPIRUN = sys.argv[2] if len(sys.argv) > 2 else "mpirun"
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1",
+           OMPI_MCA_rmaps_base_oversubscribe="1")
+# A single process must not see the launcher's variables (it would start MPI).
+SINGLE_ENV = {k: v for k, v in ENV.items() if not k.startswith(("OMPI_COMM_WORLD", "PMIX_", "PMI_"))}
+PROCESSES = [1, 2, 3, 4]
+failures = []
+
+
+def run(args, processes=None, cwd=None):
+    cmd = [EXE] + args if processes is None else [MPIRUN, "--oversubscribe", "-q", "--mca", "btl", "self,vader", "-np", str(processes), EXE] + args
+    return subprocess.run(cmd, cwd=cwd, env=SINGLE_ENV if processes is None else ENV, capture_output=True, text=True,
+                          timeout=120)
+
+
+def check(ok, what):
+    if not ok:
+        failures.append(what)
+        print("FAIL:", what, flush=True)
+
+
+def grid(shape, rng, pole=False, close=None, scale=1.0):
+    """Smooth points with noise; `close` repeats the first line along that axis at its end."""
+    axes = np.meshgrid(*[np.linspace(0, 1, n) for n in shape], indexing="ij")
+    base = [axes[0] * 2 + 0.3 * np.sin(3 * axes[-1]), axes[-1] + 0.2 * axes[0] ** 2,
+            np.cos(2 * axes[0]) * np.sin(3 * axes[-1]) + (axes[1] if len(shape) == 3 else 0)]
+    g = np.stack(base, -1) + 0.01 * rng.random(tuple(shape) + (3,))
+    if len(shape) == 2 and close == 1:  # a tube: v around a circle
+        t = np.linspace(0, 2 * np.pi, shape[1], endpoint=False)
+        g = np.stack([np.cos(t)[None, :] * (1 + 0.3 * axes[0]), np.sin(t)[None, :] * (1 + 0.3 * axes[0]), axes[0] * 3], -1)
+        g = g + 0.001 * rng.random(g.shape)
+    if pole:  # the first row collapses to one point
+        g[0] = g[0].mean(axis=tuple(range(g.ndim - 2)))
+    if close is not None:
+        first = np.take(g, [0], axis=close)
+        g = np.concatenate([g, first], axis=close)
+    return g * scale
+
+
+def cases(rng):
+    yield "surface 53x37 (uneven rows)", grid((53, 37), rng), {}, "61"
+    yield "surface pole row, centripetal", grid((40, 21), rng, pole=True), {"param": "centripetal", "degree": [3, 2]}, "45x7"
+    yield "surface uniform, degree 5x2, float32 big-endian", grid((35, 9), rng).astype(">f4"), \
+        {"param": "uniform", "degree": [5, 2]}, "33"
+    yield "surface closed u, even degree", grid((47, 19), rng, close=0), {"periodic": [True, False], "degree": [2, 3]}, "40"
+    yield "surface closed v (tube), even degree", grid((50, 24), rng, close=1), {"periodic": [False, True], "degree": [3, 4]}, "41"
+    yield "surface closed along u, not declared (warning), extreme scale", grid((33, 12), rng, close=0, scale=1e300), {}, "30"
+    yield "volume closed w, even degree", grid((38, 7, 8), rng, close=2), {"periodic": [False, False, True], "degree": [3, 2, 2]}, \
+        "29x33x17"
+    yield "volume closed u, centripetal", grid((36, 5, 4), rng, close=0), \
+        {"periodic": [True, False, False], "degree": [3, 2, 2], "param": "centripetal"}, "9"
+
+
+def same_outputs(d, name, spec_file, eval_grid):
+    for args in [["build", spec_file, "-o", "out.npz"], ["eval", spec_file, "--grid", eval_grid, "-o", "out.npy"]]:
+        out = os.path.join(d, args[-1])
+        one = run(args, cwd=d)
+        check(one.returncode == 0, f"{name}: single process {args}: {one.stderr}")
+        want = open(out, "rb").read()
+        os.remove(out)
+        for p in PROCESSES:
+            r = run(args, p, cwd=d)
+            check(r.returncode == 0, f"{name}: {p} processes {args}: status {r.returncode}: {r.stderr}")
+            check(r.stderr == one.stderr, f"{name}: {p} processes {args}: stderr {r.stderr!r}, single {one.stderr!r}")
+            got = open(out, "rb").read() if os.path.exists(out) else b""
+            check(got == want, f"{name}: {p} processes {args}: output differs ({len(got)} bytes, single {len(want)})")
+            if os.path.exists(out):
+                os.remove(out)
+        check(sorted(os.listdir(d)) == sorted([spec_file, "points.npy"]), f"{name}: files left: {os.listdir(d)}")
+
+
+def same_failure(d, name, args, status):
+    good = os.path.join(d, "good" + os.path.splitext(args[args.index("-o") + 1])[1])
+    one = run(args, cwd=d)
+    check(one.returncode == status, f"{name}: single process status {one.returncode}, expected {status}: {one.stderr}")
+    before = sorted(os.listdir(d))
+    for p in PROCESSES:
+        r = run(args, p, cwd=d)
+        lines = r.stderr.splitlines()
+        check(r.returncode == status, f"{name}: {p} processes: status {r.returncode}, expected {status}: {r.stderr}")
+        check(len(lines) == 1, f"{name}: {p} processes: {len(lines)} lines on stderr: {r.stderr!r}")
+        check(r.stderr == one.stderr, f"{name}: {p} processes: {r.stderr!r}, single {one.stderr!r}")
+        check(sorted(os.listdir(d)) == before, f"{name}: {p} processes: files {sorted(os.listdir(d))}, before {before}")
+    if os.path.exists(good):
+        check(open(good, "rb").read() == b"good", f"{name}: the existing output was changed")
+
+
+def a_rank_cannot_read(d, rng):
+    """Ranks 1 and 2 run in a directory where the points file cannot be read (it is a
+    directory there): the first of them reports, all three end with status 4, and no
+    output appears."""
+    a, b = os.path.join(d, "a"), os.path.join(d, "b")
+    os.makedirs(a)
+    os.makedirs(os.path.join(b, "points.npy"))
+    np.save(os.path.join(a, "points.npy"), grid((50, 20), rng))
+    for w in (a, b):
+        with open(os.path.join(w, "spec.json"), "w") as f:
+            json.dump({"type": "interpolate", "points": {"npy": "points.npy"}}, f)
+    out = os.path.join(d, "split.npz")
+    args = ["build", "spec.json", "-o", out]
+    cmd = [MPIRUN, "--oversubscribe", "-q", "--mca", "btl", "self,vader", "-np", "1", "--wdir", a, EXE] + args + \
+          [":", "-np", "2", "--wdir", b, EXE] + args
+    r = subprocess.run(cmd, env=ENV, capture_output=True, text=True, timeout=120)
+    lines = r.stderr.splitlines()
+    check(r.returncode == 4, f"a rank cannot read: status {r.returncode}, expected 4: {r.stderr}")
+    check(len(lines) == 1 and "cannot" in r.stderr and "points.npy" in r.stderr,
+          f"a rank cannot read: stderr {r.stderr!r}")
+    check(not os.path.exists(out) and not [f for f in os.listdir(d) if "interpatch" in f],
+          f"a rank cannot read: files left: {os.listdir(d)}")
+
+
+def main():
+    rng = np.random.default_rng(19)
+    for name, points, options, eval_grid in cases(rng):
+        with tempfile.TemporaryDirectory() as d:
+            np.save(os.path.join(d, "points.npy"), points)
+            spec_type = "interpolate_volume" if points.ndim == 4 else "interpolate"
+            with open(os.path.join(d, "spec.json"), "w") as f:
+                json.dump(dict({"type": spec_type, "points": {"npy": "points.npy"}}, **options), f)
+            same_outputs(d, name, "spec.json", eval_grid)
+            print("ok:", name, flush=True)
+    with tempfile.TemporaryDirectory() as d:
+        g = grid((50, 20), rng)
+        g[49, 7, 1] = np.nan  # in the last process's rows for every count of processes
+        np.save(os.path.join(d, "points.npy"), g)
+        with open(os.path.join(d, "good.npy"), "wb") as f:
+            f.write(b"good")
+        same_failure(d, "NaN in the last rows", ["eval", "points.npy", "--grid", "20", "-o", "good.npy"], 3)
+        np.save(os.path.join(d, "points.npy"), grid((50, 20), rng))
+        with open(os.path.join(d, "spec.json"), "w") as f:
+            json.dump({"type": "interpolate", "points": {"npy": "missing.npy"}}, f)
+        same_failure(d, "missing points file", ["build", "spec.json", "-o", "good.npz"], 4)
+        with open(os.path.join(d, "spec.json"), "w") as f:
+            json.dump({"type": "interpolate", "points": {"npy": "points.npy"}, "degree": [3, 30]}, f)
+        same_failure(d, "degree too high", ["build", "spec.json", "-o", "good.npz"], 3)
+        same_failure(d, "bad --grid", ["eval", "spec.json", "--grid", "1", "-o", "good.npy"], 2)
+        same_failure(d, "output in a missing directory", ["eval", "spec.json", "--grid", "5", "-o", "no/dir/x.npy"], 4)
+        a_rank_cannot_read(d, rng)
+        print("ok: failures", flush=True)
+    if failures:
+        print(f"{len(failures)} failures")
+        return 1
+    print("all outputs equal the single process's")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
