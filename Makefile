@@ -107,7 +107,7 @@ BENCH_OUT ?= build/bench/results.json
 # docs/bench_interpolation.png and prints the Markdown tables of docs/BENCHMARKS.md.
 COMPARE_FLAGS ?= --reps 5
 COMPARE_OUT ?= build/bench/compare.json
-bench: deps
+bench: viewer-deps
 	cmake --preset bench
 	cmake --build --preset bench -j $(JOBS)
 	env $(BENCH_ENV) ./build/bench/bench/interpatch_bench $(BENCH_FLAGS) \
