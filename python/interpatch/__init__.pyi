@@ -23,7 +23,8 @@ class Construction:
     @property
     def type(self) -> str: ...
     def info(self) -> dict[str, Any]:
-        """The dict `interpatch info` prints."""
+        """The dict `interpatch info` prints. Its check at the data (max_data_error) compares
+        with the arrays the construction was built from as they are now: it keeps them, not a copy."""
     def write(self, path: _Path, res: Optional[Sequence[int]] = None) -> None:
         """.json .npz .step .igs (the exact form), .obj .ply .stl .vtk .vts .xyz (a mesh of res vertices)
         or .html (a viewer page of res samples, as `interpatch view` writes it)."""

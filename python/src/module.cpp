@@ -7,6 +7,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <cstring>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <new>
@@ -62,13 +63,15 @@ std::shared_ptr<ip::io::PointArray> point_array(const py::handle& x, const std::
     for (py::ssize_t k = 0; k < a.ndim(); ++k) shape += (k ? ", " : "") + std::to_string(a.shape(k));
     throw ip::error(ip::errc::size_mismatch, name + ": expected an array of points of shape (..., 3), got (" + shape + ")");
   }
-  auto out = std::make_shared<ip::io::PointArray>();
-  for (py::ssize_t k = 0; k + 1 < a.ndim(); ++k) out->shape.push_back(static_cast<std::size_t>(a.shape(k)));
-  const auto count = static_cast<std::size_t>(a.size() / 3);
-  out->points.resize(count);
-  std::memcpy(&out->points.data()->x, a.data(), count * sizeof(ip::Vec3));
-  return out;
+  std::vector<std::size_t> shape;
+  for (py::ssize_t k = 0; k + 1 < a.ndim(); ++k) shape.push_back(static_cast<std::size_t>(a.shape(k)));
+  py::gil_scoped_release free;  // `a` keeps the memory alive
+  return std::make_shared<ip::io::PointArray>(ip::io::copy_point_array(a.data(), std::move(shape)));
 }
+
+// The arrays a construction was built from, as the caller gave them (the data points
+// its DataSets lend: BuildOptions::borrow_arrays).
+using Sources = std::map<std::string, py::object>;
 
 // A built spec: the construction, and a lock for the one step that may change it
 // (making its exact form on first use) while threads evaluate without the GIL.
@@ -82,13 +85,16 @@ py::object to_python(const nlohmann::ordered_json& j) { return py::module_::impo
 // What surfaces and volumes share: the built spec, its info, its files.
 class PyBuilt {
  public:
-  explicit PyBuilt(std::shared_ptr<Built> b) : b_(std::move(b)) {}
+  PyBuilt(std::shared_ptr<Built> b, std::shared_ptr<const Sources> sources)
+      : b_(std::move(b)), sources_(std::move(sources)) {}
 
   py::object info() const {
+    LentPoints lent = lent_data();
     nlohmann::ordered_json j;
     {
       py::gil_scoped_release free;
       std::lock_guard<std::mutex> hold(b_->lock);
+      const WithData with(b_->c, lent);
       if (ip::io::has_exact_form(b_->c)) (void)ip::io::exact_form(b_->c);  // info reports it, as the command does
       j = ip::io::info_json(b_->c);
     }
@@ -102,8 +108,11 @@ class PyBuilt {
   // of `res` samples.
   void write(const std::filesystem::path& path, const std::optional<std::vector<std::size_t>>& res) const {
     namespace cli = ip::cli;
+    // A viewer page shows the data points.
+    LentPoints lent = ip::io::is_view_format(path.extension().string()) ? lent_data() : LentPoints();
     py::gil_scoped_release free;
     std::lock_guard<std::mutex> hold(b_->lock);
+    const WithData with(b_->c, lent);
     const bool volume = ip::io::is_volume(b_->c);
     // res as given, or `fallback`: (nu, nv) for a surface, (nu, nv, nw) for a volume.
     const auto resolution = [&](const cli::Resolution& fallback) {
@@ -141,6 +150,45 @@ class PyBuilt {
   }
 
  protected:
+  // The data points the build left in the caller's arrays (BuildOptions::borrow_arrays),
+  // copied from them as they are now (the GIL held): data set index and points.
+  using LentPoints = std::vector<std::pair<std::size_t, ip::io::PointStorage>>;
+  [[nodiscard]] LentPoints lent_data() const {
+    LentPoints out;
+    const auto& data = b_->c.data;  // set at build; only `points` of lent sets change, under the lock
+    for (std::size_t i = 0; i < data.size(); ++i) {
+      if (data[i].array.empty()) continue;
+      const auto it = sources_ ? sources_->find(data[i].array) : Sources::const_iterator();
+      if (!sources_ || it == sources_->end())
+        throw ip::error(ip::errc::internal, "the array \"" + data[i].array + "\" is not kept");
+      auto a = point_array(it->second, data[i].array);
+      std::size_t expected = 1;
+      for (const auto& p : data[i].params) expected *= p.size();
+      if (a->points.size() != expected)
+        throw ip::error(ip::errc::size_mismatch, data[i].array + ": the array holds " + std::to_string(a->points.size()) +
+                                                     " points now; the construction was built from " + std::to_string(expected));
+      out.emplace_back(i, std::move(a->points));
+    }
+    return out;
+  }
+
+  // Lent data points in the construction while the lock is held, gone again after.
+  class WithData {
+   public:
+    WithData(ip::io::Construction& c, LentPoints& lent) : c_(c), lent_(lent) {
+      for (auto& [i, points] : lent_) std::swap(c_.data[i].points, points);
+    }
+    ~WithData() {
+      for (auto& [i, points] : lent_) std::swap(c_.data[i].points, points);
+    }
+    WithData(const WithData&) = delete;
+    WithData& operator=(const WithData&) = delete;
+
+   private:
+    ip::io::Construction& c_;
+    LentPoints& lent_;
+  };
+
   // A capsule that keeps the construction alive while arrays view its memory.
   [[nodiscard]] py::capsule alive() const {
     return py::capsule(new std::shared_ptr<Built>(b_), [](void* p) { delete static_cast<std::shared_ptr<Built>*>(p); });
@@ -152,6 +200,7 @@ class PyBuilt {
     return std::get<Exact>(ip::io::exact_form(b_->c));
   }
   std::shared_ptr<Built> b_;
+  std::shared_ptr<const Sources> sources_;
 };
 
 py::array_t<double> knots_array(const ip::KnotVector& k, const py::capsule& alive) {
@@ -289,38 +338,41 @@ class PyVolume : public PyBuilt {
   }
 };
 
-py::object wrap(ip::io::Construction c) {
+py::object wrap(ip::io::Construction c, std::shared_ptr<const Sources> sources) {
   auto b = std::make_shared<Built>();
   b->c = std::move(c);
   if (ip::io::is_volume(b->c)) {
     // A volume's formula evaluates without the lock: make its exact form now if it has one
     // and the formula is not kept (volume_evaluator needs one of them).
-    return py::cast(PyVolume(std::move(b)));
+    return py::cast(PyVolume(std::move(b), std::move(sources)));
   }
-  return py::cast(PySurface(std::move(b)));
+  return py::cast(PySurface(std::move(b), std::move(sources)));
 }
 
 py::object build(const py::object& spec, const std::filesystem::path& base_dir, const py::dict& arrays) {
   ip::io::BuildOptions o;
   o.defer_exact = true;
-  for (const auto& [k, v] : arrays) o.arrays[k.cast<std::string>()] = point_array(v, k.cast<std::string>());
+  // The data points stay in the caller's arrays until info() asks for the check at the
+  // data: the object keeps the arrays rather than a copy of the grid.
+  o.borrow_arrays = true;
+  auto sources = std::make_shared<Sources>();
+  for (const auto& [k, v] : arrays) {
+    const auto name = k.cast<std::string>();
+    o.arrays[name] = point_array(v, name);
+    (*sources)[name] = py::reinterpret_borrow<py::object>(v);
+  }
+  ip::io::Construction c;
   if (py::isinstance<py::dict>(spec)) {
     const std::string text = py::module_::import("json").attr("dumps")(spec).cast<std::string>();
     const nlohmann::json j = ip::io::parse_json(text, "spec");
-    ip::io::Construction c;
-    {
-      py::gil_scoped_release free;
-      c = ip::io::build(j, base_dir, o);
-    }
-    return wrap(std::move(c));
-  }
-  const auto path = spec.cast<std::filesystem::path>();
-  ip::io::Construction c;
-  {
+    py::gil_scoped_release free;
+    c = ip::io::build(j, base_dir, o);
+  } else {
+    const auto path = spec.cast<std::filesystem::path>();
     py::gil_scoped_release free;
     c = ip::io::build_file(path, o);
   }
-  return wrap(std::move(c));
+  return wrap(std::move(c), std::move(sources));
 }
 
 }  // namespace
@@ -352,7 +404,10 @@ PYBIND11_MODULE(_core, m) {
 
   py::class_<PyBuilt>(m, "Construction", "What surfaces and volumes share.")
       .def_property_readonly("type", &PyBuilt::type, "The spec's \"type\".")
-      .def("info", &PyBuilt::info, "The dict `interpatch info` prints for this construction.")
+      .def("info", &PyBuilt::info,
+           "The dict `interpatch info` prints for this construction. Its check at the data "
+           "(max_data_error) compares with the NumPy arrays the construction was built from as they "
+           "are when info() is called: the construction keeps those arrays, not a copy of them.")
       .def("write", &PyBuilt::write, py::arg("path"), py::arg("res") = py::none(),
            "Write as `interpatch build` (.json .npz .step .igs: the exact form), `interpatch mesh` "
            "(.obj .ply .stl .vtk .vts .xyz: res = (nu, nv) vertices, 64 x 64 by default; a volume's "

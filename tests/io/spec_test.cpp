@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -136,6 +137,95 @@ TEST(Spec, InMemoryArraysTakenWhenNamedOnceAndHeldByNobodyElse) {
   const auto& s = std::get<BSplineSurface>(*r.exact);
   EXPECT_EQ(twice.arrays.at("c")->points.size(), row.size()) << "named twice: copied both times";
   for (const double u : {0.0, 0.3, 1.0}) EXPECT_EQ(s.point(u, 0.0), s.point(u, 1.0)) << "both curves the same, at u " << u;
+}
+
+// borrow_arrays: the data set of an interpolated or approximated in-memory grid names
+// the array instead of copying it; filled by the caller, info reports what the copy
+// gives. Arrays from anywhere else are copied as before.
+TEST(Spec, BorrowedArraysLeaveTheDataPointsToTheCaller) {
+  auto g = test::rng(23);
+  for (const char* type : {"interpolate", "approximate"}) {
+    const PointGrid q = test::random_grid(g, 9, 7);
+    json spec = {{"type", type}, {"points", {{"array", "q"}}}};
+    if (std::string(type) == "approximate") spec["control_points"] = {6, 5};
+    const auto array_of = [&] {
+      auto a = std::make_shared<PointArray>();
+      a->shape = {q.extent(0), q.extent(1)};
+      a->points.assign(q.values().begin(), q.values().end());
+      return a;
+    };
+    BuildOptions copied;
+    copied.arrays["q"] = array_of();
+    const Construction a = build(spec, {}, copied);
+    BuildOptions lent;
+    lent.arrays["q"] = array_of();
+    lent.borrow_arrays = true;
+    Construction b = build(spec, {}, lent);
+    ASSERT_EQ(a.data.size(), 1u) << type;
+    ASSERT_EQ(b.data.size(), 1u) << type;
+    EXPECT_TRUE(a.data[0].array.empty()) << type;
+    EXPECT_EQ(a.data[0].points.size(), q.size()) << type;
+    EXPECT_EQ(b.data[0].array, "q") << type;
+    EXPECT_TRUE(b.data[0].points.empty()) << type;
+    EXPECT_EQ(b.data[0].params, a.data[0].params) << type;
+    EXPECT_EQ(info_json(b)["max_data_error"], nullptr) << type << ": no points, no check";
+    b.data[0].points.assign(q.values().begin(), q.values().end());
+    b.data[0].array.clear();
+    EXPECT_EQ(info_json(b)["max_data_error"], info_json(a)["max_data_error"]) << type;
+  }
+  // Points from a file are copied even when arrays are lent.
+  BuildOptions lent;
+  lent.borrow_arrays = true;
+  const Construction inline_points = build(interpolate_spec(test::random_grid(g, 4, 5)), {}, lent);
+  ASSERT_EQ(inline_points.data.size(), 1u);
+  EXPECT_TRUE(inline_points.data[0].array.empty());
+  EXPECT_EQ(inline_points.data[0].points.size(), 20u);
+}
+
+// copy_point_array copies exactly and says whether every coordinate is finite; a
+// non-finite one in any piece, even the last point's z, is found, and the reader's
+// error for it is the same as for an array nobody checked.
+TEST(Spec, CopiedPointArraysAreCheckedWhileCopied) {
+  auto g = test::rng(24);
+  // 300 x 200 points: more than one piece of 2^14 and enough for both threads.
+  const std::vector<std::size_t> shape = {300, 200};
+  std::vector<double> xyz(3 * 300 * 200);
+  for (double& x : xyz) x = test::uniform(g, -5, 5);
+  const PointArray a = copy_point_array(xyz.data(), shape);
+  EXPECT_EQ(a.shape, shape);
+  EXPECT_TRUE(a.finite);
+  ASSERT_EQ(a.points.size(), 60000u);
+  EXPECT_EQ(std::memcmp(a.points.data(), xyz.data(), xyz.size() * sizeof(double)), 0);
+  const json spec = {{"type", "interpolate"}, {"points", {{"array", "q"}}}};
+  const auto refusal = [&](const BuildOptions& o) -> std::string {
+    try {
+      (void)build(spec, {}, o);
+    } catch (const error& e) {
+      EXPECT_EQ(e.code(), errc::not_finite) << e.what();
+      return e.what();
+    }
+    ADD_FAILURE() << "a non-finite coordinate was taken";
+    return {};
+  };
+  const std::size_t anywhere = std::uniform_int_distribution<std::size_t>(0, xyz.size() - 1)(g);
+  for (const std::size_t bad : {std::size_t{0}, std::size_t{3 * 16384 + 1}, xyz.size() - 1, anywhere}) {
+    for (const double value : {std::numeric_limits<double>::quiet_NaN(), -std::numeric_limits<double>::infinity()}) {
+      std::vector<double> broken = xyz;
+      broken[bad] = value;
+      auto checked = std::make_shared<PointArray>(copy_point_array(broken.data(), shape));
+      EXPECT_FALSE(checked->finite) << "value " << bad;
+      auto unchecked = std::make_shared<PointArray>(*checked);
+      unchecked->finite = false;
+      BuildOptions o1, o2;
+      o1.arrays["q"] = checked;
+      o2.arrays["q"] = unchecked;
+      const std::string m1 = refusal(o1), m2 = refusal(o2);
+      EXPECT_EQ(m1, m2);
+      const std::string at = "/points/" + std::to_string(bad / 3 / 200) + "/" + std::to_string(bad / 3 % 200) + "/" +
+                             std::to_string(bad % 3) + ":";
+      EXPECT_NE(m1.find(at), std::string::npos) << m1;
+    }
+  }
 }
 
 // build, mesh and eval build without the copy of the data points (keep_data false):

@@ -64,6 +64,34 @@ def test_info_is_the_command_lines(tmp_path):
         assert got[key] == want[key], key
 
 
+def test_info_checks_the_arrays_the_construction_keeps():
+    # The construction keeps the caller's array, not a copy of its points: the check at
+    # the data compares with the array as it is when info() is called.
+    grid = terrain()
+    s = interpatch.interpolate_surface(grid)
+    before = s.info()["max_data_error"]
+    assert before["absolute"] < 1e-12 * np.abs(grid).max()  # interpolated to rounding
+    grid[7, 11, 2] += 0.5
+    moved = s.info()["max_data_error"]
+    assert moved["at"] == "/points/7/11"
+    assert abs(moved["absolute"] - 0.5) < 1e-12
+    grid[7, 11, 2] -= 0.5
+    assert s.info()["max_data_error"] == before  # every call reads the array afresh
+    # Any dtype and order: a float32 Fortran-order array is kept and converted each time.
+    f = np.asfortranarray(terrain().astype(np.float32))
+    t = interpatch.interpolate_surface(f)
+    assert t.info()["max_data_error"]["absolute"] < 1e-12 * np.abs(f).max()
+    # An approximation with a missing point: the check skips it, as the command line's does.
+    holed = terrain()
+    holed[3, 4] = np.nan
+    a = interpatch.approximate_surface(holed, control_points=(8, 9))
+    info = a.info()
+    assert info["parameters"]["missing_points"] == 1
+    # The largest error over the points given, the one the fit reports (both evaluate the
+    # same surface at the same points; 1e-12 of the data's size for rounding).
+    assert abs(info["max_data_error"]["absolute"] - info["parameters"]["max_error"]) < 1e-12 * np.nanmax(np.abs(holed))
+
+
 def test_constructors_make_what_the_spec_makes():
     grid = terrain()
     spec = {"type": "interpolate", "points": grid.tolist()}

@@ -42,7 +42,12 @@ using PointStorage = std::vector<Vec3, large_allocator<Vec3>>;
 /// (for a volume, at (params[0][i], params[1][j], params[2][k]) points[(i * nv + j) * nw + k]).
 struct DataSet {
   std::vector<std::vector<double>> params;
+  /// The data points; empty while `array` names where they are.
   PointStorage points;
+  /// Not empty when the points were left where the caller holds them
+  /// (BuildOptions::borrow_arrays): the name of that in-memory array. The caller
+  /// puts its points into `points` before info_json() or write_view() needs them.
+  std::string array;
   /// JSON Pointer of the spec field the points came from, e.g. "/points"; the
   /// pointer of one point appends its indices ("/points/3/7").
   std::string pointer;
@@ -119,6 +124,11 @@ struct BuildOptions {
   /// (`use_count() == 1`) is taken, not copied: its points move into the
   /// construction and the map's entry is left empty. Any other array is copied.
   std::map<std::string, std::shared_ptr<PointArray>, std::less<>> arrays;
+  /// With keep_data, the data points that come from `arrays` are not copied: their
+  /// DataSet keeps the array's name in DataSet::array and no points, for a caller
+  /// that holds the array itself (the Python module keeps the NumPy array) to fill
+  /// in when the error check at the data is asked for. Saves a copy of the grid.
+  bool borrow_arrays = false;
 };
 
 /// The construction's exact form, converted on first use when the build deferred it.
@@ -226,7 +236,17 @@ struct SpecForm {
 struct PointArray {
   std::vector<std::size_t> shape;
   PointStorage points;
+  /// Every coordinate is known to be finite (whoever made the array checked, as the
+  /// Python module does while it converts a NumPy array), so the spec reader does
+  /// not check again. Set it only when that is so.
+  bool finite = false;
 };
+
+/// A point array of the given shape (without the trailing 3) copied from its
+/// float64 triples in C order, `xyz` (a NumPy array's memory, say), on every core;
+/// the same pass checks every coordinate and sets PointArray::finite when all are.
+/// @throws error too_large when the copy does not fit in memory.
+[[nodiscard]] PointArray copy_point_array(const double* xyz, std::vector<std::size_t> shape);
 
 /// Reads a point array of the given rank (1: a list of points, 2: a grid, 3: a
 /// volume grid) from any of its three forms: nested lists of [x, y, z],

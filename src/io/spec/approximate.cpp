@@ -138,12 +138,7 @@ Construction build_approximate(const json& spec, Context& ctx) {
   for (std::size_t a = 0; a < D; ++a) gs[a] = shape[a];
   Grid<Vec3, D> grid(gs, std::move(pts.points));
   // The data as given, missing points and all: info's error at the data skips them.
-  DataSet data;
-  data.pointer = "/points";
-  if (ctx.keep_data) {
-    require_memory(grid.size(), sizeof(Vec3), cat("/points: a copy of the ", extents_text(shape), " data points for the error check"));
-    data.points.assign(grid.values().begin(), grid.values().end());
-  }
+  DataSet data = grid_data(spec.at("points"), grid.values(), shape, ctx);
   ctx.parsed();
 
   Construction c;

@@ -21,6 +21,17 @@ namespace {
 template <std::size_t D>
 struct Tensor;
 
+// The exact form and its parameters, moved: `return {form, {params...}}` would pick
+// std::pair's copying constructor (a braced list deduces no type) and copy the whole
+// control net, and the list of parameters would copy each vector.
+template <class Exact, class... Params>
+std::pair<Exact, std::vector<std::vector<double>>> moved(Exact form, Params... params) {
+  std::vector<std::vector<double>> p;
+  p.reserve(sizeof...(Params));
+  (p.push_back(std::move(params)), ...);
+  return {std::move(form), std::move(p)};
+}
+
 template <>
 struct Tensor<2> {
   using Exact = BSplineSurface;
@@ -42,7 +53,7 @@ struct Tensor<2> {
     o.progress = progress;
     o.periodic = {periodic[0], periodic[1]};
     SurfaceInterpolation r = interpolate_surface(std::move(grid), o);
-    return {std::move(r.surface), {std::move(r.params_u), std::move(r.params_v)}};
+    return moved(std::move(r.surface), std::move(r.params_u), std::move(r.params_v));
   }
   static Exact make(std::array<KnotVector, 2> k, Points cp, Grid<double, 2> w) {
     return Exact(std::move(k[0]), std::move(k[1]), std::move(cp), std::move(w));
@@ -73,7 +84,7 @@ struct Tensor<3> {
     o.progress = progress;
     o.periodic = periodic;
     VolumeInterpolation r = interpolate_volume(std::move(grid), o);
-    return {std::move(r.volume), {std::move(r.params_u), std::move(r.params_v), std::move(r.params_w)}};
+    return moved(std::move(r.volume), std::move(r.params_u), std::move(r.params_v), std::move(r.params_w));
   }
   static Exact make(std::array<KnotVector, 3> k, Points cp, Grid<double, 3> w) {
     return Exact(std::move(k[0]), std::move(k[1]), std::move(k[2]), std::move(cp), std::move(w));
@@ -188,12 +199,7 @@ Construction build_interpolate(const json& spec, Context& ctx) {
   typename T::Points grid(grid_shape<D>(pts.shape), std::move(pts.points));
   nlohmann::ordered_json notes = check_grid_axes(spec, degree, periodic, pts.shape, T::kind,
                                                  [&](std::size_t a) { return grid_closing(grid, static_cast<int>(a)); }, ctx);
-  DataSet data;
-  data.pointer = "/points";
-  if (ctx.keep_data) {
-    require_memory(grid.size(), sizeof(Vec3), cat("/points: a copy of the ", extents_text(pts.shape), " data points for the error check"));
-    data.points.assign(grid.values().begin(), grid.values().end());
-  }
+  DataSet data = grid_data(spec.at("points"), grid.values(), pts.shape, ctx);
   ctx.parsed();
   auto [exact, params] = at("/points", [&] { return T::interpolate(std::move(grid), degree, param, periodic, ctx.progress); });
   const auto dom = exact.domain();

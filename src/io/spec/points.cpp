@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "detail/parallel.hpp"
@@ -193,7 +194,7 @@ PointArray memory_points(const json& obj, std::size_t rank, std::string_view ptr
          expected_shape(rank));
   for (std::size_t s : a.shape)
     if (s == 0) fail(errc::too_few_points, place(ptr), ": the array has shape ", shape_text(a.shape), ", no points");
-  check_finite_points(a.shape, a.points, ptr, "the array", missing_allowed);
+  if (!a.finite) check_finite_points(a.shape, a.points, ptr, "the array", missing_allowed);
   // Named once and held by nobody else (BuildOptions::arrays): taken, not copied.
   const auto uses = ctx.array_uses.find(name.get<std::string>());
   if (given->use_count() == 1 && uses != ctx.array_uses.end() && uses->second == 1) return std::move(**given);
@@ -210,6 +211,21 @@ PointArray points_impl(const json& j, std::size_t rank, std::string_view ptr, Co
     fail(errc::missing_field, place(ptr), ": a point array given as an object needs \"npy\": file or \"csv\": file with \"shape\"");
   }
   return inline_points(j, rank, ptr, missing_allowed);
+}
+
+DataSet grid_data(const json& points_spec, std::span<const Vec3> points, std::span<const std::size_t> shape,
+                  const Context& ctx) {
+  DataSet data;
+  data.pointer = "/points";
+  if (!ctx.keep_data) return data;
+  if (ctx.borrow_arrays && points_spec.is_object() && points_spec.contains("array")) {
+    data.array = points_spec.at("array").get<std::string>();  // a string: memory_points checked it
+    return data;
+  }
+  require_memory(points.size(), sizeof(Vec3),
+                 cat("/points: a copy of the ", extents_text(shape), " data points for the error check"));
+  data.points.assign(points.begin(), points.end());
+  return data;
 }
 
 PointArray interpolation_points(const json& j, std::size_t rank, std::string_view ptr, Context& ctx) {
@@ -271,3 +287,29 @@ void check_finite_block(const std::vector<std::size_t>& shape, std::span<const V
 }
 
 }  // namespace interpatch::io::reader
+
+namespace interpatch::io {
+
+PointArray copy_point_array(const double* xyz, std::vector<std::size_t> shape) {
+  PointArray out;
+  const std::size_t count = reader::checked_product(shape, "a point array");
+  require_memory(count, sizeof(Vec3), detail::cat("a copy of ", reader::extents_text(shape), " points"));
+  out.shape = std::move(shape);
+  resize_for_overwrite(out.points, count);
+  // Pieces of 2^14 points (384 KiB) are copied and then scanned while they are still
+  // in the core's cache; both cores take pieces.
+  constexpr std::size_t piece = std::size_t{1} << 14;
+  const auto pieces = static_cast<long long>((count + piece - 1) / piece);
+  Vec3* dst = out.points.data();
+  long long bad = pieces;
+#pragma omp parallel for schedule(static) reduction(min : bad) if (count >= detail::parallel_min_work)
+  for (long long k = 0; k < pieces; ++k) {
+    const std::size_t first = static_cast<std::size_t>(k) * piece, n = std::min(piece, count - first);
+    std::memcpy(static_cast<void*>(dst + first), xyz + 3 * first, n * sizeof(Vec3));
+    if (detail::first_non_finite(dst + first, n) < n && k < bad) bad = k;
+  }
+  out.finite = bad == pieces;
+  return out;
+}
+
+}  // namespace interpatch::io

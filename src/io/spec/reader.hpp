@@ -79,6 +79,7 @@ struct Context {
   bool defer_exact = false;  // leave a formula's exact form to exact_form()
   const std::map<std::string, std::shared_ptr<PointArray>, std::less<>>* arrays = nullptr;  // BuildOptions::arrays
   std::map<std::string, std::size_t, std::less<>> array_uses;  // how many times the spec names each of them
+  bool borrow_arrays = false;  // BuildOptions::borrow_arrays
   std::vector<std::string> warnings;
   Clock::time_point start = Clock::now();
   std::optional<Clock::time_point> parsed_at;
@@ -148,6 +149,12 @@ PointArray points_impl(const json& j, std::size_t rank, std::string_view ptr, Co
 /// points_impl for interpolation's data: a missing point (NaN in a file, null in a
 /// list) is refused, and the message says that approximation takes missing points.
 PointArray interpolation_points(const json& j, std::size_t rank, std::string_view ptr, Context& ctx);
+/// The data set of the grid at `/points` a construction interpolates or approximates,
+/// for the error check at the data (params left to the caller): a copy of `points`;
+/// no points without keep_data; the array's name and no points when they came from
+/// an in-memory array the caller holds and lends (borrow_arrays).
+DataSet grid_data(const json& points_spec, std::span<const Vec3> points, std::span<const std::size_t> shape,
+                  const Context& ctx);
 /// A grid of numbers (weights) given as nested lists, Rank 2 or 3.
 template <std::size_t Rank>
 Grid<double, Rank> inline_number_grid(const json& j, std::string_view ptr);

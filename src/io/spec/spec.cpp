@@ -237,6 +237,7 @@ Construction build(const json& spec, const std::filesystem::path& base_dir, cons
   ctx.keep_data = options.keep_data;
   ctx.defer_exact = options.defer_exact;
   ctx.arrays = &options.arrays;
+  ctx.borrow_arrays = options.borrow_arrays;
   return build_impl(spec, ctx);
 }
 
@@ -253,6 +254,7 @@ Construction build_file(const std::filesystem::path& spec_path, const BuildOptio
   ctx.keep_data = options.keep_data;
   ctx.defer_exact = options.defer_exact;
   ctx.arrays = &options.arrays;
+  ctx.borrow_arrays = options.borrow_arrays;
   return build_impl(spec, ctx);
 }
 
