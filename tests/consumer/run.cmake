@@ -61,3 +61,24 @@ if(MODE STREQUAL "install")
     endif()
   endforeach()
 endif()
+# The installed Python package, imported by Debian's python3 from outside the build
+# tree, as `make install` then `python3 -c "import interpatch"` would (the prefix here
+# is a scratch one, so PYTHONPATH points at it; /usr/local's is on python3's path).
+if(MODE STREQUAL "install" AND EXISTS "${BINARY_DIR}/python/interpatch" AND EXISTS /usr/bin/python3)
+  file(GLOB site "${work}/prefix/lib/python3*/dist-packages")
+  if(NOT site)
+    message(FATAL_ERROR "the Python package was built but not installed under ${work}/prefix/lib/python3*/dist-packages")
+  endif()
+  set(ENV{PYTHONPATH} "${site}")
+  execute_process(COMMAND /usr/bin/python3 -c
+                          "import interpatch, numpy as np; print(interpatch.__version__, interpatch.__file__); g = np.stack(np.meshgrid(np.arange(3.0), np.arange(4.0), indexing='ij') + [np.zeros((3, 4))], axis=-1); print(round(float(interpatch.interpolate_surface(g).evaluate([0.5], [1.0])[0, 0, 1]), 12))"
+                  WORKING_DIRECTORY "${work}" OUTPUT_VARIABLE out RESULT_VARIABLE rc OUTPUT_STRIP_TRAILING_WHITESPACE)
+  if(rc)
+    message(FATAL_ERROR "import interpatch from the installed package failed: ${rc}")
+  endif()
+  file(READ "${SOURCE_DIR}/CMakeLists.txt" top)
+  string(REGEX MATCH "project\\(interpatch VERSION ([0-9.]+)" _ "${top}")
+  if(NOT out MATCHES "^${CMAKE_MATCH_1} ${site}/interpatch/__init__.py\n3\\.0$")
+    message(FATAL_ERROR "the installed package says:\n${out}\nexpected version ${CMAKE_MATCH_1} from ${site} and the point 3")
+  endif()
+endif()
