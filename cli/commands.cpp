@@ -349,8 +349,9 @@ void write_eval(io::Construction& c, const fs::path& out, const Resolution& grid
   ProgressLine progress("evaluating");
   if (lower_extension(out) == ".npy") {
     const std::size_t shape[3] = {grid.nu, grid.nv, 3};
+    const auto rows = s.rows(params[1]);  // what depends on v alone, once for every block
     write_npy_by_rows(out, shape, params[0], grid.nv, progress.callback(),
-                      [&](std::span<const double> us, std::span<Vec3> points) { s.evaluate_into(us, params[1], points); });
+                      [&](std::span<const double> us, std::span<Vec3> points) { rows->evaluate_into(us, points); });
     progress.clear();
     return;
   }

@@ -242,54 +242,97 @@ SurfaceDerivatives BlendedSurface::derivatives(double u, double v) const {
   return d;
 }
 
+namespace {
+
+double clamped(double t) { return std::clamp(t, 0.0, 1.0); }
+double value(const detail::Scalar& f, double t) { return f.spline ? f.spline->point(t).x : f.fn(t, 0); }
+
+// The rows of a blended surface on one set of v: per v, a line of values for each
+// function of v, A[k][j] = a_k(v_j) and G[l][j] = g_l(v_j) three times over (as
+// detail::PointTerm takes it); per block of u, F[i][k] = f_k(u_i) and P[i][l] = b_l(u_i)
+// + Σ_k c_kl f_k(u_i), the factor of g_l(v); then row i is Σ_k f_k(u_i) A[k] + Σ_l
+// G[l] P[i][l], summed in that order four points at a time in registers (the kernel
+// of the exact conversion).
+class BlendedRows final : public Surface::Rows {
+ public:
+  BlendedRows(std::shared_ptr<const detail::BlendedTerms> terms, std::span<const double> vs)
+      : t_(std::move(terms)), nv_(vs.size()) {
+    const auto& T = *t_;
+    detail::check_unit_parameters(vs, "v");
+    const std::size_t KA = T.a.size(), L = T.g.size();
+    A_.resize(KA * nv_);
+    G_.resize(L * 3 * nv_);
+    for (std::size_t j = 0; j < nv_; ++j) {
+      const double v = clamped(vs[j]);
+      for (std::size_t l = 0; l < L; ++l) {
+        const double g = value(T.g[l], v);
+        for (std::size_t c = 0; c < 3; ++c) G_[(l * nv_ + j) * 3 + c] = g;
+      }
+      for (std::size_t k = 0; k < KA; ++k) A_[k * nv_ + j] = T.a[k].point(v);
+    }
+  }
+
+  void evaluate_into(std::span<const double> us, std::span<Vec3> out, const progress_callback& progress) const override {
+    const auto& T = *t_;
+    detail::check_output_size(out.size(), {us.size(), nv_}, "surface evaluation");
+    detail::check_unit_parameters(us, "u");
+    const std::size_t nu = us.size(), nv = nv_, K = T.f.size(), L = T.g.size(), KA = T.a.size();
+    if (nu == 0 || nv == 0) {
+      if (progress) progress(1.0);
+      return;
+    }
+    std::vector<double> F(nu * K);
+    std::vector<Vec3> P(nu * L);
+    for (std::size_t i = 0; i < nu; ++i) {
+      const double u = clamped(us[i]);
+      for (std::size_t k = 0; k < K; ++k) F[i * K + k] = value(T.f[k], u);
+      for (std::size_t l = 0; l < L; ++l) {
+        Vec3 p = l < T.b.size() ? T.b[l].point(u) : Vec3{};
+        if (!T.c.empty())
+          for (std::size_t k = 0; k < K; ++k) p += F[i * K + k] * T.c(k, l);
+        P[i * L + l] = p;
+      }
+    }
+    const auto rows = static_cast<long long>(nu);
+    std::atomic<std::size_t> done{0};
+#pragma omp parallel if (nu * nv * (KA + L) >= detail::parallel_min_work)
+    {
+      std::vector<detail::LineTerm> lines(KA);
+      std::vector<detail::PointTerm> points;
+      points.reserve(L);
+#pragma omp for schedule(static, 16)
+      for (long long ri = 0; ri < rows; ++ri) {
+        const auto i = static_cast<std::size_t>(ri);
+        for (std::size_t k = 0; k < KA; ++k) lines[k] = {F[i * K + k], &A_[k * nv].x};
+        points.clear();
+        for (std::size_t l = 0; l < L; ++l) points.emplace_back(G_.data() + l * 3 * nv, P[i * L + l]);
+        detail::sum_terms(&out[i * nv].x, nv, lines, points);
+        const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
+        if (progress && detail::thread_index() == 0 && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(nu));
+      }
+    }
+    if (progress) progress(1.0);
+  }
+
+ private:
+  std::shared_ptr<const detail::BlendedTerms> t_;
+  std::size_t nv_;
+  std::vector<Vec3> A_;
+  std::vector<double> G_;
+};
+
+}  // namespace
+
+std::unique_ptr<Surface::Rows> BlendedSurface::rows(std::span<const double> vs) const {
+  if (!t_->gregory.empty()) return Surface::rows(vs);
+  return std::make_unique<BlendedRows>(t_, vs);
+}
+
 void BlendedSurface::evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
                                    const progress_callback& progress) const {
-  const auto& T = *t_;
-  if (!T.gregory.empty()) return Surface::evaluate_into(us, vs, out, progress);
+  if (!t_->gregory.empty()) return Surface::evaluate_into(us, vs, out, progress);
   detail::check_output_size(out.size(), {us.size(), vs.size()}, "surface evaluation");
-  detail::check_unit_parameters(us, "u");
-  detail::check_unit_parameters(vs, "v");
-  const std::size_t nu = us.size(), nv = vs.size(), K = T.f.size(), L = T.g.size();
-  auto value = [](const detail::Scalar& f, double t) { return f.spline ? f.spline->point(t).x : f.fn(t, 0); };
-  auto clamp = [](double t) { return std::clamp(t, 0.0, 1.0); };
-  // Per u: F[i][k] = f_k(u_i), and P[i][l] = b_l(u_i) + Σ_k c_kl f_k(u_i), the factor
-  // of g_l(v). Per v: G[j][l] = g_l(v_j), A[j][k] = a_k(v_j).
-  std::vector<double> F(nu * K), G(nv * L);
-  std::vector<Vec3> P(nu * L), A(nv * T.a.size());
-  for (std::size_t i = 0; i < nu; ++i) {
-    const double u = clamp(us[i]);
-    for (std::size_t k = 0; k < K; ++k) F[i * K + k] = value(T.f[k], u);
-    for (std::size_t l = 0; l < L; ++l) {
-      Vec3 p = l < T.b.size() ? T.b[l].point(u) : Vec3{};
-      if (!T.c.empty())
-        for (std::size_t k = 0; k < K; ++k) p += F[i * K + k] * T.c(k, l);
-      P[i * L + l] = p;
-    }
-  }
-  for (std::size_t j = 0; j < nv; ++j) {
-    const double v = clamp(vs[j]);
-    for (std::size_t l = 0; l < L; ++l) G[j * L + l] = value(T.g[l], v);
-    for (std::size_t k = 0; k < T.a.size(); ++k) A[j * T.a.size() + k] = T.a[k].point(v);
-  }
-  const std::size_t KA = T.a.size();
-  const auto rows = static_cast<long long>(nu);
-  std::atomic<std::size_t> done{0};
-#pragma omp parallel for schedule(static, 16) if (nu * nv * (KA + L) >= detail::parallel_min_work)
-  for (long long ri = 0; ri < rows; ++ri) {
-    const auto i = static_cast<std::size_t>(ri);
-    const double* f = F.data() + i * K;
-    const Vec3* p = P.data() + i * L;
-    Vec3* o = out.data() + i * nv;
-    for (std::size_t j = 0; j < nv; ++j) {
-      Vec3 s{};
-      for (std::size_t k = 0; k < KA; ++k) s += f[k] * A[j * KA + k];
-      for (std::size_t l = 0; l < L; ++l) s += G[j * L + l] * p[l];
-      o[j] = s;
-    }
-    const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
-    if (progress && detail::thread_index() == 0 && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(nu));
-  }
-  if (progress) progress(1.0);
+  BlendedRows(t_, vs).evaluate_into(us, out, progress);
 }
 
 Grid<SurfaceDerivatives, 2> BlendedSurface::evaluate_derivatives(std::span<const double> us,

@@ -1,6 +1,8 @@
 #include "interpatch/surface.hpp"
 
 #include <algorithm>
+#include <memory>
+#include <vector>
 
 #include "detail/parallel.hpp"
 #include "detail/text.hpp"
@@ -14,6 +16,27 @@ PointGrid Surface::evaluate(std::span<const double> us, std::span<const double> 
   PointGrid out({us.size(), vs.size()}, for_overwrite);
   evaluate_into(us, vs, std::span<Vec3>(out.data(), out.size()), progress);
   return out;
+}
+
+namespace {
+
+// Rows evaluated by the surface's evaluate_into, the vs kept.
+class DirectRows final : public Surface::Rows {
+ public:
+  DirectRows(const Surface& s, std::span<const double> vs) : s_(s), vs_(vs.begin(), vs.end()) {}
+  void evaluate_into(std::span<const double> us, std::span<Vec3> out, const progress_callback& progress) const override {
+    s_.evaluate_into(us, vs_, out, progress);
+  }
+
+ private:
+  const Surface& s_;
+  std::vector<double> vs_;
+};
+
+}  // namespace
+
+std::unique_ptr<Surface::Rows> Surface::rows(std::span<const double> vs) const {
+  return std::make_unique<DirectRows>(*this, vs);
 }
 
 void Surface::evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,

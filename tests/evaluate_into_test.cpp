@@ -104,6 +104,13 @@ void expect_surface_into_matches_evaluate(const Surface& s, std::span<const doub
                                        [&](std::span<const double> u, std::span<Vec3> out, const progress_callback& p) {
                                          s.evaluate_into(u, vs, out, p);
                                        });
+  // The same through rows(vs): what depends on v worked out once for every block.
+  SCOPED_TRACE("through rows(vs)");
+  const auto rows = s.rows(vs);
+  expect_same_bits_whole_and_in_blocks(std::span<const Vec3>(expected.data(), expected.size()), us, vs.size(), blocks,
+                                       [&](std::span<const double> u, std::span<Vec3> out, const progress_callback& p) {
+                                         rows->evaluate_into(u, out, p);
+                                       });
 }
 
 void expect_volume_into_matches_evaluate(const Volume& v, std::span<const double> us, std::span<const double> vs,
@@ -285,6 +292,8 @@ TEST(EvaluateInto, EmptyGridsAreAccepted) {
       [&](const Surface& s) {
         EXPECT_NO_THROW(s.evaluate_into(none, some, {}));
         EXPECT_NO_THROW(s.evaluate_into(some, none, {}));
+        EXPECT_NO_THROW(s.rows(some)->evaluate_into(none, {}));
+        EXPECT_NO_THROW(s.rows(none)->evaluate_into(some, {}));
       },
       [&](const Volume& v) {
         EXPECT_NO_THROW(v.evaluate_into(none, some, some, {}));
@@ -309,6 +318,9 @@ TEST(EvaluateInto, OutputOfTheWrongSizeIsSizeMismatch) {
         EXPECT_ERRC(s.evaluate_into(v4, u3, first(3)), size_mismatch, "the 4x3 grid has 12");
         EXPECT_ERRC(s.evaluate_into(none, v4, first(1)), size_mismatch,
                     "the output holds 1 points, the 0x4 grid has 0");
+        EXPECT_ERRC(s.rows(v4)->evaluate_into(u3, first(11)), size_mismatch,
+                    "the output holds 11 points, the 3x4 grid has 12");
+        EXPECT_ERRC(s.rows(u3)->evaluate_into(v4, first(3)), size_mismatch, "the 4x3 grid has 12");
       },
       [&](const Volume& v) {
         EXPECT_ERRC(v.evaluate_into(u3, v4, w2, first(23)), size_mismatch,
@@ -335,6 +347,11 @@ TEST(EvaluateInto, ParameterOutsideTheDomainIsOutOfDomain) {
         EXPECT_ERRC(s.evaluate_into(good, below, sized(6)), out_of_domain, "parameter v = -0.25 is outside the domain");
         EXPECT_ERRC(s.evaluate_into(not_a_number, good, sized(6)), out_of_domain, "parameter u = ");
         EXPECT_ERRC(s.evaluate_into(good, not_a_number, sized(6)), out_of_domain, "parameter v = ");
+        // Through rows(): refused by rows() itself or by the evaluation after it.
+        EXPECT_ERRC(s.rows(good)->evaluate_into(above, sized(9)), out_of_domain, "parameter u = 1.5 is outside the domain");
+        EXPECT_ERRC(s.rows(below)->evaluate_into(good, sized(6)), out_of_domain,
+                    "parameter v = -0.25 is outside the domain");
+        EXPECT_ERRC(s.rows(not_a_number)->evaluate_into(good, sized(6)), out_of_domain, "parameter v = ");
       },
       [&](const Volume& v) {
         EXPECT_ERRC(v.evaluate_into(above, good, good, sized(27)), out_of_domain,

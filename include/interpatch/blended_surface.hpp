@@ -41,6 +41,10 @@ class BlendedSurface final : public Surface {
   /// count. @throws error out_of_domain, size_mismatch.
   void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
                      const progress_callback& progress = {}) const override;
+  /// Rows on the parameters vs: the blending functions and curves of v evaluated
+  /// here, once; each block of rows then costs its functions of u and the sums.
+  /// (Gregory-corrected patches: Surface::rows.) @throws error out_of_domain.
+  [[nodiscard]] std::unique_ptr<Rows> rows(std::span<const double> vs) const override;
   /// Points and derivatives up to second order at every (us[i], vs[j]), the same
   /// way: each factor with its derivatives once per parameter, then short sums per
   /// point (Gregory-corrected patches point by point). @throws error out_of_domain, too_large.

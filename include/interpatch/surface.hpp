@@ -4,6 +4,7 @@
 /// batch evaluation over parameter grids, and its exact B-spline form.
 
 #include <array>
+#include <memory>
 #include <span>
 #include <utility>
 
@@ -56,6 +57,21 @@ class Surface {
   /// @throws error out_of_domain; size_mismatch when out.size() != us.size() * vs.size().
   virtual void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
                              const progress_callback& progress = {}) const;
+  /// Rows of points on one set of v parameters, evaluated a block of rows at a time
+  /// (a file written block by block): Surface::rows() works out once what depends on
+  /// v alone, which evaluate_into() would work out again for every block.
+  class Rows {
+   public:
+    virtual ~Rows() = default;
+    /// evaluate_into(us, vs, out, progress) with the vs given to rows(): the same
+    /// points. @throws error out_of_domain; size_mismatch when out.size() != us.size() * vs.size().
+    virtual void evaluate_into(std::span<const double> us, std::span<Vec3> out, const progress_callback& progress = {}) const = 0;
+  };
+  /// The rows of this surface on the parameters `vs` (copied), for evaluate_into() of
+  /// block after block of u; the surface must outlive the result. A blended surface
+  /// evaluates its functions of v here, once. @throws error out_of_domain, here or from
+  /// Rows::evaluate_into.
+  [[nodiscard]] virtual std::unique_ptr<Rows> rows(std::span<const double> vs) const;
   /// Points and derivatives at every (us[i], vs[j]). @throws error out_of_domain, too_large.
   [[nodiscard]] virtual Grid<SurfaceDerivatives, 2> evaluate_derivatives(std::span<const double> us,
                                                                          std::span<const double> vs) const;
