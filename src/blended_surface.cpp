@@ -1,6 +1,7 @@
 #include "interpatch/blended_surface.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -9,6 +10,7 @@
 #include "detail/kernel.hpp"
 #include "detail/parallel.hpp"
 #include "detail/text.hpp"
+#include "interpatch/evaluate.hpp"
 #include "interpatch/hermite.hpp"
 #include "interpatch/memory.hpp"
 
@@ -150,6 +152,25 @@ void add_product(SurfaceDerivatives& d, const X* x, const Y* y) {
   d.suu += x[2] * y[0];
   d.suv += x[1] * y[1];
   d.svv += x[0] * y[2];
+}
+
+// The factors of u with their first two derivatives at every us[i]: F[i][k] = f_k(u_i)
+// and P[i][l] = b_l(u_i) + Σ_k c_kl f_k(u_i), the factor of g_l(v).
+void u_factors(const detail::BlendedTerms& T, std::span<const double> us, std::vector<S3>& F, std::vector<D3>& P) {
+  const std::size_t nu = us.size(), K = T.f.size(), L = T.g.size();
+  F.assign(nu * K, S3{});
+  P.assign(nu * L, D3{});
+  for (std::size_t i = 0; i < nu; ++i) {
+    const double u = std::clamp(us[i], 0.0, 1.0);
+    for (std::size_t k = 0; k < K; ++k) T.f[k].eval(u, F[i * K + k].v);
+    for (std::size_t l = 0; l < L; ++l) {
+      D3 p = l < T.b.size() ? eval(T.b[l], u) : D3{};
+      if (!T.c.empty())
+        for (std::size_t k = 0; k < K; ++k)
+          for (int r = 0; r < 3; ++r) p.v[r] += F[i * K + k].v[r] * T.c(k, l);
+      P[i * L + l] = p;
+    }
+  }
 }
 
 // Gregory's blend weight w = a / (a + b) and its partials, a = |u − i|, b = |v − j|.
@@ -347,19 +368,9 @@ Grid<SurfaceDerivatives, 2> BlendedSurface::evaluate_derivatives(std::span<const
   // As evaluate_into, with the first two derivatives of every factor: per u, F[i][k]
   // = f_k(u_i) and P[i][l] = b_l(u_i) + Σ_k c_kl f_k(u_i); per v, G[j][l] = g_l(v_j)
   // and A[j][k] = a_k(v_j).
-  std::vector<S3> F(nu * K), G(nv * L);
-  std::vector<D3> P(nu * L), A(nv * KA);
-  for (std::size_t i = 0; i < nu; ++i) {
-    const double u = clamp(us[i]);
-    for (std::size_t k = 0; k < K; ++k) T.f[k].eval(u, F[i * K + k].v);
-    for (std::size_t l = 0; l < L; ++l) {
-      D3 p = l < T.b.size() ? eval(T.b[l], u) : D3{};
-      if (!T.c.empty())
-        for (std::size_t k = 0; k < K; ++k)
-          for (int r = 0; r < 3; ++r) p.v[r] += F[i * K + k].v[r] * T.c(k, l);
-      P[i * L + l] = p;
-    }
-  }
+  std::vector<S3> F, G(nv * L);
+  std::vector<D3> P, A(nv * KA);
+  u_factors(T, us, F, P);
   for (std::size_t j = 0; j < nv; ++j) {
     const double v = clamp(vs[j]);
     for (std::size_t l = 0; l < L; ++l) T.g[l].eval(v, G[j * L + l].v);
@@ -378,6 +389,81 @@ Grid<SurfaceDerivatives, 2> BlendedSurface::evaluate_derivatives(std::span<const
     }
   }
   return out;
+}
+
+void BlendedSurface::evaluate_normals_into(std::span<const double> us, std::span<const double> vs,
+                                           std::span<Vec3> points, std::span<Vec3> normals,
+                                           const progress_callback& progress) const {
+  const auto& T = *t_;
+  if (!T.gregory.empty()) return Surface::evaluate_normals_into(us, vs, points, normals, progress);
+  detail::check_output_size(points.size(), {us.size(), vs.size()}, "surface evaluation (points)");
+  detail::check_output_size(normals.size(), {us.size(), vs.size()}, "surface evaluation (normals)");
+  detail::check_unit_parameters(us, "u");
+  detail::check_unit_parameters(vs, "v");
+  const std::size_t nu = us.size(), nv = vs.size(), K = T.f.size(), L = T.g.size(), KA = T.a.size();
+  if (nu == 0 || nv == 0) {
+    if (progress) progress(1.0);
+    return;
+  }
+  // Per u, each factor with its derivatives: F[i][k] (f_k) and P[i][l] (the factor
+  // of g_l), as evaluate_derivatives makes them. Per v, lines of values and of first
+  // derivatives: A[d][k][j] = a_k^(d)(v_j), G[d][l][j] = g_l^(d)(v_j) three times over.
+  std::vector<S3> F;
+  std::vector<D3> P;
+  u_factors(T, us, F, P);
+  std::array<std::vector<Vec3>, 2> A{std::vector<Vec3>(KA * nv), std::vector<Vec3>(KA * nv)};
+  std::array<std::vector<double>, 2> G{std::vector<double>(L * 3 * nv), std::vector<double>(L * 3 * nv)};
+  for (std::size_t j = 0; j < nv; ++j) {
+    const double v = clamped(vs[j]);
+    for (std::size_t l = 0; l < L; ++l) {
+      double g[3];
+      T.g[l].eval(v, g);
+      for (std::size_t d = 0; d < 2; ++d)
+        for (std::size_t c = 0; c < 3; ++c) G[d][(l * nv + j) * 3 + c] = g[d];
+    }
+    for (std::size_t k = 0; k < KA; ++k) {
+      const D3 a = eval(T.a[k], v);
+      for (std::size_t d = 0; d < 2; ++d) A[d][k * nv + j] = a.v[d];
+    }
+  }
+  // Row i: S and its partials su (f', P'), sv (a', g') and suv (both), each summed by
+  // the kernel of evaluate_into, then the normal of every point of the row.
+  const auto rows = static_cast<long long>(nu);
+  std::atomic<std::size_t> done{0};
+#pragma omp parallel if (nu * nv * (KA + L) * 4 >= detail::parallel_min_work)
+  {
+    std::vector<detail::LineTerm> lines(KA);
+    std::vector<detail::PointTerm> terms;
+    terms.reserve(L);
+    std::array<std::vector<Vec3>, 3> partial{std::vector<Vec3>(nv), std::vector<Vec3>(nv), std::vector<Vec3>(nv)};
+    // The row's sum of derivative order du in u and dv in v into o.
+    const auto sum = [&](std::size_t i, std::size_t du, std::size_t dv, Vec3* o) {
+      for (std::size_t k = 0; k < KA; ++k) lines[k] = {F[i * K + k].v[du], &A[dv][k * nv].x};
+      terms.clear();
+      for (std::size_t l = 0; l < L; ++l) terms.emplace_back(G[dv].data() + l * 3 * nv, P[i * L + l].v[du]);
+      detail::sum_terms(&o->x, nv, lines, terms);
+    };
+#pragma omp for schedule(static, 16)
+    for (long long ri = 0; ri < rows; ++ri) {
+      const auto i = static_cast<std::size_t>(ri);
+      Vec3* row = points.data() + i * nv;
+      sum(i, 0, 0, row);
+      sum(i, 1, 0, partial[0].data());
+      sum(i, 0, 1, partial[1].data());
+      sum(i, 1, 1, partial[2].data());
+      for (std::size_t j = 0; j < nv; ++j) {
+        SurfaceDerivatives d{};
+        d.s = row[j];
+        d.su = partial[0][j];
+        d.sv = partial[1][j];
+        d.suv = partial[2][j];
+        normals[i * nv + j] = unit_normal(d);
+      }
+      const std::size_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
+      if (progress && detail::thread_index() == 0 && n % 64 == 0) progress(static_cast<double>(n) / static_cast<double>(nu));
+    }
+  }
+  if (progress) progress(1.0);
 }
 
 bool BlendedSurface::has_exact_form() const noexcept {

@@ -6,6 +6,7 @@
 
 #include "detail/parallel.hpp"
 #include "detail/text.hpp"
+#include "interpatch/evaluate.hpp"
 #include "interpatch/memory.hpp"
 
 namespace interpatch {
@@ -34,6 +35,29 @@ class DirectRows final : public Surface::Rows {
 };
 
 }  // namespace
+
+void Surface::evaluate_normals_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> points,
+                                    std::span<Vec3> normals, const progress_callback& progress) const {
+  detail::check_output_size(points.size(), {us.size(), vs.size()}, "surface evaluation (points)");
+  detail::check_output_size(normals.size(), {us.size(), vs.size()}, "surface evaluation (normals)");
+  const std::size_t nu = us.size(), nv = vs.size();
+  // Blocks of 2^17 points (18 MiB of derivatives): each block works out the surface's
+  // functions of v again, so blocks of many rows.
+  const std::size_t block = std::max<std::size_t>(1, (std::size_t{1} << 17) / std::max<std::size_t>(1, nv));
+  for (std::size_t i0 = 0; i0 < nu; i0 += block) {
+    const std::size_t nb = std::min(block, nu - i0);
+    const auto d = evaluate_derivatives(us.subspan(i0, nb), vs);
+    const auto cells = static_cast<long long>(nb * nv);
+#pragma omp parallel for schedule(static) if (nb * nv >= detail::parallel_min_work / 16)
+    for (long long c = 0; c < cells; ++c) {
+      const auto q = static_cast<std::size_t>(c);
+      points[i0 * nv + q] = d.data()[q].s;
+      normals[i0 * nv + q] = unit_normal(d.data()[q]);
+    }
+    if (progress) progress(static_cast<double>(i0 + nb) / static_cast<double>(nu));
+  }
+  if (progress && nu == 0) progress(1.0);
+}
 
 std::unique_ptr<Surface::Rows> Surface::rows(std::span<const double> vs) const {
   return std::make_unique<DirectRows>(*this, vs);

@@ -24,6 +24,7 @@
 #include "detail/parallel.hpp"
 #include "interpatch/coons.hpp"
 #include "interpatch/coons_volume.hpp"
+#include "interpatch/evaluate.hpp"
 #include "interpatch/interpolate.hpp"
 #include "interpatch/volume_patches.hpp"
 #include "surface_util.hpp"
@@ -301,6 +302,62 @@ TEST(EvaluateInto, EmptyGridsAreAccepted) {
       });
 }
 
+// evaluate_normals_into: the points evaluate() gives, and the unit normals of the
+// derivatives evaluate_derivatives() gives, for every kind of surface, whole and in
+// blocks; at a pole too.
+void expect_normals_of_the_derivatives(const Surface& s, std::span<const double> us, std::span<const double> vs) {
+  const auto d = s.evaluate_derivatives(us, vs);
+  std::vector<Vec3> points(us.size() * vs.size(), garbage), normals(points.size(), garbage);
+  s.evaluate_normals_into(us, vs, points, normals);
+  double scale = 0;
+  for (const auto& x : d.values()) scale = std::max({scale, max_abs(x.s), max_abs(x.su), max_abs(x.sv)});
+  for (std::size_t q = 0; q < points.size(); ++q) {
+    // The sums of a blended surface's row kernel may round differently from the
+    // pointwise sums (fused multiply-adds where the processor has them): 1e-13 of
+    // the surface's size; a normal, a unit vector from well-separated partials,
+    // to 1e-10.
+    ASSERT_LE(norm(points[q] - d.data()[q].s), 1e-13 * scale) << "point " << q;
+    ASSERT_LE(norm(normals[q] - unit_normal(d.data()[q])), 1e-10) << "normal " << q;
+  }
+  // Blocks of 5 rows into the same place: the same bits as the whole.
+  std::vector<Vec3> bp(points.size(), garbage), bn(points.size(), garbage);
+  for (std::size_t i0 = 0; i0 < us.size(); i0 += 5) {
+    const std::size_t n = std::min<std::size_t>(5, us.size() - i0), m = vs.size();
+    s.evaluate_normals_into(us.subspan(i0, n), vs, std::span<Vec3>(bp).subspan(i0 * m, n * m),
+                            std::span<Vec3>(bn).subspan(i0 * m, n * m));
+  }
+  EXPECT_TRUE(same_bits(bp, points));
+  EXPECT_TRUE(same_bits(bn, normals));
+}
+
+TEST(EvaluateInto, NormalsAreThoseOfTheDerivatives) {
+  auto g = test::rng(147);
+  const std::vector<double> us = random_parameters(g, 23), vs = random_parameters(g, 17);
+  for_every_evaluator(
+      148, [&](const Surface& s) { expect_normals_of_the_derivatives(s, us, vs); }, [](const Volume&) {});
+  // A Coons patch whose side u = 0 is one point: a pole, where S_v vanishes and the
+  // normal is the limit along the row (unit_normal's rule).
+  const BSplineSurface src = test::random_bspline_surface(g, 3, 3, 5, 5);
+  CoonsBoundary b = test::boundary_of(src);
+  const Vec3 pole = src.point(0, 0);
+  b.u0 = BSplineCurve(b.u0.knots(), std::vector<Vec3>(b.u0.control_points().size(), pole));
+  b.v1 = BSplineCurve(KnotVector(1, {0, 0, 1, 1}), {pole, src.point(1, 1)});
+  b.u1 = BSplineCurve(KnotVector(1, {0, 0, 1, 1}), {src.point(1, 0), src.point(1, 1)});
+  b.v0 = BSplineCurve(KnotVector(1, {0, 0, 1, 1}), {pole, src.point(1, 0)});
+  const BlendedSurface cone = coons(b);
+  expect_normals_of_the_derivatives(cone, us, vs);
+  std::vector<Vec3> p(vs.size()), n(vs.size()), inside(vs.size()), in_n(vs.size());
+  const std::vector<double> at_pole{0.0}, near_pole{1e-7};
+  cone.evaluate_normals_into(at_pole, vs, p, n);
+  cone.evaluate_normals_into(near_pole, vs, inside, in_n);
+  for (std::size_t j = 0; j < vs.size(); ++j) {
+    EXPECT_LE(norm(p[j] - pole), 1e-14) << "v " << vs[j];
+    // The limit: the normal a ten-millionth inside, to within the distance (1e-7
+    // times the curvature of the row, of order one here).
+    EXPECT_LE(norm(n[j] - in_n[j]), 1e-5) << "v " << vs[j];
+  }
+}
+
 // --- errors ------------------------------------------------------------------------
 
 TEST(EvaluateInto, OutputOfTheWrongSizeIsSizeMismatch) {
@@ -321,6 +378,11 @@ TEST(EvaluateInto, OutputOfTheWrongSizeIsSizeMismatch) {
         EXPECT_ERRC(s.rows(v4)->evaluate_into(u3, first(11)), size_mismatch,
                     "the output holds 11 points, the 3x4 grid has 12");
         EXPECT_ERRC(s.rows(u3)->evaluate_into(v4, first(3)), size_mismatch, "the 4x3 grid has 12");
+        std::vector<Vec3> twelve(12);
+        EXPECT_ERRC(s.evaluate_normals_into(u3, v4, first(11), twelve), size_mismatch,
+                    "surface evaluation (points): the output holds 11 points, the 3x4 grid has 12");
+        EXPECT_ERRC(s.evaluate_normals_into(u3, v4, twelve, first(13)), size_mismatch,
+                    "surface evaluation (normals): the output holds 13 points, the 3x4 grid has 12");
       },
       [&](const Volume& v) {
         EXPECT_ERRC(v.evaluate_into(u3, v4, w2, first(23)), size_mismatch,
@@ -352,6 +414,12 @@ TEST(EvaluateInto, ParameterOutsideTheDomainIsOutOfDomain) {
         EXPECT_ERRC(s.rows(below)->evaluate_into(good, sized(6)), out_of_domain,
                     "parameter v = -0.25 is outside the domain");
         EXPECT_ERRC(s.rows(not_a_number)->evaluate_into(good, sized(6)), out_of_domain, "parameter v = ");
+        std::vector<Vec3> normals(9);
+        EXPECT_ERRC(s.evaluate_normals_into(above, good, sized(9), normals), out_of_domain,
+                    "parameter u = 1.5 is outside the domain");
+        normals.resize(6);
+        EXPECT_ERRC(s.evaluate_normals_into(good, below, sized(6), normals), out_of_domain,
+                    "parameter v = -0.25 is outside the domain");
       },
       [&](const Volume& v) {
         EXPECT_ERRC(v.evaluate_into(above, good, good, sized(27)), out_of_domain,

@@ -45,6 +45,11 @@ class BlendedSurface final : public Surface {
   /// here, once; each block of rows then costs its functions of u and the sums.
   /// (Gregory-corrected patches: Surface::rows.) @throws error out_of_domain.
   [[nodiscard]] std::unique_ptr<Rows> rows(std::span<const double> vs) const override;
+  /// Points and unit normals: per row, the point and its first partials (su, sv and
+  /// suv, for poles) summed as evaluate_into() sums the point, then the normal.
+  /// (Gregory-corrected patches: Surface::evaluate_normals_into.) @throws error out_of_domain, size_mismatch.
+  void evaluate_normals_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> points,
+                             std::span<Vec3> normals, const progress_callback& progress = {}) const override;
   /// Points and derivatives up to second order at every (us[i], vs[j]), the same
   /// way: each factor with its derivatives once per parameter, then short sums per
   /// point (Gregory-corrected patches point by point). @throws error out_of_domain, too_large.

@@ -57,6 +57,15 @@ class Surface {
   /// @throws error out_of_domain; size_mismatch when out.size() != us.size() * vs.size().
   virtual void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
                              const progress_callback& progress = {}) const;
+  /// Points and unit normals at every (us[i], vs[j]) into memory the caller owns,
+  /// points[i * vs.size() + j] and normals[...] (unit_normal() of the derivatives
+  /// there: at a pole, the limit along the vanishing direction). What a mesh with
+  /// normals needs, without the grid of second derivatives evaluate_derivatives()
+  /// makes (a blended surface sums its first derivatives row by row, in place).
+  /// @throws error out_of_domain; size_mismatch when either output's size is not
+  /// us.size() * vs.size().
+  virtual void evaluate_normals_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> points,
+                                     std::span<Vec3> normals, const progress_callback& progress = {}) const;
   /// Rows of points on one set of v parameters, evaluated a block of rows at a time
   /// (a file written block by block): Surface::rows() works out once what depends on
   /// v alone, which evaluate_into() would work out again for every block.

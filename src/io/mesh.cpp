@@ -642,22 +642,8 @@ SurfaceMesh sample_mesh(const Surface& surface, std::span<const double> us, std:
                         const progress_callback& progress) {
   const std::size_t nu = us.size(), nv = vs.size();
   SurfaceMesh mesh{PointGrid({nu, nv}, for_overwrite), PointGrid({nu, nv}, for_overwrite), {false, false}};
-  // Blocks of 2^17 points (18 MiB of derivatives): each block works out the surface's
-  // functions of v again, so fewer, larger blocks (32 of 2^15 points cost 12 % of a
-  // 1000 x 1000 mesh of a Coons patch in evaluations of its curves of v).
-  const std::size_t block = std::max<std::size_t>(1, (std::size_t{1} << 17) / std::max<std::size_t>(1, nv));
-  for (std::size_t i0 = 0; i0 < nu; i0 += block) {
-    const std::size_t nb = std::min(block, nu - i0);
-    const auto d = surface.evaluate_derivatives(us.subspan(i0, nb), vs);
-    const auto cells = static_cast<long long>(nb * nv);
-#pragma omp parallel for schedule(static) if (nb * nv >= interpatch::detail::parallel_min_work / 16)
-    for (long long c = 0; c < cells; ++c) {
-      const std::size_t i = static_cast<std::size_t>(c) / nv, j = static_cast<std::size_t>(c) % nv;
-      mesh.points(i0 + i, j) = d(i, j).s;
-      mesh.normals(i0 + i, j) = unit_normal(d(i, j));
-    }
-    if (progress) progress(static_cast<double>(i0 + nb) / static_cast<double>(nu));
-  }
+  surface.evaluate_normals_into(us, vs, std::span<Vec3>(mesh.points.data(), mesh.points.size()),
+                                std::span<Vec3>(mesh.normals.data(), mesh.normals.size()), progress);
   // A direction in which a B-spline surface is periodic and the samples span one
   // whole period closes: its last row (column) is its first again, points and
   // normals copied so that every format sees one seam.
