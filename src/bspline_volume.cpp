@@ -89,28 +89,43 @@ void contract(const Net& b, const std::vector<Basis>& bu, const std::vector<Basi
       const auto i = static_cast<std::size_t>(ri);
       const Basis& a = bu[i];
       for (int k = 0; k < nu_terms; ++k) {
-        H* out = U[k].data();
-        std::fill(out, out + plane, H{0, 0, 0, 0});
+        // Each entry summed over the p + 1 planes in registers, in the order of the
+        // planes, and stored once (a pass per plane read each entry back from the
+        // store before: stalls on this processor).
+        const Vec3* planes[max_degree + 1];
+        const double* weights[max_degree + 1];
+        double c[max_degree + 1];
         for (int e = 0; e <= p; ++e) {
-          const double c = a.d[k * (p + 1) + e];
+          c[e] = a.d[k * (p + 1) + e];
           const auto ii = static_cast<std::size_t>(b.ku.wrap_index(a.span - p + e));
-          const Vec3* P = b.planes.row(ii);
-          if (rat) {
-            const double* wp = &wt(ii, 0, 0);
-            for (std::size_t x = 0; x < plane; ++x) {
-              const double cw = c * wp[x];
-              out[x][0] += cw * P[x].x;
-              out[x][1] += cw * P[x].y;
-              out[x][2] += cw * P[x].z;
-              out[x][3] += cw;
+          planes[e] = b.planes.row(ii);
+          weights[e] = rat ? &wt(ii, 0, 0) : nullptr;
+        }
+        H* out = U[k].data();
+        if (rat) {
+          for (std::size_t x = 0; x < plane; ++x) {
+            H h{0, 0, 0, 0};
+            for (int e = 0; e <= p; ++e) {
+              const Vec3& P = planes[e][x];
+              const double cw = c[e] * weights[e][x];
+              h[0] += cw * P.x;
+              h[1] += cw * P.y;
+              h[2] += cw * P.z;
+              h[3] += cw;
             }
-          } else {
-            for (std::size_t x = 0; x < plane; ++x) {
-              out[x][0] += c * P[x].x;
-              out[x][1] += c * P[x].y;
-              out[x][2] += c * P[x].z;
-              out[x][3] += c;
+            out[x] = h;
+          }
+        } else {
+          for (std::size_t x = 0; x < plane; ++x) {
+            H h{0, 0, 0, 0};
+            for (int e = 0; e <= p; ++e) {
+              const Vec3& P = planes[e][x];
+              h[0] += c[e] * P.x;
+              h[1] += c[e] * P.y;
+              h[2] += c[e] * P.z;
+              h[3] += c[e];
             }
+            out[x] = h;
           }
         }
       }
