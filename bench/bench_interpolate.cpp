@@ -388,7 +388,7 @@ const interpatch::CurveNetwork& bench_network(NetworkKind kind) {
 // surface's formula (BlendedSurface::evaluate_into), or by its exact form
 // (to_bspline, then BSplineSurface::evaluate_into). `interpatch eval` takes whichever
 // costs fewer operations (io::evaluator): the exact form for the common network
-// (502 × 499 control points), the formula for the drawn one (511 × 8314 for the
+// (502 × 499 control points), the formula for the drawn one (511 × 8004 for the
 // spec of docs/BENCHMARKS.md: the v-curves' knots merged).
 enum class NetworkSample { none, formula, exact };
 

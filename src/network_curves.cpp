@@ -438,6 +438,10 @@ struct Knot {
 // points of about 30 (a cubic's basis functions and their sum); for parallel_min_work.
 constexpr std::size_t span_work = 4 * 3 * 30;
 
+// Fitting every curve of a family on the union of their own knots costs up to this
+// many multiply-adds a round (about a millisecond here) where the family shares them.
+constexpr std::size_t merge_work = std::size_t{1} << 20;
+
 // Knots of different curves nearer than this are one: the curves' knots at their
 // crossings all pull back to the common parameter, up to rounding.
 constexpr double knot_room = 1e-9;
@@ -513,23 +517,32 @@ Checked check_fit(const FitJob& job, const BSplineCurve& fit, const std::vector<
 }
 
 // Where a span [a, b] of a curve's own knots is cut into k: near a + (b − a) r / k,
-// r = 1 … k − 1, at a knot of another curve of the family (`others`, increasing)
-// where one is within a quarter piece of there, so that the union of the family's
-// knots, the exact form's, grows only where no other curve has one.
+// r = 1 … k − 1, within a quarter piece of there, at the nearest knot of another
+// curve of the family (`others`, increasing) if there is one, else at the coarsest
+// dyadic fraction i / 2^l: the union of the family's knots, the exact form's, grows
+// only where no other curve has a knot, and there by points that the other curves'
+// cuts nearby take as well.
 void cut(double a, double b, int k, const std::vector<double>& others, std::vector<double>& into) {
-  const double piece = (b - a) / k;
+  const double piece = (b - a) / k, room = 0.25 * piece;
   double last = a;
   for (int r = 1; r < k; ++r) {
     const double want = a + piece * r;
-    double x = want, best = 0.25 * piece;
+    const auto inside = [&](double x) { return x > last && x < b && std::abs(x - want) <= room; };
+    double x = want, best = room;
     const auto it = std::lower_bound(others.begin(), others.end(), want);
-    for (auto c : {it, it == others.begin() ? it : std::prev(it)}) {
-      if (c == others.end() || !(*c > last && *c < b)) continue;
-      if (std::abs(*c - want) <= best) {
+    for (auto c : {it, it == others.begin() ? it : std::prev(it)})
+      if (c != others.end() && inside(*c) && std::abs(*c - want) <= best) {
         best = std::abs(*c - want);
         x = *c;
       }
-    }
+    if (x == want)
+      for (int l = 0; l < 60; ++l) {
+        const double step = std::ldexp(1.0, -l), d = std::round(want / step) * step;
+        if (inside(d)) {
+          x = d;
+          break;
+        }
+      }
     into.push_back(x);
     last = x;
   }
@@ -713,12 +726,17 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
   if (auto shared = fit_group(jobs, family, interior, nodes, closed, target, all, nullptr)) return std::move(*shared);
   // The shared knots would need more halvings than all curves' own knots make (curves
   // whose parameters are irregular, e.g. centripetal through unevenly spaced points,
-  // break where the average does not): every curve on its own knots, refined alone.
-  // The surface's formula does not need shared knots, and its exact form merges them.
+  // break where the average does not). Where fitting every curve on all the curves'
+  // knots is little work (under about a millisecond a round), they share those, which
+  // keeps the exact form smallest; otherwise every curve goes on its own knots,
+  // refined alone: the surface's formula does not need shared knots, and its exact
+  // form merges them.
   std::vector<Knot> every;
   for (std::size_t j = 0; j < m; ++j)
     for (double x : own[j]) every.push_back({x, 1, j});
   const std::vector<double> union_of_own = merged(std::move(every));
+  if (m * union_of_own.size() * span_work <= merge_work)
+    return std::move(*fit_group(jobs, family, union_of_own, nodes, closed, target, 0, nullptr));
   std::vector<std::optional<Refit>> fitted(m);
   std::vector<std::exception_ptr> thrown(m);
   const auto count = static_cast<long long>(m);

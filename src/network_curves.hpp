@@ -75,11 +75,12 @@ struct FitJob {
 /// densest curve, not the sum of all), spans where some curve is too far halved. When
 /// the halvings that would take outnumber all curves' own knots together (curves whose
 /// parameters are irregular, e.g. centripetal through uneven stations, break where the
-/// average does not), each curve is fitted on its own knots pulled back instead, and
-/// its spans still too far are cut where the error says, at knots of the other curves
-/// where there are some (the exact form merges the family's knots). Rational curves
-/// are fitted in homogeneous coordinates. `closed`: every C_j periodic, every D_j
-/// periodic over [0, 1).
+/// average does not), the family shares all its curves' own knots, halved where still
+/// too far, if fitting on them is little work; otherwise each curve is fitted on its
+/// own knots pulled back, and its spans still too far are cut where the error says, at
+/// knots of the other curves or else at coarse dyadic fractions (the exact form merges
+/// the family's knots). Rational curves are fitted in homogeneous coordinates.
+/// `closed`: every C_j periodic, every D_j periodic over [0, 1).
 struct Refit {
   BSplineCurve curve;
   double error = 0;     ///< the largest |D(u) − C(map(u))| measured
