@@ -492,7 +492,7 @@ Checked check_fit(const FitJob& job, const BSplineCurve& fit, const std::vector<
   Checked out;
   struct At {
     double u, y;
-    Vec3 c;  // C(y), y = map(u)
+    Vec3 d, c;  // D(u) and C(y), y = map(u)
   };
   std::vector<At> at;
   at.reserve(4 * sp.size());
@@ -500,11 +500,11 @@ Checked check_fit(const FitJob& job, const BSplineCurve& fit, const std::vector<
     for (int q = 0; q <= (i + 2 == sp.size() ? 4 : 3); ++q) {
       const double u = sp[i] + (sp[i + 1] - sp[i]) * q / 4;
       const double x = job.map(u), y = closed ? x : std::clamp(x, 0.0, 1.0);
-      const Vec3 c = job.c->point(y);
-      const double here = distance(fit.point(u), c);
+      const Vec3 d = fit.point(u), c = job.c->point(y);
+      const double here = distance(d, c);
       err[i] = std::max(err[i], here);
       if (q == 0 && i > 0) err[i - 1] = std::max(err[i - 1], here);
-      at.push_back({u, y, c});
+      at.push_back({u, y, d, c});
     }
     out.error = std::max(out.error, err[i]);
     if (err[i] > give_up) stop = true;
@@ -512,7 +512,7 @@ Checked check_fit(const FitJob& job, const BSplineCurve& fit, const std::vector<
   }
   if (out.error > target) return out;
   for (const At& a : at)
-    out.distance = std::max(out.distance, distance(fit.point(a.u) + job.G->point(a.u), job.given ? job.given->point(a.y) : a.c));
+    out.distance = std::max(out.distance, distance(a.d + job.G->point(a.u), job.given ? job.given->point(a.y) : a.c));
   return out;
 }
 
@@ -552,11 +552,12 @@ void cut(double a, double b, int k, const std::vector<double>& others, std::vect
 // `interior`, until every one is within `target` of its curve. Shared knots
 // (`others` null): every span where some curve is farther halved; empty when `all`
 // (the count of the curves' own knots together) is not 0 and the halvings the error
-// calls for would make more knots than that, so the caller gives each curve its own
-// knots instead. One curve on its own knots (`others`: the family's knots): a span
-// farther than `target` by a factor f is cut into about f^(1/4) pieces (the distance
-// falls with the fourth power of the span, the curve C2 between its own knots), at
-// knots of `others` where there are some.
+// calls for would make more knots than that, so the caller takes the curves' own
+// knots instead. One curve on its own knots (`others`: the family's own knots, all
+// curves'): a span farther than half the target by a factor f is cut into about
+// f^(1/4) pieces (the distance falls with the fourth power of the span, the curve C2
+// between its own knots; aiming at half, the cut spans' neighbours, which the new fit
+// moves a little, rarely need another round), where `cut` puts them.
 std::optional<std::vector<Refit>> fit_group(const std::vector<FitJob>& jobs, const std::vector<std::size_t>& members,
                                             std::vector<double> interior, const std::vector<double>& nodes,
                                             bool closed, double target, std::size_t all,
