@@ -1121,9 +1121,10 @@ TEST(NetworkDrawn, RefitGivesEachCurveKnotsOfItsOwn) {
 // v-curves (which take knots of their own): the surface stays within the default
 // tolerance of every curve, its exact form is its formula, and with 1 and 2 threads it
 // is the same, bit for bit. (With stations nearer than a quarter spacing, a v-curve
-// can crawl into its end so slowly, 0.01 of its mean speed, that the crossing search
-// stops 2e-8 short there, the crossing snaps to the end 1.4e-7 away on the curve, and
-// the surface departs from the u-curve by 1.1 × 1e-7 of the diagonal: the reader warns.)
+// can crawl into its end at a few thousandths of its mean speed; the crossing search
+// there ends 2e-5 short of the end in parameter with a gap of 2.4e-8, the crossing is
+// snapped to the end, 1.4e-7 away, and the surface departs from the u-curve by 1.1 ×
+// 1e-7 of the diagonal, so the reader warns: seed 380, trial 1, without the spacing.)
 TEST(NetworkDrawn, CurvesThroughRandomStationsAreFittedOnKnotsOfTheirOwn) {
   auto g = test::rng(380);
   for (int trial = 0; trial < 3; ++trial) {
