@@ -324,7 +324,8 @@ const interpatch::BlendedSurface& terrain_network(std::size_t n, interpatch::Net
 //   drawn:    500 uneven stations (the ends, the 15 nodes, random ones), chord
 //             parameters along u, centripetal along v: each curve crosses the others at
 //             parameters of its own, so the network finds the crossings of every pair
-//             and re-expresses the curves on shared knots.
+//             and re-expresses the curves: the u-curves on shared knots, the v-curves
+//             each on knots of its own.
 //   shuffled: drawn, the families in random order and every other curve reversed.
 // No crossing parameters given (as in the specs): the network finds them in every case.
 enum class NetworkKind { common, drawn, shuffled };
@@ -387,7 +388,8 @@ const interpatch::CurveNetwork& bench_network(NetworkKind kind) {
 // surface's formula (BlendedSurface::evaluate_into), or by its exact form
 // (to_bspline, then BSplineSurface::evaluate_into). `interpatch eval` takes whichever
 // costs fewer operations (io::evaluator): the exact form for the common network
-// (502 × 499 control points), the formula for the drawn one (511 × 7455).
+// (502 × 499 control points), the formula for the drawn one (511 × 8004 for the
+// spec of docs/BENCHMARKS.md: the v-curves' knots merged).
 enum class NetworkSample { none, formula, exact };
 
 // network_surface (what `interpatch eval` and `info` call: the surface and its report,

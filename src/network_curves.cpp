@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <exception>
+#include <numeric>
 #include <optional>
 
 #include "detail/banded.hpp"
@@ -302,20 +305,31 @@ double inverse(const Reparametrization& map, double y) {
   std::size_t i = 0;
   while (i + 2 < n && (up ? y > map.to[i + 1] : y < map.to[i + 1])) ++i;
   const double h = map.at[i + 1] - map.at[i];
-  const auto f = [&](double tau) { return hermite(map.to[i], map.to[i + 1], map.slope[i], map.slope[i + 1], h, tau) - y; };
-  // Bisection on the monotone piece, then to the last bit.
+  const double y0 = map.to[i], y1 = map.to[i + 1], m0 = map.slope[i] * h, m1 = map.slope[i + 1] * h;
+  const auto f = [&](double tau) { return hermite(y0, y1, map.slope[i], map.slope[i + 1], h, tau) - y; };
+  // The slope in τ: 6τ(1 − τ)(y1 − y0) + m0(1 − 4τ + 3τ²) + m1(3τ² − 2τ), of one sign on
+  // the monotone piece.
+  const auto df = [&](double tau) {
+    return 6 * tau * (1 - tau) * (y1 - y0) + m0 * (1 - 4 * tau + 3 * tau * tau) + m1 * (3 * tau * tau - 2 * tau);
+  };
+  // Newton inside a bracket that shrinks every step, bisecting where Newton would
+  // leave it, to the last bit.
   double lo = 0, hi = 1;
   const double flo = f(0);
   if (flo == 0) return map.at[i];
-  for (int it = 0; it < 64 && hi - lo > 0; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    if (mid <= lo || mid >= hi) break;
-    const double fm = f(mid);
-    if (fm == 0) return map.at[i] + mid * h;
-    if ((fm > 0) == (flo > 0)) lo = mid;
-    else hi = mid;
+  double tau = std::clamp((y - y0) / (y1 - y0), 0.0, 1.0);
+  for (int it = 0; it < 100 && hi - lo > 0; ++it) {
+    const double fm = f(tau);
+    if (fm == 0) break;
+    if ((fm > 0) == (flo > 0)) lo = tau;
+    else hi = tau;
+    const double d = df(tau);
+    double next = d != 0 ? tau - fm / d : lo;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    if (next <= lo || next >= hi || next == tau) break;
+    tau = next;
   }
-  return std::clamp(map.at[i] + 0.5 * (lo + hi) * h, map.at[i], map.at[i + 1]);
+  return std::clamp(map.at[i] + tau * h, map.at[i], map.at[i + 1]);
 }
 
 // ------------------------------------------------------------------- refit
@@ -420,6 +434,14 @@ struct Knot {
   std::size_t curve;
 };
 
+// The work of checking a fit, per span, in multiply-adds: 4 points, each 3 curve
+// points of about 30 (a cubic's basis functions and their sum); for parallel_min_work.
+constexpr std::size_t span_work = 4 * 3 * 30;
+
+// Fitting every curve of a family on the union of their own knots costs up to this
+// many multiply-adds a round (about a millisecond here) where the family shares them.
+constexpr std::size_t merge_work = std::size_t{1} << 20;
+
 // Knots of different curves nearer than this are one: the curves' knots at their
 // crossings all pull back to the common parameter, up to rounding.
 constexpr double knot_room = 1e-9;
@@ -446,26 +468,203 @@ std::vector<double> merged(std::vector<Knot> k) {
   return out;
 }
 
+// The breaks of interior knots over [0, 1]: 0, the distinct knots, 1.
+std::vector<double> spans_of(const std::vector<double>& interior) {
+  std::vector<double> b{0.0};
+  for (double x : interior)
+    if (x > b.back()) b.push_back(x);
+  if (b.back() < 1.0) b.push_back(1.0);
+  return b;
+}
+
+// One fitted curve checked against its job at 4 points of every span of `sp` (the
+// next span's first is this one's end): err[i] the largest distance at the 5 points
+// of span i, its ends included (too far at a knot, the spans on both sides are to
+// blame). Stops early, with `stop` set, once a distance is beyond `give_up`, or when
+// `stop` is set elsewhere. The distance from the curve as given (with the correction
+// G) is measured only when no span is farther than `target`: a fit that is, is
+// refined and measured again.
+struct Checked {
+  double error = 0, distance = 0;
+};
+Checked check_fit(const FitJob& job, const BSplineCurve& fit, const std::vector<double>& sp, bool closed,
+                  double target, double give_up, std::vector<double>& err, std::atomic<bool>& stop) {
+  Checked out;
+  struct At {
+    double u, y;
+    Vec3 d, c;  // D(u) and C(y), y = map(u)
+  };
+  std::vector<At> at;
+  at.reserve(4 * sp.size());
+  for (std::size_t i = 0; i + 1 < sp.size(); ++i) {
+    for (int q = 0; q <= (i + 2 == sp.size() ? 4 : 3); ++q) {
+      const double u = sp[i] + (sp[i + 1] - sp[i]) * q / 4;
+      const double x = job.map(u), y = closed ? x : std::clamp(x, 0.0, 1.0);
+      const Vec3 d = fit.point(u), c = job.c->point(y);
+      const double here = distance(d, c);
+      err[i] = std::max(err[i], here);
+      if (q == 0 && i > 0) err[i - 1] = std::max(err[i - 1], here);
+      at.push_back({u, y, d, c});
+    }
+    out.error = std::max(out.error, err[i]);
+    if (err[i] > give_up) stop = true;
+    if (stop) return out;
+  }
+  if (out.error > target) return out;
+  for (const At& a : at)
+    out.distance = std::max(out.distance, distance(a.d + job.G->point(a.u), job.given ? job.given->point(a.y) : a.c));
+  return out;
+}
+
+// Where a span [a, b] of a curve's own knots is cut into k: near a + (b − a) r / k,
+// r = 1 … k − 1, within a quarter piece of there, at the nearest knot of another
+// curve of the family (`others`, increasing) if there is one, else at the coarsest
+// dyadic fraction i / 2^l: the union of the family's knots, the exact form's, grows
+// only where no other curve has a knot, and there by points that the other curves'
+// cuts nearby take as well.
+void cut(double a, double b, int k, const std::vector<double>& others, std::vector<double>& into) {
+  const double piece = (b - a) / k, room = 0.25 * piece;
+  double last = a;
+  for (int r = 1; r < k; ++r) {
+    const double want = a + piece * r;
+    const auto inside = [&](double x) { return x > last && x < b && std::abs(x - want) <= room; };
+    double x = want, best = room;
+    const auto it = std::lower_bound(others.begin(), others.end(), want);
+    for (auto c : {it, it == others.begin() ? it : std::prev(it)})
+      if (c != others.end() && inside(*c) && std::abs(*c - want) <= best) {
+        best = std::abs(*c - want);
+        x = *c;
+      }
+    if (x == want)
+      for (int l = 0; l < 60; ++l) {
+        const double step = std::ldexp(1.0, -l), d = std::round(want / step) * step;
+        if (inside(d)) {
+          x = d;
+          break;
+        }
+      }
+    into.push_back(x);
+    last = x;
+  }
+}
+
+// Curves of one family (`members` of `jobs`) fitted on one knot vector, starting from
+// `interior`, until every one is within `target` of its curve. Shared knots
+// (`others` null): every span where some curve is farther halved; empty when `all`
+// (the count of the curves' own knots together) is not 0 and the halvings the error
+// calls for would make more knots than that, so the caller takes the curves' own
+// knots instead. One curve on its own knots (`others`: the family's own knots, all
+// curves'): a span farther than half the target by a factor f is cut into about
+// f^(1/4) pieces (the distance falls with the fourth power of the span, the curve C2
+// between its own knots; aiming at half, the cut spans' neighbours, which the new fit
+// moves a little, rarely need another round), where `cut` puts them.
+std::optional<std::vector<Refit>> fit_group(const std::vector<FitJob>& jobs, const std::vector<std::size_t>& members,
+                                            std::vector<double> interior, const std::vector<double>& nodes,
+                                            bool closed, double target, std::size_t all,
+                                            const std::vector<double>* others) {
+  const std::size_t m = members.size();
+  const auto insert_mid = [&](double a, double b) {
+    const double x = 0.5 * (a + b);
+    interior.insert(std::upper_bound(interior.begin(), interior.end(), x), x);
+  };
+  // Two nodes that want one collocation site: a knot between them, in the widest gap
+  // left there (the midpoint of the two may already be a knot of full multiplicity).
+  const auto split_between = [&](double a, double b) {
+    if (a > b) std::swap(a, b);
+    std::vector<double> at{a};
+    for (double x : interior)
+      if (x > a && x < b && x > at.back()) at.push_back(x);
+    at.push_back(b);
+    std::size_t w = 0;
+    for (std::size_t i = 0; i + 1 < at.size(); ++i)
+      if (at[i + 1] - at[i] > at[w + 1] - at[w]) w = i;
+    insert_mid(at[w], at[w + 1]);
+  };
+  const auto split_all = [&] {
+    const auto sp = spans_of(interior);
+    for (std::size_t i = 0; i + 1 < sp.size(); ++i) insert_mid(sp[i], sp[i + 1]);
+  };
+  int p_max = 1;
+  for (std::size_t j : members) p_max = std::max(p_max, jobs[j].c->degree());
+  while (closed && spans_of(interior).size() < static_cast<std::size_t>(p_max) + 2) split_all();
+  const std::size_t initial = std::max(interior.size(), all);
+  std::vector<Refit> out;
+  for (int round = 0; round < 60; ++round) {
+    // Halving a span divides the distance by 8 or more (cubic pieces against a
+    // function C2 between the curve's own knots): the most halvings worth making on
+    // shared knots are those that keep them fewer than the curves' own together, and
+    // a distance that would need more stops the check at once.
+    double give_up = std::numeric_limits<double>::infinity();
+    if (all > 0) {
+      int h = 0;
+      while (h < 60 && std::ldexp(static_cast<double>(interior.size()), h + 1) <= static_cast<double>(all)) ++h;
+      give_up = target * std::pow(8.0, h);
+    }
+    // Every curve fitted and checked, in parallel: fit_one does not throw, and the
+    // check only reads.
+    const auto sp = spans_of(interior);
+    std::vector<OneFit> fits(m);
+    std::vector<std::vector<double>> err(m, std::vector<double>(sp.size(), 0.0));
+    std::vector<Checked> checked(m);
+    std::atomic<bool> stop{false};
+    const auto count = static_cast<long long>(m);
+#pragma omp parallel for schedule(dynamic, 1) if (m * sp.size() * span_work >= parallel_min_work)
+    for (long long jj = 0; jj < count; ++jj) {
+      const auto j = static_cast<std::size_t>(jj);
+      const FitJob& job = jobs[members[j]];
+      if (stop) continue;
+      fits[j] = fit_one(*job.c, job.map, nodes, closed, interior);
+      if (fits[j].curve) checked[j] = check_fit(job, *fits[j].curve, sp, closed, target, give_up, err[j], stop);
+    }
+    // Whether some curve was too far to go on is the same on any number of threads:
+    // the curve that stopped the others stops the check on one thread as well.
+    if (stop) return std::nullopt;
+    if (interior.size() > 64 * initial + 4096)
+      fail(errc::internal, "re-expressing ", m, " network curves found no knots that fit them (", interior.size(), " tried)");
+    bool again = false;
+    for (std::size_t j = 0; j < m && !again; ++j) {
+      if (fits[j].failed) split_all();
+      else if (!fits[j].curve) split_between(fits[j].clash.first, fits[j].clash.second);
+      again = !fits[j].curve;
+    }
+    if (again) continue;
+    std::vector<double> worst(sp.size(), 0.0);  // by span, over the curves
+    out.clear();
+    for (std::size_t j = 0; j < m; ++j) {
+      for (std::size_t i = 0; i < sp.size(); ++i) worst[i] = std::max(worst[i], err[j][i]);
+      out.push_back({std::move(*fits[j].curve), checked[j].error, checked[j].distance});
+    }
+    if (std::none_of(worst.begin(), worst.end(), [&](double e) { return e > target; })) return out;
+    std::vector<double> cuts;
+    for (std::size_t i = 0; i + 1 < sp.size(); ++i) {
+      if (!(worst[i] > (others ? 0.5 * target : target))) continue;
+      if (!others) {
+        cuts.push_back(0.5 * (sp[i] + sp[i + 1]));
+        continue;
+      }
+      const double pieces = std::ceil(std::pow(2 * worst[i] / target, 0.25));
+      cut(sp[i], sp[i + 1], static_cast<int>(std::clamp(pieces, 2.0, 8.0)), *others, cuts);
+    }
+    interior.insert(interior.end(), cuts.begin(), cuts.end());
+    std::sort(interior.begin(), interior.end());
+  }
+  fail(errc::internal, "re-expressing ", m, " network curves found no knots that fit them after 60 rounds");
+}
+
 }  // namespace
 
 std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<double>& nodes, bool closed, double target) {
   const std::size_t m = jobs.size();
-  std::vector<const BSplineCurve*> curves;
-  std::vector<Reparametrization> maps;
-  for (const auto& j : jobs) {
-    curves.push_back(j.c);
-    maps.push_back(j.map);
-  }
   // The knots of each curve, pulled back through its map: its corners (multiple knots)
-  // all kept; its simple knots averaged over the family quantile by quantile.
+  // and its simple knots.
   std::vector<Knot> corners;
   std::vector<std::vector<double>> simple(m);
   std::size_t most = 0;
   for (std::size_t j = 0; j < m; ++j) {
-    Reparametrization unwrapped = maps[j];
+    Reparametrization unwrapped = jobs[j].map;
     unwrapped.period = 0;
     const double lo = std::min(unwrapped(0.0), unwrapped(1.0)), hi = std::max(unwrapped(0.0), unwrapped(1.0));
-    for (const auto& [kappa, mult] : curves[j]->knots().interior_breaks())
+    for (const auto& [kappa, mult] : jobs[j].c->knots().interior_breaks())
       for (int shift = closed ? -1 : 0; shift <= (closed ? 2 : 0); ++shift) {
         const double y = kappa + shift;
         if (!(closed ? y >= lo && y < hi : y > lo && y < hi)) continue;
@@ -483,6 +682,9 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
     std::sort(simple[j].begin(), simple[j].end());
     most = std::max(most, simple[j].size());
   }
+  // First the family on shared knots (so the exact form of the surface has about as
+  // many control points as the densest curve, not the sum of all): every curve's
+  // corners, and its simple knots averaged over the family quantile by quantile.
   std::vector<double> interior = merged(corners);
   const double room = 0.25 / static_cast<double>(most + 1);  // a simple knot this near a corner is left out
   for (std::size_t k = 1; k <= most; ++k) {
@@ -507,111 +709,52 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
   }
   if (closed && std::find(interior.begin(), interior.end(), 0.0) == interior.end()) interior.push_back(0.0);
   std::sort(interior.begin(), interior.end());
-  const auto insert_mid = [&](double a, double b) {
-    const double x = 0.5 * (a + b);
-    interior.insert(std::upper_bound(interior.begin(), interior.end(), x), x);
-  };
-  // Two nodes that want one collocation site: a knot between them, in the widest gap
-  // left there (the midpoint of the two may already be a knot of full multiplicity).
-  const auto split_between = [&](double a, double b) {
-    if (a > b) std::swap(a, b);
-    std::vector<double> at{a};
-    for (double x : interior)
-      if (x > a && x < b && x > at.back()) at.push_back(x);
-    at.push_back(b);
-    std::size_t w = 0;
-    for (std::size_t i = 0; i + 1 < at.size(); ++i)
-      if (at[i + 1] - at[i] > at[w + 1] - at[w]) w = i;
-    insert_mid(at[w], at[w + 1]);
-  };
-  const auto spans = [&] {
-    std::vector<double> b{0.0};
-    for (double x : interior)
-      if (x > b.back()) b.push_back(x);
-    if (b.back() < 1.0) b.push_back(1.0);
-    return b;
-  };
-  const auto split_all = [&] {
-    const auto sp = spans();
-    for (std::size_t i = 0; i + 1 < sp.size(); ++i) insert_mid(sp[i], sp[i + 1]);
-  };
-  int p_max = 1;
-  for (const auto* c : curves) p_max = std::max(p_max, c->degree());
-  while (closed && spans().size() < static_cast<std::size_t>(p_max) + 2) split_all();
-  // Every curve's own knots, pulled back: where each curve has its breaks, so every fit
-  // converges at once, but as many knots as all curves together. Taken when refining
-  // the averaged knots outgrows it (curves whose parameters are irregular, e.g.
-  // centripetal through unevenly spaced points, break where the average does not).
-  std::vector<Knot> own_knots = corners;
-  for (std::size_t j = 0; j < m; ++j)
-    for (double x : simple[j]) own_knots.push_back({x, 1, j});
-  if (closed) own_knots.push_back({0.0, 1, m});
-  const std::vector<double> all = merged(std::move(own_knots));
-  bool own = false;
-  const std::size_t initial = all.size();
-  std::vector<Refit> out;
-  for (int round = 0; round < 60; ++round) {
-    // Every curve fitted and checked at 4 points of every span (the next span's first
-    // is this one's end), in parallel: fit_one does not throw, and the check only reads.
-    const auto sp = spans();
-    std::vector<OneFit> fits(m);
-    std::vector<std::vector<char>> far(m, std::vector<char>(sp.size(), 0));
-    std::vector<double> worst_of(m, 0.0), apart(m, 0.0);
-    const auto count = static_cast<long long>(m);
-#pragma omp parallel for schedule(dynamic, 1) if (m * sp.size() * 16 >= parallel_min_work)
-    for (long long jj = 0; jj < count; ++jj) {
-      const auto j = static_cast<std::size_t>(jj);
-      fits[j] = fit_one(*curves[j], maps[j], nodes, closed, interior);
-      if (!fits[j].curve) continue;
-      for (std::size_t i = 0; i + 1 < sp.size(); ++i) {
-        double e = 0;
-        for (int q = 0; q <= (i + 2 == sp.size() ? 4 : 3); ++q) {
-          const double u = sp[i] + (sp[i + 1] - sp[i]) * q / 4;
-          const double x = maps[j](u), y = closed ? x : std::clamp(x, 0.0, 1.0);
-          const Vec3 d = fits[j].curve->point(u), c = curves[j]->point(y);
-          const double here = distance(d, c);
-          e = std::max(e, here);
-          // Too far at a knot: the span before it is as much to blame as this one.
-          if (q == 0 && i > 0 && here > target) far[j][i - 1] = 1;
-          apart[j] = std::max(apart[j], distance(d + jobs[j].G->point(u), jobs[j].given ? jobs[j].given->point(y) : c));
-        }
-        worst_of[j] = std::max(worst_of[j], e);
-        far[j][i] = static_cast<char>(far[j][i] | (e > target));
-      }
-    }
-    bool again = false;
-    if (interior.size() > 64 * initial + 4096)
-      fail(errc::internal, "re-expressing ", m, " network curves found no knots that fit them (", interior.size(), " tried)");
-    for (std::size_t j = 0; j < m && !again; ++j) {
-      if (fits[j].failed) split_all();
-      else if (!fits[j].curve) split_between(fits[j].clash.first, fits[j].clash.second);
-      again = !fits[j].curve;
-    }
-    if (again) continue;
-    std::vector<char> split(sp.size(), 0);
-    out.clear();
-    for (std::size_t j = 0; j < m; ++j) {
-      for (std::size_t i = 0; i < sp.size(); ++i) split[i] = static_cast<char>(split[i] | far[j][i]);
-      out.push_back({std::move(*fits[j].curve), worst_of[j], apart[j]});
-    }
-    if (std::none_of(split.begin(), split.end(), [](char x) { return x != 0; }) || interior.size() > 64 * initial + 4096)
-      break;
-    // Halving a span divides the distance by 8 or more (cubic pieces against a
-    // function C2 between the curve's own knots): when the halvings still needed
-    // would make more knots than the curves' own together, take those.
-    double worst = 0;
-    for (const auto& o : out) worst = std::max(worst, o.error);
-    const double halvings = std::ceil(std::log(worst / target) / std::log(8.0));
-    if (!own && std::ldexp(static_cast<double>(interior.size()), static_cast<int>(std::min(halvings, 60.0))) > static_cast<double>(all.size())) {
-      interior = all;
-      own = true;
-      continue;
-    }
-    for (std::size_t i = 0; i + 1 < sp.size(); ++i)
-      if (split[i]) insert_mid(sp[i], sp[i + 1]);
+  // Each curve's own knots (with the seam of a closed one): where it has its breaks,
+  // so its fit converges at once.
+  std::vector<std::vector<double>> own(m);
+  std::size_t all = 0;
+  for (std::size_t j = 0; j < m; ++j) {
+    std::vector<Knot> k;
+    for (const Knot& c : corners)
+      if (c.curve == j) k.push_back(c);
+    for (double x : simple[j]) k.push_back({x, 1, j});
+    if (closed) k.push_back({0.0, 1, m});
+    own[j] = merged(std::move(k));
+    all += own[j].size();
   }
-  if (out.size() != m)
-    fail(errc::internal, "re-expressing ", m, " network curves found no knots that fit them after 60 rounds");
+  std::vector<std::size_t> family(m);
+  std::iota(family.begin(), family.end(), 0);
+  if (auto shared = fit_group(jobs, family, interior, nodes, closed, target, all, nullptr)) return std::move(*shared);
+  // The shared knots would need more halvings than all curves' own knots make (curves
+  // whose parameters are irregular, e.g. centripetal through unevenly spaced points,
+  // break where the average does not). Where fitting every curve on all the curves'
+  // knots is little work (under about a millisecond a round), they share those, which
+  // keeps the exact form smallest; otherwise every curve goes on its own knots,
+  // refined alone: the surface's formula does not need shared knots, and its exact
+  // form merges them.
+  std::vector<Knot> every;
+  for (std::size_t j = 0; j < m; ++j)
+    for (double x : own[j]) every.push_back({x, 1, j});
+  const std::vector<double> union_of_own = merged(std::move(every));
+  if (m * union_of_own.size() * span_work <= merge_work)
+    return std::move(*fit_group(jobs, family, union_of_own, nodes, closed, target, 0, nullptr));
+  std::vector<std::optional<Refit>> fitted(m);
+  std::vector<std::exception_ptr> thrown(m);
+  const auto count = static_cast<long long>(m);
+#pragma omp parallel for schedule(dynamic, 1) if (all * span_work >= parallel_min_work)
+  for (long long jj = 0; jj < count; ++jj) {
+    const auto j = static_cast<std::size_t>(jj);
+    try {
+      fitted[j] = std::move(fit_group(jobs, {j}, own[j], nodes, closed, target, 0, &union_of_own)->front());
+    } catch (...) {
+      thrown[j] = std::current_exception();
+    }
+  }
+  for (const auto& e : thrown)
+    if (e) std::rethrow_exception(e);
+  std::vector<Refit> out;
+  out.reserve(m);
+  for (auto& f : fitted) out.push_back(std::move(*f));
   return out;
 }
 

@@ -66,16 +66,21 @@ struct FitJob {
   Reparametrization map;
 };
 
-/// Curves of one family re-expressed over the surface's parameter on shared knots:
-/// D_j(u) ≈ C_j(map_j(u)), of C_j's degree, through C_j(map_j(nodes[k])) at nodes[k]
-/// exactly (to rounding). The shared interior knots are every curve's corners
-/// (multiple knots) pulled back through its map, and its simple knots pulled back and
-/// averaged over the family quantile by quantile (so the exact form of the surface
-/// has about as many control points as the densest curve, not the sum of all), or,
-/// when that would take more halvings than it is worth, all curves' own knots; spans
-/// where some curve is farther than `target` from its input, measured at 4 points of
-/// every span, are split until none is. Rational curves are fitted in homogeneous
-/// coordinates. `closed`: every C_j periodic, every D_j periodic over [0, 1).
+/// Curves of one family re-expressed over the surface's parameter: D_j(u) ≈
+/// C_j(map_j(u)), of C_j's degree, through C_j(map_j(nodes[k])) at nodes[k] exactly
+/// (to rounding), within `target` of C_j(map_j(u)) measured at 4 points of every span.
+/// First on shared knots: every curve's corners (multiple knots) pulled back through
+/// its map, and its simple knots pulled back and averaged over the family quantile by
+/// quantile (so the exact form of the surface has about as many control points as the
+/// densest curve, not the sum of all), spans where some curve is too far halved. When
+/// the halvings that would take outnumber all curves' own knots together (curves whose
+/// parameters are irregular, e.g. centripetal through uneven stations, break where the
+/// average does not), the family shares all its curves' own knots, halved where still
+/// too far, if fitting on them is little work; otherwise each curve is fitted on its
+/// own knots pulled back, and its spans still too far are cut where the error says, at
+/// knots of the other curves or else at coarse dyadic fractions (the exact form merges
+/// the family's knots). Rational curves are fitted in homogeneous coordinates.
+/// `closed`: every C_j periodic, every D_j periodic over [0, 1).
 struct Refit {
   BSplineCurve curve;
   double error = 0;     ///< the largest |D(u) − C(map(u))| measured

@@ -17,7 +17,8 @@ f(u_i, t) at u_i = i / (V_CURVES - 1), at stations t from 0 to 1.
   u-curve, the v_j along a v-curve) and random ones, POINTS in all; u-curves with
   "param": "chord", v-curves with "centripetal". The curves pass through the nodes,
   but at parameters that differ from curve to curve, so the network must find its
-  crossings and re-express the curves on shared knots.
+  crossings and re-express the curves (the u-curves on shared knots, the v-curves
+  each on knots of its own).
 - common: POINTS equally spaced stations and "param": "uniform". The nodes must be
   stations, (POINTS - 1) a multiple of U_CURVES - 1 and of V_CURVES - 1 (15 x 15
   curves: POINTS = 35 * 14 + 1 = 491, say); the curves then cross at the common
