@@ -38,6 +38,13 @@ std::string mpi_message(int code) {
   return std::string(text, static_cast<std::size_t>(len));
 }
 
+// n bytes in pieces an int counts (1 GiB): io(done, k) for each, in order.
+template <class F>
+void in_pieces(std::size_t n, const F& io) {
+  constexpr std::size_t piece = std::size_t{1} << 30;
+  for (std::size_t done = 0; done < n; done += std::min(piece, n - done)) io(done, std::min(piece, n - done));
+}
+
 MPI_Datatype point_type() {
   static MPI_Datatype t = [] {
     MPI_Datatype d;
@@ -170,9 +177,7 @@ std::pair<std::size_t, std::size_t> chunk_block(std::size_t rows, int r, int siz
 }
 
 std::pair<std::size_t, std::size_t> even_block(std::size_t n, int r, int size) {
-  const auto P = static_cast<std::size_t>(size), k = static_cast<std::size_t>(r);
-  const std::size_t a = n * k / P, b = n * (k + 1) / P;
-  return {a, b - a};
+  return detail::even_share(n, static_cast<std::size_t>(r), static_cast<std::size_t>(size));
 }
 
 // ---------------------------------------------------------------------------
@@ -201,20 +206,16 @@ InputFile::~InputFile() {
 }
 
 void InputFile::read(char* dst, std::size_t n, std::uint64_t offset) const {
-  auto f = static_cast<MPI_File>(file_);
-  // In pieces an int counts.
-  constexpr std::size_t piece = std::size_t{1} << 30;
-  for (std::size_t done = 0; done < n;) {
-    const std::size_t k = std::min(piece, n - done);
+  in_pieces(n, [&](std::size_t done, std::size_t k) {
     MPI_Status st;
-    const int rc = MPI_File_read_at(f, static_cast<MPI_Offset>(offset + done), dst + done, static_cast<int>(k), MPI_BYTE, &st);
+    const int rc =
+        MPI_File_read_at(static_cast<MPI_File>(file_), static_cast<MPI_Offset>(offset + done), dst + done, static_cast<int>(k), MPI_BYTE, &st);
     int got = 0;
     MPI_Get_count(&st, MPI_BYTE, &got);
     if (rc != MPI_SUCCESS || static_cast<std::size_t>(got) != k)
       fail(errc::file_unreadable, "'", path_.string(), "': cannot read ", k, " bytes at offset ", offset + done,
            rc != MPI_SUCCESS ? ": " + mpi_message(rc) : cat(": got ", got));
-    done += k;
-  }
+  });
 }
 
 // ---------------------------------------------------------------------------
@@ -250,21 +251,17 @@ OutputFile::OutputFile(const fs::path& path, const Team& team) : team_(team), pa
 }
 
 void OutputFile::write(const void* data, std::size_t n, std::uint64_t offset) const {
-  auto f = static_cast<MPI_File>(file_);
-  constexpr std::size_t piece = std::size_t{1} << 30;
   const char* bytes = static_cast<const char*>(data);
-  for (std::size_t done = 0; done < n;) {
-    const std::size_t k = std::min(piece, n - done);
+  in_pieces(n, [&](std::size_t done, std::size_t k) {
     MPI_Status st;
-    const int rc =
-        MPI_File_write_at(f, static_cast<MPI_Offset>(offset + done), bytes + done, static_cast<int>(k), MPI_BYTE, &st);
+    const int rc = MPI_File_write_at(static_cast<MPI_File>(file_), static_cast<MPI_Offset>(offset + done), bytes + done,
+                                     static_cast<int>(k), MPI_BYTE, &st);
     int put = 0;
     MPI_Get_count(&st, MPI_BYTE, &put);
     if (rc != MPI_SUCCESS || static_cast<std::size_t>(put) != k)
       fail(errc::file_unwritable, "'", path_.string(), "': cannot write ", k, " bytes at offset ", offset + done,
            rc != MPI_SUCCESS ? ": " + mpi_message(rc) : cat(": wrote ", put));
-    done += k;
-  }
+  });
 }
 
 void OutputFile::close() noexcept {

@@ -54,7 +54,9 @@ class Team final : public detail::RowTeam {
   /// Points in blocks: send[r] goes to process r, recv[r] comes from it (points,
   /// counted per process; the buffers are laid out in process order).
   void exchange(const Vec3* send, std::span<const std::size_t> send_counts, Vec3* recv,
-                std::span<const std::size_t> recv_counts) const;
+                std::span<const std::size_t> recv_counts) const override;
+  [[nodiscard]] std::size_t processes() const override { return static_cast<std::size_t>(size_); }
+  [[nodiscard]] std::size_t process() const override { return static_cast<std::size_t>(rank_); }
 
  private:
   Classify classify_;
