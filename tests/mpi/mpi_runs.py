@@ -74,14 +74,50 @@ def cases(rng):
         {"periodic": [True, False, False], "degree": [3, 2, 2], "param": "centripetal"}, "9"
 
 
-def same_outputs(d, name, spec_file, eval_grid):
+def holes(g, rng):
+    """NaN (missing points) scattered, in a block and in a whole row: approximation's holes."""
+    g = g.copy()
+    n0, n1 = g.shape[:2]
+    g[n0 // 3:n0 // 3 + 6, n1 // 4:n1 // 4 + 5] = np.nan
+    g[n0 - 2, :, 0] = np.nan
+    for i, j in zip(rng.integers(0, n0, 12), rng.integers(0, n1, 12)):
+        g[i, j, rng.integers(0, 3)] = np.nan
+    return g
+
+
+def approximate_cases(rng):
+    """(name, points, options, eval grid, process counts): the split approximation's
+    ways, the separable fit and the sparse system with and without holes; the slower
+    cases on fewer process counts."""
+    yield "approximate 53x37 control points (separable)", grid((53, 37), rng), {"control_points": [20, 15]}, "61", PROCESSES
+    yield "approximate 70x29 holes, control points", holes(grid((70, 29), rng), rng), {"control_points": [24, 12]}, "40x23", \
+        PROCESSES
+    yield "approximate holes, smoothing, centripetal, float32 big-endian", holes(grid((45, 30), rng), rng).astype(">f4"), \
+        {"smoothing": 1e-3, "param": "centripetal", "degree": [3, 2]}, "35", [1, 3]
+    g = grid((40, 20), rng)
+    g[:, 5:9] = np.nan  # control points with no data under them: the fill term settles them
+    yield "approximate columns of holes, as many control points as data along v", g, {"control_points": [5, 20]}, "11", [3]
+    yield "approximate smoothing auto, uniform", grid((40, 25), rng), {"smoothing": "auto", "param": "uniform"}, "30", [2, 4]
+
+
+def split_ran(d, spec_file):
+    """Whether a run on 2 processes was split (rank 1 reports its stages) rather than run on rank 0 alone."""
+    env = dict(ENV, INTERPATCH_MPI_TIMINGS="1")
+    cmd = [MPIRUN, "--oversubscribe", "-q", "--mca", "btl", "self,vader", "-np", "2", "-x", "INTERPATCH_MPI_TIMINGS", EXE,
+           "build", spec_file, "-o", "split.npz"]
+    r = subprocess.run(cmd, cwd=d, env=env, capture_output=True, text=True, timeout=120)
+    os.path.exists(os.path.join(d, "split.npz")) and os.remove(os.path.join(d, "split.npz"))
+    return r.returncode == 0 and "rank 1 stages" in r.stderr
+
+
+def same_outputs(d, name, spec_file, eval_grid, processes=PROCESSES):
     for args in [["build", spec_file, "-o", "out.npz"], ["eval", spec_file, "--grid", eval_grid, "-o", "out.npy"]]:
         out = os.path.join(d, args[-1])
         one = run(args, cwd=d)
         check(one.returncode == 0, f"{name}: single process {args}: {one.stderr}")
         want = open(out, "rb").read()
         os.remove(out)
-        for p in PROCESSES:
+        for p in processes:
             r = run(args, p, cwd=d)
             check(r.returncode == 0, f"{name}: {p} processes {args}: status {r.returncode}: {r.stderr}")
             check(r.stderr == one.stderr, f"{name}: {p} processes {args}: stderr {r.stderr!r}, single {one.stderr!r}")
@@ -142,6 +178,24 @@ def main():
                 json.dump(dict({"type": spec_type, "points": {"npy": "points.npy"}}, **options), f)
             same_outputs(d, name, "spec.json", eval_grid)
             print("ok:", name, flush=True)
+    for name, points, options, eval_grid, processes in approximate_cases(rng):
+        with tempfile.TemporaryDirectory() as d:
+            np.save(os.path.join(d, "points.npy"), points)
+            with open(os.path.join(d, "spec.json"), "w") as f:
+                json.dump(dict({"type": "approximate", "points": {"npy": "points.npy"}}, **options), f)
+            check(split_ran(d, "spec.json"), f"{name}: not split between the processes")
+            same_outputs(d, name, "spec.json", eval_grid, processes)
+            print("ok:", name, flush=True)
+    with tempfile.TemporaryDirectory() as d:
+        g = np.full((40, 20, 3), np.nan)
+        np.save(os.path.join(d, "points.npy"), g)
+        with open(os.path.join(d, "spec.json"), "w") as f:
+            json.dump({"type": "approximate", "points": {"npy": "points.npy"}, "control_points": [5, 5]}, f)
+        same_failure(d, "approximate: every point missing", ["build", "spec.json", "-o", "good.npz"], 3)
+        g = grid((40, 20), rng)
+        g[38, 3, 2] = np.inf  # in the last process's rows
+        np.save(os.path.join(d, "points.npy"), g)
+        same_failure(d, "approximate: infinity in the last rows", ["eval", "spec.json", "--grid", "9", "-o", "good.npy"], 3)
     with tempfile.TemporaryDirectory() as d:
         g = grid((50, 20), rng)
         g[49, 7, 1] = np.nan  # in the last process's rows for every count of processes
