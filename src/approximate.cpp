@@ -1443,9 +1443,10 @@ const Vec3* as_points(const double* d) { return reinterpret_cast<const Vec3*>(d)
 Vec3* as_points(double* d) { return reinterpret_cast<Vec3*>(d); }
 
 // A rows × width array of points held in consecutive blocks of rows (`mine` here),
-// turned into columns: every row of this process's even share of the columns.
-std::vector<double> rows_to_columns(const std::vector<double>& rows, std::size_t mine, std::size_t width,
-                                    const detail::RowTeam& team) {
+// turned into columns: every row of this process's even share of the columns. A
+// missing point (a NaN coordinate) goes as zeros: its weight 0 times the point, as
+// the weighted data of right_hand_side.
+std::vector<double> rows_to_columns(const Vec3* rows, std::size_t mine, std::size_t width, const detail::RowTeam& team) {
   const std::size_t P = team.processes(), me = team.process();
   const std::vector<double> counts = team.gather(std::vector<double>{static_cast<double>(mine)});
   std::size_t total = 0;
@@ -1460,8 +1461,11 @@ std::vector<double> rows_to_columns(const std::vector<double>& rows, std::size_t
   std::size_t at = 0;
   for (std::size_t s = 0; s < P; ++s) {
     const std::pair<std::size_t, std::size_t> cols = detail::even_share(width, s, P);
-    for (std::size_t i = 0; i < mine; ++i)
-      std::copy_n(rows.data() + 3 * (i * width + cols.first), 3 * cols.second, send.data() + 3 * (at + i * cols.second));
+    for (std::size_t i = 0; i < mine; ++i) {
+      const Vec3* from = rows + i * width + cols.first;
+      Vec3* to = as_points(send.data()) + at + i * cols.second;
+      for (std::size_t k = 0; k < cols.second; ++k) to[k] = is_missing(from[k]) ? Vec3{} : from[k];
+    }
     sc[s] = mine * cols.second;
     rc[s] = static_cast<std::size_t>(counts[s]) * C;
     at += sc[s];
@@ -1600,17 +1604,7 @@ ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOption
   // Bᵀ (w Q): along u on columns of the data, along v on rows of the result.
   std::vector<double> rhs;
   {
-    std::vector<double> local;
-    team.run([&] {
-      require_memory(mine, sizeof(Vec3), "the weighted data points");
-      local.resize(3 * mine);
-    });
-    for (std::size_t i = 0; i < mine; ++i) {
-      const double w = weight(base + i);
-      for (std::size_t k = 0; k < 3; ++k) local[i * 3 + k] = w > 0 ? w * pts[i][static_cast<int>(k)] : 0.0;
-    }
-    std::vector<double> cols = rows_to_columns(local, b.count, M, team), tmp;
-    std::vector<double>().swap(local);
+    std::vector<double> cols = rows_to_columns(pts, b.count, M, team), tmp;
     Shape<R> cs{shape[0], even_share(M, me, P).second};
     basis_pass<true, R>(f.axes[0], cols.data(), cs, 0, tmp);
     std::vector<double>().swap(cols);
@@ -1635,7 +1629,7 @@ ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOption
   ApproxRows out;
   out.first = even_share(c0, me, P).first;
   if (separable) {
-    std::vector<double> cols = rows_to_columns(rhs, nr, c1, team);
+    std::vector<double> cols = rows_to_columns(as_points(rhs.data()), nr, c1, team);
     const std::size_t cshape[2] = {c0, even_share(c1, me, P).second}, rshape[2] = {nr, c1};
     std::visit([&](const auto& s) { solve_along_axis(s, cols.data(), cshape, R, 0, 3); }, *lu[0]);
     std::vector<double> rows = columns_to_rows(cols, c0, c1, team);
