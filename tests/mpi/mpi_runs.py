@@ -4,7 +4,9 @@
 Runs `interpatch eval` and `interpatch build` on grids whose rows split unevenly
 between 1..4 processes (chunks of 16 rows), closed directions of odd and even
 degree, collapsed rows (poles), every parametrization, float32 and big-endian
-input, surfaces and volumes; every output must equal the single process's, byte for
+input, surfaces and volumes, and approximations (a given number of control points,
+the separable fit and the sparse one with holes, smoothing, smoothing "auto"), each
+checked to have run split; every output must equal the single process's, byte for
 byte. Then the failures: a missing points file, a NaN in the last process's rows,
 bad options, an output in a missing directory; each must end every process with
 the single process's exit status and error line, exactly one line on stderr, no
