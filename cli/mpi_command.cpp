@@ -137,7 +137,7 @@ Plan plan_of(const MpiRequest& r, const mpi::Team& team) {
   }
   const auto dt = io::internal::parse_npy_dtype(plan.header.descr);
   const auto& shape = plan.header.shape;
-  if (!dt || dt->kind != 'f' || plan.header.fortran_order || shape.size() != plan.dims + 1 || shape.back() != 3)
+  if (!dt || dt->kind != 'f' || shape.size() != plan.dims + 1 || shape.back() != 3)
     return plan;
   plan.dtype = *dt;
   std::uint64_t count = 1;
@@ -166,9 +166,47 @@ Plan plan_of(const MpiRequest& r, const mpi::Team& team) {
   return plan;
 }
 
-// Rows of the .npy file as doubles: rows [r, r + n) of `row` values each.
+// One value of the file's dtype as a double (float32 widened, byte order swapped).
+double file_value(const unsigned char* raw, const io::internal::NpyDtype& dtype) {
+  const std::size_t es = dtype.size;
+  unsigned char b[8];
+  std::memcpy(b, raw, es);
+  if (dtype.big_endian != (std::endian::native == std::endian::big)) std::reverse(b, b + es);
+  if (es == 8) return std::bit_cast<double>(b);
+  float f;
+  std::memcpy(&f, b, 4);
+  return static_cast<double>(f);
+}
+
+// Rows of the .npy file as doubles: rows [r, r + n) of `row` values each, C order.
 void read_rows(const mpi::InputFile& file, const Plan& plan, std::size_t row, std::size_t r, std::size_t n, double* dst) {
   const std::size_t es = plan.dtype.size, total = row * n;
+  if (n == 0) return;
+  if (plan.header.fortran_order) {
+    // Value q of a row (in the file's order: the first index after u fastest) is a
+    // run of the n rows' values, n0 values apart from the next: a strided read of
+    // the runs, then each value to its place in C order.
+    const auto& shape = plan.header.shape;
+    const std::size_t n0 = shape[0];
+    const std::size_t group = std::max<std::size_t>(1, (std::size_t{1} << 20) / n);
+    std::vector<unsigned char> raw(std::min(group, row) * n * es);
+    for (std::size_t q0 = 0; q0 < row; q0 += group) {
+      const std::size_t g = std::min(group, row - q0);
+      file.read_strided(reinterpret_cast<char*>(raw.data()), g, n * es, std::uint64_t{n0} * es,
+                        plan.header.data_offset + (std::uint64_t{r} + std::uint64_t{n0} * q0) * es);
+      for (std::size_t q = q0; q < q0 + g; ++q) {
+        std::size_t pos = 0, rest = q;  // q's place in a row in C order
+        for (std::size_t a = 1; a < shape.size(); ++a) {
+          std::size_t later = 1;
+          for (std::size_t b = a + 1; b < shape.size(); ++b) later *= shape[b];
+          pos += (rest % shape[a]) * later;
+          rest /= shape[a];
+        }
+        for (std::size_t i = 0; i < n; ++i) dst[i * row + pos] = file_value(raw.data() + ((q - q0) * n + i) * es, plan.dtype);
+      }
+    }
+    return;
+  }
   const std::uint64_t at = plan.header.data_offset + std::uint64_t{r} * row * es;
   if (es == 8 && !plan.dtype.big_endian && std::endian::native == std::endian::little) {
     file.read(reinterpret_cast<char*>(dst), total * 8, at);
@@ -179,17 +217,7 @@ void read_rows(const mpi::InputFile& file, const Plan& plan, std::size_t row, st
   for (std::size_t done = 0; done < total; done += piece) {
     const std::size_t k = std::min(piece, total - done);
     file.read(reinterpret_cast<char*>(raw.data()), k * es, at + done * es);
-    for (std::size_t i = 0; i < k; ++i) {
-      unsigned char b[8];
-      std::memcpy(b, raw.data() + i * es, es);
-      if (plan.dtype.big_endian != (std::endian::native == std::endian::big)) std::reverse(b, b + es);
-      if (es == 8) dst[done + i] = std::bit_cast<double>(b);
-      else {
-        float f;
-        std::memcpy(&f, b, 4);
-        dst[done + i] = static_cast<double>(f);
-      }
-    }
+    for (std::size_t i = 0; i < k; ++i) dst[done + i] = file_value(raw.data() + i * es, plan.dtype);
   }
 }
 
@@ -682,7 +710,7 @@ int approximate_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team
   b.row0 = rb.halo[1].data();
   b.last = rb.halo[4].data();
   detail::ApproxRows fit;
-  io::reader::at("/points", [&] { fit = detail::approximate_rows(b, plan.approx, team); });
+  io::reader::at("/points", [&] { fit = detail::approximate_rows(b, plan.approx, team, [&] { release(rb.rows); }); });
   release(rb.rows);
   stages.done("fit");
   const std::size_t N = fit.net[0], width = fit.net[1];

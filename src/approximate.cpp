@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <functional>
 #include <numeric>
 #include <random>
 #include <variant>
@@ -1446,7 +1447,9 @@ Vec3* as_points(double* d) { return reinterpret_cast<Vec3*>(d); }
 // turned into columns: every row of this process's even share of the columns. A
 // missing point (a NaN coordinate) goes as zeros: its weight 0 times the point, as
 // the weighted data of right_hand_side.
-std::vector<double> rows_to_columns(const Vec3* rows, std::size_t mine, std::size_t width, const detail::RowTeam& team) {
+// `packed` is called once the rows are read.
+std::vector<double> rows_to_columns(const Vec3* rows, std::size_t mine, std::size_t width, const detail::RowTeam& team,
+                                    const std::function<void()>& packed = {}) {
   const std::size_t P = team.processes(), me = team.process();
   const std::vector<double> counts = team.gather(std::vector<double>{static_cast<double>(mine)});
   std::size_t total = 0;
@@ -1470,7 +1473,9 @@ std::vector<double> rows_to_columns(const Vec3* rows, std::size_t mine, std::siz
     rc[s] = static_cast<std::size_t>(counts[s]) * C;
     at += sc[s];
   }
-  std::vector<double> out(3 * total * C);
+  if (packed) packed();
+  std::vector<double> out;
+  team.run([&] { out.resize(3 * total * C); });
   team.exchange(as_points(send.data()), sc, as_points(out.data()), rc);
   return out;
 }
@@ -1527,7 +1532,8 @@ bool approximate_rows_covers(const SurfaceApproximationOptions& o) {
   return !o.tolerance && o.weights.empty() && !o.periodic[0] && !o.periodic[1];
 }
 
-ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOptions& o, const RowTeam& team) {
+ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOptions& o, const RowTeam& team,
+                            const std::function<void()>& release) {
   constexpr std::size_t R = 2;
   INTERPATCH_ASSERT(b.rank == 2 && approximate_rows_covers(o));
   const std::size_t P = team.processes(), me = team.process();
@@ -1542,7 +1548,10 @@ ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOption
   team.sum(missing);
   const std::size_t present = total - missing[0];
   const bool fill = missing[0] > 0;
-  auto weight = [&](std::size_t flat) { return is_missing(pts[flat - base]) ? 0.0 : 1.0; };
+  // Which points are present, kept past the points themselves.
+  std::vector<bool> present_here(fill ? mine : 0);
+  for (std::size_t i = 0; i < present_here.size(); ++i) present_here[i] = !is_missing(pts[i]);
+  auto weight = [&](std::size_t flat) { return !fill || present_here[flat - base] ? 1.0 : 0.0; };
   team.run([&] {
     if (present == 0)
       fail(errc::too_few_points, "all ", total, " points are missing or have weight 0: there is nothing to approximate");
@@ -1604,7 +1613,9 @@ ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOption
   // Bᵀ (w Q): along u on columns of the data, along v on rows of the result.
   std::vector<double> rhs;
   {
-    std::vector<double> cols = rows_to_columns(pts, b.count, M, team), tmp;
+    std::vector<double> cols = rows_to_columns(pts, b.count, M, team, [&] {
+      if (release && !o.auto_smoothing) release();
+    }), tmp;
     Shape<R> cs{shape[0], even_share(M, me, P).second};
     basis_pass<true, R>(f.axes[0], cols.data(), cs, 0, tmp);
     std::vector<double>().swap(cols);

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include "detail/grid_rows.hpp"
@@ -31,6 +32,9 @@ struct ApproxRows {
 
 /// The approximation of the grid `b` (rows may hold NaN: missing points), the
 /// options covered (approximate_rows_covers). Errors as approximate_surface's.
-ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOptions& o, const RowTeam& team);
+/// `release` is called once the block's points are read no more: the caller may
+/// free them then (a smoothing "auto" reads them to the end).
+ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOptions& o, const RowTeam& team,
+                            const std::function<void()>& release = {});
 
 }  // namespace interpatch::detail

@@ -218,6 +218,30 @@ void InputFile::read(char* dst, std::size_t n, std::uint64_t offset) const {
   });
 }
 
+void InputFile::read_strided(char* dst, std::size_t runs, std::size_t run, std::uint64_t stride, std::uint64_t offset) const {
+  auto f = static_cast<MPI_File>(file_);
+  // Groups of runs an int counts, each read through a file view of that many runs.
+  constexpr std::size_t piece = std::size_t{1} << 30;
+  const std::size_t group = std::max<std::size_t>(1, piece / std::max<std::size_t>(run, 1));
+  const int len = as_int(run, "a run of a strided read");
+  for (std::size_t r0 = 0; r0 < runs; r0 += group) {
+    const std::size_t g = std::min(group, runs - r0);
+    MPI_Datatype view;
+    MPI_Type_create_hvector(as_int(g, "a strided read"), len, static_cast<MPI_Aint>(stride), MPI_BYTE, &view);
+    MPI_Type_commit(&view);
+    MPI_File_set_view(f, static_cast<MPI_Offset>(offset + r0 * stride), MPI_BYTE, view, "native", MPI_INFO_NULL);
+    MPI_Status st;
+    const int rc = MPI_File_read(f, dst + r0 * run, as_int(g * run, "a strided read"), MPI_BYTE, &st);
+    int got = 0;
+    MPI_Get_count(&st, MPI_BYTE, &got);
+    MPI_File_set_view(f, 0, MPI_BYTE, MPI_BYTE, "native", MPI_INFO_NULL);
+    MPI_Type_free(&view);
+    if (rc != MPI_SUCCESS || static_cast<std::size_t>(got) != g * run)
+      fail(errc::file_unreadable, "'", path_.string(), "': cannot read ", g, " runs of ", run, " bytes from offset ",
+           offset + r0 * stride, rc != MPI_SUCCESS ? ": " + mpi_message(rc) : cat(": got ", got, " bytes"));
+  }
+}
+
 // ---------------------------------------------------------------------------
 
 OutputFile::OutputFile(const fs::path& path, const Team& team) : team_(team), path_(path) {

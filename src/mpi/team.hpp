@@ -79,6 +79,9 @@ class InputFile {
   [[nodiscard]] std::uint64_t size() const noexcept { return size_; }
   /// n bytes at `offset` into dst, this process alone.
   void read(char* dst, std::size_t n, std::uint64_t offset) const;
+  /// `runs` runs of `run` bytes each, `stride` bytes apart from `offset` on, into dst
+  /// one after another (a strided view of the file), this process alone.
+  void read_strided(char* dst, std::size_t runs, std::size_t run, std::uint64_t stride, std::uint64_t offset) const;
 
  private:
   std::filesystem::path path_;

@@ -4,7 +4,7 @@
 Runs `interpatch eval` and `interpatch build` on grids whose rows split unevenly
 between 1..4 processes (chunks of 16 rows), closed directions of odd and even
 degree, collapsed rows (poles), every parametrization, float32 and big-endian
-input, surfaces and volumes, and approximations (a given number of control points,
+input, Fortran-order input, surfaces and volumes, and approximations (a given number of control points,
 the separable fit and the sparse one with holes, smoothing, smoothing "auto"), each
 checked to have run split; every output must equal the single process's, byte for
 byte. Then the failures: a missing points file, a NaN in the last process's rows,
@@ -29,6 +29,10 @@ ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIR
 # A single process must not see the launcher's variables (it would start MPI).
 SINGLE_ENV = {k: v for k, v in ENV.items() if not k.startswith(("OMPI_COMM_WORLD", "PMIX_", "PMI_"))}
 PROCESSES = [1, 2, 3, 4]
+# The failures: one process alone, an uneven split and the most processes (2 adds no case of its own).
+FAILURE_PROCESSES = [1, 3, 4]
+# Cases whose one-process run under mpirun adds nothing to the first case's.
+SPLIT_ONLY = [2, 3, 4]
 failures = []
 
 
@@ -64,14 +68,20 @@ def grid(shape, rng, pole=False, close=None, scale=1.0):
 
 def cases(rng):
     yield "surface 53x37 (uneven rows)", grid((53, 37), rng), {}, "61"
-    yield "surface pole row, centripetal", grid((40, 21), rng, pole=True), {"param": "centripetal", "degree": [3, 2]}, "45x7"
+    yield "surface pole row, centripetal", grid((40, 21), rng, pole=True), {"param": "centripetal", "degree": [3, 2]}, "45x7", \
+        SPLIT_ONLY
     yield "surface uniform, degree 5x2, float32 big-endian", grid((35, 9), rng).astype(">f4"), \
-        {"param": "uniform", "degree": [5, 2]}, "33"
+        {"param": "uniform", "degree": [5, 2]}, "33", SPLIT_ONLY
     yield "surface closed u, even degree", grid((47, 19), rng, close=0), {"periodic": [True, False], "degree": [2, 3]}, "40"
-    yield "surface closed v (tube), even degree", grid((50, 24), rng, close=1), {"periodic": [False, True], "degree": [3, 4]}, "41"
+    yield "surface closed v (tube), even degree", grid((50, 24), rng, close=1), {"periodic": [False, True], "degree": [3, 4]}, "41", \
+        SPLIT_ONLY
     yield "surface closed along u, not declared (warning), extreme scale", grid((33, 12), rng, close=0, scale=1e300), {}, "30"
     yield "volume closed w, even degree", grid((38, 7, 8), rng, close=2), {"periodic": [False, False, True], "degree": [3, 2, 2]}, \
         "29x33x17"
+    yield "surface Fortran order, float32", np.asfortranarray(grid((37, 22), rng).astype("<f4")), {"degree": [3, 2]}, "29", \
+        [2, 3]
+    yield "volume Fortran order, big-endian", np.asfortranarray(grid((34, 6, 5), rng).astype(">f8")), {"degree": [3, 2, 2]}, \
+        "13x9x7", [3]
     yield "volume closed u, centripetal", grid((36, 5, 4), rng, close=0), \
         {"periodic": [True, False, False], "degree": [3, 2, 2], "param": "centripetal"}, "9"
 
@@ -92,14 +102,14 @@ def approximate_cases(rng):
     ways, the separable fit and the sparse system with and without holes; the slower
     cases on fewer process counts."""
     yield "approximate 53x37 control points (separable)", grid((53, 37), rng), {"control_points": [20, 15]}, "61", PROCESSES
-    yield "approximate 70x29 holes, control points", holes(grid((70, 29), rng), rng), {"control_points": [24, 12]}, "40x23", \
-        PROCESSES
+    yield "approximate 70x29 holes, control points, Fortran order", np.asfortranarray(holes(grid((70, 29), rng), rng)), \
+        {"control_points": [24, 12]}, "40x23", [2, 4]
     yield "approximate holes, smoothing, centripetal, float32 big-endian", holes(grid((45, 30), rng), rng).astype(">f4"), \
-        {"smoothing": 1e-3, "param": "centripetal", "degree": [3, 2]}, "35", [1, 3]
+        {"smoothing": 1e-3, "param": "centripetal", "degree": [3, 2]}, "35", [3]
     g = grid((40, 20), rng)
     g[:, 5:9] = np.nan  # control points with no data under them: the fill term settles them
     yield "approximate columns of holes, as many control points as data along v", g, {"control_points": [5, 20]}, "11", [3]
-    yield "approximate smoothing auto, uniform", grid((40, 25), rng), {"smoothing": "auto", "param": "uniform"}, "30", [2, 4]
+    yield "approximate smoothing auto, uniform", grid((40, 25), rng), {"smoothing": "auto", "param": "uniform"}, "30", [3]
 
 
 def split_ran(d, spec_file):
@@ -130,7 +140,7 @@ def same_outputs(d, name, spec_file, eval_grid, processes=PROCESSES):
         check(sorted(os.listdir(d)) == sorted([spec_file, "points.npy"]), f"{name}: files left: {os.listdir(d)}")
 
 
-def same_failure(d, name, args, status, processes=PROCESSES):
+def same_failure(d, name, args, status, processes=FAILURE_PROCESSES):
     good = os.path.join(d, "good" + os.path.splitext(args[args.index("-o") + 1])[1])
     one = run(args, cwd=d)
     check(one.returncode == status, f"{name}: single process status {one.returncode}, expected {status}: {one.stderr}")
@@ -172,13 +182,15 @@ def a_rank_cannot_read(d, rng):
 
 def main():
     rng = np.random.default_rng(19)
-    for name, points, options, eval_grid in cases(rng):
+    for name, points, options, eval_grid, *processes in cases(rng):
         with tempfile.TemporaryDirectory() as d:
             np.save(os.path.join(d, "points.npy"), points)
             spec_type = "interpolate_volume" if points.ndim == 4 else "interpolate"
             with open(os.path.join(d, "spec.json"), "w") as f:
                 json.dump(dict({"type": spec_type, "points": {"npy": "points.npy"}}, **options), f)
-            same_outputs(d, name, "spec.json", eval_grid)
+            if points.flags.f_contiguous and not points.flags.c_contiguous:  # read split, not by rank 0 alone
+                check(split_ran(d, "spec.json"), f"{name}: not split between the processes")
+            same_outputs(d, name, "spec.json", eval_grid, *processes)
             print("ok:", name, flush=True)
     for name, points, options, eval_grid, processes in approximate_cases(rng):
         with tempfile.TemporaryDirectory() as d:
