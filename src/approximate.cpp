@@ -2,8 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
+#include <exception>
 #include <functional>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <variant>
@@ -1558,14 +1559,21 @@ ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOption
   });
 
   // Degrees and parameters.
+  // In one process's order: the degree along u, the parameters along u, the degree
+  // along v (a refusal kept until the parameters along u are found), along v.
   Fit<R> f;
-  team.run([&] {
-    for (std::size_t a = 0; a < R; ++a) set_degree<R>(f.axes[a], o, a, shape[a]);
-  });
+  team.run([&] { set_degree<R>(f.axes[0], o, 0, shape[0]); });
+  std::exception_ptr v_degree;
+  try {
+    set_degree<R>(f.axes[1], o, 1, shape[1]);
+  } catch (const error&) {
+    v_degree = std::current_exception();
+  }
+  const std::size_t axes = v_degree ? 1 : R;
   if (o.param == Parametrization::uniform) {
     for (std::size_t a = 0; a < R; ++a) f.axes[a].t = uniform_parameters(shape[a], false);
   } else if (!fill) {
-    std::vector<std::vector<double>> t = block_parameters(b, o.param, team);
+    std::vector<std::vector<double>> t = block_parameters(b, o.param, team, axes);
     for (std::size_t a = 0; a < R; ++a) f.axes[a].t = std::move(t[a]);
   } else {
     // Along u each step's chords lie in the rows of one process (the row before the
@@ -1598,11 +1606,15 @@ ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOption
     };
     team.run([&] {
       f.axes[0].t = parameters_from_sums(all_sum0, counts(all_used0.begin(), all_used0.end()), shape[0], 0, o.param, false);
+      if (axes < R) return;
       f.axes[1].t = parameters_from_sums(std::vector<double>(acc1.begin(), acc1.begin() + static_cast<std::ptrdiff_t>(steps1)),
                                          counts(acc1.begin() + static_cast<std::ptrdiff_t>(steps1), acc1.end()), shape[1], 1,
                                          o.param, false);
     });
   }
+  team.run([&] {
+    if (v_degree) std::rethrow_exception(v_degree);
+  });
   team.run([&] {
     check_control_points<R>(f.axes, o);
     set_fit_knots<R>(f.axes, o);

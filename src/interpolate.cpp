@@ -993,7 +993,8 @@ Closing block_closing(const GridBlock& b, std::size_t axis, std::span<const Vec3
   return find_closing(lines, n, point, diagonal, where, team, first_line);
 }
 
-std::vector<std::vector<double>> block_parameters(const GridBlock& b, Parametrization param, const RowTeam& team) {
+std::vector<std::vector<double>> block_parameters(const GridBlock& b, Parametrization param, const RowTeam& team,
+                                                  std::size_t axes) {
   const std::size_t R = b.rank, M = b.row_size();
   // As grid_parameters_of: a grid of extreme scale is measured scaled by 2^-shift.
   const int shift = param == Parametrization::uniform ? 0 : extreme_shift(b, team);
@@ -1029,7 +1030,7 @@ std::vector<std::vector<double>> block_parameters(const GridBlock& b, Parametriz
   const std::vector<double> all_steps = team.gather(steps);
   team.run([&] {
     t[0] = chords.u_parameters(all_steps);
-    for (std::size_t a = 1; a < R; ++a) t[a] = chords.in_row_parameters(a);
+    for (std::size_t a = 1; a < std::min(R, axes); ++a) t[a] = chords.in_row_parameters(a);
   });
   return t;
 }

@@ -137,8 +137,9 @@ void insert_seam(Grid<Vec3, Rank>& points, std::size_t axis, KnotVector& knots, 
 template <std::size_t Rank>
 void drop_last_line(Grid<Vec3, Rank>& points, std::size_t axis);
 
-/// The parameters along every axis of a grid held in blocks of rows, as grid_parameters gives them
-/// for the whole grid (every axis, open directions, every point present).
-std::vector<std::vector<double>> block_parameters(const GridBlock& b, Parametrization param, const RowTeam& team);
+/// The parameters along the first `axes` axes of a grid held in blocks of rows, as
+/// grid_parameters gives them for the whole grid (open directions, every point present).
+std::vector<std::vector<double>> block_parameters(const GridBlock& b, Parametrization param, const RowTeam& team,
+                                                  std::size_t axes);
 
 }  // namespace interpatch::detail

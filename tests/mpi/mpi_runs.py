@@ -207,6 +207,13 @@ def main():
             json.dump({"type": "approximate", "points": {"npy": "points.npy"}, "control_points": [5, 5]}, f)
         same_failure(d, "approximate: every point missing", ["build", "spec.json", "-o", "good.npz"], 3, [2])
         g = grid((40, 20), rng)
+        g[17, :] = g[16, :]  # rows 16 and 17 coincide: zero chords along u, and a degree along v too high
+        np.save(os.path.join(d, "points.npy"), g)
+        with open(os.path.join(d, "spec.json"), "w") as f:
+            json.dump({"type": "approximate", "points": {"npy": "points.npy"}, "smoothing": 0.1, "degree": [3, 25]}, f)
+        same_failure(d, "approximate: two faults, the first in one process's order", ["build", "spec.json", "-o", "good.npz"], 3,
+                     [2])
+        g = grid((40, 20), rng)
         g[38, 3, 2] = np.inf  # in the last process's rows
         np.save(os.path.join(d, "points.npy"), g)
         same_failure(d, "approximate: infinity in the last rows", ["eval", "spec.json", "--grid", "9", "-o", "good.npy"], 3,
