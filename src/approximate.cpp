@@ -1657,7 +1657,7 @@ ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOption
     std::visit([&](const auto& s) { solve_along_axis(s, cols.data(), cshape, R, 0, 3); }, *lu[0]);
     std::vector<double> rows = columns_to_rows(cols, c0, c1, team);
     std::visit([&](const auto& s) { solve_along_axis(s, rows.data(), rshape, R, 1, 3); }, *lu[1]);
-    out.rows.assign(as_points(rows.data()), as_points(rows.data()) + nr * c1);
+    if (nr > 0) out.rows.assign(as_points(rows.data()), as_points(rows.data()) + nr * c1);
   } else {
     Stencil<R> st(f.axes);
     if (!fill) add_grams<R>(st, f.axes);
