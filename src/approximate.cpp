@@ -358,7 +358,8 @@ void add_weighted_points(double* v_, const Stencil<R>& st, const std::array<Axis
   for (std::size_t i = first; i < first + count; ++i) {
     const double w = weight(i);
     if (!(w > 0)) continue;
-    const std::vector<std::size_t> idx = unflatten<R>(i, shape);
+    std::array<std::size_t, R> idx{};
+    for (std::size_t a = R, rest = i; a-- > 0; rest /= shape[a]) idx[a] = rest % shape[a];
     for (std::size_t s = 0; s < support; ++s) {
       double v = w;
       std::size_t r = 0, cd = 0;
@@ -383,7 +384,11 @@ void add_weighted_points(double* v_, const Stencil<R>& st, const std::array<Axis
     for (std::size_t s = 0; s < support; ++s) {
       if (val[s] == 0.0) continue;
       double* dst = v_ + row[s] * st.size + centre - code[s];
-      for (std::size_t t = 0; t < support; ++t) dst[code[t]] += val[s] * val[t] / w;
+      // x / 1 is x exactly: the division only where a weight is not 1.
+      if (w == 1.0)
+        for (std::size_t t = 0; t < support; ++t) dst[code[t]] += val[s] * val[t];
+      else
+        for (std::size_t t = 0; t < support; ++t) dst[code[t]] += val[s] * val[t] / w;
     }
   }
 }
