@@ -344,9 +344,10 @@ struct Stencil {
 // Σ_i w_i B(t_i) B(t_i)ᵀ over the points, the tensor basis of each point expanded.
 // Points [first, first + count) in storage order, into v (a stencil's values):
 // the same additions in the same order whichever block of the points a process holds.
-template <std::size_t R, class Weight>
+// Only the stencil rows (control points) `keep` accepts are added to.
+template <std::size_t R, class Weight, class Keep>
 void add_weighted_points(double* v_, const Stencil<R>& st, const std::array<Axis, R>& axes, const Shape<R>& shape,
-                         std::size_t first, std::size_t count, const Weight& weight) {
+                         std::size_t first, std::size_t count, const Weight& weight, const Keep& keep) {
   std::array<std::size_t, R> pp{};
   std::size_t support = 1;
   for (std::size_t a = 0; a < R; ++a) {
@@ -382,7 +383,7 @@ void add_weighted_points(double* v_, const Stencil<R>& st, const std::array<Axis
     std::size_t centre = 0;
     for (std::size_t a = 0; a < R; ++a) centre += st.half[a] * st.stride[a];
     for (std::size_t s = 0; s < support; ++s) {
-      if (val[s] == 0.0) continue;
+      if (val[s] == 0.0 || !keep(row[s])) continue;
       double* dst = v_ + row[s] * st.size + centre - code[s];
       // x / 1 is x exactly: the division only where a weight is not 1.
       if (w == 1.0)
@@ -395,7 +396,8 @@ void add_weighted_points(double* v_, const Stencil<R>& st, const std::array<Axis
 
 template <std::size_t R>
 void add_weighted_data(Stencil<R>& st, const std::array<Axis, R>& axes, const Data<R>& d) {
-  add_weighted_points<R>(st.v.data(), st, axes, d.shape, 0, d.points.size(), [&](std::size_t i) { return d.w(i); });
+  add_weighted_points<R>(st.v.data(), st, axes, d.shape, 0, d.points.size(), [&](std::size_t i) { return d.w(i); },
+                         [](std::size_t) { return true; });
 }
 
 // The data term of points all present with weight 1: the Kronecker product of the
@@ -1530,6 +1532,76 @@ Axis axis_slice(const Axis& ax, std::size_t first, std::size_t count) {
   return s;
 }
 
+// Data rows [first, first + count) of a surface's grid held by this process: their
+// part of the data term Σ w B Bᵀ, summed as one process sums it (point after point)
+// and gathered into st on every process. A control row's entries take sums over the
+// data rows its basis functions reach, in order: the rows whose data lie in one
+// process's block are summed there, all at once; those whose data straddle the
+// block before (a few rows at each boundary) start from the sums the processes
+// before have reached, handed on in order, and go on with this process's points.
+template <class Weight>
+void add_block_data(Stencil<2>& st, const std::array<Axis, 2>& axes, const Shape<2>& shape, const detail::GridBlock& b,
+                    const Weight& weight, const detail::RowTeam& team) {
+  const std::size_t P = team.processes(), me = team.process(), c0 = st.c[0], c1 = st.c[1];
+  const std::size_t row_len = c1 * st.size;  // doubles of a control row of the stencil
+  const std::size_t base = b.first * shape[1], mine = b.count * shape[1];
+  const Axis& u = axes[0];
+  // The control rows each process's data rows reach: [lo, hi], −1 for none.
+  const double lo_here = b.count > 0 ? static_cast<double>(u.first[b.first]) : -1.0;
+  const double hi_here = b.count > 0 ? static_cast<double>(u.first[b.first + b.count - 1] + u.p) : -1.0;
+  const std::vector<double> los = team.gather(std::vector<double>{lo_here}), his = team.gather(std::vector<double>{hi_here});
+  auto has = [&](std::size_t r) { return los[r] >= 0; };
+  auto lo_of = [&](std::size_t r) { return static_cast<std::size_t>(los[r]); };
+  auto hi_of = [&](std::size_t r) { return static_cast<std::size_t>(his[r]); };
+  auto before = [&](std::size_t r) {  // the last process before r with data rows, P for none
+    for (std::size_t q = r; q-- > 0;)
+      if (has(q)) return q;
+    return P;
+  };
+  auto after = [&](std::size_t r) {
+    for (std::size_t q = r + 1; q < P; ++q)
+      if (has(q)) return q;
+    return P;
+  };
+  // Rows [s_lo, s_hi] of process r continue the sums of the processes before it.
+  auto continued = [&](std::size_t r) -> std::pair<std::size_t, std::size_t> {
+    const std::size_t q = before(r);
+    if (!has(r) || q == P || hi_of(q) < lo_of(r)) return {1, 0};
+    return {lo_of(r), std::min(hi_of(r), hi_of(q))};
+  };
+  const std::pair<std::size_t, std::size_t> mine_continued = continued(me);
+  const std::size_t s_lo = mine_continued.first, s_hi = mine_continued.second;
+  auto in_continued = [&](std::size_t row) { return row / c1 >= s_lo && row / c1 <= s_hi; };
+  add_weighted_points<2>(st.v.data(), st, axes, shape, base, mine, weight, [&](std::size_t row) { return !in_continued(row); });
+  std::size_t width = 0;
+  for (std::size_t r = 0; r < P; ++r) {
+    const std::pair<std::size_t, std::size_t> c = continued(r);
+    if (c.second >= c.first) width = std::max(width, c.second - c.first + 1);
+  }
+  std::vector<double> acc(width * row_len, 0.0);
+  team.fold(acc, [&](std::span<double> a) {
+    if (!has(me)) return;  // hands on what it got
+    if (s_hi >= s_lo) {
+      std::copy_n(a.data(), (s_hi - s_lo + 1) * row_len, st.v.data() + s_lo * row_len);
+      add_weighted_points<2>(st.v.data(), st, axes, shape, base, mine, weight, in_continued);
+    }
+    if (const std::size_t next = after(me); next < P) {
+      const std::pair<std::size_t, std::size_t> c = continued(next);
+      if (c.second >= c.first) std::copy_n(st.v.data() + c.first * row_len, (c.second - c.first + 1) * row_len, a.data());
+    }
+  });
+  // Each control row from the last process that added to it: process r the rows from
+  // its first (0 for the first process with data) up to the next one's first.
+  std::size_t own_lo = 0, own_hi = 0;
+  if (has(me)) {
+    own_lo = before(me) == P ? 0 : lo_of(me);
+    own_hi = after(me) == P ? c0 : lo_of(after(me));
+  }
+  std::vector<double> all = team.gather(std::span<const double>(st.v.data() + own_lo * row_len, (own_hi - own_lo) * row_len));
+  INTERPATCH_ASSERT(all.size() == st.v.size());
+  st.v = std::move(all);
+}
+
 }  // namespace
 
 namespace detail {
@@ -1666,10 +1738,7 @@ ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOption
   } else {
     Stencil<R> st(f.axes);
     if (!fill) add_grams<R>(st, f.axes);
-    else
-      team.fold(st.v, [&](std::span<double> acc) {
-        add_weighted_points<R>(acc.data(), st, f.axes, shape, base, mine, weight);
-      });
+    else add_block_data(st, f.axes, shape, b, weight, team);
     SparseSystem<R> sys(f.axes, st, static_cast<double>(present), total);
     const std::vector<double> all_rhs = team.gather(rhs);
     if (o.auto_smoothing) {
