@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "detail/approx_rows.hpp"
 #include "detail/grid_rows.hpp"
 #include "detail/row_window.hpp"
 #include "exit_status.hpp"
@@ -89,6 +90,8 @@ struct Plan {
   std::vector<std::size_t> counts;  // --grid
   io::internal::NpyHeader header;
   io::internal::NpyDtype dtype;
+  bool approximate = false;  // an approximate spec (dims 2), its options:
+  SurfaceApproximationOptions approx;
 };
 
 Plan plan_of(const MpiRequest& r, const mpi::Team& team) {
@@ -109,7 +112,8 @@ Plan plan_of(const MpiRequest& r, const mpi::Team& team) {
   const nlohmann::json& s = plan.spec;
   if (!s.is_object() || !s.contains("type") || !s["type"].is_string()) return plan;
   const std::string type = s["type"].get<std::string>();
-  plan.dims = type == "interpolate" ? 2 : type == "interpolate_volume" ? 3 : 0;
+  const bool approx = type == "approximate";
+  plan.dims = type == "interpolate" || approx ? 2 : type == "interpolate_volume" ? 3 : 0;
   if (plan.dims == 0 || !s.contains("points") || !s["points"].is_object() || !s["points"].contains("npy")) return plan;
   io::reader::Context ctx;
   ctx.base_dir = plan.base;
@@ -133,7 +137,7 @@ Plan plan_of(const MpiRequest& r, const mpi::Team& team) {
   }
   const auto dt = io::internal::parse_npy_dtype(plan.header.descr);
   const auto& shape = plan.header.shape;
-  if (!dt || dt->kind != 'f' || plan.header.fortran_order || shape.size() != plan.dims + 1 || shape.back() != 3)
+  if (!dt || dt->kind != 'f' || shape.size() != plan.dims + 1 || shape.back() != 3)
     return plan;
   plan.dtype = *dt;
   std::uint64_t count = 1;
@@ -142,13 +146,67 @@ Plan plan_of(const MpiRequest& r, const mpi::Team& team) {
     count *= e;
   }
   if (count == 0 || plan.header.data_offset + count * dt->size != size) return plan;
+  if (approx) {
+    // What the split approximation does not cover (a fit to a tolerance, weights,
+    // closed directions), and options the single process refuses, run there.
+    try {
+      io::reader::Context fields;
+      fields.base_dir = plan.base;
+      (void)io::reader::check_fields(s, "", io::reader::find_type("approximate")->fields, fields);
+      const std::vector<std::size_t> grid(shape.begin(), shape.begin() + 2);
+      if (grid[0] < 2 || grid[1] < 2) return plan;
+      plan.approx = io::reader::approximation_options<2>(s, "", grid, "/points");
+    } catch (const error&) {
+      return plan;
+    }
+    if (!detail::approximate_rows_covers(plan.approx)) return plan;
+    plan.approximate = true;
+  }
   plan.split = true;
   return plan;
 }
 
-// Rows of the .npy file as doubles: rows [r, r + n) of `row` values each.
+// One value of the file's dtype as a double (float32 widened, byte order swapped).
+double file_value(const unsigned char* raw, const io::internal::NpyDtype& dtype) {
+  const std::size_t es = dtype.size;
+  unsigned char b[8];
+  std::memcpy(b, raw, es);
+  if (dtype.big_endian != (std::endian::native == std::endian::big)) std::reverse(b, b + es);
+  if (es == 8) return std::bit_cast<double>(b);
+  float f;
+  std::memcpy(&f, b, 4);
+  return static_cast<double>(f);
+}
+
+// Rows of the .npy file as doubles: rows [r, r + n) of `row` values each, C order.
 void read_rows(const mpi::InputFile& file, const Plan& plan, std::size_t row, std::size_t r, std::size_t n, double* dst) {
   const std::size_t es = plan.dtype.size, total = row * n;
+  if (n == 0) return;
+  if (plan.header.fortran_order) {
+    // Value q of a row (in the file's order: the first index after u fastest) is a
+    // run of the n rows' values, n0 values apart from the next: a strided read of
+    // the runs, then each value to its place in C order.
+    const auto& shape = plan.header.shape;
+    const std::size_t n0 = shape[0];
+    const std::size_t group = std::max<std::size_t>(1, (std::size_t{1} << 20) / n);
+    std::vector<unsigned char> raw(std::min(group, row) * n * es);
+    for (std::size_t q0 = 0; q0 < row; q0 += group) {
+      const std::size_t g = std::min(group, row - q0);
+      file.read_strided(reinterpret_cast<char*>(raw.data()), g, n * es, std::uint64_t{n0} * es,
+                        plan.header.data_offset + (std::uint64_t{r} + std::uint64_t{n0} * q0) * es);
+      for (std::size_t q = q0; q < q0 + g; ++q) {
+        std::size_t pos = 0, rest = q;  // q's place in a row in C order
+        for (std::size_t a = 1; a < shape.size(); ++a) {
+          std::size_t later = 1;
+          for (std::size_t b = a + 1; b < shape.size(); ++b) later *= shape[b];
+          pos += (rest % shape[a]) * later;
+          rest /= shape[a];
+        }
+        for (std::size_t i = 0; i < n; ++i) dst[i * row + pos] = file_value(raw.data() + ((q - q0) * n + i) * es, plan.dtype);
+      }
+    }
+    return;
+  }
   const std::uint64_t at = plan.header.data_offset + std::uint64_t{r} * row * es;
   if (es == 8 && !plan.dtype.big_endian && std::endian::native == std::endian::little) {
     file.read(reinterpret_cast<char*>(dst), total * 8, at);
@@ -159,17 +217,7 @@ void read_rows(const mpi::InputFile& file, const Plan& plan, std::size_t row, st
   for (std::size_t done = 0; done < total; done += piece) {
     const std::size_t k = std::min(piece, total - done);
     file.read(reinterpret_cast<char*>(raw.data()), k * es, at + done * es);
-    for (std::size_t i = 0; i < k; ++i) {
-      unsigned char b[8];
-      std::memcpy(b, raw.data() + i * es, es);
-      if (plan.dtype.big_endian != (std::endian::native == std::endian::big)) std::reverse(b, b + es);
-      if (es == 8) dst[done + i] = std::bit_cast<double>(b);
-      else {
-        float f;
-        std::memcpy(&f, b, 4);
-        dst[done + i] = static_cast<double>(f);
-      }
-    }
+    for (std::size_t i = 0; i < k; ++i) dst[done + i] = file_value(raw.data() + i * es, plan.dtype);
   }
 }
 
@@ -223,41 +271,161 @@ Grid<Vec3, D> rows_grid(const std::array<std::size_t, 3>& n, std::size_t rows) {
   return Grid<Vec3, D>(s, for_overwrite);
 }
 
+// This process's rows of the points, and the few rows of the others it looks at.
+template <std::size_t D>
+struct RowBlock {
+  std::array<std::size_t, 3> n{};  // the grid's extents
+  std::size_t M = 1, first = 0, count = 0;
+  // C order. Not a Grid: a Grid's buffer, freed, is kept for reuse
+  // (detail/pages.cpp), which would hold a second share of the data here.
+  std::vector<Vec3> rows;
+  std::array<Grid<Vec3, D>, 5> halo;  // the row before the block; rows 0, 1, n−2, n−1
+};
+
+template <std::size_t D>
+RowBlock<D> read_block(const Plan& plan, const mpi::Team& team) {
+  RowBlock<D> b;
+  std::array<std::size_t, 3>& n = b.n;
+  for (std::size_t a = 0; a < D; ++a) n[a] = plan.header.shape[a];
+  for (std::size_t a = 1; a < D; ++a) b.M *= n[a];
+  const std::size_t M = b.M;
+  // Plain variables, not a structured binding: lambdas capture them (clang 14 refuses bindings).
+  const std::pair<std::size_t, std::size_t> block = mpi::chunk_block(n[0], team.rank(), team.size());
+  const std::size_t first = b.first = block.first, count = b.count = block.second;
+  team.run([&] {
+    require_memory(count * M, sizeof(Vec3), cat("/points: this process's ", count, " rows of the grid"));
+    b.rows.resize(count * M);
+    io::reader::at("/points", [&] {
+      const mpi::InputFile file(plan.points, team);
+      read_rows(file, plan, 3 * M, first, count, doubles(b.rows.data()));
+      const std::size_t at[5] = {first > 0 ? first - 1 : 0, 0, std::min<std::size_t>(1, n[0] - 1), n[0] < 2 ? 0 : n[0] - 2,
+                                 n[0] - 1};
+      for (std::size_t h = 0; h < 5; ++h) {
+        b.halo[h] = rows_grid<D>(n, 1);
+        read_rows(file, plan, 3 * M, at[h], 1, doubles(b.halo[h].data()));
+      }
+    });
+  });
+  return b;
+}
+
+// The rows of the output a process writes ({first, count}) and the control rows
+// they need, [lo, hi] (past the end around a periodic u): for build an even share of
+// the N control rows, for eval those of its share of the output grid's rows. `type`
+// names the spec's type in messages.
+struct OutputRows {
+  Resolution grid{};
+  std::vector<double> us;
+  std::size_t first = 0, count = 0;
+  long long lo = 0, hi = -1;
+};
+
+template <std::size_t D>
+OutputRows output_rows(const MpiRequest& r, const Plan& plan, const mpi::Team& team, const KnotVector& ku, std::size_t N,
+                       const char* type) {
+  OutputRows o;
+  const int P = team.size();
+  if (r.build) {
+    std::tie(o.first, o.count) = mpi::even_block(N, team.rank(), P);
+    o.lo = static_cast<long long>(o.first);
+    o.hi = o.lo + static_cast<long long>(o.count) - 1;
+    return o;
+  }
+  Resolution& grid = o.grid;
+  team.run([&] {
+    grid = plan.counts.size() == 1 ? Resolution{plan.counts[0], plan.counts[0], D == 3 ? plan.counts[0] : 0}
+                                   : Resolution{plan.counts[0], plan.counts[1], plan.counts.size() > 2 ? plan.counts[2] : 0};
+    if (plan.counts.size() > 1 && (plan.counts.size() == 3) != (D == 3)) {
+      io::Construction c;
+      c.type = type;
+      if constexpr (D == 3) c.exact = BSplineVolume(KnotVector::bezier(1), KnotVector::bezier(1), KnotVector::bezier(1), PointGrid3({2, 2, 2}));
+      else c.exact = BSplineSurface(KnotVector::bezier(1), KnotVector::bezier(1), PointGrid({2, 2}));
+      check_counts_kind(c, grid_option, grid);
+    }
+    require_eval_room(grid, r.out);
+  });
+  std::tie(o.first, o.count) = mpi::even_block(grid.nu, team.rank(), P);
+  const std::vector<double> all_us = linspace(0, 1, grid.nu);
+  o.us.assign(all_us.begin() + static_cast<std::ptrdiff_t>(o.first),
+              all_us.begin() + static_cast<std::ptrdiff_t>(o.first + o.count));
+  long long prev = -1;
+  for (const double u : o.us) {
+    const double t = ku.periodic() ? ku.wrap(u) : std::clamp(u, ku.front(), ku.back());
+    long long s = ku.find_span(t);
+    if (s < prev) s += static_cast<long long>(N);  // wrapped past the end of a periodic u
+    prev = s;
+    if (o.hi < o.lo) o.lo = s - ku.degree();
+    o.hi = s;
+  }
+  return o;
+}
+
+// Writes the output from control rows [o.lo, o.lo + window) (around a periodic u)
+// of a net of `net_shape` points, row_size of them a row: build writes this
+// process's even share of the rows into the archive, eval its rows of the output
+// grid, evaluated.
+template <std::size_t D>
+void write_output(const MpiRequest& r, const mpi::Team& team, const std::vector<int>& degrees,
+                  const std::vector<KnotVector>& knots, const std::vector<std::size_t>& net_shape,
+                  const std::vector<Vec3>& cp, const OutputRows& o, std::size_t window, Stages& stages) {
+  const std::size_t N = net_shape[0];
+  std::size_t row_size = 1;
+  for (std::size_t a = 1; a < D; ++a) row_size *= net_shape[a];
+  mpi::OutputFile file(r.out, team);
+  if (r.build) {
+    std::vector<const KnotVector*> kp;
+    for (const KnotVector& k : knots) kp.push_back(&k);
+    const std::size_t bytes = cp.size() * sizeof(Vec3);
+    const std::vector<std::uint64_t> crcs = team.all(io::internal::crc32(cp.data(), bytes));
+    const std::vector<std::uint64_t> lens = team.all(bytes);
+    std::uint32_t crc = 0;
+    for (std::size_t s = 0; s < crcs.size(); ++s)
+      if (lens[s]) crc = io::internal::crc32_combine(crc, static_cast<std::uint32_t>(crcs[s]), lens[s]);
+    const io::internal::NpzFrame frame = io::internal::exact_npz_frame(degrees, kp, net_shape, crc);
+    team.run([&] {
+      if (team.rank() == 0) {
+        io::check_disk_space(r.out, frame.total, cat("the archive '", r.out, "'"));
+        file.write(frame.head.data(), frame.head.size(), 0);
+        file.write(frame.tail.data(), frame.tail.size(), frame.points_offset + std::uint64_t{N} * row_size * sizeof(Vec3));
+      }
+      file.write(cp.data(), bytes, frame.points_offset + std::uint64_t{o.first} * row_size * sizeof(Vec3));
+    });
+  } else {
+    const std::vector<double> vs = linspace(0, 1, o.grid.nv), ws = D == 3 ? linspace(0, 1, o.grid.nw) : std::vector<double>{};
+    const std::size_t per_row = o.grid.nv * (D == 3 ? o.grid.nw : 1);
+    std::vector<std::size_t> out_shape{o.grid.nu, o.grid.nv};
+    if (D == 3) out_shape.push_back(o.grid.nw);
+    out_shape.push_back(3);
+    const std::string header = io::internal::npy_header("<f8", out_shape);
+    team.run([&] {
+      require_memory(o.count * per_row, sizeof(Vec3), "this process's rows of the evaluation grid");
+      std::vector<Vec3> out(o.count * per_row);
+      const detail::RowWindow w{cp.data(), o.lo, window, N, row_size};
+      if (o.count > 0) {
+        if constexpr (D == 2) detail::evaluate_surface_rows(knots[0], knots[1], w, o.us, vs, out);
+        else detail::evaluate_volume_rows(knots[0], knots[1], knots[2], w, o.us, vs, ws, out);
+      }
+      if (team.rank() == 0) file.write(header.data(), header.size(), 0);
+      file.write(out.data(), out.size() * sizeof(Vec3), header.size() + std::uint64_t{o.first} * per_row * sizeof(Vec3));
+    });
+  }
+  file.commit();
+  stages.done(r.build ? "write" : "evaluate_write");
+}
+
 template <std::size_t D>
 int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
   const int P = team.size();
   Stages stages(team.rank());
   io::reader::Context ctx;
   ctx.base_dir = plan.base;
-  std::array<std::size_t, 3> n{};
-  for (std::size_t a = 0; a < D; ++a) n[a] = plan.header.shape[a];
-  std::size_t M = 1;
-  for (std::size_t a = 1; a < D; ++a) M *= n[a];
-
-  // Each process's rows and the few rows of the others it looks at.
-  // Plain variables, not a structured binding: lambdas capture them (clang 14 refuses bindings).
-  const std::pair<std::size_t, std::size_t> block = mpi::chunk_block(n[0], team.rank(), P);
-  const std::size_t first = block.first, count = block.second;
-  // This process's rows, C order. Not a Grid: a Grid's buffer, freed, is kept for
-  // reuse (detail/pages.cpp), which would hold a second share of the data here.
-  std::vector<Vec3> rows;
-  std::size_t nrows = 0;
-  std::array<Grid<Vec3, D>, 5> halo;  // the row before the block; rows 0, 1, n−2, n−1
-  team.run([&] {
-    require_memory(count * M, sizeof(Vec3), cat("/points: this process's ", count, " rows of the grid"));
-    rows.resize(count * M);
-    nrows = count;
-    io::reader::at("/points", [&] {
-      const mpi::InputFile file(plan.points, team);
-      read_rows(file, plan, 3 * M, first, count, doubles(rows.data()));
-      const std::size_t at[5] = {first > 0 ? first - 1 : 0, 0, std::min<std::size_t>(1, n[0] - 1), n[0] < 2 ? 0 : n[0] - 2,
-                                 n[0] - 1};
-      for (std::size_t h = 0; h < 5; ++h) {
-        halo[h] = rows_grid<D>(n, 1);
-        read_rows(file, plan, 3 * M, at[h], 1, doubles(halo[h].data()));
-      }
-    });
-  });
+  RowBlock<D> rb = read_block<D>(plan, team);
+  std::array<std::size_t, 3> n = rb.n;
+  std::size_t M = rb.M;
+  const std::size_t first = rb.first, count = rb.count;
+  std::vector<Vec3> rows = std::move(rb.rows);
+  std::size_t nrows = count;
+  std::array<Grid<Vec3, D>, 5> halo = std::move(rb.halo);
   // As the reader does: the first point that is not finite, named in the whole grid.
   team.run([&] {
     try {
@@ -395,10 +563,6 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
 
   // Which control rows each process needs: its share (build), or the window its
   // output rows' basis functions reach (eval), around a periodic u past the end.
-  std::vector<double> us;
-  Resolution grid{};
-  std::size_t out_first = 0, out_count = 0;
-  long long lo = 0, hi = -1;
   std::vector<KnotVector> knots = rs.knots;
   std::array<bool, 3> seam{};
   for (std::size_t a = 1; a < D; ++a) seam[a] = periodic[a] && p[a] % 2 == 0;
@@ -415,39 +579,9 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
     if (!unit)
       for (KnotVector& k : knots) k = k.mapped(0.0, 1.0);
   });
-  if (r.build) {
-    std::tie(out_first, out_count) = mpi::even_block(N, team.rank(), P);
-    lo = static_cast<long long>(out_first);
-    hi = lo + static_cast<long long>(out_count) - 1;
-  } else {
-    team.run([&] {
-      grid = plan.counts.size() == 1 ? Resolution{plan.counts[0], plan.counts[0], D == 3 ? plan.counts[0] : 0}
-                                     : Resolution{plan.counts[0], plan.counts[1], plan.counts.size() > 2 ? plan.counts[2] : 0};
-      if (plan.counts.size() > 1 && (plan.counts.size() == 3) != (D == 3)) {
-        io::Construction c;
-        c.type = D == 2 ? "interpolate" : "interpolate_volume";
-        if constexpr (D == 3) c.exact = BSplineVolume(KnotVector::bezier(1), KnotVector::bezier(1), KnotVector::bezier(1), PointGrid3({2, 2, 2}));
-        else c.exact = BSplineSurface(KnotVector::bezier(1), KnotVector::bezier(1), PointGrid({2, 2}));
-        check_counts_kind(c, grid_option, grid);
-      }
-      require_eval_room(grid, r.out);
-    });
-    std::tie(out_first, out_count) = mpi::even_block(grid.nu, team.rank(), P);
-    const std::vector<double> all_us = linspace(0, 1, grid.nu);
-    us.assign(all_us.begin() + static_cast<std::ptrdiff_t>(out_first),
-              all_us.begin() + static_cast<std::ptrdiff_t>(out_first + out_count));
-    const KnotVector& ku = knots[0];
-    long long prev = -1;
-    for (const double u : us) {
-      const double t = ku.periodic() ? ku.wrap(u) : std::clamp(u, ku.front(), ku.back());
-      long long s = ku.find_span(t);
-      if (s < prev) s += static_cast<long long>(N);  // wrapped past the end of a periodic u
-      prev = s;
-      if (hi < lo) lo = s - ku.degree();
-      hi = s;
-    }
-  }
-  const std::size_t window = hi >= lo ? static_cast<std::size_t>(hi - lo + 1) : 0;
+  const OutputRows orows = output_rows<D>(r, plan, team, knots[0], N, D == 2 ? "interpolate" : "interpolate_volume");
+  const long long lo = orows.lo;
+  const std::size_t window = orows.hi >= lo ? static_cast<std::size_t>(orows.hi - lo + 1) : 0;
 
   // Columns back to rows: process s gets the rows of its window, from each column.
   const std::vector<std::uint64_t> los = team.all(static_cast<std::uint64_t>(lo)), counts = team.all(window);
@@ -500,56 +634,91 @@ int split_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
         cp.assign(g.data(), g.data() + g.size());
       }
   });
-  const std::size_t row_points = cp.size() / std::max<std::size_t>(window, 1);
-  const std::size_t row_size = window ? row_points : [&] {
-    std::size_t m = 1;
-    for (std::size_t a = 1; a < D; ++a) m *= cn[a];
-    return m;
-  }();
 
-  mpi::OutputFile file(r.out, team);
-  if (r.build) {
-    std::vector<int> degrees(p.begin(), p.end());
-    std::vector<const KnotVector*> kp;
-    for (const KnotVector& k : knots) kp.push_back(&k);
-    std::vector<std::size_t> net_shape{N};
-    for (std::size_t a = 1; a < D; ++a) net_shape.push_back(cn[a]);
-    const std::size_t bytes = cp.size() * sizeof(Vec3);
-    const std::vector<std::uint64_t> crcs = team.all(io::internal::crc32(cp.data(), bytes));
-    const std::vector<std::uint64_t> lens = team.all(bytes);
-    std::uint32_t crc = 0;
-    for (std::size_t s = 0; s < crcs.size(); ++s)
-      if (lens[s]) crc = io::internal::crc32_combine(crc, static_cast<std::uint32_t>(crcs[s]), lens[s]);
-    const io::internal::NpzFrame frame = io::internal::exact_npz_frame(degrees, kp, net_shape, crc);
-    team.run([&] {
-      if (team.rank() == 0) {
-        io::check_disk_space(r.out, frame.total, cat("the archive '", r.out, "'"));
-        file.write(frame.head.data(), frame.head.size(), 0);
-        file.write(frame.tail.data(), frame.tail.size(), frame.points_offset + std::uint64_t{N} * row_size * sizeof(Vec3));
-      }
-      file.write(cp.data(), bytes, frame.points_offset + std::uint64_t{out_first} * row_size * sizeof(Vec3));
-    });
-  } else {
-    const std::vector<double> vs = linspace(0, 1, grid.nv), ws = D == 3 ? linspace(0, 1, grid.nw) : std::vector<double>{};
-    const std::size_t per_row = grid.nv * (D == 3 ? grid.nw : 1);
-    std::vector<std::size_t> out_shape{grid.nu, grid.nv};
-    if (D == 3) out_shape.push_back(grid.nw);
-    out_shape.push_back(3);
-    const std::string header = io::internal::npy_header("<f8", out_shape);
-    team.run([&] {
-      require_memory(out_count * per_row, sizeof(Vec3), "this process's rows of the evaluation grid");
-      std::vector<Vec3> out(out_count * per_row);
-      const detail::RowWindow w{cp.data(), lo, window, N, row_size};
-      if (out_count > 0) {
-        if constexpr (D == 2) detail::evaluate_surface_rows(knots[0], knots[1], w, us, vs, out);
-        else detail::evaluate_volume_rows(knots[0], knots[1], knots[2], w, us, vs, ws, out);
-      }
-      if (team.rank() == 0) file.write(header.data(), header.size(), 0);
-      file.write(out.data(), out.size() * sizeof(Vec3), header.size() + std::uint64_t{out_first} * per_row * sizeof(Vec3));
-    });
+  std::vector<std::size_t> net_shape{N};
+  for (std::size_t a = 1; a < D; ++a) net_shape.push_back(cn[a]);
+  write_output<D>(r, team, std::vector<int>(p.begin(), p.end()), knots, net_shape, cp, orows, window, stages);
+  stages.print();
+  if (team.rank() == 0)
+    for (const std::string& w : ctx.warnings) std::fprintf(stderr, "interpatch: warning: %s\n", w.c_str());
+  return 0;
+}
+
+// The control rows [lo, lo + window) of a net of N rows of `width` points (modulo N
+// around a periodic u), from the processes holding them: this one rows
+// [first, first + mine.size() / width).
+std::vector<Vec3> window_rows(const std::vector<Vec3>& mine, std::size_t first, std::size_t N, std::size_t width, long long lo,
+                              std::size_t window, const mpi::Team& team) {
+  const auto P = static_cast<std::size_t>(team.size());
+  const std::vector<std::uint64_t> los = team.all(static_cast<std::uint64_t>(lo)), counts = team.all(window);
+  const std::vector<std::uint64_t> firsts = team.all(first), held = team.all(width ? mine.size() / width : 0);
+  auto row_of = [&](long long v) {
+    const auto n = static_cast<long long>(N);
+    return static_cast<std::size_t>(((v % n) + n) % n);
+  };
+  auto owner = [&](std::size_t g) {
+    std::size_t s = 0;
+    while (s + 1 < P && !(g >= firsts[s] && g < firsts[s] + held[s])) ++s;
+    return s;
+  };
+  std::vector<Vec3> send, recv(window * width), out(window * width);
+  std::vector<std::size_t> sc(P, 0), rc(P, 0);
+  for (std::size_t s = 0; s < P; ++s)
+    for (std::uint64_t v = 0; v < counts[s]; ++v) {
+      const std::size_t g = row_of(static_cast<long long>(los[s]) + static_cast<long long>(v));
+      if (g < first || g >= first + held[static_cast<std::size_t>(team.rank())]) continue;
+      send.insert(send.end(), mine.begin() + static_cast<std::ptrdiff_t>((g - first) * width),
+                  mine.begin() + static_cast<std::ptrdiff_t>((g - first + 1) * width));
+      sc[s] += width;
+    }
+  for (std::size_t v = 0; v < window; ++v) rc[owner(row_of(lo + static_cast<long long>(v)))] += width;
+  team.exchange(send.data(), sc, recv.data(), rc);
+  // From each process its rows of the window, in window order.
+  std::vector<std::size_t> at(P, 0);
+  for (std::size_t s = 1; s < P; ++s) at[s] = at[s - 1] + rc[s - 1];
+  for (std::size_t v = 0; v < window; ++v) {
+    const std::size_t s = owner(row_of(lo + static_cast<long long>(v)));
+    std::copy_n(recv.data() + at[s], width, out.data() + v * width);
+    at[s] += width;
   }
-  file.commit();
-  stages.done(r.build ? "write" : "evaluate_write");
+  return out;
+}
+
+// An approximation split between the processes: detail::approximate_rows on the
+// blocks of rows, then the output as for an interpolation.
+int approximate_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team) {
+  Stages stages(team.rank());
+  io::reader::Context ctx;
+  ctx.base_dir = plan.base;
+  team.run([&] {
+    if (team.rank() == 0) (void)io::reader::check_fields(plan.spec, "", io::reader::find_type("approximate")->fields, ctx);
+  });
+  RowBlock<2> rb = read_block<2>(plan, team);
+  // As the reader does: NaN marks a missing point, infinity is refused.
+  team.run([&] {
+    io::reader::check_finite_block({rb.n[0], rb.n[1]}, {rb.rows.data(), rb.rows.size()}, rb.first * rb.M, "/points", plan.file,
+                                   true);
+  });
+  stages.done("read");
+  detail::GridBlock b;
+  b.rank = 2;
+  b.n = rb.n;
+  b.data = rb.rows.data();
+  b.first = rb.first;
+  b.count = rb.count;
+  b.before = rb.halo[0].data();
+  b.row0 = rb.halo[1].data();
+  b.last = rb.halo[4].data();
+  detail::ApproxRows fit;
+  io::reader::at("/points", [&] { fit = detail::approximate_rows(b, plan.approx, team, [&] { release(rb.rows); }); });
+  release(rb.rows);
+  stages.done("fit");
+  const std::size_t N = fit.net[0], width = fit.net[1];
+  const OutputRows o = output_rows<2>(r, plan, team, fit.knots[0], N, "approximate");
+  const std::size_t window = o.hi >= o.lo ? static_cast<std::size_t>(o.hi - o.lo + 1) : 0;
+  const std::vector<Vec3> cp = window_rows(fit.rows, fit.first, N, width, o.lo, window, team);
+  stages.done("to_rows");
+  write_output<2>(r, team, {fit.degree[0], fit.degree[1]}, {fit.knots[0], fit.knots[1]}, {N, width}, cp, o, window, stages);
   stages.print();
   if (team.rank() == 0)
     for (const std::string& w : ctx.warnings) std::fprintf(stderr, "interpatch: warning: %s\n", w.c_str());
@@ -571,6 +740,7 @@ int mpi_command(const MpiRequest& request, const std::function<int()>& single) {
       split[0] = static_cast<int>(s[0]);
     }
     if (split[0] == 0) return team.await(team.rank() == 0 ? single() : 0);
+    if (plan.approximate) return approximate_run(request, plan, team);
     return plan.dims == 3 ? split_run<3>(request, plan, team) : split_run<2>(request, plan, team);
   } catch (const detail::peer_failure& p) {
     return p.status;

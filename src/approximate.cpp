@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <random>
@@ -10,6 +12,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
+#include "detail/approx_rows.hpp"
 #include "detail/banded.hpp"
 #include "detail/parallel.hpp"
 #include "detail/text.hpp"
@@ -339,8 +342,12 @@ struct Stencil {
 };
 
 // Σ_i w_i B(t_i) B(t_i)ᵀ over the points, the tensor basis of each point expanded.
-template <std::size_t R>
-void add_weighted_data(Stencil<R>& st, const std::array<Axis, R>& axes, const Data<R>& d) {
+// Points [first, first + count) in storage order, into v (a stencil's values):
+// the same additions in the same order whichever block of the points a process holds.
+// Only the stencil rows (control points) `keep` accepts are added to.
+template <std::size_t R, class Weight, class Keep>
+void add_weighted_points(double* v_, const Stencil<R>& st, const std::array<Axis, R>& axes, const Shape<R>& shape,
+                         std::size_t first, std::size_t count, const Weight& weight, const Keep& keep) {
   std::array<std::size_t, R> pp{};
   std::size_t support = 1;
   for (std::size_t a = 0; a < R; ++a) {
@@ -349,10 +356,11 @@ void add_weighted_data(Stencil<R>& st, const std::array<Axis, R>& axes, const Da
   }
   std::vector<double> val(support);
   std::vector<std::size_t> row(support), code(support);
-  for (std::size_t i = 0; i < d.points.size(); ++i) {
-    const double w = d.w(i);
+  for (std::size_t i = first; i < first + count; ++i) {
+    const double w = weight(i);
     if (!(w > 0)) continue;
-    const std::vector<std::size_t> idx = unflatten<R>(i, d.shape);
+    std::array<std::size_t, R> idx{};
+    for (std::size_t a = R, rest = i; a-- > 0; rest /= shape[a]) idx[a] = rest % shape[a];
     for (std::size_t s = 0; s < support; ++s) {
       double v = w;
       std::size_t r = 0, cd = 0;
@@ -375,11 +383,34 @@ void add_weighted_data(Stencil<R>& st, const std::array<Axis, R>& axes, const Da
     std::size_t centre = 0;
     for (std::size_t a = 0; a < R; ++a) centre += st.half[a] * st.stride[a];
     for (std::size_t s = 0; s < support; ++s) {
-      if (val[s] == 0.0) continue;
-      double* dst = st.v.data() + row[s] * st.size + centre - code[s];
-      for (std::size_t t = 0; t < support; ++t) dst[code[t]] += val[s] * val[t] / w;
+      if (val[s] == 0.0 || !keep(row[s])) continue;
+      double* dst = v_ + row[s] * st.size + centre - code[s];
+      // x / 1 is x exactly: the division only where a weight is not 1.
+      if (w == 1.0)
+        for (std::size_t t = 0; t < support; ++t) dst[code[t]] += val[s] * val[t];
+      else
+        for (std::size_t t = 0; t < support; ++t) dst[code[t]] += val[s] * val[t] / w;
     }
   }
+}
+
+template <std::size_t R>
+void add_weighted_data(Stencil<R>& st, const std::array<Axis, R>& axes, const Data<R>& d) {
+  add_weighted_points<R>(st.v.data(), st, axes, d.shape, 0, d.points.size(), [&](std::size_t i) { return d.w(i); },
+                         [](std::size_t) { return true; });
+}
+
+// The data term of points all present with weight 1: the Kronecker product of the
+// directions' Gram matrices.
+template <std::size_t R>
+void add_grams(Stencil<R>& st, const std::array<Axis, R>& axes) {
+  std::array<Band, R> g;
+  std::array<const Band*, R> bands{};
+  for (std::size_t a = 0; a < R; ++a) {
+    g[a] = axes[a].gram(axes[a].p);
+    bands[a] = &g[a];
+  }
+  st.add_kronecker(bands, 1.0);
 }
 
 // The sparse normal equations G + λ s K: G the data term, K the fairness term
@@ -391,23 +422,26 @@ struct SparseSystem {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
   bool analyzed = false;
 
-  SparseSystem(const std::array<Axis, R>& axes, const Data<R>& d) {
+  SparseSystem(const std::array<Axis, R>& axes, const Data<R>& d)
+      : SparseSystem(axes, data_term(axes, d), d.weight_sum, count_of<R>(d.shape)) {}
+
+  // The data term as a stencil: with every point present and of weight 1, the
+  // Kronecker product of the Gram matrices; otherwise summed over the points.
+  static Stencil<R> data_term(const std::array<Axis, R>& axes, const Data<R>& d) {
+    Stencil<R> st(axes);
+    if (d.uniform()) add_grams<R>(st, axes);
+    else add_weighted_data<R>(st, axes, d);
+    return st;
+  }
+
+  // `points` data points of total weight `weight_sum`.
+  SparseSystem(const std::array<Axis, R>& axes, const Stencil<R>& data_stencil, double weight_sum, std::size_t points) {
     std::array<Band, R> gram, fair;
     for (std::size_t a = 0; a < R; ++a) {
       gram[a] = axes[a].gram(axes[a].p);
       fair[a] = axes[a].fairness(2);
     }
-    {
-      Stencil<R> st(axes);
-      if (d.uniform()) {
-        std::array<const Band*, R> bands{};
-        for (std::size_t a = 0; a < R; ++a) bands[a] = &gram[a];
-        st.add_kronecker(bands, 1.0);
-      } else {
-        add_weighted_data<R>(st, axes, d);
-      }
-      data = st.lower(axes);
-    }
+    data = data_stencil.lower(axes);
     Stencil<R> k(axes);
     for (std::size_t a = 0; a < R; ++a) {
       std::array<const Band*, R> bands{};
@@ -415,7 +449,7 @@ struct SparseSystem {
       k.add_kronecker(bands, static_cast<double>(axes[a].n));
     }
     fairness = k.lower(axes);
-    scale = d.weight_sum / static_cast<double>(count_of<R>(d.shape));
+    scale = weight_sum / static_cast<double>(points);
   }
 
   void factor(double lambda) {
@@ -477,16 +511,61 @@ struct SparseSystem {
 // each step over the lines where both its points are present (a step with none
 // takes the mean of the others). Without missing points along an open direction,
 // interpolation's own parameters.
+std::vector<double> uniform_parameters(std::size_t n, bool closed) {
+  const std::size_t steps = closed ? n : n - 1;
+  std::vector<double> t(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) t[i] = static_cast<double>(i) / static_cast<double>(steps);
+  if (!closed) t.back() = 1.0;
+  return t;
+}
+
+// Parameters from the chords summed per step over the lines (sum[k]: step k to
+// k + 1, used[k] lines adding to it).
+std::vector<double> parameters_from_sums(std::vector<double> sum, const std::vector<std::size_t>& used, std::size_t n,
+                                         std::size_t a, Parametrization param, bool closed) {
+  const std::size_t steps = sum.size();
+  double known = 0;
+  std::size_t known_count = 0;
+  for (std::size_t k = 0; k < steps; ++k)
+    if (used[k] > 0) {
+      sum[k] /= static_cast<double>(used[k]);
+      known += sum[k];
+      ++known_count;
+    }
+  if (known_count == 0) return uniform_parameters(n, closed);
+  for (std::size_t k = 0; k < steps; ++k) {
+    if (used[k] == 0) sum[k] = known / static_cast<double>(known_count);
+    // Means below 1e-14 of the total are rounding noise: the points coincide in every line.
+    if (!(sum[k] > 1e-14 * known))
+      fail(errc::zero_chord, "along ", axis_name(a), ": points ", k, " and ", (k + 1) % n,
+           " coincide in every line (mean chord ", sum[k], "): parameters must increase");
+    if (param == Parametrization::centripetal) sum[k] = std::sqrt(sum[k]);
+  }
+  double total = 0;
+  for (std::size_t k = 0; k < steps; ++k) total += sum[k];
+  std::vector<double> t(n, 0.0);
+  for (std::size_t k = 1; k < n; ++k) t[k] = t[k - 1] + sum[k - 1];
+  for (std::size_t k = 1; k < n; ++k) t[k] /= total;
+  if (!closed) t.back() = 1.0;
+  return t;
+}
+
+// The chord from p0 to p1 added to a step's sum when both are present.
+inline void add_chord(const Vec3& p0, const Vec3& p1, double& sum, std::size_t& used) {
+  if (is_missing(p0) || is_missing(p1)) return;
+  sum += distance(p0, p1);
+  ++used;
+}
+
+// Parameters along axis a, averaged over the lines of the grid: the mean chord of
+// each step over the lines where both its points are present (a step with none
+// takes the mean of the others). Without missing points along an open direction,
+// interpolation's own parameters.
 template <std::size_t R>
 std::vector<double> axis_parameters(const Data<R>& d, std::size_t a, Parametrization param, bool closed) {
   const std::size_t n = d.shape[a];
   const std::size_t steps = closed ? n : n - 1;
-  std::vector<double> t(closed ? n : n, 0.0);
-  if (param == Parametrization::uniform) {
-    for (std::size_t i = 0; i < n; ++i) t[i] = static_cast<double>(i) / static_cast<double>(steps);
-    if (!closed) t.back() = 1.0;
-    return t;
-  }
+  if (param == Parametrization::uniform) return uniform_parameters(n, closed);
   if (!closed && d.missing == 0) {
     if constexpr (R == 1) return curve_parameters(std::span<const Vec3>(d.points.data(), n), param);
     else return grid_parameters(d.points, static_cast<int>(a), param);
@@ -498,36 +577,10 @@ std::vector<double> axis_parameters(const Data<R>& d, std::size_t a, Parametriza
   std::vector<std::size_t> used(steps, 0);
   for (std::size_t o = 0; o < outer; ++o)
     for (std::size_t in = 0; in < inner; ++in)
-      for (std::size_t k = 1; k <= steps; ++k) {
-        const Vec3& p0 = d.points.data()[(o * n + k - 1) * inner + in];
-        const Vec3& p1 = d.points.data()[(o * n + k % n) * inner + in];
-        if (is_missing(p0) || is_missing(p1)) continue;
-        sum[k - 1] += distance(p0, p1);
-        ++used[k - 1];
-      }
-  double known = 0;
-  std::size_t known_count = 0;
-  for (std::size_t k = 0; k < steps; ++k)
-    if (used[k] > 0) {
-      sum[k] /= static_cast<double>(used[k]);
-      known += sum[k];
-      ++known_count;
-    }
-  if (known_count == 0) return axis_parameters(d, a, Parametrization::uniform, closed);
-  for (std::size_t k = 0; k < steps; ++k) {
-    if (used[k] == 0) sum[k] = known / static_cast<double>(known_count);
-    // Means below 1e-14 of the total are rounding noise: the points coincide in every line.
-    if (!(sum[k] > 1e-14 * known))
-      fail(errc::zero_chord, "along ", axis_name(a), ": points ", k, " and ", (k + 1) % n,
-           " coincide in every line (mean chord ", sum[k], "): parameters must increase");
-    if (param == Parametrization::centripetal) sum[k] = std::sqrt(sum[k]);
-  }
-  double total = 0;
-  for (std::size_t k = 0; k < steps; ++k) total += sum[k];
-  for (std::size_t k = 1; k < n; ++k) t[k] = t[k - 1] + sum[k - 1];
-  for (std::size_t k = 1; k < n; ++k) t[k] /= total;
-  if (!closed) t.back() = 1.0;
-  return t;
+      for (std::size_t k = 1; k <= steps; ++k)
+        add_chord(d.points.data()[(o * n + k - 1) * inner + in], d.points.data()[(o * n + k % n) * inner + in], sum[k - 1],
+                  used[k - 1]);
+  return parameters_from_sums(std::move(sum), used, n, a, param, closed);
 }
 
 // Knots of a clamped spline with the given interior knots over [t.front(), t.back()].
@@ -614,6 +667,83 @@ struct Residuals {
   }
 };
 
+// Residuals of data rows [q0, q1) (every index but the last fixed; row q of
+// `partial` at partial + (q − base)·3c, of the points at pts + (q − base)·n): the
+// distances, their sums in row order and the maxima, into r. off[i·(p+1) + k]: where
+// basis function k of point i along the last axis finds its control point's
+// coordinates in a row of `partial` (residual_offsets); `row` and `e2` are scratch
+// of 3n and n doubles.
+template <std::size_t R, class Weight>
+void residual_rows(Residuals<R>& r, const std::array<Axis, R>& axes, const Shape<R>& shape, const double* partial,
+                   const Vec3* pts_, std::size_t base, std::size_t q0, std::size_t q1, const Weight& weight,
+                   const std::size_t* off, double* row, double* e2) {
+  const Axis& last = axes[R - 1];
+  const std::size_t n = last.n, c = static_cast<std::size_t>(last.c), pp = static_cast<std::size_t>(last.p) + 1;
+  for (std::size_t q = q0; q < q1; ++q) {
+    const double* src = partial + (q - base) * c * 3;
+    for (std::size_t i = 0; i < n; ++i) {
+      double x = 0, y = 0, z = 0;
+      for (std::size_t k = 0; k < pp; ++k) {
+        const double w = last.b[i * pp + k];
+        const double* v = src + off[i * pp + k];
+        x += w * v[0];
+        y += w * v[1];
+        z += w * v[2];
+      }
+      row[3 * i] = x, row[3 * i + 1] = y, row[3 * i + 2] = z;
+    }
+    // Squared distances first (a loop the compiler vectorizes), then the maxima:
+    // of the row for the axes before the last, per interval along the last.
+    const Vec3* pts = pts_ + (q - base) * n;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double dx = row[3 * i] - pts[i].x, dy = row[3 * i + 1] - pts[i].y, dz = row[3 * i + 2] - pts[i].z;
+      e2[i] = dx * dx + dy * dy + dz * dz;
+    }
+    double row_max = -1;
+    std::size_t row_worst = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double w = weight(q * n + i);
+      if (!(w > 0)) continue;
+      r.sum_sq += e2[i];
+      r.weighted_sq += w * e2[i];
+      if (e2[i] > row_max) {
+        row_max = e2[i];
+        row_worst = i;
+      }
+      auto& m = r.interval_max[R - 1][static_cast<std::size_t>(last.interval[i])];
+      if (e2[i] > m) {
+        m = e2[i];
+        r.interval_worst[R - 1][static_cast<std::size_t>(last.interval[i])] = q * n + i;
+      }
+    }
+    if (row_max < 0) continue;  // every point of the row missing
+    const std::size_t flat = q * n + row_worst;
+    if (row_max > r.max) {
+      r.max = row_max;
+      r.worst = flat;
+    }
+    for (std::size_t a = R - 1, rest = q; a-- > 0; rest /= shape[a]) {
+      const auto k = static_cast<std::size_t>(axes[a].interval[rest % shape[a]]);
+      if (row_max > r.interval_max[a][k]) {
+        r.interval_max[a][k] = row_max;
+        r.interval_worst[a][k] = flat;
+      }
+    }
+  }
+}
+
+std::vector<std::size_t> residual_offsets(const Axis& last) {
+  const std::size_t pp = static_cast<std::size_t>(last.p) + 1;
+  std::vector<std::size_t> off(last.n * pp);
+  for (std::size_t i = 0; i < last.n; ++i)
+    for (std::size_t k = 0; k < pp; ++k) off[i * pp + k] = 3 * last.col(last.first[i] + static_cast<int>(k));
+  return off;
+}
+
+// Data rows are taken in blocks of this many, each block's sums formed on its own
+// and the blocks' added in order (in one process as in a split run).
+constexpr std::size_t residual_block_rows = 16;
+
 // The distances |S(t_i) − Q_i| at every point present, evaluated a row at a time
 // (every index but the last fixed) and never stored: the control net goes through B
 // along every direction but the last once (n_0 ⋯ n_{R−2} × c_{R−1} values), and each
@@ -628,76 +758,21 @@ Residuals<R> residuals(const std::array<Axis, R>& axes, const Data<R>& d, const 
     basis_pass<false, R>(axes[a], partial.data(), shape, a, scratch);
     std::swap(partial, scratch);
   }
-  const Axis& last = axes[R - 1];
-  const std::size_t n = last.n, c = static_cast<std::size_t>(last.c), pp = static_cast<std::size_t>(last.p) + 1;
+  const std::size_t n = axes[R - 1].n, pp = static_cast<std::size_t>(axes[R - 1].p) + 1;
   const std::size_t rows = d.points.size() / n;
-  constexpr std::size_t rows_per_block = 16;
-  const std::size_t blocks = (rows + rows_per_block - 1) / rows_per_block;
+  const std::size_t blocks = (rows + residual_block_rows - 1) / residual_block_rows;
   std::vector<Residuals<R>> part(blocks, Residuals<R>(axes));
   const auto nb = static_cast<long long>(blocks);
-  // Where each basis function of each point along the last axis finds its control
-  // point's coordinates in a row of `partial`.
-  std::vector<std::size_t> off(n * pp);
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t k = 0; k < pp; ++k) off[i * pp + k] = 3 * last.col(last.first[i] + static_cast<int>(k));
+  auto weight = [&](std::size_t i) { return d.w(i); };
+  const std::vector<std::size_t> off = residual_offsets(axes[R - 1]);
 #pragma omp parallel if (d.points.size() * pp * 3 >= parallel_work)
   {
     std::vector<double> row(3 * n), e2(n);
 #pragma omp for schedule(static)
     for (long long bi = 0; bi < nb; ++bi) {
       const auto b = static_cast<std::size_t>(bi);
-      Residuals<R>& r = part[b];
-      for (std::size_t q = b * rows_per_block; q < std::min(rows, (b + 1) * rows_per_block); ++q) {
-        const double* src = partial.data() + q * c * 3;
-        for (std::size_t i = 0; i < n; ++i) {
-          double x = 0, y = 0, z = 0;
-          for (std::size_t k = 0; k < pp; ++k) {
-            const double w = last.b[i * pp + k];
-            const double* v = src + off[i * pp + k];
-            x += w * v[0];
-            y += w * v[1];
-            z += w * v[2];
-          }
-          row[3 * i] = x, row[3 * i + 1] = y, row[3 * i + 2] = z;
-        }
-        // Squared distances first (a loop the compiler vectorizes), then the maxima:
-        // of the row for the axes before the last, per interval along the last.
-        const Vec3* pts = d.points.data() + q * n;
-        for (std::size_t i = 0; i < n; ++i) {
-          const double dx = row[3 * i] - pts[i].x, dy = row[3 * i + 1] - pts[i].y, dz = row[3 * i + 2] - pts[i].z;
-          e2[i] = dx * dx + dy * dy + dz * dz;
-        }
-        double row_max = -1;
-        std::size_t row_worst = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-          const double w = d.w(q * n + i);
-          if (!(w > 0)) continue;
-          r.sum_sq += e2[i];
-          r.weighted_sq += w * e2[i];
-          if (e2[i] > row_max) {
-            row_max = e2[i];
-            row_worst = i;
-          }
-          auto& m = r.interval_max[R - 1][static_cast<std::size_t>(last.interval[i])];
-          if (e2[i] > m) {
-            m = e2[i];
-            r.interval_worst[R - 1][static_cast<std::size_t>(last.interval[i])] = q * n + i;
-          }
-        }
-        if (row_max < 0) continue;  // every point of the row missing
-        const std::size_t flat = q * n + row_worst;
-        if (row_max > r.max) {
-          r.max = row_max;
-          r.worst = flat;
-        }
-        for (std::size_t a = R - 1, rest = q; a-- > 0; rest /= d.shape[a]) {
-          const auto k = static_cast<std::size_t>(axes[a].interval[rest % d.shape[a]]);
-          if (row_max > r.interval_max[a][k]) {
-            r.interval_max[a][k] = row_max;
-            r.interval_worst[a][k] = flat;
-          }
-        }
-      }
+      residual_rows<R>(part[b], axes, d.shape, partial.data(), d.points.data(), 0, b * residual_block_rows,
+                       std::min(rows, (b + 1) * residual_block_rows), weight, off.data(), row.data(), e2.data());
     }
   }
   Residuals<R> all(axes);
@@ -757,6 +832,16 @@ bool needs_fill(const Data<R>& d) {
 // any tolerance a user asks for.
 constexpr double fill_fraction = 1e-5;
 
+// The fit of the sparse system with fairness weight λ (none: 0), at least the
+// weight that fills holes when `fill`.
+template <std::size_t R>
+void sparse_fit(Fit<R>& f, SparseSystem<R>& sys, const std::vector<double>& rhs, std::optional<double> lambda, bool fill) {
+  const double filler = fill ? fill_fraction * sys.diagonal_ratio() : 0.0;
+  f.lambda = lambda ? std::max(*lambda, filler) : filler;
+  sys.factor(f.lambda);
+  f.cp = sys.solve(rhs);
+}
+
 template <std::size_t R>
 void solve_once(Fit<R>& f, const Data<R>& d, std::optional<double> lambda) {
   ++f.fits;
@@ -774,26 +859,23 @@ void solve_once(Fit<R>& f, const Data<R>& d, std::optional<double> lambda) {
     }
   }
   SparseSystem<R> sys(f.axes, d);
-  const double filler = fill ? fill_fraction * sys.diagonal_ratio() : 0.0;
-  f.lambda = lambda ? std::max(*lambda, filler) : filler;
-  sys.factor(f.lambda);
-  f.cp = sys.solve(right_hand_side<R>(f.axes, d));
+  sparse_fit<R>(f, sys, right_hand_side<R>(f.axes, d), lambda, fill);
 }
 
 // λ by generalized cross-validation: the minimum over λ of
 //   V(λ) = n Σ w r² / (n − tr H(λ))²,
 // n the points present, H the map from data to fitted values (its trace estimated),
 // first on a grid of one value per decade, then by golden section around the best.
-template <std::size_t R>
-void solve_gcv(Fit<R>& f, const Data<R>& d) {
-  SparseSystem<R> sys(f.axes, d);
-  const std::vector<double> rhs = right_hand_side<R>(f.axes, d);
-  const auto n = static_cast<double>(d.present);
+// `present` points with data, `fill`: some are missing; rss(cp): the weighted sum of
+// squared residuals of control points cp.
+template <std::size_t R, class Rss>
+void gcv_fit(Fit<R>& f, SparseSystem<R>& sys, const std::vector<double>& rhs, std::size_t present, bool fill, const Rss& rss_of) {
+  const auto n = static_cast<double>(present);
   // Probes of the trace estimate: its error, about sqrt(2 / probes) of the Frobenius
   // norm of M⁻¹ λ s K (at most sqrt(C)), stays a small part of n − tr H.
   constexpr int probes = 24;
   // With holes, λ never goes below the weight that fills them.
-  const double floor = needs_fill(d) ? fill_fraction * sys.diagonal_ratio() : 0.0;
+  const double floor = fill ? fill_fraction * sys.diagonal_ratio() : 0.0;
   auto score = [&](double log_lambda) {
     ++f.fits;
     const double lambda = std::max(floor, std::pow(10.0, log_lambda));
@@ -804,7 +886,7 @@ void solve_gcv(Fit<R>& f, const Data<R>& d) {
       return std::numeric_limits<double>::infinity();  // too little fairness for the data: not a candidate
     }
     f.cp = sys.solve(rhs);
-    const double rss = residuals<R>(f.axes, d, f.cp).weighted_sq;
+    const double rss = rss_of(f.cp);
     // n − tr H = n − C + tr(M⁻¹ λ s K).
     const double rest = n - static_cast<double>(sys.data.rows()) + sys.fairness_trace(lambda, probes);
     if (!(rest > 0)) return std::numeric_limits<double>::infinity();
@@ -836,6 +918,13 @@ void solve_gcv(Fit<R>& f, const Data<R>& d) {
   f.lambda = std::max(floor, std::pow(10.0, x));
   sys.factor(f.lambda);
   f.cp = sys.solve(rhs);
+}
+
+template <std::size_t R>
+void solve_gcv(Fit<R>& f, const Data<R>& d) {
+  SparseSystem<R> sys(f.axes, d);
+  gcv_fit<R>(f, sys, right_hand_side<R>(f.axes, d), d.present, needs_fill(d),
+             [&](const std::vector<double>& cp) { return residuals<R>(f.axes, d, cp).weighted_sq; });
 }
 
 // The residual at point `i` of the least-squares fit along axis a alone of the line
@@ -1122,14 +1211,9 @@ void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_cal
   }
 }
 
+// Exactly one of the three ways, and enough points.
 template <std::size_t R>
-struct Result {
-  Fit<R> fit;
-  ApproximationReport report;
-};
-
-template <std::size_t R>
-Result<R> approximate(Data<R> d, const ApproximationOptions<R>& o, const char* what) {
+void check_request(const ApproximationOptions<R>& o, const Shape<R>& shape, const char* what) {
   // Exactly one of the three ways.
   const int ways = (o.control_points ? 1 : 0) + (o.tolerance ? 1 : 0) + ((o.smoothing || o.auto_smoothing) ? 1 : 0);
   if (ways != 1)
@@ -1141,9 +1225,60 @@ Result<R> approximate(Data<R> d, const ApproximationOptions<R>& o, const char* w
   if (o.smoothing && !(*o.smoothing >= 0 && std::isfinite(*o.smoothing)))
     fail(errc::wrong_type, "smoothing ", *o.smoothing, " is not a non-negative number");
   for (std::size_t a = 0; a < R; ++a)
-    if (d.shape[a] < 2)
+    if (shape[a] < 2)
       fail(errc::too_few_points, what, " approximation needs at least 2 points along ", axis_name(a), ", got ",
-           d.shape[a]);
+           shape[a]);
+}
+
+// Direction a of n data points: its degree, checked.
+template <std::size_t R>
+void set_degree(Axis& ax, const ApproximationOptions<R>& o, std::size_t a, std::size_t n) {
+  ax.n = n;
+  ax.periodic = o.periodic[a];
+  const int p = o.degree[a] ? *o.degree[a] : std::min<int>(3, static_cast<int>(ax.n) - 1);
+  if (p < 1 || p > max_degree)
+    fail(errc::invalid_degree, "degree ", p, " along ", axis_name(a), " is outside 1..", max_degree);
+  if (ax.n < static_cast<std::size_t>(p) + 1)
+    fail(errc::too_few_points, "degree ", p, " along ", axis_name(a), " needs at least ", p + 1, " points, got ", ax.n);
+  ax.p = p;
+}
+
+template <std::size_t R>
+void check_control_points(const std::array<Axis, R>& axes, const ApproximationOptions<R>& o) {
+  if (o.control_points)
+    for (std::size_t a = 0; a < R; ++a) {
+      const int c = (*o.control_points)[a];
+      const Axis& ax = axes[a];
+      if (c < ax.p + 1)
+        fail(errc::too_few_points, c, " control points along ", axis_name(a), " are fewer than degree ", ax.p,
+             " needs (", ax.p + 1, ")");
+      if (static_cast<std::size_t>(c) > ax.n)
+        fail(errc::too_few_points, c, " control points along ", axis_name(a), " are more than the ", ax.n,
+             " data points there: least squares needs at least as many data as control points");
+    }
+}
+
+// The knots of a fit with a given number of control points or a smoothing fit.
+template <std::size_t R>
+void set_fit_knots(std::array<Axis, R>& axes, const ApproximationOptions<R>& o) {
+  for (std::size_t a = 0; a < R; ++a) {
+    Axis& ax = axes[a];
+    int c = 0;
+    if (o.control_points) c = (*o.control_points)[a];
+    else c = std::max(ax.p + 1, std::min(static_cast<int>(ax.n), smoothing_max_control_points));
+    ax.set_knots(knots_from_breaks(ax, least_squares_breaks(ax, c)));
+  }
+}
+
+template <std::size_t R>
+struct Result {
+  Fit<R> fit;
+  ApproximationReport report;
+};
+
+template <std::size_t R>
+Result<R> approximate(Data<R> d, const ApproximationOptions<R>& o, const char* what) {
+  check_request<R>(o, d.shape, what);
 
   // Missing points, weights.
   const std::size_t total = d.points.size();
@@ -1188,40 +1323,16 @@ Result<R> approximate(Data<R> d, const ApproximationOptions<R>& o, const char* w
   Result<R> res;
   Fit<R>& f = res.fit;
   for (std::size_t a = 0; a < R; ++a) {
-    Axis& ax = f.axes[a];
-    ax.n = d.shape[a];
-    ax.periodic = o.periodic[a];
-    const int p = o.degree[a] ? *o.degree[a] : std::min<int>(3, static_cast<int>(ax.n) - 1);
-    if (p < 1 || p > max_degree)
-      fail(errc::invalid_degree, "degree ", p, " along ", axis_name(a), " is outside 1..", max_degree);
-    if (ax.n < static_cast<std::size_t>(p) + 1)
-      fail(errc::too_few_points, "degree ", p, " along ", axis_name(a), " needs at least ", p + 1, " points, got ", ax.n);
-    ax.p = p;
-    ax.t = axis_parameters<R>(d, a, o.param, ax.periodic);
+    set_degree<R>(f.axes[a], o, a, d.shape[a]);
+    f.axes[a].t = axis_parameters<R>(d, a, o.param, f.axes[a].periodic);
   }
-  if (o.control_points)
-    for (std::size_t a = 0; a < R; ++a) {
-      const int c = (*o.control_points)[a];
-      const Axis& ax = f.axes[a];
-      if (c < ax.p + 1)
-        fail(errc::too_few_points, c, " control points along ", axis_name(a), " are fewer than degree ", ax.p,
-             " needs (", ax.p + 1, ")");
-      if (static_cast<std::size_t>(c) > ax.n)
-        fail(errc::too_few_points, c, " control points along ", axis_name(a), " are more than the ", ax.n,
-             " data points there: least squares needs at least as many data as control points");
-    }
+  check_control_points<R>(f.axes, o);
   if (o.progress) o.progress(0.0);
 
   if (o.tolerance) {
     solve_tolerance<R>(f, d, *o.tolerance, o.progress);
   } else {
-    for (std::size_t a = 0; a < R; ++a) {
-      Axis& ax = f.axes[a];
-      int c = 0;
-      if (o.control_points) c = (*o.control_points)[a];
-      else c = std::max(ax.p + 1, std::min(static_cast<int>(ax.n), smoothing_max_control_points));
-      ax.set_knots(knots_from_breaks(ax, least_squares_breaks(ax, c)));
-    }
+    set_fit_knots<R>(f.axes, o);
     if (o.auto_smoothing) solve_gcv<R>(f, d);
     else solve_once<R>(f, d, o.smoothing);
   }
@@ -1330,5 +1441,342 @@ VolumeApproximation approximate_volume(PointGrid3 points, const VolumeApproximat
   return {BSplineVolume(ax[0].knots, ax[1].knots, ax[2].knots, std::move(net)), std::move(ax[0].t), std::move(ax[1].t),
           std::move(ax[2].t), std::move(r.report)};
 }
+
+
+// ------------------------------------------------------------------ split between processes
+
+namespace {
+
+static_assert(sizeof(Vec3) == 3 * sizeof(double), "points move between processes as triples of doubles");
+const Vec3* as_points(const double* d) { return reinterpret_cast<const Vec3*>(d); }
+Vec3* as_points(double* d) { return reinterpret_cast<Vec3*>(d); }
+
+// A rows × width array of points held in consecutive blocks of rows (`mine` here),
+// turned into columns: every row of this process's even share of the columns. A
+// missing point (a NaN coordinate) goes as zeros: its weight 0 times the point, as
+// the weighted data of right_hand_side.
+// `packed` is called once the rows are read.
+std::vector<double> rows_to_columns(const Vec3* rows, std::size_t mine, std::size_t width, const detail::RowTeam& team,
+                                    const std::function<void()>& packed = {}) {
+  const std::size_t P = team.processes(), me = team.process();
+  const std::vector<double> counts = team.gather(std::vector<double>{static_cast<double>(mine)});
+  std::size_t total = 0;
+  for (const double c : counts) total += static_cast<std::size_t>(c);
+  const std::size_t C = detail::even_share(width, me, P).second;
+  std::vector<double> send;
+  team.run([&] {
+    require_memory(mine * width + total * C, sizeof(Vec3), "a transpose of the data between processes");
+    send.resize(3 * mine * width);
+  });
+  std::vector<std::size_t> sc(P), rc(P);
+  std::size_t at = 0;
+  for (std::size_t s = 0; s < P; ++s) {
+    const std::pair<std::size_t, std::size_t> cols = detail::even_share(width, s, P);
+    for (std::size_t i = 0; i < mine; ++i) {
+      const Vec3* from = rows + i * width + cols.first;
+      Vec3* to = as_points(send.data()) + at + i * cols.second;
+      for (std::size_t k = 0; k < cols.second; ++k) to[k] = is_missing(from[k]) ? Vec3{} : from[k];
+    }
+    sc[s] = mine * cols.second;
+    rc[s] = static_cast<std::size_t>(counts[s]) * C;
+    at += sc[s];
+  }
+  if (packed) packed();
+  std::vector<double> out;
+  team.run([&] { out.resize(3 * total * C); });
+  team.exchange(as_points(send.data()), sc, as_points(out.data()), rc);
+  return out;
+}
+
+// The reverse with a new split: columns (total × this process's even share of the
+// width) to this process's even share of the rows, whole.
+std::vector<double> columns_to_rows(const std::vector<double>& cols, std::size_t total, std::size_t width,
+                                    const detail::RowTeam& team) {
+  const std::size_t P = team.processes(), me = team.process();
+  const std::size_t C = detail::even_share(width, me, P).second, mine = detail::even_share(total, me, P).second;
+  std::vector<std::size_t> sc(P), rc(P);
+  for (std::size_t s = 0; s < P; ++s) {
+    sc[s] = detail::even_share(total, s, P).second * C;
+    rc[s] = mine * detail::even_share(width, s, P).second;
+  }
+  std::vector<double> recv, out;
+  team.run([&] {
+    require_memory(2 * mine * width, sizeof(Vec3), "a transpose of the data between processes");
+    recv.resize(3 * mine * width);
+    out.resize(3 * mine * width);
+  });
+  // The columns are in row order: process s's rows are the s-th run of them.
+  team.exchange(as_points(cols.data()), sc, as_points(recv.data()), rc);
+  std::size_t at = 0;
+  for (std::size_t s = 0; s < P; ++s) {
+    const std::pair<std::size_t, std::size_t> c = detail::even_share(width, s, P);
+    for (std::size_t v = 0; v < mine; ++v, at += c.second)
+      std::copy_n(recv.data() + 3 * at, 3 * c.second, out.data() + 3 * (v * width + c.first));
+  }
+  return out;
+}
+
+// Data points [first, first + count) of an axis: its basis values there.
+Axis axis_slice(const Axis& ax, std::size_t first, std::size_t count) {
+  Axis s = ax;
+  const auto pp = static_cast<std::size_t>(ax.p) + 1;
+  auto part = [&](const auto& v, std::size_t per) {
+    using V = std::decay_t<decltype(v)>;
+    return V(v.begin() + static_cast<std::ptrdiff_t>(first * per), v.begin() + static_cast<std::ptrdiff_t>((first + count) * per));
+  };
+  s.n = count;
+  s.t = part(ax.t, 1);
+  s.first = part(ax.first, 1);
+  s.b = part(ax.b, pp);
+  s.interval = part(ax.interval, 1);
+  return s;
+}
+
+// Data rows [first, first + count) of a surface's grid held by this process: their
+// part of the data term Σ w B Bᵀ, summed as one process sums it (point after point)
+// and gathered into st on every process. A control row's entries take sums over the
+// data rows its basis functions reach, in order: the rows whose data lie in one
+// process's block are summed there, all at once; those whose data straddle the
+// block before (a few rows at each boundary) start from the sums the processes
+// before have reached, handed on in order, and go on with this process's points.
+template <class Weight>
+void add_block_data(Stencil<2>& st, const std::array<Axis, 2>& axes, const Shape<2>& shape, const detail::GridBlock& b,
+                    const Weight& weight, const detail::RowTeam& team) {
+  const std::size_t P = team.processes(), me = team.process(), c0 = st.c[0], c1 = st.c[1];
+  const std::size_t row_len = c1 * st.size;  // doubles of a control row of the stencil
+  const std::size_t base = b.first * shape[1], mine = b.count * shape[1];
+  const Axis& u = axes[0];
+  // The control rows each process's data rows reach: [lo, hi], −1 for none.
+  const double lo_here = b.count > 0 ? static_cast<double>(u.first[b.first]) : -1.0;
+  const double hi_here = b.count > 0 ? static_cast<double>(u.first[b.first + b.count - 1] + u.p) : -1.0;
+  const std::vector<double> los = team.gather(std::vector<double>{lo_here}), his = team.gather(std::vector<double>{hi_here});
+  auto has = [&](std::size_t r) { return los[r] >= 0; };
+  auto lo_of = [&](std::size_t r) { return static_cast<std::size_t>(los[r]); };
+  auto hi_of = [&](std::size_t r) { return static_cast<std::size_t>(his[r]); };
+  auto before = [&](std::size_t r) {  // the last process before r with data rows, P for none
+    for (std::size_t q = r; q-- > 0;)
+      if (has(q)) return q;
+    return P;
+  };
+  auto after = [&](std::size_t r) {
+    for (std::size_t q = r + 1; q < P; ++q)
+      if (has(q)) return q;
+    return P;
+  };
+  // Rows [s_lo, s_hi] of process r continue the sums of the processes before it.
+  auto continued = [&](std::size_t r) -> std::pair<std::size_t, std::size_t> {
+    const std::size_t q = before(r);
+    if (!has(r) || q == P || hi_of(q) < lo_of(r)) return {1, 0};
+    return {lo_of(r), std::min(hi_of(r), hi_of(q))};
+  };
+  const std::pair<std::size_t, std::size_t> mine_continued = continued(me);
+  const std::size_t s_lo = mine_continued.first, s_hi = mine_continued.second;
+  auto in_continued = [&](std::size_t row) { return row / c1 >= s_lo && row / c1 <= s_hi; };
+  add_weighted_points<2>(st.v.data(), st, axes, shape, base, mine, weight, [&](std::size_t row) { return !in_continued(row); });
+  std::size_t width = 0;
+  for (std::size_t r = 0; r < P; ++r) {
+    const std::pair<std::size_t, std::size_t> c = continued(r);
+    if (c.second >= c.first) width = std::max(width, c.second - c.first + 1);
+  }
+  std::vector<double> acc(width * row_len, 0.0);
+  team.fold(acc, [&](std::span<double> a) {
+    if (!has(me)) return;  // hands on what it got
+    if (s_hi >= s_lo) {
+      std::copy_n(a.data(), (s_hi - s_lo + 1) * row_len, st.v.data() + s_lo * row_len);
+      add_weighted_points<2>(st.v.data(), st, axes, shape, base, mine, weight, in_continued);
+    }
+    if (const std::size_t next = after(me); next < P) {
+      const std::pair<std::size_t, std::size_t> c = continued(next);
+      if (c.second >= c.first) std::copy_n(st.v.data() + c.first * row_len, (c.second - c.first + 1) * row_len, a.data());
+    }
+  });
+  // Each control row from the last process that added to it: process r the rows from
+  // its first (0 for the first process with data) up to the next one's first.
+  std::size_t own_lo = 0, own_hi = 0;
+  if (has(me)) {
+    own_lo = before(me) == P ? 0 : lo_of(me);
+    own_hi = after(me) == P ? c0 : lo_of(after(me));
+  }
+  std::vector<double> all = team.gather(std::span<const double>(st.v.data() + own_lo * row_len, (own_hi - own_lo) * row_len));
+  INTERPATCH_ASSERT(all.size() == st.v.size());
+  st.v = std::move(all);
+}
+
+}  // namespace
+
+namespace detail {
+
+bool approximate_rows_covers(const SurfaceApproximationOptions& o) {
+  return !o.tolerance && o.weights.empty() && !o.periodic[0] && !o.periodic[1];
+}
+
+ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOptions& o, const RowTeam& team,
+                            const std::function<void()>& release) {
+  constexpr std::size_t R = 2;
+  INTERPATCH_ASSERT(b.rank == 2 && approximate_rows_covers(o));
+  const std::size_t P = team.processes(), me = team.process();
+  const Shape<R> shape{b.n[0], b.n[1]};
+  const std::size_t M = shape[1], total = shape[0] * shape[1], mine = b.count * M, base = b.first * M;
+  const Vec3* pts = b.data;
+  team.run([&] { check_request<R>(o, shape, "surface"); });
+
+  // The points present have weight 1, the missing ones 0, as in approximate().
+  std::size_t missing[1] = {0};
+  for (std::size_t i = 0; i < mine; ++i) missing[0] += is_missing(pts[i]) ? 1 : 0;
+  team.sum(missing);
+  const std::size_t present = total - missing[0];
+  const bool fill = missing[0] > 0;
+  // Which points are present, kept past the points themselves.
+  std::vector<bool> present_here(fill ? mine : 0);
+  for (std::size_t i = 0; i < present_here.size(); ++i) present_here[i] = !is_missing(pts[i]);
+  auto weight = [&](std::size_t flat) { return !fill || present_here[flat - base] ? 1.0 : 0.0; };
+  team.run([&] {
+    if (present == 0)
+      fail(errc::too_few_points, "all ", total, " points are missing or have weight 0: there is nothing to approximate");
+  });
+
+  // Degrees and parameters.
+  // In one process's order: the degree along u, the parameters along u, the degree
+  // along v (a refusal kept until the parameters along u are found), along v.
+  Fit<R> f;
+  team.run([&] { set_degree<R>(f.axes[0], o, 0, shape[0]); });
+  std::exception_ptr v_degree;
+  try {
+    set_degree<R>(f.axes[1], o, 1, shape[1]);
+  } catch (const error&) {
+    v_degree = std::current_exception();
+  }
+  const std::size_t axes = v_degree ? 1 : R;
+  if (o.param == Parametrization::uniform) {
+    for (std::size_t a = 0; a < R; ++a) f.axes[a].t = uniform_parameters(shape[a], false);
+  } else if (!fill) {
+    std::vector<std::vector<double>> t = block_parameters(b, o.param, team, axes);
+    for (std::size_t a = 0; a < R; ++a) f.axes[a].t = std::move(t[a]);
+  } else {
+    // Along u each step's chords lie in the rows of one process (the row before the
+    // block from its neighbour) and are summed over the row, as in one process;
+    // along v the lines are summed row after row, a running sum passed on in order.
+    std::vector<double> sum0, used0;
+    for (std::size_t k = b.first == 0 ? 1 : 0; k < b.count; ++k) {
+      const Vec3* prev = k == 0 ? b.before : pts + (k - 1) * M;
+      double sum = 0;
+      std::size_t used = 0;
+      for (std::size_t i = 0; i < M; ++i) add_chord(prev[i], pts[k * M + i], sum, used);
+      sum0.push_back(sum);
+      used0.push_back(static_cast<double>(used));
+    }
+    const std::vector<double> all_sum0 = team.gather(sum0), all_used0 = team.gather(used0);
+    const std::size_t steps1 = M - 1;
+    std::vector<double> acc1(2 * steps1, 0.0);
+    team.fold(acc1, [&](std::span<double> acc) {
+      for (std::size_t r = 0; r < b.count; ++r)
+        for (std::size_t k = 1; k <= steps1; ++k) {
+          std::size_t used = 0;
+          add_chord(pts[r * M + k - 1], pts[r * M + k], acc[k - 1], used);
+          acc[steps1 + k - 1] += static_cast<double>(used);
+        }
+    });
+    auto counts = [](auto first, auto last) {
+      std::vector<std::size_t> c;
+      for (; first != last; ++first) c.push_back(static_cast<std::size_t>(*first));
+      return c;
+    };
+    team.run([&] {
+      f.axes[0].t = parameters_from_sums(all_sum0, counts(all_used0.begin(), all_used0.end()), shape[0], 0, o.param, false);
+      if (axes < R) return;
+      f.axes[1].t = parameters_from_sums(std::vector<double>(acc1.begin(), acc1.begin() + static_cast<std::ptrdiff_t>(steps1)),
+                                         counts(acc1.begin() + static_cast<std::ptrdiff_t>(steps1), acc1.end()), shape[1], 1,
+                                         o.param, false);
+    });
+  }
+  team.run([&] {
+    if (v_degree) std::rethrow_exception(v_degree);
+  });
+  team.run([&] {
+    check_control_points<R>(f.axes, o);
+    set_fit_knots<R>(f.axes, o);
+  });
+  const auto c0 = static_cast<std::size_t>(f.axes[0].c), c1 = static_cast<std::size_t>(f.axes[1].c);
+  const std::size_t nr = even_share(c0, me, P).second;
+
+  // Bᵀ (w Q): along u on columns of the data, along v on rows of the result.
+  std::vector<double> rhs;
+  {
+    std::vector<double> cols = rows_to_columns(pts, b.count, M, team, [&] {
+      if (release && !o.auto_smoothing) release();
+    }), tmp;
+    Shape<R> cs{shape[0], even_share(M, me, P).second};
+    basis_pass<true, R>(f.axes[0], cols.data(), cs, 0, tmp);
+    std::vector<double>().swap(cols);
+    std::vector<double> rows = columns_to_rows(tmp, c0, M, team);
+    Shape<R> rs{nr, M};
+    basis_pass<true, R>(f.axes[1], rows.data(), rs, 1, rhs);
+  }
+
+  // The separable fit when it applies (separable_fit), else the sparse system.
+  bool separable = !o.smoothing && !o.auto_smoothing && !fill;
+  std::array<std::optional<AxisSolver>, R> lu;
+  if (separable) {
+    team.run([&] {
+      try {
+        for (std::size_t a = 0; a < R; ++a) lu[a] = factor_gram(f.axes[a], a);
+      } catch (const error& e) {
+        if (e.code() != errc::singular) throw;
+        separable = false;
+      }
+    });
+  }
+  ApproxRows out;
+  out.first = even_share(c0, me, P).first;
+  if (separable) {
+    std::vector<double> cols = rows_to_columns(as_points(rhs.data()), nr, c1, team);
+    const std::size_t cshape[2] = {c0, even_share(c1, me, P).second}, rshape[2] = {nr, c1};
+    std::visit([&](const auto& s) { solve_along_axis(s, cols.data(), cshape, R, 0, 3); }, *lu[0]);
+    std::vector<double> rows = columns_to_rows(cols, c0, c1, team);
+    std::visit([&](const auto& s) { solve_along_axis(s, rows.data(), rshape, R, 1, 3); }, *lu[1]);
+    if (nr > 0) out.rows.assign(as_points(rows.data()), as_points(rows.data()) + nr * c1);
+  } else {
+    Stencil<R> st(f.axes);
+    if (!fill) add_grams<R>(st, f.axes);
+    else add_block_data(st, f.axes, shape, b, weight, team);
+    SparseSystem<R> sys(f.axes, st, static_cast<double>(present), total);
+    const std::vector<double> all_rhs = team.gather(rhs);
+    if (o.auto_smoothing) {
+      // Σ w r² over the data: blocks of rows as in residuals(), their sums added in order.
+      const Axis slice = axis_slice(f.axes[0], b.first, b.count);
+      const std::vector<std::size_t> off = residual_offsets(f.axes[1]);
+      std::vector<double> row(3 * M), e2(M);
+      auto rss = [&](const std::vector<double>& cp) {
+        Shape<R> sh{c0, c1};
+        std::vector<double> partial;
+        basis_pass<false, R>(slice, cp.data(), sh, 0, partial);
+        std::vector<double> sums;
+        for (std::size_t q = b.first; q < b.first + b.count; q += residual_block_rows) {
+          Residuals<R> r(f.axes);
+          residual_rows<R>(r, f.axes, shape, partial.data(), pts, b.first, q,
+                           std::min(b.first + b.count, q + residual_block_rows), weight, off.data(), row.data(), e2.data());
+          sums.push_back(r.weighted_sq);
+        }
+        std::vector<double> acc(1, 0.0);
+        team.fold(acc, [&](std::span<double> a) {
+          for (const double x : sums) a[0] += x;
+        });
+        return acc[0];
+      };
+      team.run([&] { gcv_fit<R>(f, sys, all_rhs, present, fill, rss); });
+    } else {
+      team.run([&] { sparse_fit<R>(f, sys, all_rhs, o.smoothing, fill || !o.smoothing); });
+    }
+    out.rows.assign(as_points(f.cp.data()) + out.first * c1, as_points(f.cp.data()) + (out.first + nr) * c1);
+  }
+  for (std::size_t a = 0; a < R; ++a) {
+    out.degree[a] = f.axes[a].p;
+    out.knots[a] = f.axes[a].knots.mapped(0.0, 1.0);
+  }
+  out.net = {c0, c1};
+  return out;
+}
+
+}  // namespace detail
 
 }  // namespace interpatch

@@ -993,6 +993,48 @@ Closing block_closing(const GridBlock& b, std::size_t axis, std::span<const Vec3
   return find_closing(lines, n, point, diagonal, where, team, first_line);
 }
 
+std::vector<std::vector<double>> block_parameters(const GridBlock& b, Parametrization param, const RowTeam& team,
+                                                  std::size_t axes) {
+  const std::size_t R = b.rank, M = b.row_size();
+  // As grid_parameters_of: a grid of extreme scale is measured scaled by 2^-shift.
+  const int shift = param == Parametrization::uniform ? 0 : extreme_shift(b, team);
+  GridBlock s = b;
+  std::vector<Vec3> scaled;
+  if (shift != 0) {
+    team.run([&] {
+      check_block_finite(b);
+      require_memory((b.count + 3) * M, sizeof(Vec3), "a scaled copy of the grid");
+    });
+    scaled.resize((b.count + 3) * M);
+    Vec3* at = scaled.data();
+    auto copy = [&](const Vec3* from, std::size_t rows) {
+      Vec3* to = at;
+      if (from != nullptr) std::copy_n(from, rows * M, to);
+      at += rows * M;
+      return to;
+    };
+    s.data = copy(b.data, b.count);
+    s.before = b.first > 0 ? copy(b.before, 1) : nullptr;
+    s.row0 = copy(b.row0, 1);
+    s.last = copy(b.last, 1);
+    scale_points(scaled.data(), static_cast<std::size_t>(at - scaled.data()), -shift);
+  }
+  const GridChords chords(s, param, {}, team);
+  std::vector<std::vector<double>> t(R);
+  std::vector<double> steps(s.count, 0.0);
+  if (chords.uses_chords()) {
+    std::vector<double> scratch(M);
+    for (std::size_t k = s.first == 0 ? 1 : 0; k < s.count; ++k)
+      steps[k] = chords.row_step(k == 0 ? s.before : s.data + (k - 1) * M, s.data + k * M, scratch.data());
+  }
+  const std::vector<double> all_steps = team.gather(steps);
+  team.run([&] {
+    t[0] = chords.u_parameters(all_steps);
+    for (std::size_t a = 1; a < std::min(R, axes); ++a) t[a] = chords.in_row_parameters(a);
+  });
+  return t;
+}
+
 RowSolution solve_rows(const GridBlock& b, std::span<const int> p, Parametrization param, std::span<const bool> periodic,
                        const RowTeam& team) {
   const std::size_t R = b.rank, M = b.row_size();

@@ -9,11 +9,13 @@
 // (exact in any order), running sums handed from process to process in row order
 // (the fixed order of the single process), and the rows' steps gathered in order.
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <functional>
 #include <optional>
 #include <span>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -49,7 +51,24 @@ class RowTeam {
   virtual void fold(std::span<double> acc, const std::function<void(std::span<double>)>& add) const { add(acc); }
   /// Every process's values, concatenated in order.
   [[nodiscard]] virtual std::vector<double> gather(std::span<const double> mine) const { return {mine.begin(), mine.end()}; }
+  /// How many processes there are, and which one this is (row order).
+  [[nodiscard]] virtual std::size_t processes() const { return 1; }
+  [[nodiscard]] virtual std::size_t process() const { return 0; }
+  /// Points in blocks: send[r] goes to process r, recv[r] comes from it (counted per
+  /// process, the buffers laid out in process order). Alone: a copy.
+  virtual void exchange(const Vec3* send, std::span<const std::size_t> send_counts, Vec3* recv,
+                        std::span<const std::size_t> recv_counts) const {
+    (void)recv_counts;
+    std::copy_n(send, send_counts[0], recv);
+  }
 };
+
+/// An even split of n items between `parts` processes: {first, count} of process k.
+[[nodiscard]] inline std::pair<std::size_t, std::size_t> even_share(std::size_t n, std::size_t k, std::size_t parts) {
+  const std::size_t a = n * k / parts, b = n * (k + 1) / parts;
+  return {a, b - a};
+}
+
 
 /// Thrown on the processes whose peers failed a RowTeam::run step: the failing
 /// process reports; the others end with the same exit status, silently.
@@ -117,5 +136,10 @@ void insert_seam(Grid<Vec3, Rank>& points, std::size_t axis, KnotVector& knots, 
 /// Leaves out the last line along `axis` (a closing line equal to the first).
 template <std::size_t Rank>
 void drop_last_line(Grid<Vec3, Rank>& points, std::size_t axis);
+
+/// The parameters along the first `axes` axes of a grid held in blocks of rows, as
+/// grid_parameters gives them for the whole grid (open directions, every point present).
+std::vector<std::vector<double>> block_parameters(const GridBlock& b, Parametrization param, const RowTeam& team,
+                                                  std::size_t axes);
 
 }  // namespace interpatch::detail

@@ -38,6 +38,13 @@ std::string mpi_message(int code) {
   return std::string(text, static_cast<std::size_t>(len));
 }
 
+// n bytes in pieces an int counts (1 GiB): io(done, k) for each, in order.
+template <class F>
+void in_pieces(std::size_t n, const F& io) {
+  constexpr std::size_t piece = std::size_t{1} << 30;
+  for (std::size_t done = 0; done < n; done += std::min(piece, n - done)) io(done, std::min(piece, n - done));
+}
+
 MPI_Datatype point_type() {
   static MPI_Datatype t = [] {
     MPI_Datatype d;
@@ -170,9 +177,7 @@ std::pair<std::size_t, std::size_t> chunk_block(std::size_t rows, int r, int siz
 }
 
 std::pair<std::size_t, std::size_t> even_block(std::size_t n, int r, int size) {
-  const auto P = static_cast<std::size_t>(size), k = static_cast<std::size_t>(r);
-  const std::size_t a = n * k / P, b = n * (k + 1) / P;
-  return {a, b - a};
+  return detail::even_share(n, static_cast<std::size_t>(r), static_cast<std::size_t>(size));
 }
 
 // ---------------------------------------------------------------------------
@@ -201,19 +206,39 @@ InputFile::~InputFile() {
 }
 
 void InputFile::read(char* dst, std::size_t n, std::uint64_t offset) const {
-  auto f = static_cast<MPI_File>(file_);
-  // In pieces an int counts.
-  constexpr std::size_t piece = std::size_t{1} << 30;
-  for (std::size_t done = 0; done < n;) {
-    const std::size_t k = std::min(piece, n - done);
+  in_pieces(n, [&](std::size_t done, std::size_t k) {
     MPI_Status st;
-    const int rc = MPI_File_read_at(f, static_cast<MPI_Offset>(offset + done), dst + done, static_cast<int>(k), MPI_BYTE, &st);
+    const int rc =
+        MPI_File_read_at(static_cast<MPI_File>(file_), static_cast<MPI_Offset>(offset + done), dst + done, static_cast<int>(k), MPI_BYTE, &st);
     int got = 0;
     MPI_Get_count(&st, MPI_BYTE, &got);
     if (rc != MPI_SUCCESS || static_cast<std::size_t>(got) != k)
       fail(errc::file_unreadable, "'", path_.string(), "': cannot read ", k, " bytes at offset ", offset + done,
            rc != MPI_SUCCESS ? ": " + mpi_message(rc) : cat(": got ", got));
-    done += k;
+  });
+}
+
+void InputFile::read_strided(char* dst, std::size_t runs, std::size_t run, std::uint64_t stride, std::uint64_t offset) const {
+  auto f = static_cast<MPI_File>(file_);
+  // Groups of runs an int counts, each read through a file view of that many runs.
+  constexpr std::size_t piece = std::size_t{1} << 30;
+  const std::size_t group = std::max<std::size_t>(1, piece / std::max<std::size_t>(run, 1));
+  const int len = as_int(run, "a run of a strided read");
+  for (std::size_t r0 = 0; r0 < runs; r0 += group) {
+    const std::size_t g = std::min(group, runs - r0);
+    MPI_Datatype view;
+    MPI_Type_create_hvector(as_int(g, "a strided read"), len, static_cast<MPI_Aint>(stride), MPI_BYTE, &view);
+    MPI_Type_commit(&view);
+    MPI_File_set_view(f, static_cast<MPI_Offset>(offset + r0 * stride), MPI_BYTE, view, "native", MPI_INFO_NULL);
+    MPI_Status st;
+    const int rc = MPI_File_read(f, dst + r0 * run, as_int(g * run, "a strided read"), MPI_BYTE, &st);
+    int got = 0;
+    MPI_Get_count(&st, MPI_BYTE, &got);
+    MPI_File_set_view(f, 0, MPI_BYTE, MPI_BYTE, "native", MPI_INFO_NULL);
+    MPI_Type_free(&view);
+    if (rc != MPI_SUCCESS || static_cast<std::size_t>(got) != g * run)
+      fail(errc::file_unreadable, "'", path_.string(), "': cannot read ", g, " runs of ", run, " bytes from offset ",
+           offset + r0 * stride, rc != MPI_SUCCESS ? ": " + mpi_message(rc) : cat(": got ", got, " bytes"));
   }
 }
 
@@ -250,21 +275,17 @@ OutputFile::OutputFile(const fs::path& path, const Team& team) : team_(team), pa
 }
 
 void OutputFile::write(const void* data, std::size_t n, std::uint64_t offset) const {
-  auto f = static_cast<MPI_File>(file_);
-  constexpr std::size_t piece = std::size_t{1} << 30;
   const char* bytes = static_cast<const char*>(data);
-  for (std::size_t done = 0; done < n;) {
-    const std::size_t k = std::min(piece, n - done);
+  in_pieces(n, [&](std::size_t done, std::size_t k) {
     MPI_Status st;
-    const int rc =
-        MPI_File_write_at(f, static_cast<MPI_Offset>(offset + done), bytes + done, static_cast<int>(k), MPI_BYTE, &st);
+    const int rc = MPI_File_write_at(static_cast<MPI_File>(file_), static_cast<MPI_Offset>(offset + done), bytes + done,
+                                     static_cast<int>(k), MPI_BYTE, &st);
     int put = 0;
     MPI_Get_count(&st, MPI_BYTE, &put);
     if (rc != MPI_SUCCESS || static_cast<std::size_t>(put) != k)
       fail(errc::file_unwritable, "'", path_.string(), "': cannot write ", k, " bytes at offset ", offset + done,
            rc != MPI_SUCCESS ? ": " + mpi_message(rc) : cat(": wrote ", put));
-    done += k;
-  }
+  });
 }
 
 void OutputFile::close() noexcept {

@@ -54,7 +54,9 @@ class Team final : public detail::RowTeam {
   /// Points in blocks: send[r] goes to process r, recv[r] comes from it (points,
   /// counted per process; the buffers are laid out in process order).
   void exchange(const Vec3* send, std::span<const std::size_t> send_counts, Vec3* recv,
-                std::span<const std::size_t> recv_counts) const;
+                std::span<const std::size_t> recv_counts) const override;
+  [[nodiscard]] std::size_t processes() const override { return static_cast<std::size_t>(size_); }
+  [[nodiscard]] std::size_t process() const override { return static_cast<std::size_t>(rank_); }
 
  private:
   Classify classify_;
@@ -77,6 +79,9 @@ class InputFile {
   [[nodiscard]] std::uint64_t size() const noexcept { return size_; }
   /// n bytes at `offset` into dst, this process alone.
   void read(char* dst, std::size_t n, std::uint64_t offset) const;
+  /// `runs` runs of `run` bytes each, `stride` bytes apart from `offset` on, into dst
+  /// one after another (a strided view of the file), this process alone.
+  void read_strided(char* dst, std::size_t runs, std::size_t run, std::uint64_t stride, std::uint64_t offset) const;
 
  private:
   std::filesystem::path path_;

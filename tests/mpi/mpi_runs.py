@@ -4,7 +4,9 @@
 Runs `interpatch eval` and `interpatch build` on grids whose rows split unevenly
 between 1..4 processes (chunks of 16 rows), closed directions of odd and even
 degree, collapsed rows (poles), every parametrization, float32 and big-endian
-input, surfaces and volumes; every output must equal the single process's, byte for
+input, Fortran-order input, surfaces and volumes, and approximations (a given number of control points,
+the separable fit and the sparse one with holes, smoothing, smoothing "auto"), each
+checked to have run split; every output must equal the single process's, byte for
 byte. Then the failures: a missing points file, a NaN in the last process's rows,
 bad options, an output in a missing directory; each must end every process with
 the single process's exit status and error line, exactly one line on stderr, no
@@ -27,6 +29,10 @@ ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIR
 # A single process must not see the launcher's variables (it would start MPI).
 SINGLE_ENV = {k: v for k, v in ENV.items() if not k.startswith(("OMPI_COMM_WORLD", "PMIX_", "PMI_"))}
 PROCESSES = [1, 2, 3, 4]
+# The failures: one process alone, an uneven split and the most processes (2 adds no case of its own).
+FAILURE_PROCESSES = [1, 3, 4]
+# Cases whose one-process run under mpirun adds nothing to the first case's.
+SPLIT_ONLY = [2, 3, 4]
 failures = []
 
 
@@ -62,26 +68,68 @@ def grid(shape, rng, pole=False, close=None, scale=1.0):
 
 def cases(rng):
     yield "surface 53x37 (uneven rows)", grid((53, 37), rng), {}, "61"
-    yield "surface pole row, centripetal", grid((40, 21), rng, pole=True), {"param": "centripetal", "degree": [3, 2]}, "45x7"
+    yield "surface pole row, centripetal", grid((40, 21), rng, pole=True), {"param": "centripetal", "degree": [3, 2]}, "45x7", \
+        SPLIT_ONLY
     yield "surface uniform, degree 5x2, float32 big-endian", grid((35, 9), rng).astype(">f4"), \
-        {"param": "uniform", "degree": [5, 2]}, "33"
+        {"param": "uniform", "degree": [5, 2]}, "33", SPLIT_ONLY
     yield "surface closed u, even degree", grid((47, 19), rng, close=0), {"periodic": [True, False], "degree": [2, 3]}, "40"
-    yield "surface closed v (tube), even degree", grid((50, 24), rng, close=1), {"periodic": [False, True], "degree": [3, 4]}, "41"
+    yield "surface closed v (tube), even degree", grid((50, 24), rng, close=1), {"periodic": [False, True], "degree": [3, 4]}, "41", \
+        SPLIT_ONLY
     yield "surface closed along u, not declared (warning), extreme scale", grid((33, 12), rng, close=0, scale=1e300), {}, "30"
     yield "volume closed w, even degree", grid((38, 7, 8), rng, close=2), {"periodic": [False, False, True], "degree": [3, 2, 2]}, \
         "29x33x17"
+    yield "surface Fortran order, float32", np.asfortranarray(grid((37, 22), rng).astype("<f4")), {"degree": [3, 2]}, "29", \
+        [2, 3]
+    yield "volume Fortran order, big-endian", np.asfortranarray(grid((34, 6, 5), rng).astype(">f8")), {"degree": [3, 2, 2]}, \
+        "13x9x7", [3]
     yield "volume closed u, centripetal", grid((36, 5, 4), rng, close=0), \
         {"periodic": [True, False, False], "degree": [3, 2, 2], "param": "centripetal"}, "9"
 
 
-def same_outputs(d, name, spec_file, eval_grid):
+def holes(g, rng):
+    """NaN (missing points) scattered, in a block and in a whole row: approximation's holes."""
+    g = g.copy()
+    n0, n1 = g.shape[:2]
+    g[n0 // 3:n0 // 3 + 6, n1 // 4:n1 // 4 + 5] = np.nan
+    g[n0 - 2, :, 0] = np.nan
+    for i, j in zip(rng.integers(0, n0, 12), rng.integers(0, n1, 12)):
+        g[i, j, rng.integers(0, 3)] = np.nan
+    return g
+
+
+def approximate_cases(rng):
+    """(name, points, options, eval grid, process counts): the split approximation's
+    ways, the separable fit and the sparse system with and without holes; the slower
+    cases on fewer process counts."""
+    yield "approximate 53x37 control points (separable)", grid((53, 37), rng), {"control_points": [20, 15]}, "61", PROCESSES
+    yield "approximate 70x29 holes, control points, Fortran order", np.asfortranarray(holes(grid((70, 29), rng), rng)), \
+        {"control_points": [24, 12]}, "40x23", [2, 4]
+    yield "approximate holes, smoothing, centripetal, float32 big-endian", holes(grid((45, 30), rng), rng).astype(">f4"), \
+        {"smoothing": 1e-3, "param": "centripetal", "degree": [3, 2]}, "35", [3]
+    g = grid((40, 20), rng)
+    g[:, 5:9] = np.nan  # control points with no data under them: the fill term settles them
+    yield "approximate columns of holes, as many control points as data along v", g, {"control_points": [5, 20]}, "11", [3]
+    yield "approximate smoothing auto, uniform", grid((40, 25), rng), {"smoothing": "auto", "param": "uniform"}, "30", [3]
+
+
+def split_ran(d, spec_file):
+    """Whether a run on 2 processes was split (rank 1 reports its stages) rather than run on rank 0 alone."""
+    env = dict(ENV, INTERPATCH_MPI_TIMINGS="1")
+    cmd = [MPIRUN, "--oversubscribe", "-q", "--mca", "btl", "self,vader", "-np", "2", "-x", "INTERPATCH_MPI_TIMINGS", EXE,
+           "build", spec_file, "-o", "split.npz"]
+    r = subprocess.run(cmd, cwd=d, env=env, capture_output=True, text=True, timeout=120)
+    os.path.exists(os.path.join(d, "split.npz")) and os.remove(os.path.join(d, "split.npz"))
+    return r.returncode == 0 and "rank 1 stages" in r.stderr
+
+
+def same_outputs(d, name, spec_file, eval_grid, processes=PROCESSES):
     for args in [["build", spec_file, "-o", "out.npz"], ["eval", spec_file, "--grid", eval_grid, "-o", "out.npy"]]:
         out = os.path.join(d, args[-1])
         one = run(args, cwd=d)
         check(one.returncode == 0, f"{name}: single process {args}: {one.stderr}")
         want = open(out, "rb").read()
         os.remove(out)
-        for p in PROCESSES:
+        for p in processes:
             r = run(args, p, cwd=d)
             check(r.returncode == 0, f"{name}: {p} processes {args}: status {r.returncode}: {r.stderr}")
             check(r.stderr == one.stderr, f"{name}: {p} processes {args}: stderr {r.stderr!r}, single {one.stderr!r}")
@@ -92,12 +140,12 @@ def same_outputs(d, name, spec_file, eval_grid):
         check(sorted(os.listdir(d)) == sorted([spec_file, "points.npy"]), f"{name}: files left: {os.listdir(d)}")
 
 
-def same_failure(d, name, args, status):
+def same_failure(d, name, args, status, processes=FAILURE_PROCESSES):
     good = os.path.join(d, "good" + os.path.splitext(args[args.index("-o") + 1])[1])
     one = run(args, cwd=d)
     check(one.returncode == status, f"{name}: single process status {one.returncode}, expected {status}: {one.stderr}")
     before = sorted(os.listdir(d))
-    for p in PROCESSES:
+    for p in processes:
         r = run(args, p, cwd=d)
         lines = r.stderr.splitlines()
         check(r.returncode == status, f"{name}: {p} processes: status {r.returncode}, expected {status}: {r.stderr}")
@@ -134,14 +182,42 @@ def a_rank_cannot_read(d, rng):
 
 def main():
     rng = np.random.default_rng(19)
-    for name, points, options, eval_grid in cases(rng):
+    for name, points, options, eval_grid, *processes in cases(rng):
         with tempfile.TemporaryDirectory() as d:
             np.save(os.path.join(d, "points.npy"), points)
             spec_type = "interpolate_volume" if points.ndim == 4 else "interpolate"
             with open(os.path.join(d, "spec.json"), "w") as f:
                 json.dump(dict({"type": spec_type, "points": {"npy": "points.npy"}}, **options), f)
-            same_outputs(d, name, "spec.json", eval_grid)
+            if points.flags.f_contiguous and not points.flags.c_contiguous:  # read split, not by rank 0 alone
+                check(split_ran(d, "spec.json"), f"{name}: not split between the processes")
+            same_outputs(d, name, "spec.json", eval_grid, *processes)
             print("ok:", name, flush=True)
+    for name, points, options, eval_grid, processes in approximate_cases(rng):
+        with tempfile.TemporaryDirectory() as d:
+            np.save(os.path.join(d, "points.npy"), points)
+            with open(os.path.join(d, "spec.json"), "w") as f:
+                json.dump(dict({"type": "approximate", "points": {"npy": "points.npy"}}, **options), f)
+            check(split_ran(d, "spec.json"), f"{name}: not split between the processes")
+            same_outputs(d, name, "spec.json", eval_grid, processes)
+            print("ok:", name, flush=True)
+    with tempfile.TemporaryDirectory() as d:
+        g = np.full((40, 20, 3), np.nan)
+        np.save(os.path.join(d, "points.npy"), g)
+        with open(os.path.join(d, "spec.json"), "w") as f:
+            json.dump({"type": "approximate", "points": {"npy": "points.npy"}, "control_points": [5, 5]}, f)
+        same_failure(d, "approximate: every point missing", ["build", "spec.json", "-o", "good.npz"], 3, [2])
+        g = grid((40, 20), rng)
+        g[17, :] = g[16, :]  # rows 16 and 17 coincide: zero chords along u, and a degree along v too high
+        np.save(os.path.join(d, "points.npy"), g)
+        with open(os.path.join(d, "spec.json"), "w") as f:
+            json.dump({"type": "approximate", "points": {"npy": "points.npy"}, "smoothing": 0.1, "degree": [3, 25]}, f)
+        same_failure(d, "approximate: two faults, the first in one process's order", ["build", "spec.json", "-o", "good.npz"], 3,
+                     [2])
+        g = grid((40, 20), rng)
+        g[38, 3, 2] = np.inf  # in the last process's rows
+        np.save(os.path.join(d, "points.npy"), g)
+        same_failure(d, "approximate: infinity in the last rows", ["eval", "spec.json", "--grid", "9", "-o", "good.npy"], 3,
+                     [3])
     with tempfile.TemporaryDirectory() as d:
         g = grid((50, 20), rng)
         g[49, 7, 1] = np.nan  # in the last process's rows for every count of processes

@@ -177,6 +177,14 @@ Construction build_approximate(const json& spec, Context& ctx) {
 }
 
 template Construction build_approximate<2>(const json& spec, Context& ctx);
+
+template <std::size_t D>
+ApproximationOptions<D> approximation_options(const json& obj, std::string_view ptr, const std::vector<std::size_t>& shape,
+                                              std::string_view pts_at) {
+  return read_options<D>(obj, ptr, shape, pts_at);
+}
+template ApproximationOptions<2> approximation_options<2>(const json&, std::string_view, const std::vector<std::size_t>&,
+                                                          std::string_view);
 template Construction build_approximate<3>(const json& spec, Context& ctx);
 
 BSplineCurve approximated_curve(const json& obj, std::string_view ptr, Context& ctx) {

@@ -24,6 +24,7 @@
 
 #include "detail/text.hpp"
 #include "interpatch/grid.hpp"
+#include "interpatch/approximate.hpp"
 #include "interpatch/interpolate.hpp"
 #include "interpatch/blended_surface.hpp"
 #include "interpatch/blended_volume.hpp"
@@ -209,6 +210,11 @@ template <std::size_t Dims>
 Construction build_bspline(const json& spec, Context& ctx);
 template <std::size_t Dims>
 Construction build_approximate(const json& spec, Context& ctx);
+/// The options of an approximation (`ptr` the object holding its fields), checked
+/// against the points' shape; `pts_at` names the points in messages.
+template <std::size_t D>
+ApproximationOptions<D> approximation_options(const json& obj, std::string_view ptr, const std::vector<std::size_t>& shape,
+                                              std::string_view pts_at);
 /// {"approximate": points, ...} as a curve (approximate.cpp), mapped onto [0, 1].
 BSplineCurve approximated_curve(const json& obj, std::string_view ptr, Context& ctx);
 Construction build_trilinear(const json& spec, Context& ctx);

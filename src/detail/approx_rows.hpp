@@ -1,0 +1,40 @@
+#pragma once
+// Surface approximation (approximate_surface) of a grid held in blocks of whole rows
+// by the processes of a RowTeam (src/mpi/): the same control points, bit for bit, as
+// the single process finds, every sum over the data made in the single process's
+// order. Covered: a given number of control points and smoothing (a number or
+// "auto"), with missing points (NaN), open directions, no weights; a fit to a
+// tolerance and the other cases run in one process.
+
+#include <array>
+#include <cstddef>
+#include <functional>
+#include <vector>
+
+#include "detail/grid_rows.hpp"
+#include "interpatch/approximate.hpp"
+#include "interpatch/knot_vector.hpp"
+#include "interpatch/vec3.hpp"
+
+namespace interpatch::detail {
+
+/// Whether approximate_rows covers these options.
+[[nodiscard]] bool approximate_rows_covers(const SurfaceApproximationOptions& o);
+
+/// The fitted surface, its control rows split evenly between the processes.
+struct ApproxRows {
+  std::array<int, 2> degree{};
+  std::array<KnotVector, 2> knots{KnotVector::bezier(1), KnotVector::bezier(1)};  ///< mapped onto [0, 1]
+  std::array<std::size_t, 2> net{};  ///< control points along u and v
+  std::size_t first = 0;             ///< this process's first control row (even_share)
+  std::vector<Vec3> rows;            ///< its control rows, C order
+};
+
+/// The approximation of the grid `b` (rows may hold NaN: missing points), the
+/// options covered (approximate_rows_covers). Errors as approximate_surface's.
+/// `release` is called once the block's points are read no more: the caller may
+/// free them then (a smoothing "auto" reads them to the end).
+ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOptions& o, const RowTeam& team,
+                            const std::function<void()>& release = {});
+
+}  // namespace interpatch::detail
