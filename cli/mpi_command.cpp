@@ -147,8 +147,8 @@ Plan plan_of(const MpiRequest& r, const mpi::Team& team) {
   }
   if (count == 0 || plan.header.data_offset + count * dt->size != size) return plan;
   if (approx) {
-    // What the split approximation does not cover (a fit to a tolerance, weights,
-    // closed directions), and options the single process refuses, run there.
+    // What the split approximation does not cover (a fit to a tolerance), and
+    // options the single process refuses, run there.
     try {
       io::reader::Context fields;
       fields.base_dir = plan.base;
@@ -709,6 +709,7 @@ int approximate_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team
   b.before = rb.halo[0].data();
   b.row0 = rb.halo[1].data();
   b.last = rb.halo[4].data();
+  b.ends = {rb.halo[1].data(), rb.halo[2].data(), rb.halo[3].data(), rb.halo[4].data()};
   detail::ApproxRows fit;
   io::reader::at("/points", [&] { fit = detail::approximate_rows(b, plan.approx, team, [&] { release(rb.rows); }); });
   release(rb.rows);

@@ -1276,6 +1276,19 @@ struct Result {
   ApproximationReport report;
 };
 
+// Weights of the shape of the points, finite and not negative.
+template <std::size_t R>
+void check_weights(const Grid<double, R>& weights, const Shape<R>& shape) {
+  for (std::size_t a = 0; a < R; ++a)
+    if (weights.extent(a) != shape[a])
+      fail(errc::size_mismatch, "weights: ", weights.extent(a), " along ", axis_name(a), ", the points have ", shape[a]);
+  for (std::size_t i = 0; i < weights.size(); ++i) {
+    const double w = weights.values()[i];
+    if (std::isnan(w) || std::isinf(w)) fail(errc::not_finite, "weight ", index_text<R>(i, shape), " is ", w);
+    if (w < 0) fail(errc::invalid_weight, "weight ", index_text<R>(i, shape), " = ", w, " is negative");
+  }
+}
+
 template <std::size_t R>
 Result<R> approximate(Data<R> d, const ApproximationOptions<R>& o, const char* what) {
   check_request<R>(o, d.shape, what);
@@ -1283,17 +1296,8 @@ Result<R> approximate(Data<R> d, const ApproximationOptions<R>& o, const char* w
   // Missing points, weights.
   const std::size_t total = d.points.size();
   if (!o.weights.empty()) {
-    for (std::size_t a = 0; a < R; ++a)
-      if (o.weights.extent(a) != d.shape[a])
-        fail(errc::size_mismatch, "weights: ", o.weights.extent(a), " along ", axis_name(a), ", the points have ",
-             d.shape[a]);
+    check_weights<R>(o.weights, d.shape);
     d.weight.assign(o.weights.values().begin(), o.weights.values().end());
-    for (std::size_t i = 0; i < total; ++i) {
-      if (std::isnan(d.weight[i]) || std::isinf(d.weight[i]))
-        fail(errc::not_finite, "weight ", index_text<R>(i, d.shape), " is ", d.weight[i]);
-      if (d.weight[i] < 0)
-        fail(errc::invalid_weight, "weight ", index_text<R>(i, d.shape), " = ", d.weight[i], " is negative");
-    }
   }
   for (std::size_t i = 0; i < total; ++i) {
     const Vec3& q = d.points.data()[i];
@@ -1360,6 +1364,26 @@ Grid<Vec3, R> control_net(const Fit<R>& f) {
   return g;
 }
 
+// A closed direction's last line that nearly repeats the first.
+[[noreturn]] void refuse_closing_gap(std::size_t a) {
+  fail(errc::closing_gap, "the last line of points along ", axis_name(a),
+       " nearly repeats the first: repeat the first line exactly, or leave the last one out");
+}
+
+// The grid without its last line along axis a.
+template <class T, std::size_t R>
+void cut_last_line(Grid<T, R>& g, std::size_t a) {
+  auto shape = g.shape();
+  std::size_t outer = 1, inner = 1;
+  for (std::size_t x = 0; x < a; ++x) outer *= shape[x];
+  for (std::size_t x = a + 1; x < R; ++x) inner *= shape[x];
+  const std::size_t n = shape[a];
+  shape[a] = n - 1;
+  Grid<T, R> kept(shape, for_overwrite);
+  for (std::size_t o = 0; o < outer; ++o) std::copy_n(g.data() + o * n * inner, (n - 1) * inner, kept.data() + o * (n - 1) * inner);
+  g = std::move(kept);
+}
+
 // A closed direction's last line, when it repeats the first (interpolation's rule),
 // is left out, with its weights.
 template <std::size_t R>
@@ -1371,25 +1395,10 @@ Data<R> closed_data(Grid<Vec3, R> points, Grid<double, R>& weights, const std::a
     Closing c;
     if constexpr (R == 1) c = closing_point(std::span<const Vec3>(points.data(), points.size()));
     else c = grid_closing(points, static_cast<int>(a));
-    if (c.nearly)
-      fail(errc::closing_gap, "the last line of points along ", axis_name(a),
-           " nearly repeats the first: repeat the first line exactly, or leave the last one out");
+    if (c.nearly) refuse_closing_gap(a);
     if (!c.dropped) continue;
-    auto shape = points.shape();
-    std::size_t outer = 1, inner = 1;
-    for (std::size_t x = 0; x < a; ++x) outer *= shape[x];
-    for (std::size_t x = a + 1; x < R; ++x) inner *= shape[x];
-    const std::size_t n = shape[a];
-    shape[a] = n - 1;
-    Grid<Vec3, R> kept(shape, for_overwrite);
-    Grid<double, R> kept_w = weights.empty() ? Grid<double, R>() : Grid<double, R>(shape, 0.0);
-    for (std::size_t o = 0; o < outer; ++o) {
-      std::copy_n(points.data() + o * n * inner, (n - 1) * inner, kept.data() + o * (n - 1) * inner);
-      if (!weights.empty())
-        std::copy_n(weights.data() + o * n * inner, (n - 1) * inner, kept_w.data() + o * (n - 1) * inner);
-    }
-    points = std::move(kept);
-    if (!weights.empty()) weights = std::move(kept_w);
+    cut_last_line<Vec3, R>(points, a);
+    if (!weights.empty()) cut_last_line<double, R>(weights, a);
   }
   for (std::size_t a = 0; a < R; ++a) d.shape[a] = points.extent(a);
   d.points = std::move(points);
@@ -1451,13 +1460,19 @@ static_assert(sizeof(Vec3) == 3 * sizeof(double), "points move between processes
 const Vec3* as_points(const double* d) { return reinterpret_cast<const Vec3*>(d); }
 Vec3* as_points(double* d) { return reinterpret_cast<Vec3*>(d); }
 
+// Every point present weighs 1, a missing one 0.
+struct PresentWeighsOne {
+  double operator()(std::size_t, const Vec3& q) const { return is_missing(q) ? 0.0 : 1.0; }
+};
+
 // A rows × width array of points held in consecutive blocks of rows (`mine` here),
-// turned into columns: every row of this process's even share of the columns. A
-// missing point (a NaN coordinate) goes as zeros: its weight 0 times the point, as
-// the weighted data of right_hand_side.
+// turned into columns: every row of this process's even share of the columns. Each
+// point goes as w·Q, w = weight(its index among `rows`, Q), and as zeros where w is
+// 0 (a missing point): the weighted data of right_hand_side, multiplied as there.
 // `packed` is called once the rows are read.
+template <class Weight = PresentWeighsOne>
 std::vector<double> rows_to_columns(const Vec3* rows, std::size_t mine, std::size_t width, const detail::RowTeam& team,
-                                    const std::function<void()>& packed = {}) {
+                                    const std::function<void()>& packed = {}, const Weight& weight = {}) {
   const std::size_t P = team.processes(), me = team.process();
   const std::vector<double> counts = team.gather(std::vector<double>{static_cast<double>(mine)});
   std::size_t total = 0;
@@ -1475,7 +1490,10 @@ std::vector<double> rows_to_columns(const Vec3* rows, std::size_t mine, std::siz
     for (std::size_t i = 0; i < mine; ++i) {
       const Vec3* from = rows + i * width + cols.first;
       Vec3* to = as_points(send.data()) + at + i * cols.second;
-      for (std::size_t k = 0; k < cols.second; ++k) to[k] = is_missing(from[k]) ? Vec3{} : from[k];
+      for (std::size_t k = 0; k < cols.second; ++k) {
+        const double w = weight(i * width + cols.first + k, from[k]);
+        for (int x = 0; x < 3; ++x) to[k][x] = w > 0 ? w * from[k][x] : 0.0;
+      }
     }
     sc[s] = mine * cols.second;
     rc[s] = static_cast<std::size_t>(counts[s]) * C;
@@ -1602,36 +1620,153 @@ void add_block_data(Stencil<2>& st, const std::array<Axis, 2>& axes, const Shape
   st.v = std::move(all);
 }
 
+// add_block_data along a closed u. There the basis functions of the data rows near
+// the seam wrap: the first rows (of an even degree, whose period starts half a step
+// in) reach the last control rows, and the last rows the first ones, so a control
+// row near the seam takes the sums of two runs of data rows, one at each end, the
+// earlier run first. The control rows are unwrapped (data row i reaching rows
+// first_i .. first_i + p, non-decreasing in i, with c0 + L rows in all, L ≤ p) and
+// summed there by add_block_data; the rows past c0 repeat rows 0 .. L − 1, and
+// their run of data continues the sums the earlier run reached: the processes that
+// hold it add their points again to those rows, starting from the earlier sums and
+// handing them on in order. Then the rows are wrapped back.
+template <class Weight>
+void add_closed_block_data(Stencil<2>& st, const std::array<Axis, 2>& axes, const Shape<2>& shape, const detail::GridBlock& b,
+                           const Weight& weight, const detail::RowTeam& team) {
+  const Axis& u = axes[0];
+  const int c0 = u.c;
+  const std::size_t n = u.n;
+  // Wrapped onto the knots' period, the parameters rise, drop once (where the data
+  // pass the period's start) and rise again: the rows before the drop are a period lower.
+  std::size_t drop = 0;
+  for (std::size_t i = 1; i < n; ++i)
+    if (u.first[i] < u.first[i - 1]) {
+      INTERPATCH_ASSERT(drop == 0);
+      drop = i;
+    }
+  std::array<Axis, 2> open = axes;
+  Axis& un = open[0];
+  const int low = u.first[0] - (drop > 0 ? c0 : 0);
+  for (std::size_t i = 0; i < n; ++i) un.first[i] = u.first[i] - (i < drop ? c0 : 0) - low;
+  un.c = std::max(c0, un.first[n - 1] + u.p + 1);
+  INTERPATCH_ASSERT(un.c <= 2 * c0);  // a control row repeated at most once
+  Stencil<2> sw(open);
+  add_block_data(sw, open, shape, b, weight, team);
+
+  const auto extra = static_cast<std::size_t>(un.c - c0), c = static_cast<std::size_t>(c0);
+  const std::size_t c1 = sw.c[1], row_len = c1 * sw.size;
+  std::vector<double> late(extra * row_len, 0.0);
+  if (extra > 0) {
+    const std::size_t base = b.first * shape[1], mine = b.count * shape[1];
+    const bool reaches = b.count > 0 && static_cast<std::size_t>(un.first[b.first + b.count - 1] + u.p) >= c;
+    const std::vector<double> all = team.gather(std::vector<double>{reaches ? 1.0 : 0.0});
+    const bool first_to_reach = reaches && std::find(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(team.process()), 1.0) ==
+                                               all.begin() + static_cast<std::ptrdiff_t>(team.process());
+    team.fold(late, [&](std::span<double> acc) {
+      if (!reaches) return;  // hands on what it got
+      double* rows = sw.v.data() + c * row_len;
+      std::copy_n(first_to_reach ? sw.v.data() : acc.data(), extra * row_len, rows);
+      add_weighted_points<2>(sw.v.data(), sw, open, shape, base, mine, weight, [&](std::size_t row) { return row / c1 >= c; });
+      std::copy_n(rows, extra * row_len, acc.data());
+    });
+  }
+  // Unwrapped row x is control row x + low, modulo c0.
+  for (std::size_t x = 0; x < c; ++x) {
+    const auto row = static_cast<std::size_t>(((static_cast<long long>(x) + low) % c0 + c0) % c0);
+    std::copy_n(x < extra ? late.data() + x * row_len : sw.v.data() + x * row_len, row_len, st.v.data() + row * row_len);
+  }
+}
+
+// Counts held as doubles (gathered between processes), as counts.
+template <class It>
+std::vector<std::size_t> as_counts(It first, It last) {
+  std::vector<std::size_t> c;
+  for (; first != last; ++first) c.push_back(static_cast<std::size_t>(*first));
+  return c;
+}
+
+// closed_data on a grid held in blocks of rows: a closed direction's last line that
+// repeats the first is left out of the block (along v out of each of its rows, in
+// place) and of the weights; one that nearly repeats it is refused.
+void close_block(detail::GridBlock& b, Grid<double, 2>& weights, const std::array<bool, 2>& periodic, bool missing,
+                 const detail::RowTeam& team) {
+  for (std::size_t a = 0; a < 2; ++a) {
+    if (!periodic[a] || b.n[a] < 3) continue;
+    if (missing) break;
+    INTERPATCH_ASSERT(a > 0 || b.ends[0] != nullptr);
+    const Closing c = detail::block_closing(b, a, b.ends, false, team);
+    if (c.nearly) team.run([&] { refuse_closing_gap(a); });
+    if (!c.dropped) continue;
+    if (!weights.empty()) cut_last_line<double, 2>(weights, a);
+    const std::size_t n = b.n[a]--;
+    if (a == 0) {
+      b.count = b.first < n - 1 ? std::min(b.count, n - 1 - b.first) : 0;
+      b.last = b.ends[2];
+    } else {
+      for (std::size_t r = 1; r < b.count; ++r) std::copy(b.data + r * n, b.data + r * n + n - 1, b.data + r * (n - 1));
+    }
+  }
+}
+
 }  // namespace
 
 namespace detail {
 
 bool approximate_rows_covers(const SurfaceApproximationOptions& o) {
-  return !o.tolerance && o.weights.empty() && !o.periodic[0] && !o.periodic[1];
+  return !o.tolerance;
 }
 
-ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOptions& o, const RowTeam& team,
+ApproxRows approximate_rows(const GridBlock& given, const SurfaceApproximationOptions& o, const RowTeam& team,
                             const std::function<void()>& release) {
   constexpr std::size_t R = 2;
-  INTERPATCH_ASSERT(b.rank == 2 && approximate_rows_covers(o));
+  INTERPATCH_ASSERT(given.rank == 2 && approximate_rows_covers(o));
   const std::size_t P = team.processes(), me = team.process();
+
+  // Missing points (NaN); closed directions, whose closing line is looked for only
+  // where none is missing (closed_data).
+  std::size_t missing[1] = {0};
+  for (std::size_t i = 0; i < given.count * given.n[1]; ++i) missing[0] += is_missing(given.data[i]) ? 1 : 0;
+  team.sum(missing);
+  GridBlock b = given;
+  Grid<double, R> weights = o.weights;
+  close_block(b, weights, o.periodic, missing[0] > 0, team);
+
   const Shape<R> shape{b.n[0], b.n[1]};
   const std::size_t M = shape[1], total = shape[0] * shape[1], mine = b.count * M, base = b.first * M;
   const Vec3* pts = b.data;
-  team.run([&] { check_request<R>(o, shape, "surface"); });
-
-  // The points present have weight 1, the missing ones 0, as in approximate().
-  std::size_t missing[1] = {0};
-  for (std::size_t i = 0; i < mine; ++i) missing[0] += is_missing(pts[i]) ? 1 : 0;
-  team.sum(missing);
-  const std::size_t present = total - missing[0];
-  const bool fill = missing[0] > 0;
-  // Which points are present, kept past the points themselves.
-  std::vector<bool> present_here(fill ? mine : 0);
-  for (std::size_t i = 0; i < present_here.size(); ++i) present_here[i] = !is_missing(pts[i]);
-  auto weight = [&](std::size_t flat) { return !fill || present_here[flat - base] ? 1.0 : 0.0; };
   team.run([&] {
-    if (present == 0)
+    check_request<R>(o, shape, "surface");
+    if (!weights.empty()) check_weights<R>(weights, shape);
+  });
+
+  // Each point's weight as approximate() finds it: 0 where missing; 1 everywhere
+  // when every point is present and the weights (if any) are equal.
+  const bool uniform = missing[0] == 0 && std::all_of(weights.values().begin(), weights.values().end(),
+                                                      [&](double w) { return w == weights.values().front(); });
+  const bool zero_weight = std::any_of(weights.values().begin(), weights.values().end(), [](double w) { return !(w > 0); });
+  const bool fill = !uniform && (missing[0] > 0 || zero_weight);  // needs_fill
+  // Which points are present, kept past the points themselves.
+  std::vector<bool> present_here(missing[0] > 0 ? mine : 0);
+  for (std::size_t i = 0; i < present_here.size(); ++i) present_here[i] = !is_missing(pts[i]);
+  auto given_weight = [&](std::size_t flat) {
+    if (!present_here.empty() && !present_here[flat - base]) return 0.0;
+    return weights.empty() ? 1.0 : weights.values()[flat];
+  };
+  auto weight = [&](std::size_t flat) { return uniform ? 1.0 : given_weight(flat); };
+  // The points with a positive weight, and their weights' sum in the order of the points.
+  std::size_t present[1] = {0};
+  for (std::size_t i = base; i < base + mine; ++i) present[0] += given_weight(i) > 0 ? 1 : 0;
+  team.sum(present);
+  std::vector<double> weight_sum(1, static_cast<double>(total));
+  if (!uniform) {
+    weight_sum[0] = 0;
+    team.fold(weight_sum, [&](std::span<double> acc) {
+      for (std::size_t i = base; i < base + mine; ++i)
+        if (const double w = weight(i); w > 0) acc[0] += w;
+    });
+  }
+  team.run([&] {
+    if (present[0] == 0)
       fail(errc::too_few_points, "all ", total, " points are missing or have weight 0: there is nothing to approximate");
   });
 
@@ -1647,47 +1782,63 @@ ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOption
     v_degree = std::current_exception();
   }
   const std::size_t axes = v_degree ? 1 : R;
-  if (o.param == Parametrization::uniform) {
-    for (std::size_t a = 0; a < R; ++a) f.axes[a].t = uniform_parameters(shape[a], false);
-  } else if (!fill) {
-    std::vector<std::vector<double>> t = block_parameters(b, o.param, team, axes);
-    for (std::size_t a = 0; a < R; ++a) f.axes[a].t = std::move(t[a]);
-  } else {
-    // Along u each step's chords lie in the rows of one process (the row before the
-    // block from its neighbour) and are summed over the row, as in one process;
-    // along v the lines are summed row after row, a running sum passed on in order.
-    std::vector<double> sum0, used0;
-    for (std::size_t k = b.first == 0 ? 1 : 0; k < b.count; ++k) {
-      const Vec3* prev = k == 0 ? b.before : pts + (k - 1) * M;
-      double sum = 0;
-      std::size_t used = 0;
-      for (std::size_t i = 0; i < M; ++i) add_chord(prev[i], pts[k * M + i], sum, used);
-      sum0.push_back(sum);
-      used0.push_back(static_cast<double>(used));
+  // As axis_parameters: interpolation's parameters along an open direction without
+  // missing points, else the mean chords summed over the lines.
+  std::array<bool, R> by_sums{};
+  for (std::size_t a = 0; a < R; ++a) by_sums[a] = o.periodic[a] || missing[0] > 0;
+  auto interpolation_parameters = [&](std::size_t a) {
+    const std::vector<std::vector<double>> t = block_parameters(b, o.param, team, a + 1, a == 0);
+    f.axes[a].t = t[a];
+  };
+  auto chord_sums = [&](std::size_t a) {
+    if (a == 0) {
+      // Each step's chords lie in the rows of one process (the row before the block
+      // from its neighbour; the closing step, back to row 0, in the last rows) and
+      // are summed over the row, as in one process.
+      std::vector<double> sum0, used0;
+      auto step = [&](const Vec3* prev, const Vec3* next) {
+        double sum = 0;
+        std::size_t used = 0;
+        for (std::size_t i = 0; i < M; ++i) add_chord(prev[i], next[i], sum, used);
+        sum0.push_back(sum);
+        used0.push_back(static_cast<double>(used));
+      };
+      for (std::size_t k = b.first == 0 ? 1 : 0; k < b.count; ++k) step(k == 0 ? b.before : pts + (k - 1) * M, pts + k * M);
+      if (o.periodic[0] && b.count > 0 && b.first + b.count == shape[0]) step(pts + (b.count - 1) * M, b.row0);
+      const std::vector<double> all_sum0 = team.gather(sum0), all_used0 = team.gather(used0);
+      team.run([&] {
+        f.axes[0].t = parameters_from_sums(all_sum0, as_counts(all_used0.begin(), all_used0.end()), shape[0], 0, o.param,
+                                           o.periodic[0]);
+      });
+      return;
     }
-    const std::vector<double> all_sum0 = team.gather(sum0), all_used0 = team.gather(used0);
-    const std::size_t steps1 = M - 1;
+    // The lines along v are summed row after row, a running sum passed on in order.
+    const std::size_t steps1 = o.periodic[1] ? M : M - 1;
     std::vector<double> acc1(2 * steps1, 0.0);
     team.fold(acc1, [&](std::span<double> acc) {
       for (std::size_t r = 0; r < b.count; ++r)
         for (std::size_t k = 1; k <= steps1; ++k) {
           std::size_t used = 0;
-          add_chord(pts[r * M + k - 1], pts[r * M + k], acc[k - 1], used);
+          add_chord(pts[r * M + k - 1], pts[r * M + k % M], acc[k - 1], used);
           acc[steps1 + k - 1] += static_cast<double>(used);
         }
     });
-    auto counts = [](auto first, auto last) {
-      std::vector<std::size_t> c;
-      for (; first != last; ++first) c.push_back(static_cast<std::size_t>(*first));
-      return c;
-    };
     team.run([&] {
-      f.axes[0].t = parameters_from_sums(all_sum0, counts(all_used0.begin(), all_used0.end()), shape[0], 0, o.param, false);
-      if (axes < R) return;
       f.axes[1].t = parameters_from_sums(std::vector<double>(acc1.begin(), acc1.begin() + static_cast<std::ptrdiff_t>(steps1)),
-                                         counts(acc1.begin() + static_cast<std::ptrdiff_t>(steps1), acc1.end()), shape[1], 1,
-                                         o.param, false);
+                                         as_counts(acc1.begin() + static_cast<std::ptrdiff_t>(steps1), acc1.end()), shape[1], 1,
+                                         o.param, o.periodic[1]);
     });
+  };
+  if (o.param == Parametrization::uniform) {
+    for (std::size_t a = 0; a < R; ++a) f.axes[a].t = uniform_parameters(shape[a], o.periodic[a]);
+  } else if (!by_sums[0] && !by_sums[1] && axes == R) {
+    std::vector<std::vector<double>> t = block_parameters(b, o.param, team, axes);
+    for (std::size_t a = 0; a < R; ++a) f.axes[a].t = std::move(t[a]);
+  } else {
+    for (std::size_t a = 0; a < axes; ++a) {
+      if (by_sums[a]) chord_sums(a);
+      else interpolation_parameters(a);
+    }
   }
   team.run([&] {
     if (v_degree) std::rethrow_exception(v_degree);
@@ -1702,9 +1853,11 @@ ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOption
   // Bᵀ (w Q): along u on columns of the data, along v on rows of the result.
   std::vector<double> rhs;
   {
-    std::vector<double> cols = rows_to_columns(pts, b.count, M, team, [&] {
-      if (release && !o.auto_smoothing) release();
-    }), tmp;
+    std::vector<double> cols = rows_to_columns(
+        pts, b.count, M, team, [&] {
+          if (release && !o.auto_smoothing) release();
+        },
+        [&](std::size_t i, const Vec3&) { return weight(base + i); }), tmp;
     Shape<R> cs{shape[0], even_share(M, me, P).second};
     basis_pass<true, R>(f.axes[0], cols.data(), cs, 0, tmp);
     std::vector<double>().swap(cols);
@@ -1713,8 +1866,10 @@ ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOption
     basis_pass<true, R>(f.axes[1], rows.data(), rs, 1, rhs);
   }
 
-  // The separable fit when it applies (separable_fit), else the sparse system.
-  bool separable = !o.smoothing && !o.auto_smoothing && !fill;
+  // The separable fit when it applies (separable_fit), else the sparse system, with
+  // the term that fills holes where some weight is 0 or the separable fit fails.
+  bool separable = !o.smoothing && !o.auto_smoothing && uniform;
+  bool filled = fill;
   std::array<std::optional<AxisSolver>, R> lu;
   if (separable) {
     team.run([&] {
@@ -1723,6 +1878,7 @@ ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOption
       } catch (const error& e) {
         if (e.code() != errc::singular) throw;
         separable = false;
+        filled = true;
       }
     });
   }
@@ -1737,9 +1893,10 @@ ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOption
     if (nr > 0) out.rows.assign(as_points(rows.data()), as_points(rows.data()) + nr * c1);
   } else {
     Stencil<R> st(f.axes);
-    if (!fill) add_grams<R>(st, f.axes);
+    if (uniform) add_grams<R>(st, f.axes);
+    else if (o.periodic[0]) add_closed_block_data(st, f.axes, shape, b, weight, team);
     else add_block_data(st, f.axes, shape, b, weight, team);
-    SparseSystem<R> sys(f.axes, st, static_cast<double>(present), total);
+    SparseSystem<R> sys(f.axes, st, weight_sum[0], total);
     const std::vector<double> all_rhs = team.gather(rhs);
     if (o.auto_smoothing) {
       // Σ w r² over the data: blocks of rows as in residuals(), their sums added in order.
@@ -1763,9 +1920,9 @@ ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOption
         });
         return acc[0];
       };
-      team.run([&] { gcv_fit<R>(f, sys, all_rhs, present, fill, rss); });
+      team.run([&] { gcv_fit<R>(f, sys, all_rhs, present[0], fill, rss); });
     } else {
-      team.run([&] { sparse_fit<R>(f, sys, all_rhs, o.smoothing, fill || !o.smoothing); });
+      team.run([&] { sparse_fit<R>(f, sys, all_rhs, o.smoothing, filled); });
     }
     out.rows.assign(as_points(f.cp.data()) + out.first * c1, as_points(f.cp.data()) + (out.first + nr) * c1);
   }

@@ -994,7 +994,7 @@ Closing block_closing(const GridBlock& b, std::size_t axis, std::span<const Vec3
 }
 
 std::vector<std::vector<double>> block_parameters(const GridBlock& b, Parametrization param, const RowTeam& team,
-                                                  std::size_t axes) {
+                                                  std::size_t axes, bool along_u) {
   const std::size_t R = b.rank, M = b.row_size();
   // As grid_parameters_of: a grid of extreme scale is measured scaled by 2^-shift.
   const int shift = param == Parametrization::uniform ? 0 : extreme_shift(b, team);
@@ -1022,14 +1022,14 @@ std::vector<std::vector<double>> block_parameters(const GridBlock& b, Parametriz
   const GridChords chords(s, param, {}, team);
   std::vector<std::vector<double>> t(R);
   std::vector<double> steps(s.count, 0.0);
-  if (chords.uses_chords()) {
+  if (chords.uses_chords() && along_u) {
     std::vector<double> scratch(M);
     for (std::size_t k = s.first == 0 ? 1 : 0; k < s.count; ++k)
       steps[k] = chords.row_step(k == 0 ? s.before : s.data + (k - 1) * M, s.data + k * M, scratch.data());
   }
-  const std::vector<double> all_steps = team.gather(steps);
+  const std::vector<double> all_steps = along_u ? team.gather(steps) : std::vector<double>{};
   team.run([&] {
-    t[0] = chords.u_parameters(all_steps);
+    if (along_u) t[0] = chords.u_parameters(all_steps);
     for (std::size_t a = 1; a < std::min(R, axes); ++a) t[a] = chords.in_row_parameters(a);
   });
   return t;

@@ -3,8 +3,8 @@
 // by the processes of a RowTeam (src/mpi/): the same control points, bit for bit, as
 // the single process finds, every sum over the data made in the single process's
 // order. Covered: a given number of control points and smoothing (a number or
-// "auto"), with missing points (NaN), open directions, no weights; a fit to a
-// tolerance and the other cases run in one process.
+// "auto"), with missing points (NaN), weights, open and closed directions; a fit to
+// a tolerance runs in one process.
 
 #include <array>
 #include <cstddef>
@@ -32,6 +32,8 @@ struct ApproxRows {
 
 /// The approximation of the grid `b` (rows may hold NaN: missing points), the
 /// options covered (approximate_rows_covers). Errors as approximate_surface's.
+/// Along a closed u, b.ends must hold the whole grid's rows 0, 1, n−2, n−1; a closed
+/// v's closing column, when left out, is left out of b's rows in place.
 /// `release` is called once the block's points are read no more: the caller may
 /// free them then (a smoothing "auto" reads them to the end).
 ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOptions& o, const RowTeam& team,

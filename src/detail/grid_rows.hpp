@@ -85,6 +85,9 @@ struct GridBlock {
   const Vec3* before = nullptr;      ///< row first − 1, when first > 0
   const Vec3* row0 = nullptr;        ///< the whole grid's first row
   const Vec3* last = nullptr;        ///< and its last
+  /// The whole grid's rows 0, 1, n−2 and n−1 as read, for a closing test along u
+  /// (block_closing's `ends`); set where a closed u is approximated (approximate_rows).
+  std::array<const Vec3*, 4> ends{};
   [[nodiscard]] std::size_t row_size() const {
     std::size_t m = 1;
     for (std::size_t a = 1; a < rank; ++a) m *= n[a];
@@ -138,8 +141,9 @@ template <std::size_t Rank>
 void drop_last_line(Grid<Vec3, Rank>& points, std::size_t axis);
 
 /// The parameters along the first `axes` axes of a grid held in blocks of rows, as
-/// grid_parameters gives them for the whole grid (open directions, every point present).
+/// grid_parameters gives them for the whole grid (open directions, every point present);
+/// without `along_u`, those along u are left empty (not measured).
 std::vector<std::vector<double>> block_parameters(const GridBlock& b, Parametrization param, const RowTeam& team,
-                                                  std::size_t axes);
+                                                  std::size_t axes, bool along_u = true);
 
 }  // namespace interpatch::detail
