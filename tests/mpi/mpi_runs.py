@@ -5,10 +5,12 @@ Runs `interpatch eval` and `interpatch build` on grids whose rows split unevenly
 between 1..4 processes (chunks of 16 rows), closed directions of odd and even
 degree, collapsed rows (poles), every parametrization, float32 and big-endian
 input, Fortran-order input, surfaces and volumes, and approximations (a given number of control points,
-the separable fit and the sparse one with holes, smoothing, smoothing "auto"), each
+the separable fit and the sparse one with holes, smoothing, smoothing "auto";
+weights with zeros; closed u and v, the closing line left out or none), each
 checked to have run split; every output must equal the single process's, byte for
 byte. Then the failures: a missing points file, a NaN in the last process's rows,
-bad options, an output in a missing directory; each must end every process with
+bad options, a closing line that nearly repeats the first, an output in a missing
+directory; each must end every process with
 the single process's exit status and error line, exactly one line on stderr, no
 output file and no temporary file left, and an existing output untouched.
 
@@ -112,6 +114,31 @@ def approximate_cases(rng):
     yield "approximate smoothing auto, uniform", grid((40, 25), rng), {"smoothing": "auto", "param": "uniform"}, "30", [3]
 
 
+def weighted_closed_cases(rng):
+    """(name, points, options, eval grid, process counts): weights (zeros among them,
+    with holes), closed u and v (a closing line repeating the first, left out, and
+    none), each on one split of the rows."""
+    g = holes(grid((53, 37), rng), rng)
+    w = 0.2 + 2 * rng.random((53, 37))
+    w[10:14, 5:30] = 0  # zero weights beside the holes
+    yield "approximate weights with zeros and holes, control points", g, \
+        {"control_points": [20, 15], "weights": w.round(3).tolist()}, "29", [3]
+    w = 0.5 + rng.random((40, 25))
+    yield "approximate weights, smoothing auto", grid((40, 25), rng), {"smoothing": "auto", "weights": w.round(3).tolist()}, \
+        "17", [2]
+    yield "approximate closed u (closing row left out), even degree, control points (cyclic separable)", \
+        grid((50, 20), rng, close=0), {"periodic": [True, False], "degree": [2, 3], "control_points": [12, 8]}, "31", [4]
+    w = 0.5 + rng.random((51, 20))
+    w[0, :] = 0
+    yield "approximate closed u, weights (the first row 0), smoothing", grid((50, 20), rng, close=0), \
+        {"periodic": [True, False], "smoothing": 1e-4, "weights": w.round(3).tolist()}, "23", [2]
+    yield "approximate closed u, holes, as few control rows as degree 3 allows", holes(grid((70, 12), rng), rng), \
+        {"periodic": [True, False], "control_points": [4, 6]}, "15", [4]
+    yield "approximate closed v (tube, closing column left out), weights, control points", grid((45, 24), rng, close=1), \
+        {"periodic": [False, True], "degree": [3, 4], "control_points": [10, 9],
+         "weights": (0.5 + rng.random((45, 25))).round(3).tolist()}, "21", [3]
+
+
 def split_ran(d, spec_file):
     """Whether a run on 2 processes was split (rank 1 reports its stages) rather than run on rank 0 alone."""
     env = dict(ENV, INTERPATCH_MPI_TIMINGS="1")
@@ -200,6 +227,27 @@ def main():
             check(split_ran(d, "spec.json"), f"{name}: not split between the processes")
             same_outputs(d, name, "spec.json", eval_grid, processes)
             print("ok:", name, flush=True)
+    for name, points, options, eval_grid, processes in weighted_closed_cases(rng):
+        with tempfile.TemporaryDirectory() as d:
+            np.save(os.path.join(d, "points.npy"), points)
+            with open(os.path.join(d, "spec.json"), "w") as f:
+                json.dump(dict({"type": "approximate", "points": {"npy": "points.npy"}}, **options), f)
+            check(split_ran(d, "spec.json"), f"{name}: not split between the processes")
+            same_outputs(d, name, "spec.json", eval_grid, processes)
+            print("ok:", name, flush=True)
+    with tempfile.TemporaryDirectory() as d:
+        for axis, processes in [(0, [3]), (1, [2])]:  # a closing line off the first by a rounding error
+            g = grid((40, 20), rng, close=axis)
+            if axis == 0:
+                g[-1, :, 2] += 1e-9
+            else:
+                g[:, -1, 2] += 1e-9
+            np.save(os.path.join(d, "points.npy"), g)
+            with open(os.path.join(d, "spec.json"), "w") as f:
+                json.dump({"type": "approximate", "points": {"npy": "points.npy"}, "periodic": [axis == 0, axis == 1],
+                           "control_points": [8, 6]}, f)
+            same_failure(d, f"approximate: the last line along {'uv'[axis]} nearly repeats the first",
+                         ["eval", "spec.json", "--grid", "9", "-o", "good.npy"], 3, processes)
     with tempfile.TemporaryDirectory() as d:
         g = np.full((40, 20, 3), np.nan)
         np.save(os.path.join(d, "points.npy"), g)
