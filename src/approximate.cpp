@@ -1687,9 +1687,10 @@ std::vector<std::size_t> as_counts(It first, It last) {
 
 // closed_data on a grid held in blocks of rows: a closed direction's last line that
 // repeats the first is left out of the block (along v out of each of its rows, in
-// place) and of the weights; one that nearly repeats it is refused.
-void close_block(detail::GridBlock& b, Grid<double, 2>& weights, const std::array<bool, 2>& periodic, bool missing,
-                 const detail::RowTeam& team) {
+// place); one that nearly repeats it is refused. Whether each was left out.
+std::array<bool, 2> close_block(detail::GridBlock& b, const std::array<bool, 2>& periodic, bool missing,
+                                const detail::RowTeam& team) {
+  std::array<bool, 2> dropped{};
   for (std::size_t a = 0; a < 2; ++a) {
     if (!periodic[a] || b.n[a] < 3) continue;
     if (missing) break;
@@ -1697,7 +1698,7 @@ void close_block(detail::GridBlock& b, Grid<double, 2>& weights, const std::arra
     const Closing c = detail::block_closing(b, a, b.ends, false, team);
     if (c.nearly) team.run([&] { refuse_closing_gap(a); });
     if (!c.dropped) continue;
-    if (!weights.empty()) cut_last_line<double, 2>(weights, a);
+    dropped[a] = true;
     const std::size_t n = b.n[a]--;
     if (a == 0) {
       b.count = b.first < n - 1 ? std::min(b.count, n - 1 - b.first) : 0;
@@ -1706,6 +1707,7 @@ void close_block(detail::GridBlock& b, Grid<double, 2>& weights, const std::arra
       for (std::size_t r = 1; r < b.count; ++r) std::copy(b.data + r * n, b.data + r * n + n - 1, b.data + r * (n - 1));
     }
   }
+  return dropped;
 }
 
 }  // namespace
@@ -1728,8 +1730,15 @@ ApproxRows approximate_rows(const GridBlock& given, const SurfaceApproximationOp
   for (std::size_t i = 0; i < given.count * given.n[1]; ++i) missing[0] += is_missing(given.data[i]) ? 1 : 0;
   team.sum(missing);
   GridBlock b = given;
-  Grid<double, R> weights = o.weights;
-  close_block(b, weights, o.periodic, missing[0] > 0, team);
+  const std::array<bool, R> dropped = close_block(b, o.periodic, missing[0] > 0, team);
+  // The weights, without the lines left out (a copy only then).
+  Grid<double, R> cut;
+  if (!o.weights.empty() && (dropped[0] || dropped[1])) {
+    cut = o.weights;
+    for (std::size_t a = 0; a < R; ++a)
+      if (dropped[a]) cut_last_line<double, R>(cut, a);
+  }
+  const Grid<double, R>& weights = cut.empty() ? o.weights : cut;
 
   const Shape<R> shape{b.n[0], b.n[1]};
   const std::size_t M = shape[1], total = shape[0] * shape[1], mine = b.count * M, base = b.first * M;
