@@ -230,79 +230,88 @@ Folded fold_slab(const detail::VolumeTerms& T, std::span<const double> us, bool 
   return F;
 }
 
-// Calls at(i, j, k, S, S_u, S_v, S_w) for every grid point (the partials zero
-// without derivatives), lines along w split over the threads; each point is a sum in a
-// fixed order, so the result does not depend on the thread count.
-template <bool derivatives, class At>
-void for_each_point(const Folded& F, const progress_callback& progress, const At& at) {
+// Calls line_at(i, j, fu, fv) for every line along w of the grid (fu, fv: the
+// blending values of u_i and v_j), split over the threads, in chunks of (i, j) pairs
+// in u-major order between progress reports: a slab of a few u values still keeps
+// both cores busy.
+template <class Line>
+void for_each_line_index(const Folded& F, const progress_callback& progress, const Line& line_at) {
   const std::size_t nu = F.extent(0), nv = F.extent(1), nw = F.extent(2);
-  const std::size_t Ku = F.blends[0], Kv = F.blends[1], Kw = F.blends[2];
-  // Lines along w, (i, j) pairs in u-major order, in chunks between progress reports:
-  // a slab of a few u values still keeps both cores busy.
+  const std::size_t K = F.blends[0] + F.blends[1] + F.blends[2];
   const std::size_t lines = nu * nv, chunk = std::max<std::size_t>(nv, std::size_t{1} << 12);
   for (std::size_t l0 = 0; l0 < lines; l0 += chunk) {
     const auto l1 = static_cast<long long>(std::min(lines, l0 + chunk));
-#pragma omp parallel for schedule(static) if ((std::size_t(l1) - l0) * nw * (Ku + Kv + Kw) >= detail::parallel_min_work)
+#pragma omp parallel for schedule(static) if ((std::size_t(l1) - l0) * nw * K >= detail::parallel_min_work)
     for (auto line = static_cast<long long>(l0); line < l1; ++line) {
       const std::size_t i = static_cast<std::size_t>(line) / nv, j = static_cast<std::size_t>(line) % nv;
-      const double* fu = F.f[0].data() + i * Ku;
-      const double* dfu = F.df[0].data() + i * Ku;
-      const double* fv = F.f[1].data() + j * Kv;
-      const double* dfv = F.df[1].data() + j * Kv;
-      // Along the line: the u planes at (j, ·), the v planes at (i, ·), both
-      // contiguous in k; the w planes at (i, j), the same for the whole line.
-      using Row = std::array<const Vec3*, detail::max_volume_blends>;
-      Row U{}, Uv{}, Uw{}, V{}, Vu{}, Vw{};
-      std::array<Vec3, detail::max_volume_blends> W{}, Wu{}, Wv{};
-      const auto line_of = [&](std::size_t axis, std::size_t K, std::size_t offset, Row& value, Row& d0, Row& d1) {
-        for (std::size_t a = 0; a < K; ++a) {
-          const Plane& p = F.plane(axis, a);
-          value[a] = p.value.data() + offset;
-          if constexpr (derivatives) {
-            d0[a] = p.d0.data() + offset;
-            d1[a] = p.d1.data() + offset;
-          }
-        }
-      };
-      line_of(0, Ku, j * nw, U, Uv, Uw);
-      line_of(1, Kv, i * nw, V, Vu, Vw);
-      for (std::size_t c = 0; c < Kw; ++c) {
-        const Plane& p = F.plane(2, c);
-        W[c] = p.value[i * nv + j];
-        if constexpr (derivatives) {
-          Wu[c] = p.d0[i * nv + j];
-          Wv[c] = p.d1[i * nv + j];
-        }
-      }
-      for (std::size_t k = 0; k < nw; ++k) {
-        const double* fw = F.f[2].data() + k * Kw;
-        Vec3 s{}, su{}, sv{}, sw{};
-        for (std::size_t a = 0; a < Ku; ++a) s += fu[a] * U[a][k];
-        for (std::size_t b = 0; b < Kv; ++b) s += fv[b] * V[b][k];
-        for (std::size_t c = 0; c < Kw; ++c) s += fw[c] * W[c];
-        if constexpr (derivatives) {
-          const double* dfw = F.df[2].data() + k * Kw;
-          for (std::size_t a = 0; a < Ku; ++a) {
-            su += dfu[a] * U[a][k];
-            sv += fu[a] * Uv[a][k];
-            sw += fu[a] * Uw[a][k];
-          }
-          for (std::size_t b = 0; b < Kv; ++b) {
-            su += fv[b] * Vu[b][k];
-            sv += dfv[b] * V[b][k];
-            sw += fv[b] * Vw[b][k];
-          }
-          for (std::size_t c = 0; c < Kw; ++c) {
-            su += fw[c] * Wu[c];
-            sv += fw[c] * Wv[c];
-            sw += dfw[c] * W[c];
-          }
-        }
-        at(i, j, k, s, su, sv, sw);
-      }
+      line_at(i, j, F.f[0].data() + i * F.blends[0], F.f[1].data() + j * F.blends[1]);
     }
     if (progress) progress(static_cast<double>(l1) / static_cast<double>(lines));
   }
+}
+
+// Calls at(i, j, k, S, S_u, S_v, S_w) for every grid point (the partials zero
+// without derivatives); each point is a sum in a fixed order, so the result does not
+// depend on the thread count.
+template <bool derivatives, class At>
+void for_each_point(const Folded& F, const progress_callback& progress, const At& at) {
+  const std::size_t nv = F.extent(1), nw = F.extent(2);
+  const std::size_t Ku = F.blends[0], Kv = F.blends[1], Kw = F.blends[2];
+  for_each_line_index(F, progress, [&](std::size_t i, std::size_t j, const double* fu, const double* fv) {
+    const double* dfu = F.df[0].data() + i * Ku;
+    const double* dfv = F.df[1].data() + j * Kv;
+    // Along the line: the u planes at (j, ·), the v planes at (i, ·), both
+    // contiguous in k; the w planes at (i, j), the same for the whole line.
+    using Row = std::array<const Vec3*, detail::max_volume_blends>;
+    Row U{}, Uv{}, Uw{}, V{}, Vu{}, Vw{};
+    std::array<Vec3, detail::max_volume_blends> W{}, Wu{}, Wv{};
+    const auto line_of = [&](std::size_t axis, std::size_t K, std::size_t offset, Row& value, Row& d0, Row& d1) {
+      for (std::size_t a = 0; a < K; ++a) {
+        const Plane& p = F.plane(axis, a);
+        value[a] = p.value.data() + offset;
+        if constexpr (derivatives) {
+          d0[a] = p.d0.data() + offset;
+          d1[a] = p.d1.data() + offset;
+        }
+      }
+    };
+    line_of(0, Ku, j * nw, U, Uv, Uw);
+    line_of(1, Kv, i * nw, V, Vu, Vw);
+    for (std::size_t c = 0; c < Kw; ++c) {
+      const Plane& p = F.plane(2, c);
+      W[c] = p.value[i * nv + j];
+      if constexpr (derivatives) {
+        Wu[c] = p.d0[i * nv + j];
+        Wv[c] = p.d1[i * nv + j];
+      }
+    }
+    for (std::size_t k = 0; k < nw; ++k) {
+      const double* fw = F.f[2].data() + k * Kw;
+      Vec3 s{}, su{}, sv{}, sw{};
+      for (std::size_t a = 0; a < Ku; ++a) s += fu[a] * U[a][k];
+      for (std::size_t b = 0; b < Kv; ++b) s += fv[b] * V[b][k];
+      for (std::size_t c = 0; c < Kw; ++c) s += fw[c] * W[c];
+      if constexpr (derivatives) {
+        const double* dfw = F.df[2].data() + k * Kw;
+        for (std::size_t a = 0; a < Ku; ++a) {
+          su += dfu[a] * U[a][k];
+          sv += fu[a] * Uv[a][k];
+          sw += fu[a] * Uw[a][k];
+        }
+        for (std::size_t b = 0; b < Kv; ++b) {
+          su += fv[b] * Vu[b][k];
+          sv += dfv[b] * V[b][k];
+          sw += fv[b] * Vw[b][k];
+        }
+        for (std::size_t c = 0; c < Kw; ++c) {
+          su += fw[c] * Wu[c];
+          sv += fw[c] * Wv[c];
+          sw += dfw[c] * W[c];
+        }
+      }
+      at(i, j, k, s, su, sv, sw);
+    }
+  });
 }
 
 // The nw points of one line along w without derivatives: the sums for_each_point
@@ -377,25 +386,16 @@ INTERPATCH_KERNEL void line_of_points(std::size_t nw, std::size_t Ku, std::size_
 // points), lines split over the threads as in for_each_point.
 template <class Dest>
 void for_each_line(const Folded& F, const progress_callback& progress, const Dest& dest) {
-  const std::size_t nu = F.extent(0), nv = F.extent(1), nw = F.extent(2);
+  const std::size_t nv = F.extent(1), nw = F.extent(2);
   const std::size_t Ku = F.blends[0], Kv = F.blends[1], Kw = F.blends[2];
-  const std::size_t lines = nu * nv, chunk = std::max<std::size_t>(nv, std::size_t{1} << 12);
-  for (std::size_t l0 = 0; l0 < lines; l0 += chunk) {
-    const auto l1 = static_cast<long long>(std::min(lines, l0 + chunk));
-#pragma omp parallel for schedule(static) if ((std::size_t(l1) - l0) * nw * (Ku + Kv + Kw) >= detail::parallel_min_work)
-    for (auto line = static_cast<long long>(l0); line < l1; ++line) {
-      const std::size_t i = static_cast<std::size_t>(line) / nv, j = static_cast<std::size_t>(line) % nv;
-      const double* fu = F.f[0].data() + i * Ku;
-      const double* fv = F.f[1].data() + j * Kv;
-      std::array<const Vec3*, detail::max_volume_blends> U{}, V{};
-      std::array<Vec3, detail::max_volume_blends> W{};
-      for (std::size_t a = 0; a < Ku; ++a) U[a] = F.plane(0, a).value.data() + j * nw;
-      for (std::size_t b = 0; b < Kv; ++b) V[b] = F.plane(1, b).value.data() + i * nw;
-      for (std::size_t c = 0; c < Kw; ++c) W[c] = F.plane(2, c).value[i * nv + j];
-      line_of_points(nw, Ku, Kv, Kw, fu, fv, F.f[2].data(), U.data(), V.data(), W.data(), dest(i, j));
-    }
-    if (progress) progress(static_cast<double>(l1) / static_cast<double>(lines));
-  }
+  for_each_line_index(F, progress, [&](std::size_t i, std::size_t j, const double* fu, const double* fv) {
+    std::array<const Vec3*, detail::max_volume_blends> U{}, V{};
+    std::array<Vec3, detail::max_volume_blends> W{};
+    for (std::size_t a = 0; a < Ku; ++a) U[a] = F.plane(0, a).value.data() + j * nw;
+    for (std::size_t b = 0; b < Kv; ++b) V[b] = F.plane(1, b).value.data() + i * nw;
+    for (std::size_t c = 0; c < Kw; ++c) W[c] = F.plane(2, c).value[i * nv + j];
+    line_of_points(nw, Ku, Kv, Kw, fu, fv, F.f[2].data(), U.data(), V.data(), W.data(), dest(i, j));
+  });
 }
 
 // Points of the planes of v and w a slab is given at most: the slabs of a grid of
