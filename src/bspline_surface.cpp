@@ -10,6 +10,7 @@
 #include "detail/kernel.hpp"
 #include "detail/parallel.hpp"
 #include "detail/row_window.hpp"
+#include "detail/sample_row.hpp"
 #include "detail/text.hpp"
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/memory.hpp"
@@ -46,56 +47,11 @@ INTERPATCH_KERNEL void weighted_rows(const double* w, int count, const double* c
   }
 }
 
-// The points of one u row: out[j] = Σ_k weights[j][k] row[spans[j] − q + k], row
-// holding 3 doubles a point and one double of slack after them. Each point is
-// summed in four lanes (x, y, z and the next point's x, which is discarded) and
-// stored four doubles wide, the fourth overwritten by the next point; the last
-// point is summed in the same order one coordinate at a time. Q1 = q + 1 when it
-// is known at compile time (the loop over k unrolled), 0 when it is not.
-template <std::size_t Q1>
-[[gnu::always_inline]] inline void sample_points(const int* spans, const double* weights, int q, std::size_t nv,
-                                                 const double* row, double* out) {
-  const std::size_t q1 = Q1 != 0 ? Q1 : static_cast<std::size_t>(q + 1);
-  std::size_t j = 0;
-#if defined(__GNUC__)
-  using v4 = double __attribute__((vector_size(32)));
-  for (; j + 1 < nv; ++j) {
-    const double* h = row + 3 * static_cast<std::size_t>(spans[j] - q);
-    const double* f = weights + j * q1;
-    v4 acc = {0, 0, 0, 0};
-    for (std::size_t k = 0; k < q1; ++k) {
-      v4 p;
-      std::memcpy(&p, h + 3 * k, sizeof p);
-      acc += f[k] * p;
-    }
-    std::memcpy(out + 3 * j, &acc, sizeof acc);
-  }
-#endif
-  for (; j < nv; ++j) {
-    const double* h = row + 3 * static_cast<std::size_t>(spans[j] - q);
-    const double* f = weights + j * q1;
-    double x = 0, y = 0, z = 0;
-    for (std::size_t k = 0; k < q1; ++k) {
-      x += f[k] * h[3 * k];
-      y += f[k] * h[3 * k + 1];
-      z += f[k] * h[3 * k + 2];
-    }
-    out[3 * j] = x;
-    out[3 * j + 1] = y;
-    out[3 * j + 2] = z;
-  }
-}
-
-// sample_points with the loop over k unrolled for degrees 1 to 3 (the same sums in
-// the same order: the same bits).
+// The points of one u row from the row of the net contracted over u (3 doubles a
+// point, one of slack after them): detail::sample_points.
 INTERPATCH_KERNEL void sample_row(const int* spans, const double* weights, int q, std::size_t nv, const double* row,
                                   double* out) {
-  switch (q) {
-    case 3: return sample_points<4>(spans, weights, q, nv, row, out);
-    case 2: return sample_points<3>(spans, weights, q, nv, row, out);
-    case 1: return sample_points<2>(spans, weights, q, nv, row, out);
-    default: return sample_points<0>(spans, weights, q, nv, row, out);
-  }
+  detail::sample_by_degree<3>(spans, weights, q, nv, row, out);
 }
 
 // A line of homogeneous control points along u at column j (or along v at row i).
@@ -222,23 +178,9 @@ SurfaceDerivatives BSplineSurface::derivatives(double u, double v) const {
 
 namespace detail {
 
-// The basis functions of the v parameters packed for sample_row: spans, then q + 1
-// weights a parameter, so that both loops of a row run along memory.
-struct VTable {
-  std::vector<int> spans;
-  std::vector<double> weights;
-};
-
-VTable v_table(const KnotVector& kv, std::span<const double> vs) {
-  const auto bv = bases(kv, vs, 0, "v");
-  const auto q1 = static_cast<std::size_t>(kv.degree() + 1);
-  VTable t{std::vector<int>(vs.size()), std::vector<double>(vs.size() * q1)};
-  for (std::size_t j = 0; j < vs.size(); ++j) {
-    t.spans[j] = bv[j].span;
-    std::copy_n(bv[j].d, q1, t.weights.data() + j * q1);
-  }
-  return t;
-}
+// The basis functions of the v parameters packed for sample_row.
+using VTable = PackedBasis;
+VTable v_table(const KnotVector& kv, std::span<const double> vs) { return packed(bases(kv, vs, 0, "v"), kv.degree()); }
 
 // The points of a polynomial surface at every u of `us` and the v parameters of `vt`.
 void evaluate_rows_on(const KnotVector& ku_, const KnotVector& kv_, const RowWindow& net, std::span<const double> us,
