@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -303,11 +304,13 @@ void solve_along_axis(const Solver& lu, double* data, const std::size_t* shape, 
     const auto groups = static_cast<long long>((outer + narrow_group - 1) / narrow_group);
 #pragma omp parallel if (threads)
     {
-      std::vector<double> buf(n * narrow_group * inner);
+      // Not zeroed: every group writes the part it reads (solve_rows calls this for
+      // every few rows, and zeroing the buffer each time cost a tenth of an eval).
+      const std::unique_ptr<double[]> buf(new double[n * narrow_group * inner]);
 #pragma omp for schedule(static)
       for (long long g = 0; g < groups; ++g) {
         const std::size_t o0 = static_cast<std::size_t>(g) * narrow_group;
-        solve_narrow_group(lu, data + o0 * block, n, inner, block, std::min(narrow_group, outer - o0), buf.data());
+        solve_narrow_group(lu, data + o0 * block, n, inner, block, std::min(narrow_group, outer - o0), buf.get());
       }
     }
     return;
