@@ -264,11 +264,12 @@ std::size_t slice_width(std::size_t inner, std::size_t n) {
 constexpr std::size_t narrow_group = 8;
 
 // Copies the m lines (rows of `inner` doubles, `block` apart) side by side into buf
-// (Gather) or back out of it: plain loops, which the compiler unrolls for the usual
-// 3 doubles a row.
-template <bool Gather>
-INTERPATCH_KERNEL void shuffle_lines(double* data, std::size_t n, std::size_t inner, std::size_t block, std::size_t m,
-                                     double* buf) {
+// (Gather) or back out of it: plain loops, with the row's length known at compile
+// time for the usual 3 doubles a row (Inner = 3; 0: inner given at run time).
+template <bool Gather, std::size_t Inner>
+[[gnu::always_inline]] inline void shuffle(double* data, std::size_t n, std::size_t inner, std::size_t block,
+                                           std::size_t m, double* buf) {
+  if constexpr (Inner != 0) inner = Inner;
   const std::size_t width = m * inner;
   for (std::size_t l = 0; l < m; ++l) {
     double* line = data + l * block;
@@ -279,6 +280,13 @@ INTERPATCH_KERNEL void shuffle_lines(double* data, std::size_t n, std::size_t in
         else line[k * inner + c] = side[k * width + c];
       }
   }
+}
+
+template <bool Gather>
+INTERPATCH_KERNEL void shuffle_lines(double* data, std::size_t n, std::size_t inner, std::size_t block, std::size_t m,
+                                     double* buf) {
+  if (inner == 3) return shuffle<Gather, 3>(data, n, inner, block, m, buf);
+  shuffle<Gather, 0>(data, n, inner, block, m, buf);
 }
 
 template <class Solver>
