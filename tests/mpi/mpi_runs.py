@@ -127,17 +127,26 @@ def tolerance_cases(rng):
     """The fit to a tolerance: grids of 2^18 points or more grow their first knots on a thinned
     grid (every 4th row and column: blocks of it on every process, some empty), smaller ones
     on the whole grid; the separable fit and the sparse one with holes; row splits uneven."""
-    yield "approximate tolerance 520x520 (thinned grid)", bumps((520, 520), rng), {"tolerance": 2e-3}, "70", PROCESSES
+    yield "approximate tolerance 520x520 (thinned grid)", bumps((520, 520), rng), {"tolerance": 2e-3}, "70", [1, 4]
     yield "approximate tolerance 520x520 holes (thinned grid)", holes(bumps((520, 520), rng), rng), {"tolerance": 2e-3}, \
         "45x61", [3]
     yield "approximate tolerance 40x6600 holes: thinned along v alone, processes with no rows", \
         holes(bumps((40, 6600), rng), rng), {"tolerance": 2e-3, "degree": [2, 3]}, "9x50", [4]
-    yield "approximate tolerance 53x37, fewer control columns than processes at first", bumps((53, 37), rng), \
-        {"tolerance": 2e-3, "degree": [3, 2]}, "40", [2, 4]
+    # 3 control columns at first: a process holds none in the separable solve.
+    yield "approximate tolerance 53x37, fewer control columns than processes", bumps((53, 37), rng), \
+        {"tolerance": 2e-3, "degree": [3, 2]}, "40", [4]
     yield "approximate tolerance holes, centripetal, Fortran order", np.asfortranarray(holes(bumps((70, 45), rng), rng)), \
-        {"tolerance": 2e-3, "param": "centripetal"}, "33", [3]
-    yield "approximate control points, fewer control columns than processes", bumps((53, 37), rng), \
-        {"control_points": [10, 3], "degree": [3, 2]}, "20", [4]
+        {"tolerance": 2e-3, "param": "centripetal"}, "33", [2]
+
+
+
+def tolerance_failure():
+    """A fit to a tolerance refused on the split path as in one process: one line, its status, no output."""
+    with tempfile.TemporaryDirectory() as d:
+        np.save(os.path.join(d, "points.npy"), np.full((40, 20, 3), np.nan))
+        with open(os.path.join(d, "spec.json"), "w") as f:
+            json.dump({"type": "approximate", "points": {"npy": "points.npy"}, "tolerance": 1e-3}, f)
+        same_failure(d, "approximate tolerance: every point missing", ["build", "spec.json", "-o", "good.npz"], 3, [3])
 
 
 def split_ran(d, spec_file):
@@ -228,6 +237,7 @@ def main():
             check(split_ran(d, "spec.json"), f"{name}: not split between the processes")
             same_outputs(d, name, "spec.json", eval_grid, processes)
             print("ok:", name, flush=True)
+    tolerance_failure()
     with tempfile.TemporaryDirectory() as d:
         g = np.full((40, 20, 3), np.nan)
         np.save(os.path.join(d, "points.npy"), g)
