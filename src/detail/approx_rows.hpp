@@ -2,9 +2,9 @@
 // Surface approximation (approximate_surface) of a grid held in blocks of whole rows
 // by the processes of a RowTeam (src/mpi/): the same control points, bit for bit, as
 // the single process finds, every sum over the data made in the single process's
-// order. Covered: a given number of control points and smoothing (a number or
-// "auto"), with missing points (NaN), open directions, no weights; a fit to a
-// tolerance and the other cases run in one process.
+// order. Covered: a given number of control points, smoothing (a number or "auto")
+// and a fit to a tolerance, with missing points (NaN), open directions, no weights;
+// the other cases run in one process.
 
 #include <array>
 #include <cstddef>
@@ -33,7 +33,7 @@ struct ApproxRows {
 /// The approximation of the grid `b` (rows may hold NaN: missing points), the
 /// options covered (approximate_rows_covers). Errors as approximate_surface's.
 /// `release` is called once the block's points are read no more: the caller may
-/// free them then (a smoothing "auto" reads them to the end).
+/// free them then (a smoothing "auto" and a tolerance read them to the end).
 ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOptions& o, const RowTeam& team,
                             const std::function<void()>& release = {});
 

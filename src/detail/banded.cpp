@@ -306,6 +306,7 @@ void solve_along_axis(const Solver& lu, double* data, const std::size_t* shape, 
   for (std::size_t a = 0; a < axis; ++a) outer *= shape[a];
   for (std::size_t a = axis + 1; a < rank; ++a) inner *= shape[a];
   const std::size_t n = shape[axis];
+  if (outer == 0 || inner == 0) return;  // nothing to solve (a process of a split run holding no columns)
   const std::size_t block = n * inner;
   [[maybe_unused]] const bool threads = parallel && block * outer >= parallel_min_work;
   if (inner < 64 && outer > 1) {
