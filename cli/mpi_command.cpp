@@ -147,7 +147,8 @@ Plan plan_of(const MpiRequest& r, const mpi::Team& team) {
   }
   if (count == 0 || plan.header.data_offset + count * dt->size != size) return plan;
   if (approx) {
-    // What the split approximation does not cover (a fit to a tolerance), and
+    // What the split approximation does not cover (a fit to a tolerance with weights
+    // or closed directions), and
     // options the single process refuses, run there.
     try {
       io::reader::Context fields;

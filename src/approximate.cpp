@@ -5,6 +5,7 @@
 #include <exception>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <random>
 #include <variant>
@@ -744,6 +745,40 @@ std::vector<std::size_t> residual_offsets(const Axis& last) {
 // and the blocks' added in order (in one process as in a split run).
 constexpr std::size_t residual_block_rows = 16;
 
+// Residuals of data rows [q0, q1) (row q of `partial` at partial + (q − base)·3c, of
+// the points at pts + (q − base)·n, as residual_rows): blocks of
+// residual_block_rows rows from q0 in parallel, merged in order.
+template <std::size_t R, class Weight>
+Residuals<R> residual_blocks(const std::array<Axis, R>& axes, const Shape<R>& shape, const double* partial, const Vec3* pts,
+                             std::size_t base, std::size_t q0, std::size_t q1, const Weight& weight) {
+  const std::size_t n = axes[R - 1].n, pp = static_cast<std::size_t>(axes[R - 1].p) + 1;
+  const std::size_t blocks = (q1 - q0 + residual_block_rows - 1) / residual_block_rows;
+  std::vector<Residuals<R>> part(blocks, Residuals<R>(axes));
+  const auto nb = static_cast<long long>(blocks);
+  const std::vector<std::size_t> off = residual_offsets(axes[R - 1]);
+#pragma omp parallel if ((q1 - q0) * n * pp * 3 >= parallel_work)
+  {
+    std::vector<double> row(3 * n), e2(n);
+#pragma omp for schedule(static)
+    for (long long bi = 0; bi < nb; ++bi) {
+      const std::size_t b0 = q0 + static_cast<std::size_t>(bi) * residual_block_rows;
+      residual_rows<R>(part[static_cast<std::size_t>(bi)], axes, shape, partial, pts, base, b0,
+                       std::min(q1, b0 + residual_block_rows), weight, off.data(), row.data(), e2.data());
+    }
+  }
+  Residuals<R> all(axes);
+  for (const auto& r : part) all.merge(r);
+  return all;
+}
+
+// Squares were compared; distances are reported.
+template <std::size_t R>
+void take_roots(Residuals<R>& r) {
+  r.max = r.max < 0 ? 0.0 : std::sqrt(r.max);
+  for (std::size_t a = 0; a < R; ++a)
+    for (double& m : r.interval_max[a]) m = m < 0 ? m : std::sqrt(m);
+}
+
 // The distances |S(t_i) − Q_i| at every point present, evaluated a row at a time
 // (every index but the last fixed) and never stored: the control net goes through B
 // along every direction but the last once (n_0 ⋯ n_{R−2} × c_{R−1} values), and each
@@ -758,29 +793,9 @@ Residuals<R> residuals(const std::array<Axis, R>& axes, const Data<R>& d, const 
     basis_pass<false, R>(axes[a], partial.data(), shape, a, scratch);
     std::swap(partial, scratch);
   }
-  const std::size_t n = axes[R - 1].n, pp = static_cast<std::size_t>(axes[R - 1].p) + 1;
-  const std::size_t rows = d.points.size() / n;
-  const std::size_t blocks = (rows + residual_block_rows - 1) / residual_block_rows;
-  std::vector<Residuals<R>> part(blocks, Residuals<R>(axes));
-  const auto nb = static_cast<long long>(blocks);
-  auto weight = [&](std::size_t i) { return d.w(i); };
-  const std::vector<std::size_t> off = residual_offsets(axes[R - 1]);
-#pragma omp parallel if (d.points.size() * pp * 3 >= parallel_work)
-  {
-    std::vector<double> row(3 * n), e2(n);
-#pragma omp for schedule(static)
-    for (long long bi = 0; bi < nb; ++bi) {
-      const auto b = static_cast<std::size_t>(bi);
-      residual_rows<R>(part[b], axes, d.shape, partial.data(), d.points.data(), 0, b * residual_block_rows,
-                       std::min(rows, (b + 1) * residual_block_rows), weight, off.data(), row.data(), e2.data());
-    }
-  }
-  Residuals<R> all(axes);
-  for (const auto& r : part) all.merge(r);
-  // Squares were compared; distances are reported.
-  all.max = all.max < 0 ? 0.0 : std::sqrt(all.max);
-  for (std::size_t a = 0; a < R; ++a)
-    for (double& m : all.interval_max[a]) m = m < 0 ? m : std::sqrt(m);
+  Residuals<R> all = residual_blocks<R>(axes, d.shape, partial.data(), d.points.data(), 0, 0, d.points.size() / axes[R - 1].n,
+                                        [&](std::size_t i) { return d.w(i); });
+  take_roots<R>(all);
   return all;
 }
 
@@ -927,23 +942,13 @@ void solve_gcv(Fit<R>& f, const Data<R>& d) {
              [&](const std::vector<double>& cp) { return residuals<R>(f.axes, d, cp).weighted_sq; });
 }
 
-// The residual at point `i` of the least-squares fit along axis a alone of the line
-// through it (missing points taking the approximation's values): whether direction
-// a lacks knots there.
-template <std::size_t R>
-double line_residual(const std::array<Axis, R>& axes, const AxisSolver& lu, const Data<R>& d, const std::vector<double>& cp,
-                     std::size_t a, std::size_t i) {
-  const Axis& ax = axes[a];
-  std::size_t inner = 1;
-  for (std::size_t x = a + 1; x < R; ++x) inner *= d.shape[x];
-  const std::size_t n = d.shape[a], pos = (i / inner) % n, base = i - pos * inner;
+// The residual at point `pos` of `line` (n points along axis `ax`, 3 doubles each)
+// of the least-squares fit along that axis alone: whether the direction lacks knots
+// there.
+double line_fit_residual(const Axis& ax, const AxisSolver& lu, const std::vector<double>& line, std::size_t pos) {
+  const std::size_t n = ax.n;
   const auto pp = static_cast<std::size_t>(ax.p) + 1;
-  std::vector<double> line(n * 3), x(static_cast<std::size_t>(ax.c) * 3, 0.0);
-  for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t j = base + k * inner;
-    const Vec3 v = d.w(j) > 0 ? d.points.data()[j] : value_at<R>(axes, cp, j, d.shape);
-    for (std::size_t m = 0; m < 3; ++m) line[3 * k + m] = v[static_cast<int>(m)];
-  }
+  std::vector<double> x(static_cast<std::size_t>(ax.c) * 3, 0.0);
   for (std::size_t k = 0; k < n; ++k)
     for (std::size_t l = 0; l < pp; ++l)
       for (std::size_t m = 0; m < 3; ++m) x[3 * ax.col(ax.first[k] + static_cast<int>(l)) + m] += ax.b[k * pp + l] * line[3 * k + m];
@@ -953,6 +958,31 @@ double line_residual(const std::array<Axis, R>& axes, const AxisSolver& lu, cons
     for (std::size_t m = 0; m < 3; ++m)
       e[static_cast<int>(m)] += ax.b[pos * pp + l] * x[3 * ax.col(ax.first[pos] + static_cast<int>(l)) + m];
   return distance(e, Vec3{line[3 * pos], line[3 * pos + 1], line[3 * pos + 2]});
+}
+
+// A data point for a line fit: the point where present, else the approximation's
+// value there (cp: the control net).
+template <std::size_t R>
+Vec3 point_or_fit(const std::array<Axis, R>& axes, const std::vector<double>& cp, const Shape<R>& shape, const Vec3& q,
+                  bool present, std::size_t flat) {
+  return present ? q : value_at<R>(axes, cp, flat, shape);
+}
+
+// The residual at point `i` of the least-squares fit along axis a alone of the line
+// through it (missing points taking the approximation's values).
+template <std::size_t R>
+double line_residual(const std::array<Axis, R>& axes, const AxisSolver& lu, const Data<R>& d, const std::vector<double>& cp,
+                     std::size_t a, std::size_t i) {
+  std::size_t inner = 1;
+  for (std::size_t x = a + 1; x < R; ++x) inner *= d.shape[x];
+  const std::size_t n = d.shape[a], pos = (i / inner) % n, base = i - pos * inner;
+  std::vector<double> line(n * 3);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t j = base + k * inner;
+    const Vec3 v = point_or_fit<R>(axes, cp, d.shape, d.points.data()[j], d.w(j) > 0, j);
+    for (std::size_t m = 0; m < 3; ++m) line[3 * k + m] = v[static_cast<int>(m)];
+  }
+  return line_fit_residual(axes[a], lu, line, pos);
 }
 
 // Splits knot interval k of an axis at the middle of the data in it, between two
@@ -1023,52 +1053,89 @@ std::vector<double> removal_costs(const Fit<R>& f, std::size_t a, const std::vec
   return jump;
 }
 
+// The data a fit to a tolerance works on, all in this process (the split run has its
+// own, Block in the section "split between processes"): what the knot logic of
+// grow() and solve_tolerance() asks of the data.
+template <std::size_t R>
+struct Whole {
+  std::shared_ptr<const Data<R>> own;  // a thinned grid's data; none for the caller's
+  const Data<R>* d = nullptr;
+
+  [[nodiscard]] std::size_t size() const { return d->points.size(); }
+  [[nodiscard]] const Shape<R>& shape() const { return d->shape; }
+  void fit(Fit<R>& f) const { solve_once<R>(f, *d, std::nullopt); }
+  [[nodiscard]] Residuals<R> errors(const Fit<R>& f) const { return residuals<R>(f.axes, *d, f.cp); }
+  // line_residual at each (axis, point) of `at`, lu[axis] the axis's line solver.
+  [[nodiscard]] std::vector<double> line_residuals(const Fit<R>& f, const std::array<std::optional<AxisSolver>, R>& lu,
+                                                   const std::vector<std::pair<std::size_t, std::size_t>>& at) const {
+    std::vector<double> e;
+    for (const auto& [a, i] : at) e.push_back(line_residual<R>(f.axes, *lu[a], *d, f.cp, a, i));
+    return e;
+  }
+  // Which lines across each axis (every point with that index along it) hold data.
+  [[nodiscard]] std::array<std::vector<bool>, R> has_data() const {
+    std::array<std::vector<bool>, R> has;
+    for (std::size_t a = 0; a < R; ++a) has[a].assign(d->shape[a], d->uniform());
+    if (!d->uniform())
+      for (std::size_t i = 0; i < d->points.size(); ++i)
+        if (d->w(i) > 0) {
+          const std::vector<std::size_t> idx = unflatten<R>(i, d->shape);
+          for (std::size_t a = 0; a < R; ++a) has[a][idx[a]] = true;
+        }
+    return has;
+  }
+  [[nodiscard]] Whole thinned(const std::array<std::vector<std::size_t>, R>& kept) const;
+};
+
 // Growth from the knots in `breaks`: knots go where the error is largest, in every
 // interval whose worst point is beyond the tolerance, in the directions along which
 // that point's line, fitted on its own, misses it by more than half the tolerance
 // (where neither does, in every direction). True when the fit is within the
-// tolerance; false when no interval can split any more.
-template <std::size_t R>
-bool grow(Fit<R>& f, const Data<R>& d, double tol, std::array<std::vector<double>, R>& breaks,
+// tolerance; false when no interval can split any more. `s`: the data (Whole, or a
+// block of a split run), every decision here the same on every process.
+template <std::size_t R, class Source>
+bool grow(Fit<R>& f, const Source& s, double tol, std::array<std::vector<double>, R>& breaks,
           const progress_callback& progress) {
-  // Which lines across each axis (every point with that index along it) hold data.
-  std::array<std::vector<bool>, R> has_data;
-  for (std::size_t a = 0; a < R; ++a) has_data[a].assign(d.shape[a], d.uniform());
-  if (!d.uniform())
-    for (std::size_t i = 0; i < d.points.size(); ++i)
-      if (d.w(i) > 0) {
-        const std::vector<std::size_t> idx = unflatten<R>(i, d.shape);
-        for (std::size_t a = 0; a < R; ++a) has_data[a][idx[a]] = true;
-      }
+  const std::array<std::vector<bool>, R> has_data = s.has_data();
   for (;;) {
-    solve_once<R>(f, d, std::nullopt);
+    s.fit(f);
     if (progress) progress(std::min(0.9, 0.1 + 0.04 * f.fits));
-    const Residuals<R> r = residuals<R>(f.axes, d, f.cp);
+    const Residuals<R> r = s.errors(f);
     if (r.max <= tol) return true;
-    std::array<std::vector<int>, R> split;
-    bool any = false;
+    // The intervals beyond the tolerance; those of a direction with a line fit are
+    // decided by it, all lines of one round at once.
+    std::array<std::vector<int>, R> bad;
+    std::array<std::optional<AxisSolver>, R> lu;
+    std::vector<std::pair<std::size_t, std::size_t>> lines;
     for (std::size_t a = 0; a < R; ++a) {
       const Axis& ax = f.axes[a];
       if (static_cast<std::size_t>(ax.c) >= ax.n) continue;
       // A direction whose knots outnumber the data under them (the fit then leans on
       // the fairness term) has no line fit of its own: every bad interval of it splits.
-      std::optional<AxisSolver> lu;
       try {
-        lu = factor_gram(ax, a);
+        lu[a] = factor_gram(ax, a);
       } catch (const error& e) {
         if (e.code() != errc::singular) throw;
       }
       for (int k = 0; k < ax.intervals; ++k) {
         const auto kk = static_cast<std::size_t>(k);
         if (!(r.interval_max[a][kk] > tol)) continue;
-        if (R == 1 || !lu || line_residual<R>(f.axes, *lu, d, f.cp, a, r.interval_worst[a][kk]) > 0.5 * tol) {
+        bad[a].push_back(k);
+        if (R > 1 && lu[a]) lines.emplace_back(a, r.interval_worst[a][kk]);
+      }
+    }
+    const std::vector<double> line_error = s.line_residuals(f, lu, lines);
+    std::array<std::vector<int>, R> split;
+    bool any = false;
+    std::size_t next = 0;
+    for (std::size_t a = 0; a < R; ++a)
+      for (const int k : bad[a])
+        if (R == 1 || !lu[a] || line_error[next++] > 0.5 * tol) {
           split[a].push_back(k);
           any = true;
         }
-      }
-    }
     if (!any) {
-      const std::vector<std::size_t> w = unflatten<R>(r.worst, d.shape);
+      const std::vector<std::size_t> w = unflatten<R>(r.worst, s.shape());
       for (std::size_t a = 0; a < R; ++a) split[a].push_back(f.axes[a].interval[w[a]]);
     }
     bool added = false;
@@ -1115,7 +1182,14 @@ Data<R> thinned(const Data<R>& d, const std::array<std::vector<std::size_t>, R>&
 }
 
 template <std::size_t R>
-void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_callback& progress) {
+Whole<R> Whole<R>::thinned(const std::array<std::vector<std::size_t>, R>& kept) const {
+  auto t = std::make_shared<const Data<R>>(interpatch::thinned<R>(*d, kept));
+  return {t, t.get()};
+}
+
+// The fit to a tolerance of the data `s` (Whole, or a block of a split run).
+template <std::size_t R, class Source>
+void solve_tolerance(Fit<R>& f, const Source& s, double tol, const progress_callback& progress) {
   std::array<std::vector<double>, R> breaks;
   for (std::size_t a = 0; a < R; ++a) {
     Axis& ax = f.axes[a];
@@ -1126,13 +1200,13 @@ void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_cal
   // more points (a sixteenth of a surface's work per fit): the coarse knots a smooth
   // part of the data needs show on it as well. The whole grid then refines them.
   constexpr std::size_t thin = 4, thin_from = 128;
-  const bool thinning = d.points.size() >= (std::size_t{1} << 18);
+  const bool thinning = s.size() >= (std::size_t{1} << 18);
   Fit<R> coarse;
-  Data<R> sub;
+  std::optional<Source> sub;
   if (thinning) {
     std::array<std::vector<std::size_t>, R> kept;
     for (std::size_t a = 0; a < R; ++a) {
-      const std::size_t n = d.shape[a], step = n >= thin_from ? thin : 1;
+      const std::size_t n = s.shape()[a], step = n >= thin_from ? thin : 1;
       for (std::size_t i = 0; i < n; i += step) kept[a].push_back(i);
       if (!f.axes[a].periodic && kept[a].back() != n - 1) kept[a].push_back(n - 1);
       Axis& ax = coarse.axes[a];
@@ -1142,17 +1216,17 @@ void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_cal
       for (std::size_t i : kept[a]) ax.t.push_back(f.axes[a].t[i]);
       ax.set_knots(knots_from_breaks(ax, breaks[a]));
     }
-    sub = thinned<R>(d, kept);
-    (void)grow<R>(coarse, sub, tol, breaks, {});
+    sub.emplace(s.thinned(kept));
+    (void)grow<R>(coarse, *sub, tol, breaks, {});
     f.fits += coarse.fits;
     coarse.fits = 0;
     for (std::size_t a = 0; a < R; ++a) f.axes[a].set_knots(knots_from_breaks(f.axes[a], breaks[a]));
   }
-  if (!grow<R>(f, d, tol, breaks, progress)) return;
+  if (!grow<R>(f, s, tol, breaks, progress)) return;
   auto max_error = [&] {
-    solve_once<R>(f, d, std::nullopt);
+    s.fit(f);
     if (progress) progress(std::min(0.9, 0.1 + 0.04 * f.fits));
-    return residuals<R>(f.axes, d, f.cp);
+    return s.errors(f);
   };
   // Pruning: growth splits several intervals at once and overshoots. The knots whose
   // removal costs least go, as long as the refit stays within the tolerance: first
@@ -1196,8 +1270,8 @@ void solve_tolerance(Fit<R>& f, const Data<R>& d, double tol, const progress_cal
     bool within = true;
     if (thinning) {
       for (std::size_t a = 0; a < R; ++a) coarse.axes[a].set_knots(knots_from_breaks(coarse.axes[a], breaks[a]));
-      solve_once<R>(coarse, sub, std::nullopt);
-      within = residuals<R>(coarse.axes, sub, coarse.cp).max <= tol;
+      sub->fit(coarse);
+      within = sub->errors(coarse).max <= tol;
       f.fits += coarse.fits;
       coarse.fits = 0;
     }
@@ -1334,7 +1408,7 @@ Result<R> approximate(Data<R> d, const ApproximationOptions<R>& o, const char* w
   if (o.progress) o.progress(0.0);
 
   if (o.tolerance) {
-    solve_tolerance<R>(f, d, *o.tolerance, o.progress);
+    solve_tolerance<R>(f, Whole<R>{nullptr, &d}, *o.tolerance, o.progress);
   } else {
     set_fit_knots<R>(f.axes, o);
     if (o.auto_smoothing) solve_gcv<R>(f, d);
@@ -1710,19 +1784,278 @@ std::array<bool, 2> close_block(detail::GridBlock& b, const std::array<bool, 2>&
   return dropped;
 }
 
+// ------------------------------------------------------------------ a fit on blocks of rows
+
+// Bᵀ (w Q) of a grid of M columns held in blocks of rows, from its columns `cols`
+// (rows_to_columns: every row of this process's even share of the columns): along u
+// on the columns (`read` is called when they are read no more), along v on this
+// process's even share of the control rows of the result.
+std::vector<double> block_rhs(const std::array<Axis, 2>& axes, const std::vector<double>& cols, std::size_t M,
+                              const detail::RowTeam& team, const std::function<void()>& read = {}) {
+  const std::size_t P = team.processes(), me = team.process();
+  const auto c0 = static_cast<std::size_t>(axes[0].c);
+  std::vector<double> tmp, rhs;
+  Shape<2> cs{axes[0].n, detail::even_share(M, me, P).second};
+  basis_pass<true, 2>(axes[0], cols.data(), cs, 0, tmp);
+  if (read) read();
+  std::vector<double> rows = columns_to_rows(tmp, c0, M, team);
+  Shape<2> rs{detail::even_share(c0, me, P).second, M};
+  basis_pass<true, 2>(axes[1], rows.data(), rs, 1, rhs);
+  return rhs;
+}
+
+// Both directions' factored Gram matrices (separable_fit), or none when one is
+// singular: the sparse system then settles what the data leave open.
+std::array<std::optional<AxisSolver>, 2> separable_solvers(const std::array<Axis, 2>& axes, const detail::RowTeam& team) {
+  std::array<std::optional<AxisSolver>, 2> lu;
+  team.run([&] {
+    try {
+      for (std::size_t a = 0; a < 2; ++a) lu[a] = factor_gram(axes[a], a);
+    } catch (const error& e) {
+      if (e.code() != errc::singular) throw;
+      lu = {};
+    }
+  });
+  return lu;
+}
+
+// The separable solve of the right-hand side's rows (block_rhs: this process's even
+// share of the c0 control rows): its control rows, along u on columns, along v on rows.
+std::vector<double> separable_rows(const std::array<std::optional<AxisSolver>, 2>& lu, const std::vector<double>& rhs,
+                                   std::size_t c0, std::size_t c1, const detail::RowTeam& team) {
+  const std::size_t P = team.processes(), me = team.process(), nr = detail::even_share(c0, me, P).second;
+  std::vector<double> cols = rows_to_columns(as_points(rhs.data()), nr, c1, team);
+  const std::size_t cshape[2] = {c0, detail::even_share(c1, me, P).second}, rshape[2] = {nr, c1};
+  std::visit([&](const auto& s) { solve_along_axis(s, cols.data(), cshape, 2, 0, 3); }, *lu[0]);
+  std::vector<double> rows = columns_to_rows(cols, c0, c1, team);
+  std::visit([&](const auto& s) { solve_along_axis(s, rows.data(), rshape, 2, 1, 3); }, *lu[1]);
+  return rows;
+}
+
+// The sparse normal equations of a grid held in blocks of rows (b: this process's),
+// its weights summing to `weight_sum`: the data term from the Gram matrices when every
+// point is present with weight 1 (`uniform`), else summed over the points
+// (add_block_data; add_closed_block_data along a closed u).
+template <class Weight>
+SparseSystem<2> block_system(const std::array<Axis, 2>& axes, const Shape<2>& shape, const detail::GridBlock& b, bool uniform,
+                             const Weight& weight, double weight_sum, const detail::RowTeam& team) {
+  Stencil<2> st(axes);
+  if (uniform) add_grams<2>(st, axes);
+  else if (axes[0].periodic) add_closed_block_data(st, axes, shape, b, weight, team);
+  else add_block_data(st, axes, shape, b, weight, team);
+  return SparseSystem<2>(axes, st, weight_sum, shape[0] * shape[1]);
+}
+
+// The fitted surface of f as approximate_rows returns it, `mine` this process's even
+// share of the control rows (none: f.cp holds them all).
+detail::ApproxRows net_rows(const Fit<2>& f, const detail::RowTeam& team, const double* mine = nullptr) {
+  detail::ApproxRows out;
+  const auto c0 = static_cast<std::size_t>(f.axes[0].c), c1 = static_cast<std::size_t>(f.axes[1].c);
+  const std::pair<std::size_t, std::size_t> share = detail::even_share(c0, team.process(), team.processes());
+  if (!mine) mine = f.cp.data() + 3 * share.first * c1;
+  out.first = share.first;
+  if (share.second > 0) out.rows.assign(as_points(mine), as_points(mine) + share.second * c1);
+  for (std::size_t a = 0; a < 2; ++a) {
+    out.degree[a] = f.axes[a].p;
+    out.knots[a] = f.axes[a].knots.mapped(0.0, 1.0);
+  }
+  out.net = {c0, c1};
+  return out;
+}
+
+// A surface's grid held in blocks of rows as a fit to a tolerance sees it (Whole's
+// counterpart for solve_tolerance): each process fits, measures and gathers lines on
+// its rows; what comes back (the control net, the maxima, the lines) is the same on
+// every process, as one process finds it, so every process takes the same knot
+// decisions. The block's columns (for Bᵀ w Q) are made once and kept between fits.
+class Block {
+  // Each point's weight by its flat index in the grid: 1 present, 0 missing.
+  [[nodiscard]] auto weight() const {
+    return [this](std::size_t flat) { return uniform_ || present_[flat - first_ * n_[1]] ? 1.0 : 0.0; };
+  }
+
+ public:
+  // Rows [first, first + count) of a grid of `shape` at `pts` (`own` holds them for
+  // a thinned grid). `uniform`: the grid it comes from has every point (the data
+  // term from the Gram matrices, the separable fit tried first, as Data::uniform).
+  Block(const detail::RowTeam& team, const Shape<2>& shape, std::shared_ptr<const std::vector<Vec3>> own, const Vec3* pts,
+        std::size_t first, std::size_t count, bool uniform)
+      : team_(&team), n_(shape), own_(std::move(own)), pts_(pts), first_(first), count_(count), uniform_(uniform) {
+    const std::size_t M = n_[1];
+    std::size_t missing[1] = {0};
+    if (!uniform_) {
+      present_.resize(count_ * M);
+      for (std::size_t i = 0; i < present_.size(); ++i) {
+        present_[i] = !is_missing(pts_[i]);
+        missing[0] += present_[i] ? 0 : 1;
+      }
+    }
+    team.sum(missing);
+    present_count_ = n_[0] * M - missing[0];
+    fill_ = missing[0] > 0;
+    const std::vector<double> span = team.gather(std::vector<double>{static_cast<double>(first_), static_cast<double>(count_)});
+    for (std::size_t s = 0; s < span.size(); s += 2) spans_.emplace_back(static_cast<std::size_t>(span[s]), static_cast<std::size_t>(span[s + 1]));
+    cols_ = rows_to_columns(pts_, count_, M, team);
+  }
+
+  [[nodiscard]] std::size_t size() const { return n_[0] * n_[1]; }
+  [[nodiscard]] const Shape<2>& shape() const { return n_; }
+
+  // solve_once without a smoothing weight.
+  void fit(Fit<2>& f) const {
+    ++f.fits;
+    const auto c0 = static_cast<std::size_t>(f.axes[0].c), c1 = static_cast<std::size_t>(f.axes[1].c);
+    const std::vector<double> rhs = block_rhs(f.axes, cols_, n_[1], *team_);
+    if (uniform_) {
+      if (const auto lu = separable_solvers(f.axes, *team_); lu[0]) {
+        f.lambda = 0;
+        f.cp = team_->gather(separable_rows(lu, rhs, c0, c1, *team_));
+        return;
+      }
+    }
+    detail::GridBlock b;
+    b.rank = 2;
+    b.n = {n_[0], n_[1], 0};
+    b.first = first_;
+    b.count = count_;
+    SparseSystem<2> sys = block_system(f.axes, n_, b, uniform_, weight(), static_cast<double>(present_count_), *team_);
+    const std::vector<double> all_rhs = team_->gather(rhs);
+    // The separable fit refused (uniform): the fill term settles what the data leave open.
+    team_->run([&] { sparse_fit<2>(f, sys, all_rhs, std::nullopt, fill_ || uniform_); });
+  }
+
+  // residuals(): each process its rows, the maxima and worst points merged in process
+  // order (a later process's only where strictly greater: the first in one process's
+  // scan wins). The sums of squares are this process's alone: the fit to a tolerance
+  // reads only the maxima.
+  [[nodiscard]] Residuals<2> errors(const Fit<2>& f) const {
+    const auto c0 = static_cast<std::size_t>(f.axes[0].c), c1 = static_cast<std::size_t>(f.axes[1].c);
+    const Axis slice = axis_slice(f.axes[0], first_, count_);
+    Shape<2> sh{c0, c1};
+    std::vector<double> partial;
+    basis_pass<false, 2>(slice, f.cp.data(), sh, 0, partial);
+    const Residuals<2> mine =
+        residual_blocks<2>(f.axes, n_, partial.data(), pts_, first_, first_, first_ + count_, weight());
+    std::vector<double> pack{mine.max, static_cast<double>(mine.worst)};
+    for (std::size_t a = 0; a < 2; ++a) {
+      pack.insert(pack.end(), mine.interval_max[a].begin(), mine.interval_max[a].end());
+      for (const std::size_t w : mine.interval_worst[a]) pack.push_back(static_cast<double>(w));
+    }
+    const std::vector<double> all = team_->gather(pack);
+    Residuals<2> r(f.axes);
+    for (std::size_t at = 0; at < all.size(); at += pack.size()) {
+      Residuals<2> part(f.axes);
+      const double* x = all.data() + at;
+      part.max = *x++;
+      part.worst = static_cast<std::size_t>(*x++);
+      for (std::size_t a = 0; a < 2; ++a) {
+        for (double& m : part.interval_max[a]) m = *x++;
+        for (std::size_t& w : part.interval_worst[a]) w = static_cast<std::size_t>(*x++);
+      }
+      r.merge(part);
+    }
+    take_roots<2>(r);
+    return r;
+  }
+
+  // line_residual at each (axis, point) of `at`: the lines gathered from the
+  // processes holding them (along u a column of every process's rows, along v one
+  // process's row), all in one exchange, then fitted on every process.
+  [[nodiscard]] std::vector<double> line_residuals(const Fit<2>& f, const std::array<std::optional<AxisSolver>, 2>& lu,
+                                                   const std::vector<std::pair<std::size_t, std::size_t>>& at) const {
+    const std::size_t M = n_[1];
+    const auto w = weight();
+    auto holds = [&](std::size_t s, std::size_t row) { return row >= spans_[s].first && row < spans_[s].first + spans_[s].second; };
+    std::vector<double> mine;
+    auto put = [&](std::size_t flat) {
+      const Vec3 v = point_or_fit<2>(f.axes, f.cp, n_, pts_[flat - first_ * M], w(flat) > 0, flat);
+      mine.insert(mine.end(), {v.x, v.y, v.z});
+    };
+    for (const auto& [a, i] : at) {
+      if (a == 0)
+        for (std::size_t r = first_; r < first_ + count_; ++r) put(r * M + i % M);
+      else if (holds(team_->process(), i / M))
+        for (std::size_t j = 0; j < M; ++j) put(i / M * M + j);
+    }
+    const std::vector<double> all = team_->gather(mine);
+    std::vector<std::vector<double>> lines;
+    for (const auto& [a, i] : at) lines.emplace_back(3 * n_[a]);
+    std::size_t from = 0;
+    for (std::size_t s = 0; s < spans_.size(); ++s)
+      for (std::size_t k = 0; k < at.size(); ++k) {
+        const auto& [a, i] = at[k];
+        if (a == 0) {
+          std::copy_n(all.data() + from, 3 * spans_[s].second, lines[k].data() + 3 * spans_[s].first);
+          from += 3 * spans_[s].second;
+        } else if (holds(s, i / M)) {
+          std::copy_n(all.data() + from, 3 * M, lines[k].data());
+          from += 3 * M;
+        }
+      }
+    std::vector<double> e;
+    for (std::size_t k = 0; k < at.size(); ++k) {
+      const auto& [a, i] = at[k];
+      e.push_back(line_fit_residual(f.axes[a], *lu[a], lines[k], a == 0 ? i / M : i % M));
+    }
+    return e;
+  }
+
+  // Which rows and columns hold data: rows from their process, columns OR-reduced.
+  [[nodiscard]] std::array<std::vector<bool>, 2> has_data() const {
+    std::array<std::vector<bool>, 2> has{std::vector<bool>(n_[0], true), std::vector<bool>(n_[1], true)};
+    if (uniform_) return has;
+    std::vector<double> rows(count_, 0.0), cols(n_[1], 0.0);
+    for (std::size_t r = 0; r < count_; ++r)
+      for (std::size_t j = 0; j < n_[1]; ++j)
+        if (present_[r * n_[1] + j]) rows[r] = cols[j] = 1.0;
+    const std::vector<double> all = team_->gather(rows);
+    team_->max(cols);
+    for (std::size_t r = 0; r < n_[0]; ++r) has[0][r] = all[r] > 0;
+    for (std::size_t j = 0; j < n_[1]; ++j) has[1][j] = cols[j] > 0;
+    return has;
+  }
+
+  // thinned(): the kept rows in this block (a block of the thinned grid's rows, maybe
+  // none), the kept columns of each.
+  [[nodiscard]] Block thinned(const std::array<std::vector<std::size_t>, 2>& kept) const {
+    const auto& rows = kept[0];
+    const std::size_t lo = static_cast<std::size_t>(std::lower_bound(rows.begin(), rows.end(), first_) - rows.begin());
+    const std::size_t hi = static_cast<std::size_t>(std::lower_bound(rows.begin(), rows.end(), first_ + count_) - rows.begin());
+    const std::size_t K = kept[1].size();
+    auto own = std::make_shared<std::vector<Vec3>>((hi - lo) * K);
+    for (std::size_t r = lo; r < hi; ++r)
+      for (std::size_t k = 0; k < K; ++k) (*own)[(r - lo) * K + k] = pts_[(rows[r] - first_) * n_[1] + kept[1][k]];
+    const Vec3* p = own->data();
+    return {*team_, {rows.size(), K}, std::move(own), p, lo, hi - lo, uniform_};
+  }
+
+ private:
+  const detail::RowTeam* team_;
+  Shape<2> n_;
+  std::shared_ptr<const std::vector<Vec3>> own_;
+  const Vec3* pts_;
+  std::size_t first_, count_;
+  bool uniform_;
+  bool fill_ = false;             // points missing in this grid
+  std::size_t present_count_ = 0;
+  std::vector<bool> present_;     // per point of the block, unless uniform
+  std::vector<std::pair<std::size_t, std::size_t>> spans_;  // every process's {first, count}
+  std::vector<double> cols_;      // the block's columns (rows_to_columns)
+};
+
 }  // namespace
 
 namespace detail {
 
 bool approximate_rows_covers(const SurfaceApproximationOptions& o) {
-  return !o.tolerance;
+  if (o.tolerance) return o.weights.empty() && !o.periodic[0] && !o.periodic[1];
+  return true;
 }
 
 ApproxRows approximate_rows(const GridBlock& given, const SurfaceApproximationOptions& o, const RowTeam& team,
                             const std::function<void()>& release) {
   constexpr std::size_t R = 2;
   INTERPATCH_ASSERT(given.rank == 2 && approximate_rows_covers(o));
-  const std::size_t P = team.processes(), me = team.process();
 
   // Missing points (NaN); closed directions, whose closing line is looked for only
   // where none is missing (closed_data).
@@ -1852,12 +2185,18 @@ ApproxRows approximate_rows(const GridBlock& given, const SurfaceApproximationOp
   team.run([&] {
     if (v_degree) std::rethrow_exception(v_degree);
   });
+  if (o.tolerance) {
+    // The knots grow and are pruned on every process alike (solve_tolerance), the
+    // fits and measures on the blocks (Block).
+    const Block whole(team, shape, nullptr, pts, b.first, b.count, !fill);
+    solve_tolerance<R>(f, whole, *o.tolerance, {});
+    return net_rows(f, team);
+  }
   team.run([&] {
     check_control_points<R>(f.axes, o);
     set_fit_knots<R>(f.axes, o);
   });
   const auto c0 = static_cast<std::size_t>(f.axes[0].c), c1 = static_cast<std::size_t>(f.axes[1].c);
-  const std::size_t nr = even_share(c0, me, P).second;
 
   // Bᵀ (w Q): along u on columns of the data, along v on rows of the result.
   std::vector<double> rhs;
@@ -1866,46 +2205,19 @@ ApproxRows approximate_rows(const GridBlock& given, const SurfaceApproximationOp
         pts, b.count, M, team, [&] {
           if (release && !o.auto_smoothing) release();
         },
-        [&](std::size_t i, const Vec3&) { return weight(base + i); }), tmp;
-    Shape<R> cs{shape[0], even_share(M, me, P).second};
-    basis_pass<true, R>(f.axes[0], cols.data(), cs, 0, tmp);
-    std::vector<double>().swap(cols);
-    std::vector<double> rows = columns_to_rows(tmp, c0, M, team);
-    Shape<R> rs{nr, M};
-    basis_pass<true, R>(f.axes[1], rows.data(), rs, 1, rhs);
+        [&](std::size_t i, const Vec3&) { return weight(base + i); });
+    rhs = block_rhs(f.axes, cols, M, team, [&] { std::vector<double>().swap(cols); });
   }
 
   // The separable fit when it applies (separable_fit), else the sparse system, with
   // the term that fills holes where some weight is 0 or the separable fit fails.
-  bool separable = !o.smoothing && !o.auto_smoothing && uniform;
-  bool filled = fill;
   std::array<std::optional<AxisSolver>, R> lu;
-  if (separable) {
-    team.run([&] {
-      try {
-        for (std::size_t a = 0; a < R; ++a) lu[a] = factor_gram(f.axes[a], a);
-      } catch (const error& e) {
-        if (e.code() != errc::singular) throw;
-        separable = false;
-        filled = true;
-      }
-    });
-  }
-  ApproxRows out;
-  out.first = even_share(c0, me, P).first;
-  if (separable) {
-    std::vector<double> cols = rows_to_columns(as_points(rhs.data()), nr, c1, team);
-    const std::size_t cshape[2] = {c0, even_share(c1, me, P).second}, rshape[2] = {nr, c1};
-    std::visit([&](const auto& s) { solve_along_axis(s, cols.data(), cshape, R, 0, 3); }, *lu[0]);
-    std::vector<double> rows = columns_to_rows(cols, c0, c1, team);
-    std::visit([&](const auto& s) { solve_along_axis(s, rows.data(), rshape, R, 1, 3); }, *lu[1]);
-    if (nr > 0) out.rows.assign(as_points(rows.data()), as_points(rows.data()) + nr * c1);
-  } else {
-    Stencil<R> st(f.axes);
-    if (uniform) add_grams<R>(st, f.axes);
-    else if (o.periodic[0]) add_closed_block_data(st, f.axes, shape, b, weight, team);
-    else add_block_data(st, f.axes, shape, b, weight, team);
-    SparseSystem<R> sys(f.axes, st, weight_sum[0], total);
+  const bool separable = !o.smoothing && !o.auto_smoothing && uniform;
+  if (separable) lu = separable_solvers(f.axes, team);
+  if (lu[0]) return net_rows(f, team, separable_rows(lu, rhs, c0, c1, team).data());
+  const bool filled = fill || separable;
+  {  // the sparse system
+    SparseSystem<R> sys = block_system(f.axes, shape, b, uniform, weight, weight_sum[0], team);
     const std::vector<double> all_rhs = team.gather(rhs);
     if (o.auto_smoothing) {
       // Σ w r² over the data: blocks of rows as in residuals(), their sums added in order.
@@ -1933,14 +2245,8 @@ ApproxRows approximate_rows(const GridBlock& given, const SurfaceApproximationOp
     } else {
       team.run([&] { sparse_fit<R>(f, sys, all_rhs, o.smoothing, filled); });
     }
-    out.rows.assign(as_points(f.cp.data()) + out.first * c1, as_points(f.cp.data()) + (out.first + nr) * c1);
   }
-  for (std::size_t a = 0; a < R; ++a) {
-    out.degree[a] = f.axes[a].p;
-    out.knots[a] = f.axes[a].knots.mapped(0.0, 1.0);
-  }
-  out.net = {c0, c1};
-  return out;
+  return net_rows(f, team);
 }
 
 }  // namespace detail

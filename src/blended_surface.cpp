@@ -8,6 +8,7 @@
 
 #include "blended_terms.hpp"
 #include "detail/kernel.hpp"
+#include "detail/normals.hpp"
 #include "detail/parallel.hpp"
 #include "detail/text.hpp"
 #include "interpatch/evaluate.hpp"
@@ -451,14 +452,7 @@ void BlendedSurface::evaluate_normals_into(std::span<const double> us, std::span
       sum(i, 1, 0, partial[0].data());
       sum(i, 0, 1, partial[1].data());
       sum(i, 1, 1, partial[2].data());
-      for (std::size_t j = 0; j < nv; ++j) {
-        SurfaceDerivatives d{};
-        d.s = row[j];
-        d.su = partial[0][j];
-        d.sv = partial[1][j];
-        d.suv = partial[2][j];
-        normals[i * nv + j] = unit_normal(d);
-      }
+      detail::unit_normals(partial[0].data(), partial[1].data(), partial[2].data(), nv, normals.data() + i * nv);
       const std::size_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
       if (progress && detail::thread_index() == 0 && n % 64 == 0) progress(static_cast<double>(n) / static_cast<double>(nu));
     }

@@ -14,12 +14,14 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <span>
 #include <vector>
 
+#include "detail/kernel.hpp"
 #include "detail/parallel.hpp"
 #include "detail/text.hpp"
 #include "interpatch/blended_volume.hpp"
@@ -44,6 +46,10 @@ struct PlaneCache {
     std::vector<double> vs, ws;
     bool derivatives = false;
     std::vector<Plane> planes;
+    // The parameters of v and w clamped and their blending values (Folded's t, f, df
+    // and blends of axes 1 and 2), which every slab of u values needs again.
+    std::array<std::vector<double>, 3> t, f, df;
+    std::array<std::size_t, 3> blends{};
   };
   std::mutex mutex;
   std::shared_ptr<const Entry> last;
@@ -193,6 +199,12 @@ std::shared_ptr<const PlaneCache::Entry> u_planes(const detail::VolumeTerms& T, 
   entry->ws.assign(ws.begin(), ws.end());
   entry->derivatives = derivatives;
   entry->planes = planes_of(T, 0, F);
+  for (std::size_t a = 1; a < 3; ++a) {
+    entry->t[a] = std::move(F.t[a]);
+    entry->f[a] = std::move(F.f[a]);
+    entry->df[a] = std::move(F.df[a]);
+    entry->blends[a] = F.blends[a];
+  }
   const std::size_t bytes = T.blends[0].size() * vs.size() * ws.size() * sizeof(Vec3) * per_point;
   const std::lock_guard<std::mutex> lock(cache.mutex);
   cache.last = bytes <= max_cached_plane_bytes ? entry : nullptr;
@@ -201,92 +213,189 @@ std::shared_ptr<const PlaneCache::Entry> u_planes(const detail::VolumeTerms& T, 
 
 // A slab of u values folded: blending values of every axis, the planes of v and w
 // for the slab, the planes of u shared.
-Folded fold_slab(const detail::VolumeTerms& T, std::span<const double> us, std::span<const double> vs,
-                 std::span<const double> ws, bool derivatives, std::shared_ptr<const PlaneCache::Entry> u) {
+Folded fold_slab(const detail::VolumeTerms& T, std::span<const double> us, bool derivatives,
+                 std::shared_ptr<const PlaneCache::Entry> u) {
   Folded F;
   F.derivatives = derivatives;
-  F.u = std::move(u);
   set_axis(F, T, 0, us);
-  set_axis(F, T, 1, vs);
-  set_axis(F, T, 2, ws);
+  for (std::size_t a = 1; a < 3; ++a) {  // made with the planes of u, for the same vs and ws
+    F.t[a] = u->t[a];
+    F.f[a] = u->f[a];
+    F.df[a] = u->df[a];
+    F.blends[a] = u->blends[a];
+  }
+  F.u = std::move(u);
   F.planes[1] = planes_of(T, 1, F);
   F.planes[2] = planes_of(T, 2, F);
   return F;
 }
 
-// Calls at(i, j, k, S, S_u, S_v, S_w) for every grid point (the partials zero
-// without derivatives), lines along w split over the threads; each point is a sum in a
-// fixed order, so the result does not depend on the thread count.
-template <bool derivatives, class At>
-void for_each_point(const Folded& F, const progress_callback& progress, const At& at) {
+// Calls line_at(i, j, fu, fv) for every line along w of the grid (fu, fv: the
+// blending values of u_i and v_j), split over the threads, in chunks of (i, j) pairs
+// in u-major order between progress reports: a slab of a few u values still keeps
+// both cores busy.
+template <class Line>
+void for_each_line_index(const Folded& F, const progress_callback& progress, const Line& line_at) {
   const std::size_t nu = F.extent(0), nv = F.extent(1), nw = F.extent(2);
-  const std::size_t Ku = F.blends[0], Kv = F.blends[1], Kw = F.blends[2];
-  // Lines along w, (i, j) pairs in u-major order, in chunks between progress reports:
-  // a slab of a few u values still keeps both cores busy.
+  const std::size_t K = F.blends[0] + F.blends[1] + F.blends[2];
   const std::size_t lines = nu * nv, chunk = std::max<std::size_t>(nv, std::size_t{1} << 12);
   for (std::size_t l0 = 0; l0 < lines; l0 += chunk) {
     const auto l1 = static_cast<long long>(std::min(lines, l0 + chunk));
-#pragma omp parallel for schedule(static) if ((std::size_t(l1) - l0) * nw * (Ku + Kv + Kw) >= detail::parallel_min_work)
+#pragma omp parallel for schedule(static) if ((std::size_t(l1) - l0) * nw * K >= detail::parallel_min_work)
     for (auto line = static_cast<long long>(l0); line < l1; ++line) {
       const std::size_t i = static_cast<std::size_t>(line) / nv, j = static_cast<std::size_t>(line) % nv;
-      const double* fu = F.f[0].data() + i * Ku;
-      const double* dfu = F.df[0].data() + i * Ku;
-      const double* fv = F.f[1].data() + j * Kv;
-      const double* dfv = F.df[1].data() + j * Kv;
-      // Along the line: the u planes at (j, ·), the v planes at (i, ·), both
-      // contiguous in k; the w planes at (i, j), the same for the whole line.
-      using Row = std::array<const Vec3*, detail::max_volume_blends>;
-      Row U{}, Uv{}, Uw{}, V{}, Vu{}, Vw{};
-      std::array<Vec3, detail::max_volume_blends> W{}, Wu{}, Wv{};
-      const auto line_of = [&](std::size_t axis, std::size_t K, std::size_t offset, Row& value, Row& d0, Row& d1) {
-        for (std::size_t a = 0; a < K; ++a) {
-          const Plane& p = F.plane(axis, a);
-          value[a] = p.value.data() + offset;
-          if constexpr (derivatives) {
-            d0[a] = p.d0.data() + offset;
-            d1[a] = p.d1.data() + offset;
-          }
-        }
-      };
-      line_of(0, Ku, j * nw, U, Uv, Uw);
-      line_of(1, Kv, i * nw, V, Vu, Vw);
-      for (std::size_t c = 0; c < Kw; ++c) {
-        const Plane& p = F.plane(2, c);
-        W[c] = p.value[i * nv + j];
-        if constexpr (derivatives) {
-          Wu[c] = p.d0[i * nv + j];
-          Wv[c] = p.d1[i * nv + j];
-        }
-      }
-      for (std::size_t k = 0; k < nw; ++k) {
-        const double* fw = F.f[2].data() + k * Kw;
-        Vec3 s{}, su{}, sv{}, sw{};
-        for (std::size_t a = 0; a < Ku; ++a) s += fu[a] * U[a][k];
-        for (std::size_t b = 0; b < Kv; ++b) s += fv[b] * V[b][k];
-        for (std::size_t c = 0; c < Kw; ++c) s += fw[c] * W[c];
-        if constexpr (derivatives) {
-          const double* dfw = F.df[2].data() + k * Kw;
-          for (std::size_t a = 0; a < Ku; ++a) {
-            su += dfu[a] * U[a][k];
-            sv += fu[a] * Uv[a][k];
-            sw += fu[a] * Uw[a][k];
-          }
-          for (std::size_t b = 0; b < Kv; ++b) {
-            su += fv[b] * Vu[b][k];
-            sv += dfv[b] * V[b][k];
-            sw += fv[b] * Vw[b][k];
-          }
-          for (std::size_t c = 0; c < Kw; ++c) {
-            su += fw[c] * Wu[c];
-            sv += fw[c] * Wv[c];
-            sw += dfw[c] * W[c];
-          }
-        }
-        at(i, j, k, s, su, sv, sw);
-      }
+      line_at(i, j, F.f[0].data() + i * F.blends[0], F.f[1].data() + j * F.blends[1]);
     }
     if (progress) progress(static_cast<double>(l1) / static_cast<double>(lines));
   }
+}
+
+// Calls at(i, j, k, S, S_u, S_v, S_w) for every grid point (the partials zero
+// without derivatives); each point is a sum in a fixed order, so the result does not
+// depend on the thread count.
+template <bool derivatives, class At>
+void for_each_point(const Folded& F, const progress_callback& progress, const At& at) {
+  const std::size_t nv = F.extent(1), nw = F.extent(2);
+  const std::size_t Ku = F.blends[0], Kv = F.blends[1], Kw = F.blends[2];
+  for_each_line_index(F, progress, [&](std::size_t i, std::size_t j, const double* fu, const double* fv) {
+    const double* dfu = F.df[0].data() + i * Ku;
+    const double* dfv = F.df[1].data() + j * Kv;
+    // Along the line: the u planes at (j, ·), the v planes at (i, ·), both
+    // contiguous in k; the w planes at (i, j), the same for the whole line.
+    using Row = std::array<const Vec3*, detail::max_volume_blends>;
+    Row U{}, Uv{}, Uw{}, V{}, Vu{}, Vw{};
+    std::array<Vec3, detail::max_volume_blends> W{}, Wu{}, Wv{};
+    const auto line_of = [&](std::size_t axis, std::size_t K, std::size_t offset, Row& value, Row& d0, Row& d1) {
+      for (std::size_t a = 0; a < K; ++a) {
+        const Plane& p = F.plane(axis, a);
+        value[a] = p.value.data() + offset;
+        if constexpr (derivatives) {
+          d0[a] = p.d0.data() + offset;
+          d1[a] = p.d1.data() + offset;
+        }
+      }
+    };
+    line_of(0, Ku, j * nw, U, Uv, Uw);
+    line_of(1, Kv, i * nw, V, Vu, Vw);
+    for (std::size_t c = 0; c < Kw; ++c) {
+      const Plane& p = F.plane(2, c);
+      W[c] = p.value[i * nv + j];
+      if constexpr (derivatives) {
+        Wu[c] = p.d0[i * nv + j];
+        Wv[c] = p.d1[i * nv + j];
+      }
+    }
+    for (std::size_t k = 0; k < nw; ++k) {
+      const double* fw = F.f[2].data() + k * Kw;
+      Vec3 s{}, su{}, sv{}, sw{};
+      for (std::size_t a = 0; a < Ku; ++a) s += fu[a] * U[a][k];
+      for (std::size_t b = 0; b < Kv; ++b) s += fv[b] * V[b][k];
+      for (std::size_t c = 0; c < Kw; ++c) s += fw[c] * W[c];
+      if constexpr (derivatives) {
+        const double* dfw = F.df[2].data() + k * Kw;
+        for (std::size_t a = 0; a < Ku; ++a) {
+          su += dfu[a] * U[a][k];
+          sv += fu[a] * Uv[a][k];
+          sw += fu[a] * Uw[a][k];
+        }
+        for (std::size_t b = 0; b < Kv; ++b) {
+          su += fv[b] * Vu[b][k];
+          sv += dfv[b] * V[b][k];
+          sw += fv[b] * Vw[b][k];
+        }
+        for (std::size_t c = 0; c < Kw; ++c) {
+          su += fw[c] * Wu[c];
+          sv += fw[c] * Wv[c];
+          sw += dfw[c] * W[c];
+        }
+      }
+      at(i, j, k, s, su, sv, sw);
+    }
+  });
+}
+
+// The nw points of one line along w without derivatives: the sums for_each_point
+// makes for S, the same products added in the same order (this file is compiled
+// without fused multiply-adds, so every clone gives the same bits), four points at a
+// time. Their twelve doubles are three vectors of four lanes, (x0 y0 z0 x1),
+// (y1 z1 x2 y2), (z2 x3 y3 z3): a u or v term adds its plane's twelve doubles times
+// one blending value; a w term its point's coordinates in that pattern times the
+// four points' blending values. K = the blending functions of every axis when known
+// at compile time (loops unrolled), 0 when not.
+template <std::size_t K>
+[[gnu::always_inline]] inline void line_points(std::size_t nw, std::size_t Ku, std::size_t Kv, std::size_t Kw,
+                                               const double* fu, const double* fv, const double* fw_all,
+                                               const Vec3* const* U, const Vec3* const* V, const Vec3* W, Vec3* out) {
+  if constexpr (K != 0) Ku = Kv = Kw = K;
+  std::size_t k = 0;
+#if defined(__GNUC__)
+  using v4 = double __attribute__((vector_size(32)));
+  // s0..s2 += f times the twelve doubles at p.
+  const auto add = [](v4& s0, v4& s1, v4& s2, double f, const Vec3* p) {
+    v4 p0, p1, p2;
+    std::memcpy(&p0, &p->x, sizeof p0);
+    std::memcpy(&p1, &p->x + 4, sizeof p1);
+    std::memcpy(&p2, &p->x + 8, sizeof p2);
+    const v4 c = {f, f, f, f};
+    s0 += c * p0;
+    s1 += c * p1;
+    s2 += c * p2;
+  };
+  for (; k + 4 <= nw; k += 4) {
+    v4 s0 = {0, 0, 0, 0}, s1 = s0, s2 = s0;
+    for (std::size_t a = 0; a < Ku; ++a) add(s0, s1, s2, fu[a], U[a] + k);
+    for (std::size_t b = 0; b < Kv; ++b) add(s0, s1, s2, fv[b], V[b] + k);
+    const double* f0 = fw_all + k * Kw;
+    const double *f1 = f0 + Kw, *f2 = f1 + Kw, *f3 = f2 + Kw;
+    for (std::size_t c = 0; c < Kw; ++c) {
+      const Vec3& w = W[c];
+      s0 += v4{f0[c], f0[c], f0[c], f1[c]} * v4{w.x, w.y, w.z, w.x};
+      s1 += v4{f1[c], f1[c], f2[c], f2[c]} * v4{w.y, w.z, w.x, w.y};
+      s2 += v4{f2[c], f3[c], f3[c], f3[c]} * v4{w.z, w.x, w.y, w.z};
+    }
+    double* o = &out[k].x;
+    std::memcpy(o, &s0, sizeof s0);
+    std::memcpy(o + 4, &s1, sizeof s1);
+    std::memcpy(o + 8, &s2, sizeof s2);
+  }
+#endif
+  for (; k < nw; ++k) {
+    const double* fw = fw_all + k * Kw;
+    Vec3 s{};
+    for (std::size_t a = 0; a < Ku; ++a) s += fu[a] * U[a][k];
+    for (std::size_t b = 0; b < Kv; ++b) s += fv[b] * V[b][k];
+    for (std::size_t c = 0; c < Kw; ++c) s += fw[c] * W[c];
+    out[k] = s;
+  }
+}
+
+// line_points for every number of blending functions, linear (Coons, trilinear) and
+// cubic Hermite blends unrolled; compiled for AVX and for the baseline.
+INTERPATCH_KERNEL void line_of_points(std::size_t nw, std::size_t Ku, std::size_t Kv, std::size_t Kw, const double* fu,
+                                      const double* fv, const double* fw, const Vec3* const* U, const Vec3* const* V,
+                                      const Vec3* W, Vec3* out) {
+  const std::size_t same = Ku == Kv && Kv == Kw ? Ku : 0;
+  switch (same) {
+    case 2: return line_points<2>(nw, Ku, Kv, Kw, fu, fv, fw, U, V, W, out);
+    case 4: return line_points<4>(nw, Ku, Kv, Kw, fu, fv, fw, U, V, W, out);
+    default: return line_points<0>(nw, Ku, Kv, Kw, fu, fv, fw, U, V, W, out);
+  }
+}
+
+// The points of every line along w, without derivatives, into dest(i, j) (nw
+// points), lines split over the threads as in for_each_point.
+template <class Dest>
+void for_each_line(const Folded& F, const progress_callback& progress, const Dest& dest) {
+  const std::size_t nv = F.extent(1), nw = F.extent(2);
+  const std::size_t Ku = F.blends[0], Kv = F.blends[1], Kw = F.blends[2];
+  for_each_line_index(F, progress, [&](std::size_t i, std::size_t j, const double* fu, const double* fv) {
+    std::array<const Vec3*, detail::max_volume_blends> U{}, V{};
+    std::array<Vec3, detail::max_volume_blends> W{};
+    for (std::size_t a = 0; a < Ku; ++a) U[a] = F.plane(0, a).value.data() + j * nw;
+    for (std::size_t b = 0; b < Kv; ++b) V[b] = F.plane(1, b).value.data() + i * nw;
+    for (std::size_t c = 0; c < Kw; ++c) W[c] = F.plane(2, c).value[i * nv + j];
+    line_of_points(nw, Ku, Kv, Kw, fu, fv, F.f[2].data(), U.data(), V.data(), W.data(), dest(i, j));
+  });
 }
 
 // Points of the planes of v and w a slab is given at most: the slabs of a grid of
@@ -294,11 +403,11 @@ void for_each_point(const Folded& F, const progress_callback& progress, const At
 // change a bit of the result: every point is the same sum in any slab.
 constexpr std::size_t max_slab_plane_points = std::size_t{1} << 22;
 
-// Calls at(i, j, k, S, S_u, S_v, S_w) for every point of the grid, u in slabs.
-template <class At>
-void fold_and_evaluate(const detail::VolumeTerms& T, PlaneCache& cache, std::span<const double> us,
-                       std::span<const double> vs, std::span<const double> ws, bool derivatives,
-                       const progress_callback& progress, const At& at) {
+// Calls visit(F, progress, i0) for every slab of u values folded, u values i0 on.
+template <class Visit>
+void for_each_slab(const detail::VolumeTerms& T, PlaneCache& cache, std::span<const double> us,
+                   std::span<const double> vs, std::span<const double> ws, bool derivatives,
+                   const progress_callback& progress, const Visit& visit) {
   const std::size_t nu = us.size();
   if (nu == 0) {  // no point: no planes to make
     if (progress) progress(1.0);
@@ -309,15 +418,33 @@ void fold_and_evaluate(const detail::VolumeTerms& T, PlaneCache& cache, std::spa
   const std::size_t rows = std::max<std::size_t>(1, max_slab_plane_points / std::max<std::size_t>(1, per_row));
   for (std::size_t i0 = 0; i0 < nu; i0 += rows) {
     const std::size_t n = std::min(rows, nu - i0);
-    const Folded F = fold_slab(T, us.subspan(i0, n), vs, ws, derivatives, u);
+    const Folded F = fold_slab(T, us.subspan(i0, n), derivatives, u);
     progress_callback slab_progress;
     if (progress)
       slab_progress = [&](double f) { progress((static_cast<double>(i0) + f * static_cast<double>(n)) / static_cast<double>(nu)); };
-    const auto slab_at = [&](std::size_t i, std::size_t j, std::size_t k, const Vec3& s, const Vec3& su, const Vec3& sv,
-                             const Vec3& sw) { at(i0 + i, j, k, s, su, sv, sw); };
-    if (derivatives) for_each_point<true>(F, slab_progress, slab_at);
-    else for_each_point<false>(F, slab_progress, slab_at);
+    visit(F, slab_progress, i0);
   }
+}
+
+// Calls at(i, j, k, S, S_u, S_v, S_w) for every point of the grid, with derivatives.
+template <class At>
+void fold_and_evaluate(const detail::VolumeTerms& T, PlaneCache& cache, std::span<const double> us,
+                       std::span<const double> vs, std::span<const double> ws, const progress_callback& progress,
+                       const At& at) {
+  for_each_slab(T, cache, us, vs, ws, true, progress, [&](const Folded& F, const progress_callback& p, std::size_t i0) {
+    for_each_point<true>(F, p, [&](std::size_t i, std::size_t j, std::size_t k, const Vec3& s, const Vec3& su,
+                                   const Vec3& sv, const Vec3& sw) { at(i0 + i, j, k, s, su, sv, sw); });
+  });
+}
+
+// The points of the grid into out, lines along w at a time.
+void fold_and_evaluate_points(const detail::VolumeTerms& T, PlaneCache& cache, std::span<const double> us,
+                              std::span<const double> vs, std::span<const double> ws, std::span<Vec3> out,
+                              const progress_callback& progress) {
+  const std::size_t nv = vs.size(), nw = ws.size();
+  for_each_slab(T, cache, us, vs, ws, false, progress, [&](const Folded& F, const progress_callback& p, std::size_t i0) {
+    for_each_line(F, p, [&](std::size_t i, std::size_t j) { return out.data() + ((i0 + i) * nv + j) * nw; });
+  });
 }
 
 // Whether the grid's point count, times the bytes of a point, can be addressed; the
@@ -333,6 +460,7 @@ bool addressable(std::size_t nu, std::size_t nv, std::size_t nw) {
 
 using detail::addressable;
 using detail::fold_and_evaluate;
+using detail::fold_and_evaluate_points;
 
 void BlendedVolume::evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<const double> ws,
                                   std::span<Vec3> out, const progress_callback& progress) const {
@@ -340,10 +468,7 @@ void BlendedVolume::evaluate_into(std::span<const double> us, std::span<const do
   detail::check_unit_parameters(us, "u");
   detail::check_unit_parameters(vs, "v");
   detail::check_unit_parameters(ws, "w");
-  const std::size_t nv = vs.size(), nw = ws.size();
-  fold_and_evaluate(*t_, *planes_, us, vs, ws, false, progress,
-                    [&](std::size_t i, std::size_t j, std::size_t k, const Vec3& s, const Vec3&, const Vec3&,
-                        const Vec3&) { out[(i * nv + j) * nw + k] = s; });
+  fold_and_evaluate_points(*t_, *planes_, us, vs, ws, out, progress);
 }
 
 Grid<VolumeDerivatives, 3> BlendedVolume::evaluate_derivatives(std::span<const double> us, std::span<const double> vs,
@@ -354,7 +479,7 @@ Grid<VolumeDerivatives, 3> BlendedVolume::evaluate_derivatives(std::span<const d
   detail::check_unit_parameters(ws, "w");
   require_memory(us.size() * vs.size() * ws.size(), sizeof(VolumeDerivatives), "volume derivative grid");
   Grid<VolumeDerivatives, 3> out({us.size(), vs.size(), ws.size()}, for_overwrite);
-  fold_and_evaluate(*t_, *planes_, us, vs, ws, true, {},
+  fold_and_evaluate(*t_, *planes_, us, vs, ws, {},
                     [&](std::size_t i, std::size_t j, std::size_t k, const Vec3& s, const Vec3& su, const Vec3& sv,
                         const Vec3& sw) { out(i, j, k) = {s, su, sv, sw}; });
   return out;
@@ -369,7 +494,7 @@ VolumeJacobians BlendedVolume::evaluate_jacobians(std::span<const double> us, st
   require_memory(us.size() * vs.size() * ws.size(), sizeof(Vec3) + sizeof(double), "volume Jacobian grid");
   const std::array<std::size_t, 3> n{us.size(), vs.size(), ws.size()};
   VolumeJacobians out{PointGrid3(n, for_overwrite), Grid<double, 3>(n, for_overwrite)};
-  fold_and_evaluate(*t_, *planes_, us, vs, ws, true, progress,
+  fold_and_evaluate(*t_, *planes_, us, vs, ws, progress,
                     [&](std::size_t i, std::size_t j, std::size_t k, const Vec3& s, const Vec3& su, const Vec3& sv,
                         const Vec3& sw) {
                       out.points(i, j, k) = s;

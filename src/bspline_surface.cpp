@@ -10,6 +10,7 @@
 #include "detail/kernel.hpp"
 #include "detail/parallel.hpp"
 #include "detail/row_window.hpp"
+#include "detail/sample_row.hpp"
 #include "detail/text.hpp"
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/memory.hpp"
@@ -46,42 +47,11 @@ INTERPATCH_KERNEL void weighted_rows(const double* w, int count, const double* c
   }
 }
 
-// The points of one u row: out[j] = Σ_k weights[j][k] row[spans[j] − q + k], row
-// holding 3 doubles a point and one double of slack after them. Each point is
-// summed in four lanes (x, y, z and the next point's x, which is discarded) and
-// stored four doubles wide, the fourth overwritten by the next point; the last
-// point is summed in the same order one coordinate at a time.
+// The points of one u row from the row of the net contracted over u (3 doubles a
+// point, one of slack after them): detail::sample_points.
 INTERPATCH_KERNEL void sample_row(const int* spans, const double* weights, int q, std::size_t nv, const double* row,
                                   double* out) {
-  const auto q1 = static_cast<std::size_t>(q + 1);
-  std::size_t j = 0;
-#if defined(__GNUC__)
-  using v4 = double __attribute__((vector_size(32)));
-  for (; j + 1 < nv; ++j) {
-    const double* h = row + 3 * static_cast<std::size_t>(spans[j] - q);
-    const double* f = weights + j * q1;
-    v4 acc = {0, 0, 0, 0};
-    for (std::size_t k = 0; k < q1; ++k) {
-      v4 p;
-      std::memcpy(&p, h + 3 * k, sizeof p);
-      acc += f[k] * p;
-    }
-    std::memcpy(out + 3 * j, &acc, sizeof acc);
-  }
-#endif
-  for (; j < nv; ++j) {
-    const double* h = row + 3 * static_cast<std::size_t>(spans[j] - q);
-    const double* f = weights + j * q1;
-    double x = 0, y = 0, z = 0;
-    for (std::size_t k = 0; k < q1; ++k) {
-      x += f[k] * h[3 * k];
-      y += f[k] * h[3 * k + 1];
-      z += f[k] * h[3 * k + 2];
-    }
-    out[3 * j] = x;
-    out[3 * j + 1] = y;
-    out[3 * j + 2] = z;
-  }
+  detail::sample_by_degree<3>(spans, weights, q, nv, row, out);
 }
 
 // A line of homogeneous control points along u at column j (or along v at row i).
@@ -208,56 +178,84 @@ SurfaceDerivatives BSplineSurface::derivatives(double u, double v) const {
 
 namespace detail {
 
-// The points of a polynomial surface over a grid, its control rows taken from a
-// window (the whole net, or the rows one process of a split run holds).
-void evaluate_surface_rows(const KnotVector& ku_, const KnotVector& kv_, const RowWindow& net, std::span<const double> us,
-                           std::span<const double> vs, std::span<Vec3> out, const progress_callback& progress) {
+// The basis functions of the v parameters packed for sample_row.
+using VTable = PackedBasis;
+VTable v_table(const KnotVector& kv, std::span<const double> vs) { return packed(bases(kv, vs, 0, "v"), kv.degree()); }
+
+// The points of a polynomial surface at every u of `us` and the v parameters of `vt`.
+void evaluate_rows_on(const KnotVector& ku_, const KnotVector& kv_, const RowWindow& net, std::span<const double> us,
+                      const VTable& vt, std::span<Vec3> out, const progress_callback& progress) {
   const auto bu = bases(ku_, us, 0, "u");
-  const auto bv = bases(kv_, vs, 0, "v");
   const int p = ku_.degree(), q = kv_.degree();
   const std::size_t ncv = net.row_size;
-  const std::size_t nv = vs.size();
+  const std::size_t nv = vt.spans.size();
   // One parallel region: opening one costs microseconds with pinned threads but up
   // to milliseconds on a loaded machine, where the idle thread spins. Progress is
   // reported by the calling thread (thread 0) from a shared row count.
   [[maybe_unused]] const bool threads = us.size() * (nv + ncv) >= parallel_min_work;
   std::atomic<std::size_t> done{0};
   const auto nu = static_cast<long long>(us.size());
-  {
-    // The control net as rows of doubles, the v bases packed: both loops run along memory.
-    std::vector<int> spans(nv);
-    std::vector<double> weights(nv * static_cast<std::size_t>(q + 1));
-    for (std::size_t j = 0; j < nv; ++j) {
-      spans[j] = bv[j].span;
-      std::copy_n(bv[j].d, q + 1, weights.data() + j * static_cast<std::size_t>(q + 1));
-    }
-    const std::size_t row_doubles = 3 * ncv;
-    // A periodic v: the row's first q points repeated after it, so that spans past
-    // the last control point read on (sample_row never wraps).
-    const std::size_t wrap_doubles = kv_.periodic() ? 3 * static_cast<std::size_t>(q) : 0;
+  const std::size_t row_doubles = 3 * ncv;
+  // A periodic v: the row's first q points repeated after it, so that spans past
+  // the last control point read on (sample_row never wraps).
+  const std::size_t wrap_doubles = kv_.periodic() ? 3 * static_cast<std::size_t>(q) : 0;
 #pragma omp parallel if (threads)
-    {
-      std::vector<double> row(row_doubles + wrap_doubles + 1);  // one double of slack for sample_row
-      const double* rows[W];
-      const bool reporter = detail::thread_index() == 0;
+  {
+    std::vector<double> row(row_doubles + wrap_doubles + 1);  // one double of slack for sample_row
+    const double* rows[W];
+    const bool reporter = detail::thread_index() == 0;
 #pragma omp for schedule(static, 16)
-      for (long long ri = 0; ri < nu; ++ri) {
-        const auto i = static_cast<std::size_t>(ri);
-        const Basis& b = bu[i];
-        for (int a = 0; a <= p; ++a) rows[a] = &net.row(static_cast<std::size_t>(ku_.wrap_index(b.span - p + a)))->x;
-        weighted_rows(b.d, p + 1, rows, row_doubles, row.data());
-        std::copy_n(row.data(), wrap_doubles, row.data() + row_doubles);
-        // Not &out[i * nv].x: with no v values there is no element to index.
-        sample_row(spans.data(), weights.data(), q, nv, row.data(), reinterpret_cast<double*>(out.data() + i * nv));
-        const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
-        if (progress && reporter && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(us.size()));
-      }
+    for (long long ri = 0; ri < nu; ++ri) {
+      const auto i = static_cast<std::size_t>(ri);
+      const Basis& b = bu[i];
+      for (int a = 0; a <= p; ++a) rows[a] = &net.row(static_cast<std::size_t>(ku_.wrap_index(b.span - p + a)))->x;
+      weighted_rows(b.d, p + 1, rows, row_doubles, row.data());
+      std::copy_n(row.data(), wrap_doubles, row.data() + row_doubles);
+      // Not &out[i * nv].x: with no v values there is no element to index.
+      sample_row(vt.spans.data(), vt.weights.data(), q, nv, row.data(), reinterpret_cast<double*>(out.data() + i * nv));
+      const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
+      if (progress && reporter && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(us.size()));
     }
-    if (progress) progress(1.0);
   }
+  if (progress) progress(1.0);
+}
+
+// The points of a polynomial surface over a grid, its control rows taken from a
+// window (the whole net, or the rows one process of a split run holds).
+void evaluate_surface_rows(const KnotVector& ku_, const KnotVector& kv_, const RowWindow& net, std::span<const double> us,
+                           std::span<const double> vs, std::span<Vec3> out, const progress_callback& progress) {
+  for (const double u : us) check_parameter(ku_, u, "u");  // u first, then v, as every evaluation checks
+  evaluate_rows_on(ku_, kv_, net, us, v_table(kv_, vs), out, progress);
 }
 
 }  // namespace detail
+
+namespace {
+
+// Rows of a polynomial surface: the v basis functions worked out once.
+class PolynomialRows final : public Surface::Rows {
+ public:
+  PolynomialRows(const BSplineSurface& s, std::span<const double> vs)
+      : s_(s), nv_(vs.size()), table_(detail::v_table(s.knots_v(), vs)) {}
+  void evaluate_into(std::span<const double> us, std::span<Vec3> out, const progress_callback& progress) const override {
+    detail::check_output_size(out.size(), {us.size(), nv_}, "surface evaluation");
+    const auto& cp = s_.control_points();
+    detail::evaluate_rows_on(s_.knots_u(), s_.knots_v(), {cp.data(), 0, cp.extent(0), cp.extent(0), cp.extent(1)}, us,
+                             table_, out, progress);
+  }
+
+ private:
+  const BSplineSurface& s_;
+  std::size_t nv_;
+  detail::VTable table_;
+};
+
+}  // namespace
+
+std::unique_ptr<Surface::Rows> BSplineSurface::rows(std::span<const double> vs) const {
+  if (rational()) return Surface::rows(vs);
+  return std::make_unique<PolynomialRows>(*this, vs);
+}
 
 void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
                                    const progress_callback& progress) const {

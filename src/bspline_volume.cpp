@@ -3,11 +3,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
-#include "detail/parallel.hpp"
 #include "detail/basis_table.hpp"
+#include "detail/parallel.hpp"
+#include "detail/kernel.hpp"
 #include "detail/row_window.hpp"
+#include "detail/sample_row.hpp"
 #include "detail/text.hpp"
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/memory.hpp"
@@ -65,9 +68,71 @@ Net net_of(const BSplineVolume& b) {
           b.weights(), cp.extent(1), cp.extent(2)};
 }
 
+// The points of one (u, v) line of a polynomial volume from its row of homogeneous
+// points contracted over u and v: detail::sample_points over 4 doubles a point, the
+// loop unrolled for degrees 1 to 3. The same products summed in the same order as
+// the point-by-point loop of contract (this file is compiled without fused
+// multiply-adds), so every clone gives the same bits.
+INTERPATCH_KERNEL void sample_line(const int* spans, const double* weights, int r, std::size_t nw, const double* row,
+                                   double* out) {
+  detail::sample_by_degree<4>(spans, weights, r, nw, row, out);
+}
+
+using v4 = double __attribute__((vector_size(32)));
+
+// out[x] = Σ_e c[e] t for x < n, term(e, x, t) giving t, homogeneous points (4 doubles) summed over
+// e in order in four lanes and stored once: contract's sums, the same bits in every
+// clone (no fused multiply-adds in this file). Count = the terms when known at
+// compile time (degrees 1 to 3, unrolled), 0 when not.
+template <int Count, class Term>
+[[gnu::always_inline]] inline void combine(const double* c, int count, std::size_t n, H* out, const Term& term) {
+  const int terms = Count != 0 ? Count : count;
+  for (std::size_t x = 0; x < n; ++x) {
+    v4 acc = {0, 0, 0, 0};
+    for (int e = 0; e < terms; ++e) {
+      v4 t;
+      term(e, x, t);
+      acc += c[e] * t;
+    }
+    std::memcpy(out[x].data(), &acc, sizeof acc);
+  }
+}
+
+template <class Term>
+[[gnu::always_inline]] inline void combine_by_count(const double* c, int count, std::size_t n, H* out, const Term& term) {
+  switch (count) {
+    case 4: return combine<4>(c, count, n, out, term);
+    case 3: return combine<3>(c, count, n, out, term);
+    case 2: return combine<2>(c, count, n, out, term);
+    default: return combine<0>(c, count, n, out, term);
+  }
+}
+
+// Rows of homogeneous points combined: the rows of v of contract.
+INTERPATCH_KERNEL void combine_rows(const double* c, int count, const H* const* in, std::size_t n, H* out) {
+  combine_by_count(c, count, n, out, [&](int e, std::size_t x, v4& t) { std::memcpy(&t, in[e][x].data(), sizeof t); });
+}
+
+// The control planes of a polynomial volume combined over u, each point with weight
+// 1: the planes of u of contract.
+INTERPATCH_KERNEL void combine_planes(const double* c, int count, const Vec3* const* planes, std::size_t n, H* out) {
+  combine_by_count(c, count, n, out, [&](int e, std::size_t x, v4& t) {
+    const Vec3& P = planes[e][x];
+    t = v4{P.x, P.y, P.z, 1.0};
+  });
+}
+
+// Where contract<false> writes a polynomial volume's points a line at a time (points
+// null: point by point through the sink), with the w basis packed for sample_line.
+struct LineOut {
+  Vec3* points = nullptr;
+  detail::PackedBasis w;
+};
+
 template <bool Partials, class Sink>
 void contract(const Net& b, const std::vector<Basis>& bu, const std::vector<Basis>& bv,
-              const std::vector<Basis>& bw, std::size_t r0, std::size_t r1, [[maybe_unused]] bool threads, const Sink& sink) {
+              const std::vector<Basis>& bw, std::size_t r0, std::size_t r1, [[maybe_unused]] bool threads, const Sink& sink,
+              const LineOut& lines) {
   const int p = b.ku.degree(), q = b.kv.degree(), r = b.kw.degree();
   const Grid<double, 3>& wt = b.weights;
   const bool rat = !wt.empty();
@@ -83,7 +148,10 @@ void contract(const Net& b, const std::vector<Basis>& bu, const std::vector<Basi
     std::vector<H> U[nu_terms];
     for (auto& x : U) x.resize(plane);
     std::vector<H> V[nv_terms];
-    for (auto& x : V) x.resize(ncw);
+    // A periodic w: the row's first r points repeated after it, so that spans past
+    // the last control point read on (sample_line never wraps).
+    const std::size_t wrap = b.kw.periodic() ? static_cast<std::size_t>(r) : 0;
+    for (auto& x : V) x.resize(ncw + wrap);
 #pragma omp for schedule(static)
     for (long long ri = first; ri < last; ++ri) {
       const auto i = static_cast<std::size_t>(ri);
@@ -116,30 +184,22 @@ void contract(const Net& b, const std::vector<Basis>& bu, const std::vector<Basi
             out[x] = h;
           }
         } else {
-          for (std::size_t x = 0; x < plane; ++x) {
-            H h{0, 0, 0, 0};
-            for (int e = 0; e <= p; ++e) {
-              const Vec3& P = planes[e][x];
-              h[0] += c[e] * P.x;
-              h[1] += c[e] * P.y;
-              h[2] += c[e] * P.z;
-              h[3] += c[e];
-            }
-            out[x] = h;
-          }
+          combine_planes(c, p + 1, planes, plane, out);
         }
       }
       for (std::size_t j = 0; j < nv; ++j) {
         const Basis& bj = bv[j];
         for (int t = 0; t < nv_terms; ++t) {
-          H* out = V[t].data();
-          std::fill(out, out + ncw, H{0, 0, 0, 0});
-          for (int e = 0; e <= q; ++e) {
-            const double c = bj.d[ll[t] * (q + 1) + e];
-            const H* in = U[kk[t]].data() + static_cast<std::size_t>(b.kv.wrap_index(bj.span - q + e)) * ncw;
-            for (std::size_t x = 0; x < ncw; ++x)
-              for (std::size_t y = 0; y < 4; ++y) out[x][y] += c * in[x][y];
-          }
+          const H* in[max_degree + 1];
+          for (int e = 0; e <= q; ++e)
+            in[e] = U[kk[t]].data() + static_cast<std::size_t>(b.kv.wrap_index(bj.span - q + e)) * ncw;
+          combine_rows(bj.d + ll[t] * (q + 1), q + 1, in, ncw, V[t].data());
+        }
+        if (!Partials && lines.points) {  // a polynomial volume's points: the line at once
+          std::copy_n(V[0].data(), wrap, V[0].data() + ncw);
+          sample_line(lines.w.spans.data(), lines.w.weights.data(), r, nw, V[0].data()->data(),
+                      reinterpret_cast<double*>(lines.points + (i * nv + j) * nw));
+          continue;
         }
         for (std::size_t m = 0; m < nw; ++m) {
           const Basis& bm = bw[m];
@@ -182,18 +242,21 @@ void contract(const Net& b, const std::vector<Basis>& bu, const std::vector<Basi
 // the calling thread.
 template <bool Partials, class Sink>
 void contract_all(const Net& b, std::span<const double> us, std::span<const double> vs,
-                  std::span<const double> ws, const progress_callback& progress, const Sink& sink) {
+                  std::span<const double> ws, const progress_callback& progress, const Sink& sink,
+                  Vec3* points = nullptr) {
   const int nd = Partials ? 1 : 0;
   const auto bu = bases(b.ku, us, nd, "u");
   const auto bv = bases(b.kv, vs, nd, "v");
   const auto bw = bases(b.kw, ws, nd, "w");
+  LineOut lines;
+  if (!Partials && b.weights.empty() && points != nullptr) lines = {points, detail::packed(bw, b.kw.degree())};
   const std::size_t ncv = b.ncv, ncw = b.ncw;
   // Starting the second thread costs milliseconds: small grids stay on one.
   [[maybe_unused]] const bool threads = us.size() * (vs.size() * ws.size() + ncv * ncw) >= detail::parallel_min_work;
   constexpr std::size_t chunk = 16;
   for (std::size_t r0 = 0; r0 < us.size(); r0 += chunk) {
     const std::size_t r1 = std::min(us.size(), r0 + chunk);
-    contract<Partials>(b, bu, bv, bw, r0, r1, threads, sink);
+    contract<Partials>(b, bu, bv, bw, r0, r1, threads, sink, lines);
     if (progress) progress(static_cast<double>(r1) / static_cast<double>(us.size()));
   }
 }
@@ -394,10 +457,10 @@ void BSplineVolume::evaluate_into(std::span<const double> us, std::span<const do
                                   std::span<Vec3> out, const progress_callback& progress) const {
   detail::check_output_size(out.size(), {us.size(), vs.size(), ws.size()}, "volume evaluation");
   const std::size_t nv = vs.size(), nw = ws.size();
-  contract_all<false>(net_of(*this), us, vs, ws, progress,
-                      [&](std::size_t i, std::size_t j, std::size_t k, const VolumeDerivatives& d) {
-                        out[(i * nv + j) * nw + k] = d.s;
-                      });
+  contract_all<false>(
+      net_of(*this), us, vs, ws, progress,
+      [&](std::size_t i, std::size_t j, std::size_t k, const VolumeDerivatives& d) { out[(i * nv + j) * nw + k] = d.s; },
+      out.data());
 }
 
 namespace detail {
@@ -408,9 +471,11 @@ void evaluate_volume_rows(const KnotVector& ku, const KnotVector& kv, const Knot
   const Grid<double, 3> polynomial;
   const std::size_t nv = vs.size(), nw = ws.size();
   contract_all<false>(Net{ku, kv, kw, net, polynomial, static_cast<std::size_t>(kv.count()), static_cast<std::size_t>(kw.count())},
-                      us, vs, ws, progress, [&](std::size_t i, std::size_t j, std::size_t k, const VolumeDerivatives& d) {
+                      us, vs, ws, progress,
+                      [&](std::size_t i, std::size_t j, std::size_t k, const VolumeDerivatives& d) {
                         out[(i * nv + j) * nw + k] = d.s;
-                      });
+                      },
+                      out.data());
 }
 
 }  // namespace detail

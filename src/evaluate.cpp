@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
+
+#include "detail/kernel.hpp"
+#include "detail/normals.hpp"
 
 namespace interpatch {
 
@@ -28,6 +32,57 @@ Vec3 unit_normal(const SurfaceDerivatives& d) noexcept {
   const double lm = norm(m);
   return lm > 0 ? m / lm : Vec3{};
 }
+
+namespace detail {
+
+// Four points a block: the components gathered into lanes, n = su × sv, and n / |n|
+// where |n|² lies in [2^-900, DBL_MAX] and |n| > 1e-10 max(|su|, |sv|)², the test of
+// unit_normal on squares (both sides of it squared). There no product overflowed,
+// and one that underflowed is below 2^-450 of |n|, under its rounding: the normal is
+// unit_normal's up to rounding. Any other point (a pole, huge or tiny partials, NaN)
+// goes to unit_normal.
+INTERPATCH_KERNEL void unit_normals(const Vec3* su, const Vec3* sv, const Vec3* suv, std::size_t n, Vec3* out) {
+  std::size_t j = 0;
+#if defined(__GNUC__)
+  using v4 = double __attribute__((vector_size(32)));
+  for (; j + 4 <= n; j += 4) {
+    const Vec3 *a = su + j, *b = sv + j;
+    const v4 ax = {a[0].x, a[1].x, a[2].x, a[3].x}, ay = {a[0].y, a[1].y, a[2].y, a[3].y}, az = {a[0].z, a[1].z, a[2].z, a[3].z};
+    const v4 bx = {b[0].x, b[1].x, b[2].x, b[3].x}, by = {b[0].y, b[1].y, b[2].y, b[3].y}, bz = {b[0].z, b[1].z, b[2].z, b[3].z};
+    const v4 nx = ay * bz - az * by, ny = az * bx - ax * bz, nz = ax * by - ay * bx;
+    const v4 len2 = nx * nx + ny * ny + nz * nz;
+    const v4 a2 = ax * ax + ay * ay + az * az, b2 = bx * bx + by * by + bz * bz;
+    v4 big2, len;
+    for (int k = 0; k < 4; ++k) {
+      big2[k] = std::max(a2[k], b2[k]);
+      len[k] = std::sqrt(len2[k]);
+    }
+    constexpr double top = std::numeric_limits<double>::max();
+    const auto plain = (len2 >= 0x1p-900) & (len2 <= top) & (big2 <= top) & (len2 > 1e-20 * (big2 * big2));
+    const v4 ox = nx / len, oy = ny / len, oz = nz / len;
+    for (int k = 0; k < 4; ++k) {
+      if (plain[k]) {
+        out[j + static_cast<std::size_t>(k)] = {ox[k], oy[k], oz[k]};
+      } else {
+        SurfaceDerivatives d{};
+        d.su = a[k];
+        d.sv = b[k];
+        d.suv = suv[j + static_cast<std::size_t>(k)];
+        out[j + static_cast<std::size_t>(k)] = unit_normal(d);
+      }
+    }
+  }
+#endif
+  for (; j < n; ++j) {
+    SurfaceDerivatives d{};
+    d.su = su[j];
+    d.sv = sv[j];
+    d.suv = suv[j];
+    out[j] = unit_normal(d);
+  }
+}
+
+}  // namespace detail
 
 Curvature curvature(const SurfaceDerivatives& d) noexcept {
   // With the derivatives scaled by 2^-e, K grows by 2^2e and H and the principal

@@ -165,14 +165,19 @@ int KnotVector::find_span(double t) const noexcept {
   return static_cast<int>(it - u_.begin()) - 1;
 }
 
-void KnotVector::basis(int span, double t, double* N) const noexcept {
+namespace {
+
+// The Cox–de Boor triangle for degree P (0: the degree p given at run time), with
+// the loops unrolled when P is known: the same operations in the same order.
+template <int P>
+[[gnu::always_inline]] inline void basis_of(const double* u, int p, std::size_t s, double t, double* N) {
+  const int deg = P != 0 ? P : p;
   double left[max_degree + 1];
   double right[max_degree + 1];
-  const auto s = static_cast<std::size_t>(span);
   N[0] = 1.0;
-  for (int j = 1; j <= p_; ++j) {
-    left[j] = t - u_[s + 1 - static_cast<std::size_t>(j)];
-    right[j] = u_[s + static_cast<std::size_t>(j)] - t;
+  for (int j = 1; j <= deg; ++j) {
+    left[j] = t - u[s + 1 - static_cast<std::size_t>(j)];
+    right[j] = u[s + static_cast<std::size_t>(j)] - t;
     double saved = 0.0;
     for (int r = 0; r < j; ++r) {
       const double temp = N[r] / (right[r + 1] + left[j - r]);
@@ -180,6 +185,18 @@ void KnotVector::basis(int span, double t, double* N) const noexcept {
       saved = left[j - r] * temp;
     }
     N[j] = saved;
+  }
+}
+
+}  // namespace
+
+void KnotVector::basis(int span, double t, double* N) const noexcept {
+  const auto s = static_cast<std::size_t>(span);
+  switch (p_) {
+    case 3: return basis_of<3>(u_.data(), p_, s, t, N);
+    case 2: return basis_of<2>(u_.data(), p_, s, t, N);
+    case 1: return basis_of<1>(u_.data(), p_, s, t, N);
+    default: return basis_of<0>(u_.data(), p_, s, t, N);
   }
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -552,14 +553,35 @@ std::vector<BSplineCurve> place_curves(const Prepared& n, const Arrangement& r, 
     for (std::size_t i = 0; i < g.size(); ++i) g[i] = 0.5 * (other.node[i][k] - mine.node[k][i]);
     G.push_back(combination(phi, g));
   }
+  // How far each kept curve's line of the surface is from the given curve: a few
+  // points per knot interval, the curves shared between the threads.
+  const auto count = static_cast<long long>(along.size());
+  std::vector<std::exception_ptr> failed(along.size());  // an exception must not leave the parallel loop
+#pragma omp parallel for schedule(dynamic) if (count > 1)
+  for (long long kk = 0; kk < count; ++kk) {
+    const auto k = static_cast<std::size_t>(kk);
+    if (!mine.keep[k]) continue;
+    const std::size_t j = r.order[az][k];
+    const BSplineCurve& given = n.input[az][j];
+    try {
+      std::vector<double> at = detail::check_params(along[j].knots());
+      const std::vector<Vec3> line = detail::points_at(along[j], at), g = detail::points_at(G[k], at);
+      if (closed)
+        for (double& u : at) u -= std::floor(u);
+      const std::vector<Vec3> want = detail::points_at(given, at);
+      double d = 0;
+      for (std::size_t i = 0; i < at.size(); ++i) d = std::max(d, distance(line[i] + g[i], want[i]));
+      report[j].distance = d;
+    } catch (...) {
+      failed[k] = std::current_exception();
+    }
+  }
+  for (const std::exception_ptr& e : failed)
+    if (e) std::rethrow_exception(e);
   for (std::size_t k = 0; k < along.size(); ++k) {
     const std::size_t j = r.order[az][k];
     const BSplineCurve& given = n.input[az][j];
     if (mine.keep[k]) {
-      double d = 0;
-      for (double u : detail::check_params(along[j].knots()))
-        d = std::max(d, distance(along[j].point(u) + G[k].point(u), given.point(closed ? u - std::floor(u) : u)));
-      report[j].distance = d;
       out[k] = along[j];
       continue;
     }

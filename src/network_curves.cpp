@@ -344,6 +344,35 @@ std::vector<double> check_params(const KnotVector& k) {
   return t;
 }
 
+std::vector<Vec3> points_at(const BSplineCurve& c, std::span<const double> ts) {
+  std::vector<Vec3> out(ts.size());
+  const KnotVector& k = c.knots();
+  if (c.rational() || k.periodic()) {
+    for (std::size_t i = 0; i < ts.size(); ++i) out[i] = c.point(ts[i]);
+    return out;
+  }
+  const int p = k.degree(), last = k.count() - 1;
+  const auto& cp = c.control_points();
+  int s = -1;
+  double N[max_degree + 1];
+  for (std::size_t i = 0; i < ts.size(); ++i) {
+    const double t = ts[i];
+    if (!(t >= k.front() && t <= k.back())) {  // the slack and the errors of point()
+      out[i] = c.point(t);
+      s = -1;
+      continue;
+    }
+    // find_span's span: k[s] <= t < k[s + 1], the last one for t = back().
+    if (s < 0 || t < k[static_cast<std::size_t>(s)]) s = k.find_span(t);
+    while (s < last && t >= k[static_cast<std::size_t>(s) + 1]) ++s;
+    k.basis(s, t, N);
+    Vec3 d{};
+    for (int j = 0; j <= p; ++j) d += N[j] * cp[static_cast<std::size_t>(s - p + j)];
+    out[i] = d;
+  }
+  return out;
+}
+
 namespace {
 
 // One curve's fit on the shared interior knots (multiplicities capped at its degree):

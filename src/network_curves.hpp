@@ -92,4 +92,9 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
 /// surface: 4 in every span of its knots (closed: of its period), and the ends.
 std::vector<double> check_params(const KnotVector& k);
 
+/// The curve's points at every t of ts, as c.point(t) gives them: for a polynomial
+/// curve and increasing ts the span is walked to rather than searched for.
+/// @throws error out_of_domain.
+std::vector<Vec3> points_at(const BSplineCurve& c, std::span<const double> ts);
+
 }  // namespace interpatch::detail

@@ -1,5 +1,10 @@
 #include "interpatch/evaluate.hpp"
 
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include "detail/normals.hpp"
 #include "test_util.hpp"
 
 namespace interpatch {
@@ -47,6 +52,47 @@ TEST(Curvature, SingularFirstFormGivesNaN) {
   EXPECT_TRUE(std::isnan(c.gaussian));
   EXPECT_TRUE(std::isnan(c.mean));
   EXPECT_EQ(unit_normal(SurfaceDerivatives{}), (Vec3{0, 0, 0}));
+}
+
+// The batched normals of a mesh are unit_normal's: on partials of ordinary size to
+// rounding (the lanes may use fused multiply-adds: a few ulps of a unit vector, held
+// to 4e-16), and at poles, nearly parallel partials, partials of 1e±200 and NaN
+// (which go to unit_normal itself) bit for bit; any count of points, the last few
+// outside the blocks of four.
+TEST(UnitNormals, AreThoseOfUnitNormal) {
+  auto g = test::rng(31);
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t n : {0u, 1u, 3u, 4u, 7u, 64u, 203u}) {
+    std::vector<Vec3> su(n), sv(n), suv(n), out(n);
+    std::vector<int> kind(n);
+    for (std::size_t j = 0; j < n; ++j) {
+      kind[j] = static_cast<int>(g() % 6);
+      su[j] = test::random_point(g, 3.0);
+      sv[j] = test::random_point(g, 3.0);
+      suv[j] = test::random_point(g, 3.0);
+      switch (kind[j]) {
+        case 1: sv[j] = Vec3{}; break;                                    // a pole
+        case 2: sv[j] = 2.0 * su[j] + 1e-12 * test::random_point(g); break;  // nearly parallel
+        case 3: su[j] = 1e200 * su[j]; sv[j] = 1e200 * sv[j]; break;     // their squares overflow
+        case 4: su[j] = 1e-200 * su[j]; sv[j] = 1e-200 * sv[j]; break;   // and underflow
+        case 5: su[j].y = nan; break;
+        default: break;
+      }
+    }
+    detail::unit_normals(su.data(), sv.data(), suv.data(), n, out.data());
+    for (std::size_t j = 0; j < n; ++j) {
+      SurfaceDerivatives d{};
+      d.su = su[j];
+      d.sv = sv[j];
+      d.suv = suv[j];
+      const Vec3 want = unit_normal(d);
+      if (kind[j] == 0) {
+        EXPECT_LE(norm(out[j] - want), 4e-16) << "point " << j << " of " << n;
+      } else {  // NaN included: the same bits
+        EXPECT_EQ(std::memcmp(&out[j], &want, sizeof want), 0) << "point " << j << " of " << n << ", kind " << kind[j];
+      }
+    }
+  }
 }
 
 TEST(Linspace, EndsExact) {

@@ -333,6 +333,51 @@ struct Patch {
 // the default tolerance of every curve as drawn. The same curves shuffled and some
 // turned round give the same surface, its parameters mirrored where a whole family
 // turned out to run the other way.
+// The network's checks sample each curve at increasing parameters with a walk over
+// the spans: every point the same bits as point() gives, on clamped curves of degree
+// 1 to 5 with repeated knots, parameters in order, out of order and at the knots, and
+// on rational curves (which go through point()).
+TEST(NetworkDrawn, PointsAtIncreasingParametersAreThePointsOfTheCurve) {
+  std::mt19937_64 g(2026);
+  std::uniform_real_distribution<double> c(-10, 10), unit(0, 1);
+  for (int trial = 0; trial < 60; ++trial) {
+    const int p = 1 + trial % 5;
+    // Interior knots at distinct eighths, each repeated up to p times.
+    std::vector<double> eighths{0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875};
+    std::shuffle(eighths.begin(), eighths.end(), g);
+    std::vector<double> knots(static_cast<std::size_t>(p + 1), 0.0);
+    std::vector<double> inner(eighths.begin(), eighths.begin() + trial % 7);
+    std::sort(inner.begin(), inner.end());
+    for (const double k : inner) knots.insert(knots.end(), static_cast<std::size_t>(1 + static_cast<int>(g() % static_cast<unsigned>(p))), k);
+    knots.insert(knots.end(), static_cast<std::size_t>(p + 1), 1.0);
+    const std::size_t n = knots.size() - static_cast<std::size_t>(p) - 1;
+    std::vector<Vec3> cp(n);
+    for (auto& q : cp) q = {c(g), c(g), c(g)};
+    std::vector<double> w;
+    if (trial % 4 == 3)
+      for (std::size_t i = 0; i < n; ++i) w.push_back(0.5 + unit(g));
+    const BSplineCurve curve(KnotVector(p, knots), cp, w);
+    std::vector<double> ts = detail::check_params(curve.knots());
+    for (int i = 0; i < 20; ++i) ts.push_back(unit(g));
+    for (const double k : knots) ts.push_back(k);
+    if (trial % 2 == 0) std::sort(ts.begin(), ts.end());  // in order: the walk; else searched again where t goes back
+    const std::vector<Vec3> got = detail::points_at(curve, ts);
+    ASSERT_EQ(got.size(), ts.size());
+    for (std::size_t i = 0; i < ts.size(); ++i) {
+      const Vec3 want = curve.point(ts[i]);
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(got[i].x), std::bit_cast<std::uint64_t>(want.x)) << "trial " << trial << " t " << ts[i];
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(got[i].y), std::bit_cast<std::uint64_t>(want.y));
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(got[i].z), std::bit_cast<std::uint64_t>(want.z));
+    }
+  }
+  // Outside the domain: point()'s error, and its slack of a few ulps.
+  const BSplineCurve line(KnotVector::bezier(1), {{0, 0, 0}, {1, 1, 1}});
+  const std::vector<double> near{0.0, 1.0 + 1e-15};
+  EXPECT_EQ(detail::points_at(line, near)[1].x, line.point(1.0 + 1e-15).x);
+  const std::vector<double> far{0.5, 1.5};
+  EXPECT_THROW((void)detail::points_at(line, far), error);
+}
+
 TEST(NetworkDrawn, CurvesCutFromSmoothSurfacesAreReproducedInAnyOrderAndDirection) {
   auto g = test::rng(300);
   const std::pair<std::size_t, std::size_t> sizes[] = {{3, 3}, {5, 4}, {8, 8}, {15, 15}};

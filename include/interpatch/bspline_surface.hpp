@@ -62,6 +62,9 @@ class BSplineSurface final : public Surface {
   /// the thread count. @throws error out_of_domain, size_mismatch.
   void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
                      const progress_callback& progress = {}) const override;
+  /// Rows on the parameters vs: a polynomial surface works out the basis functions
+  /// of v here, once (the same points as evaluate_into()).
+  [[nodiscard]] std::unique_ptr<Rows> rows(std::span<const double> vs) const override;
   /// Points and derivatives at every (us[i], vs[j]). @throws error out_of_domain, too_large.
   [[nodiscard]] Grid<SurfaceDerivatives, 2> evaluate_derivatives(std::span<const double> us,
                                                                  std::span<const double> vs) const override;

@@ -4,7 +4,8 @@
 // the single process finds, every sum over the data made in the single process's
 // order. Covered: a given number of control points and smoothing (a number or
 // "auto"), with missing points (NaN), weights, open and closed directions; a fit to
-// a tolerance runs in one process.
+// a tolerance with missing points, open directions and no weights. The other fits to
+// a tolerance run in one process.
 
 #include <array>
 #include <cstddef>
@@ -35,7 +36,7 @@ struct ApproxRows {
 /// Along a closed u, b.ends must hold the whole grid's rows 0, 1, n−2, n−1; a closed
 /// v's closing column, when left out, is left out of b's rows in place.
 /// `release` is called once the block's points are read no more: the caller may
-/// free them then (a smoothing "auto" reads them to the end).
+/// free them then (a smoothing "auto" and a tolerance read them to the end).
 ApproxRows approximate_rows(const GridBlock& b, const SurfaceApproximationOptions& o, const RowTeam& team,
                             const std::function<void()>& release = {});
 

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -263,11 +264,12 @@ std::size_t slice_width(std::size_t inner, std::size_t n) {
 constexpr std::size_t narrow_group = 8;
 
 // Copies the m lines (rows of `inner` doubles, `block` apart) side by side into buf
-// (Gather) or back out of it: plain loops, which the compiler unrolls for the usual
-// 3 doubles a row.
-template <bool Gather>
-INTERPATCH_KERNEL void shuffle_lines(double* data, std::size_t n, std::size_t inner, std::size_t block, std::size_t m,
-                                     double* buf) {
+// (Gather) or back out of it: plain loops, with the row's length known at compile
+// time for the usual 3 doubles a row (Inner = 3; 0: inner given at run time).
+template <bool Gather, std::size_t Inner>
+[[gnu::always_inline]] inline void shuffle(double* data, std::size_t n, std::size_t inner, std::size_t block,
+                                           std::size_t m, double* buf) {
+  if constexpr (Inner != 0) inner = Inner;
   const std::size_t width = m * inner;
   for (std::size_t l = 0; l < m; ++l) {
     double* line = data + l * block;
@@ -278,6 +280,13 @@ INTERPATCH_KERNEL void shuffle_lines(double* data, std::size_t n, std::size_t in
         else line[k * inner + c] = side[k * width + c];
       }
   }
+}
+
+template <bool Gather>
+INTERPATCH_KERNEL void shuffle_lines(double* data, std::size_t n, std::size_t inner, std::size_t block, std::size_t m,
+                                     double* buf) {
+  if (inner == 3) return shuffle<Gather, 3>(data, n, inner, block, m, buf);
+  shuffle<Gather, 0>(data, n, inner, block, m, buf);
 }
 
 template <class Solver>
@@ -297,17 +306,20 @@ void solve_along_axis(const Solver& lu, double* data, const std::size_t* shape, 
   for (std::size_t a = 0; a < axis; ++a) outer *= shape[a];
   for (std::size_t a = axis + 1; a < rank; ++a) inner *= shape[a];
   const std::size_t n = shape[axis];
+  if (outer == 0 || inner == 0) return;  // nothing to solve (a process of a split run holding no columns)
   const std::size_t block = n * inner;
   [[maybe_unused]] const bool threads = parallel && block * outer >= parallel_min_work;
   if (inner < 64 && outer > 1) {
     const auto groups = static_cast<long long>((outer + narrow_group - 1) / narrow_group);
 #pragma omp parallel if (threads)
     {
-      std::vector<double> buf(n * narrow_group * inner);
+      // Not zeroed: every group writes the part it reads (solve_rows calls this for
+      // every few rows, and zeroing the buffer each time cost a tenth of an eval).
+      const std::unique_ptr<double[]> buf(new double[n * narrow_group * inner]);
 #pragma omp for schedule(static)
       for (long long g = 0; g < groups; ++g) {
         const std::size_t o0 = static_cast<std::size_t>(g) * narrow_group;
-        solve_narrow_group(lu, data + o0 * block, n, inner, block, std::min(narrow_group, outer - o0), buf.data());
+        solve_narrow_group(lu, data + o0 * block, n, inner, block, std::min(narrow_group, outer - o0), buf.get());
       }
     }
     return;

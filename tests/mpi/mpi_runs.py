@@ -5,8 +5,9 @@ Runs `interpatch eval` and `interpatch build` on grids whose rows split unevenly
 between 1..4 processes (chunks of 16 rows), closed directions of odd and even
 degree, collapsed rows (poles), every parametrization, float32 and big-endian
 input, Fortran-order input, surfaces and volumes, and approximations (a given number of control points,
-the separable fit and the sparse one with holes, smoothing, smoothing "auto";
-weights with zeros; closed u and v, the closing line left out or none), each
+the separable fit and the sparse one with holes, smoothing, smoothing "auto", a
+tolerance on a grid large enough to be thinned and on small ones; weights with
+zeros; closed u and v, the closing line left out or none), each
 checked to have run split; every output must equal the single process's, byte for
 byte. Then the failures: a missing points file, a NaN in the last process's rows,
 bad options, a closing line that nearly repeats the first, an output in a missing
@@ -16,6 +17,7 @@ output file and no temporary file left, and an existing output untouched.
 
 Usage: mpi_runs.py INTERPATCH [MPIRUN]
 """
+import itertools
 import json
 import os
 import subprocess
@@ -139,6 +141,41 @@ def weighted_closed_cases(rng):
          "weights": (0.5 + rng.random((45, 25))).round(3).tolist()}, "21", [3]
 
 
+def bumps(shape, rng):
+    """A smooth sheet with a narrow bump and noise of 5e-4: knots grow where the bump is, and a
+    tolerance of 2e-3 is reached (the noise of grid() would stop it short)."""
+    u, v = np.meshgrid(np.linspace(0, 1, shape[0]), np.linspace(0, 1, shape[1]), indexing="ij")
+    z = np.cos(5 * u) * np.sin(7 * v) + 0.2 * np.exp(-80 * ((u - 0.4) ** 2 + (v - 0.6) ** 2))
+    g = np.stack([2 * u + 0.3 * np.sin(3 * v), v + 0.2 * u ** 2, z], -1)
+    return g + 5e-4 * rng.random(g.shape)
+
+
+def tolerance_cases(rng):
+    """The fit to a tolerance: grids of 2^18 points or more grow their first knots on a thinned
+    grid (every 4th row and column: blocks of it on every process, some empty), smaller ones
+    on the whole grid; the separable fit and the sparse one with holes; row splits uneven."""
+    yield "approximate tolerance 520x520 (thinned grid)", bumps((520, 520), rng), {"tolerance": 2e-3}, "70", [1, 4]
+    yield "approximate tolerance 520x520 holes (thinned grid)", holes(bumps((520, 520), rng), rng), {"tolerance": 2e-3}, \
+        "45x61", [3]
+    yield "approximate tolerance 40x6600 holes: thinned along v alone, processes with no rows", \
+        holes(bumps((40, 6600), rng), rng), {"tolerance": 2e-3, "degree": [2, 3]}, "9x50", [4]
+    # 3 control columns at first: a process holds none in the separable solve.
+    yield "approximate tolerance 53x37, fewer control columns than processes", bumps((53, 37), rng), \
+        {"tolerance": 2e-3, "degree": [3, 2]}, "40", [4]
+    yield "approximate tolerance holes, centripetal, Fortran order", np.asfortranarray(holes(bumps((70, 45), rng), rng)), \
+        {"tolerance": 2e-3, "param": "centripetal"}, "33", [2]
+
+
+
+def tolerance_failure():
+    """A fit to a tolerance refused on the split path as in one process: one line, its status, no output."""
+    with tempfile.TemporaryDirectory() as d:
+        np.save(os.path.join(d, "points.npy"), np.full((40, 20, 3), np.nan))
+        with open(os.path.join(d, "spec.json"), "w") as f:
+            json.dump({"type": "approximate", "points": {"npy": "points.npy"}, "tolerance": 1e-3}, f)
+        same_failure(d, "approximate tolerance: every point missing", ["build", "spec.json", "-o", "good.npz"], 3, [3])
+
+
 def split_ran(d, spec_file):
     """Whether a run on 2 processes was split (rank 1 reports its stages) rather than run on rank 0 alone."""
     env = dict(ENV, INTERPATCH_MPI_TIMINGS="1")
@@ -219,7 +256,7 @@ def main():
                 check(split_ran(d, "spec.json"), f"{name}: not split between the processes")
             same_outputs(d, name, "spec.json", eval_grid, *processes)
             print("ok:", name, flush=True)
-    for name, points, options, eval_grid, processes in approximate_cases(rng):
+    for name, points, options, eval_grid, processes in itertools.chain(approximate_cases(rng), tolerance_cases(rng)):
         with tempfile.TemporaryDirectory() as d:
             np.save(os.path.join(d, "points.npy"), points)
             with open(os.path.join(d, "spec.json"), "w") as f:
@@ -248,6 +285,7 @@ def main():
                            "control_points": [8, 6]}, f)
             same_failure(d, f"approximate: the last line along {'uv'[axis]} nearly repeats the first",
                          ["eval", "spec.json", "--grid", "9", "-o", "good.npy"], 3, processes)
+    tolerance_failure()
     with tempfile.TemporaryDirectory() as d:
         g = np.full((40, 20, 3), np.nan)
         np.save(os.path.join(d, "points.npy"), g)
