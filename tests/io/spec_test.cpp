@@ -864,6 +864,25 @@ json network_spec(std::size_t n, std::size_t m, const char* method) {
   return {{"type", "network"}, {"u_curves", uc}, {"v_curves", vc}, {"u_params", p}, {"v_params", p}, {"method", method}};
 }
 
+// A network's curves are read on both threads: its warnings come in the order of
+// the curves, and of two bad curves the first is the one named, as when they are
+// read one after another.
+TEST(Spec, NetworkCurvesReadTogetherKeepTheSpecsOrder) {
+  json spec = network_spec(6, 60, "gordon");
+  for (const std::size_t j : {4u, 1u, 3u}) spec["v_curves"][j]["bogus"] = j;
+  const Construction c = build(spec);
+  ASSERT_EQ(c.warnings.size(), 3u);
+  EXPECT_EQ(c.warnings[0], "/v_curves/1/bogus: unknown field, ignored");
+  EXPECT_EQ(c.warnings[1], "/v_curves/3/bogus: unknown field, ignored");
+  EXPECT_EQ(c.warnings[2], "/v_curves/4/bogus: unknown field, ignored");
+  for (int trial = 0; trial < 20; ++trial) {  // whichever thread fails first
+    json bad = network_spec(6, 60, "gordon");
+    bad["u_curves"][5]["interpolate"] = json::array({json::array({0, 0, 0})});
+    bad["u_curves"][2]["interpolate"][3] = "x";
+    EXPECT_ERRC((void)build(bad), wrong_type, "/u_curves/2/interpolate/3");
+  }
+}
+
 // A Coons patch of four m-point curves at chord parameters (their knots differ).
 json coons_spec(std::size_t m) {
   json side[4];

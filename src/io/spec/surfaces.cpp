@@ -3,6 +3,7 @@
 // `info`, as curves sampled at `curve_samples` parameters.
 
 #include <array>
+#include <exception>
 #include <memory>
 #include <optional>
 
@@ -148,14 +149,50 @@ Construction build_coons(const json& spec, Context& ctx) {
   return blended("coons", at("", [&] { return coons(boundary, o); }), std::move(data), std::move(parameters));
 }
 
+// The curves of a JSON array, each as curve_impl reads it. Read on both threads when
+// the spec names no in-memory arrays (their use counts are the reader's shared
+// state): each curve with its own copy of the context, then the curves, their
+// warnings and the first error (the one reading in order meets first) in the
+// array's order, as when they are read one after another.
+static std::vector<BSplineCurve> curve_list(const json& a, const std::string& ptr, Context& ctx) {
+  const std::size_t n = a.size();
+  if (ctx.arrays != nullptr || n < 2) {
+    std::vector<BSplineCurve> c;
+    for (std::size_t i = 0; i < n; ++i) c.push_back(curve_impl(a[i], child(ptr, i), ctx));
+    return c;
+  }
+  std::vector<std::optional<BSplineCurve>> got(n);
+  std::vector<std::vector<std::string>> warned(n);
+  std::vector<std::exception_ptr> failed(n);
+  const auto count = static_cast<long long>(n);
+#pragma omp parallel for schedule(dynamic)
+  for (long long k = 0; k < count; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    Context own = ctx;
+    own.warnings.clear();
+    try {
+      got[i] = curve_impl(a[i], child(ptr, i), own);
+      warned[i] = std::move(own.warnings);
+    } catch (...) {
+      failed[i] = std::current_exception();
+    }
+  }
+  std::vector<BSplineCurve> c;
+  c.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (failed[i]) std::rethrow_exception(failed[i]);
+    for (std::string& w : warned[i]) ctx.warn(std::move(w));
+    c.push_back(std::move(*got[i]));
+  }
+  return c;
+}
+
 Construction build_network(const json& spec, Context& ctx) {
   auto curves = [&](const char* key) {
     const std::string ptr = child("", key);
     const json& a = member(spec, key, "", "an array of curves");
     if (!a.is_array()) wrong_type(ptr, "an array of curves", a);
-    std::vector<BSplineCurve> c;
-    for (std::size_t i = 0; i < a.size(); ++i) c.push_back(curve_impl(a[i], child(ptr, i), ctx));
-    return c;
+    return curve_list(a, ptr, ctx);
   };
   const std::array<bool, 3> closed = periodic_flags(spec, "", 2);
   CurveNetwork net{curves("u_curves"), curves("v_curves"), {}, {}, {closed[0], closed[1]}};
