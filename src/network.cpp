@@ -568,7 +568,17 @@ std::vector<BSplineCurve> place_curves(const Prepared& n, const Arrangement& r, 
       const std::vector<Vec3> line = detail::points_at(along[j], at), g = detail::points_at(G[k], at);
       if (closed)
         for (double& u : at) u -= std::floor(u);
-      const std::vector<Vec3> want = detail::points_at(given, at);
+      // A curve taken as given is its line's curve: its points are those already
+      // found, but where a closed curve's parameter wrapped.
+      std::vector<Vec3> want;
+      if (n.reshaped[az][j]) {
+        want = detail::points_at(given, at);
+      } else {
+        want = line;
+        const std::vector<double> own = detail::check_params(along[j].knots());
+        for (std::size_t i = 0; i < at.size(); ++i)
+          if (at[i] != own[i]) want[i] = given.point(at[i]);
+      }
       double d = 0;
       for (std::size_t i = 0; i < at.size(); ++i) d = std::max(d, distance(line[i] + g[i], want[i]));
       report[j].distance = d;
