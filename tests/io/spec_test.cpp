@@ -898,6 +898,27 @@ json coons_spec(std::size_t m) {
                         {"u0", {{"interpolate", side[2]}}}, {"u1", {{"interpolate", side[3]}}}}}};
 }
 
+// A Coons patch's four sides are read together too: a missing side and a bad one are
+// reported in the order v0, v1, u0, u1, as when they are read one after another.
+TEST(Spec, CoonsSidesReadTogetherKeepTheSpecsOrder) {
+  ASSERT_NO_THROW((void)build(coons_spec(64)));
+  json bad = coons_spec(64);
+  bad["boundary"]["v0"]["interpolate"][2] = "x";
+  bad["boundary"].erase("u1");
+  EXPECT_ERRC((void)build(bad), wrong_type, "/boundary/v0/interpolate/2");
+  bad = coons_spec(64);
+  bad["boundary"].erase("v1");
+  bad["boundary"]["u0"]["interpolate"][2] = "x";
+  EXPECT_ERRC((void)build(bad), missing_field, "/boundary/v1");
+  bad = coons_spec(64);
+  bad["boundary"]["u1"]["bogus"] = 1;
+  bad["boundary"]["v0"]["bogus"] = 0;
+  const Construction c = build(bad);
+  ASSERT_EQ(c.warnings.size(), 2u);
+  EXPECT_EQ(c.warnings[0], "/boundary/v0/bogus: unknown field, ignored");
+  EXPECT_EQ(c.warnings[1], "/boundary/u1/bogus: unknown field, ignored");
+}
+
 const BuildOptions deferred{.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}};
 
 TEST(SpecExact, DeferredUntilAskedThenTheSameAsBuiltAtOnce) {

@@ -98,14 +98,74 @@ Construction build_ruled(const json& spec, Context& ctx) {
                  nlohmann::ordered_json::object());
 }
 
+namespace {
+
+// A curve of the spec read with its own copy of the reader's context: the curve, the
+// warnings it gave and the error it met.
+struct CurveRead {
+  std::optional<BSplineCurve> curve;
+  std::vector<std::string> warnings;
+  std::exception_ptr error;
+};
+
+// The curves at items[i] (null: none there), each as curve_impl reads it at ptrs[i].
+// Read on both threads when the spec names no in-memory arrays (their use counts are
+// the reader's shared state), else one after another up to the first error.
+std::vector<CurveRead> read_curves(const std::vector<const json*>& items, const std::vector<std::string>& ptrs,
+                                   const Context& ctx) {
+  const std::size_t n = items.size();
+  std::vector<CurveRead> out(n);
+  const auto read = [&](std::size_t i) {
+    if (items[i] == nullptr) return;
+    Context own = ctx;
+    own.warnings.clear();
+    try {
+      out[i].curve = curve_impl(*items[i], ptrs[i], own);
+      out[i].warnings = std::move(own.warnings);
+    } catch (...) {
+      out[i].error = std::current_exception();
+    }
+  };
+  if (ctx.arrays != nullptr || n < 2) {
+    for (std::size_t i = 0; i < n; ++i) {
+      read(i);
+      if (out[i].error) break;
+    }
+    return out;
+  }
+  const auto count = static_cast<long long>(n);
+#pragma omp parallel for schedule(dynamic)
+  for (long long k = 0; k < count; ++k) read(static_cast<std::size_t>(k));
+  return out;
+}
+
+// A curve read by read_curves, in the spec's order: its warnings to ctx, its error
+// thrown, else the curve.
+BSplineCurve take(CurveRead& r, Context& ctx) {
+  if (r.error) std::rethrow_exception(r.error);
+  for (std::string& w : r.warnings) ctx.warn(std::move(w));
+  return std::move(*r.curve);
+}
+
+}  // namespace
+
 Construction build_coons(const json& spec, Context& ctx) {
   const char* sides[4] = {"v0", "v1", "u0", "u1"};
   auto four_curves = [&](const json& obj, const std::string& ptr) {
     expect_object(obj, ptr, "an object {\"v0\", \"v1\", \"u0\", \"u1\"} of curves");
     check_fields(obj, ptr, {"v0", "v1", "u0", "u1"}, ctx);
-    std::vector<BSplineCurve> c;
+    std::vector<const json*> items;
+    std::vector<std::string> ptrs;
     for (const char* side : sides) {
-      c.push_back(curve_impl(member(obj, side, ptr, "a curve"), child(ptr, side), ctx));
+      items.push_back(find_member(obj, side));
+      ptrs.push_back(child(ptr, side));
+    }
+    std::vector<CurveRead> read = read_curves(items, ptrs, ctx);
+    std::vector<BSplineCurve> c;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const char* side = sides[k];
+      (void)member(obj, side, ptr, "a curve");  // a missing side, in its turn
+      c.push_back(take(read[k], ctx));
       if (c.back().periodic())
         fail(errc::invalid_knots, place(child(ptr, side)), ": a closed curve (\"periodic\": true) cannot be a side of a ",
              "Coons patch, whose sides run from corner to corner");
@@ -149,50 +209,21 @@ Construction build_coons(const json& spec, Context& ctx) {
   return blended("coons", at("", [&] { return coons(boundary, o); }), std::move(data), std::move(parameters));
 }
 
-// The curves of a JSON array, each as curve_impl reads it. Read on both threads when
-// the spec names no in-memory arrays (their use counts are the reader's shared
-// state): each curve with its own copy of the context, then the curves, their
-// warnings and the first error (the one reading in order meets first) in the
-// array's order, as when they are read one after another.
-static std::vector<BSplineCurve> curve_list(const json& a, const std::string& ptr, Context& ctx) {
-  const std::size_t n = a.size();
-  if (ctx.arrays != nullptr || n < 2) {
-    std::vector<BSplineCurve> c;
-    for (std::size_t i = 0; i < n; ++i) c.push_back(curve_impl(a[i], child(ptr, i), ctx));
-    return c;
-  }
-  std::vector<std::optional<BSplineCurve>> got(n);
-  std::vector<std::vector<std::string>> warned(n);
-  std::vector<std::exception_ptr> failed(n);
-  const auto count = static_cast<long long>(n);
-#pragma omp parallel for schedule(dynamic)
-  for (long long k = 0; k < count; ++k) {
-    const auto i = static_cast<std::size_t>(k);
-    Context own = ctx;
-    own.warnings.clear();
-    try {
-      got[i] = curve_impl(a[i], child(ptr, i), own);
-      warned[i] = std::move(own.warnings);
-    } catch (...) {
-      failed[i] = std::current_exception();
-    }
-  }
-  std::vector<BSplineCurve> c;
-  c.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (failed[i]) std::rethrow_exception(failed[i]);
-    for (std::string& w : warned[i]) ctx.warn(std::move(w));
-    c.push_back(std::move(*got[i]));
-  }
-  return c;
-}
-
 Construction build_network(const json& spec, Context& ctx) {
   auto curves = [&](const char* key) {
     const std::string ptr = child("", key);
     const json& a = member(spec, key, "", "an array of curves");
     if (!a.is_array()) wrong_type(ptr, "an array of curves", a);
-    return curve_list(a, ptr, ctx);
+    std::vector<const json*> items;
+    std::vector<std::string> ptrs;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      items.push_back(&a[i]);
+      ptrs.push_back(child(ptr, i));
+    }
+    std::vector<CurveRead> read = read_curves(items, ptrs, ctx);
+    std::vector<BSplineCurve> c;
+    for (CurveRead& r : read) c.push_back(take(r, ctx));
+    return c;
   };
   const std::array<bool, 3> closed = periodic_flags(spec, "", 2);
   CurveNetwork net{curves("u_curves"), curves("v_curves"), {}, {}, {closed[0], closed[1]}};
