@@ -147,9 +147,7 @@ Plan plan_of(const MpiRequest& r, const mpi::Team& team) {
   }
   if (count == 0 || plan.header.data_offset + count * dt->size != size) return plan;
   if (approx) {
-    // What the split approximation does not cover (a fit to a tolerance with weights
-    // or closed directions), and
-    // options the single process refuses, run there.
+    // Options the single process refuses run there.
     try {
       io::reader::Context fields;
       fields.base_dir = plan.base;
@@ -160,7 +158,6 @@ Plan plan_of(const MpiRequest& r, const mpi::Team& team) {
     } catch (const error&) {
       return plan;
     }
-    if (!detail::approximate_rows_covers(plan.approx)) return plan;
     plan.approximate = true;
   }
   plan.split = true;

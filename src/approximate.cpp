@@ -1868,34 +1868,54 @@ detail::ApproxRows net_rows(const Fit<2>& f, const detail::RowTeam& team, const 
 // its rows; what comes back (the control net, the maxima, the lines) is the same on
 // every process, as one process finds it, so every process takes the same knot
 // decisions. The block's columns (for Bᵀ w Q) are made once and kept between fits.
+// Weights and closed directions as in approximate_rows: the weighted points in the
+// columns, the data term summed with the weights (wrapped along a closed u), the
+// weight sum added point after point in storage order.
 class Block {
-  // Each point's weight by its flat index in the grid: 1 present, 0 missing.
+  // Each point's weight by its flat index in the grid, as Data::w: 1 everywhere when
+  // uniform, else 0 where missing and the given weight (1 when none) elsewhere.
   [[nodiscard]] auto weight() const {
-    return [this](std::size_t flat) { return uniform_ || present_[flat - first_ * n_[1]] ? 1.0 : 0.0; };
+    return [this](std::size_t flat) {
+      if (uniform_) return 1.0;
+      const std::size_t i = flat - first_ * n_[1];
+      if (!present_[i]) return 0.0;
+      return w_ ? w_[i] : 1.0;
+    };
   }
 
  public:
   // Rows [first, first + count) of a grid of `shape` at `pts` (`own` holds them for
-  // a thinned grid). `uniform`: the grid it comes from has every point (the data
-  // term from the Gram matrices, the separable fit tried first, as Data::uniform).
+  // a thinned grid), their weights at `w` (none: every point present weighs 1;
+  // `own_w` holds them for a thinned grid). `uniform`: the grid it comes from has
+  // every point and equal weights (the data term from the Gram matrices, the
+  // separable fit tried first, as Data::uniform).
   Block(const detail::RowTeam& team, const Shape<2>& shape, std::shared_ptr<const std::vector<Vec3>> own, const Vec3* pts,
-        std::size_t first, std::size_t count, bool uniform)
-      : team_(&team), n_(shape), own_(std::move(own)), pts_(pts), first_(first), count_(count), uniform_(uniform) {
-    const std::size_t M = n_[1];
-    std::size_t missing[1] = {0};
+        std::size_t first, std::size_t count, bool uniform, std::shared_ptr<const std::vector<double>> own_w = {},
+        const double* w = nullptr)
+      : team_(&team), n_(shape), own_(std::move(own)), pts_(pts), first_(first), count_(count), uniform_(uniform),
+        own_w_(std::move(own_w)), w_(w) {
+    const std::size_t M = n_[1], base = first_ * M;
     if (!uniform_) {
       present_.resize(count_ * M);
-      for (std::size_t i = 0; i < present_.size(); ++i) {
-        present_[i] = !is_missing(pts_[i]);
-        missing[0] += present_[i] ? 0 : 1;
-      }
+      for (std::size_t i = 0; i < present_.size(); ++i) present_[i] = !is_missing(pts_[i]);
     }
-    team.sum(missing);
-    present_count_ = n_[0] * M - missing[0];
-    fill_ = missing[0] > 0;
+    // Points without data (missing or of weight 0): the fill term (needs_fill).
+    std::size_t empty[1] = {0};
+    for (std::size_t i = 0; i < present_.size(); ++i) empty[0] += weight()(base + i) > 0 ? 0 : 1;
+    team.sum(empty);
+    fill_ = empty[0] > 0;
+    std::vector<double> sum(1, static_cast<double>(n_[0] * M));
+    if (!uniform_) {
+      sum[0] = 0;
+      team.fold(sum, [&](std::span<double> acc) {
+        for (std::size_t i = 0; i < present_.size(); ++i)
+          if (const double x = weight()(base + i); x > 0) acc[0] += x;
+      });
+    }
+    weight_sum_ = sum[0];
     const std::vector<double> span = team.gather(std::vector<double>{static_cast<double>(first_), static_cast<double>(count_)});
     for (std::size_t s = 0; s < span.size(); s += 2) spans_.emplace_back(static_cast<std::size_t>(span[s]), static_cast<std::size_t>(span[s + 1]));
-    cols_ = rows_to_columns(pts_, count_, M, team);
+    cols_ = rows_to_columns(pts_, count_, M, team, {}, [&](std::size_t i, const Vec3&) { return weight()(base + i); });
   }
 
   [[nodiscard]] std::size_t size() const { return n_[0] * n_[1]; }
@@ -1918,7 +1938,7 @@ class Block {
     b.n = {n_[0], n_[1], 0};
     b.first = first_;
     b.count = count_;
-    SparseSystem<2> sys = block_system(f.axes, n_, b, uniform_, weight(), static_cast<double>(present_count_), *team_);
+    SparseSystem<2> sys = block_system(f.axes, n_, b, uniform_, weight(), weight_sum_, *team_);
     const std::vector<double> all_rhs = team_->gather(rhs);
     // The separable fit refused (uniform): the fill term settles what the data leave open.
     team_->run([&] { sparse_fit<2>(f, sys, all_rhs, std::nullopt, fill_ || uniform_); });
@@ -2000,14 +2020,16 @@ class Block {
     return e;
   }
 
-  // Which rows and columns hold data: rows from their process, columns OR-reduced.
+  // Which rows and columns hold data (a point of positive weight): rows from their
+  // process, columns OR-reduced.
   [[nodiscard]] std::array<std::vector<bool>, 2> has_data() const {
     std::array<std::vector<bool>, 2> has{std::vector<bool>(n_[0], true), std::vector<bool>(n_[1], true)};
     if (uniform_) return has;
+    const auto w = weight();
     std::vector<double> rows(count_, 0.0), cols(n_[1], 0.0);
     for (std::size_t r = 0; r < count_; ++r)
       for (std::size_t j = 0; j < n_[1]; ++j)
-        if (present_[r * n_[1] + j]) rows[r] = cols[j] = 1.0;
+        if (w((first_ + r) * n_[1] + j) > 0) rows[r] = cols[j] = 1.0;
     const std::vector<double> all = team_->gather(rows);
     team_->max(cols);
     for (std::size_t r = 0; r < n_[0]; ++r) has[0][r] = all[r] > 0;
@@ -2016,17 +2038,23 @@ class Block {
   }
 
   // thinned(): the kept rows in this block (a block of the thinned grid's rows, maybe
-  // none), the kept columns of each.
+  // none), the kept columns of each, with their weights.
   [[nodiscard]] Block thinned(const std::array<std::vector<std::size_t>, 2>& kept) const {
     const auto& rows = kept[0];
     const std::size_t lo = static_cast<std::size_t>(std::lower_bound(rows.begin(), rows.end(), first_) - rows.begin());
     const std::size_t hi = static_cast<std::size_t>(std::lower_bound(rows.begin(), rows.end(), first_ + count_) - rows.begin());
     const std::size_t K = kept[1].size();
     auto own = std::make_shared<std::vector<Vec3>>((hi - lo) * K);
+    auto own_w = std::make_shared<std::vector<double>>(w_ ? (hi - lo) * K : 0);
     for (std::size_t r = lo; r < hi; ++r)
-      for (std::size_t k = 0; k < K; ++k) (*own)[(r - lo) * K + k] = pts_[(rows[r] - first_) * n_[1] + kept[1][k]];
+      for (std::size_t k = 0; k < K; ++k) {
+        const std::size_t from = (rows[r] - first_) * n_[1] + kept[1][k], to = (r - lo) * K + k;
+        (*own)[to] = pts_[from];
+        if (w_) (*own_w)[to] = w_[from];
+      }
     const Vec3* p = own->data();
-    return {*team_, {rows.size(), K}, std::move(own), p, lo, hi - lo, uniform_};
+    const double* w = w_ ? own_w->data() : nullptr;
+    return {*team_, {rows.size(), K}, std::move(own), p, lo, hi - lo, uniform_, std::move(own_w), w};
   }
 
  private:
@@ -2036,8 +2064,10 @@ class Block {
   const Vec3* pts_;
   std::size_t first_, count_;
   bool uniform_;
-  bool fill_ = false;             // points missing in this grid
-  std::size_t present_count_ = 0;
+  std::shared_ptr<const std::vector<double>> own_w_;
+  const double* w_;               // the block's weights, none: 1 each
+  bool fill_ = false;             // points without data (missing or of weight 0) in this grid
+  double weight_sum_ = 0;         // of the whole grid's weights, in storage order
   std::vector<bool> present_;     // per point of the block, unless uniform
   std::vector<std::pair<std::size_t, std::size_t>> spans_;  // every process's {first, count}
   std::vector<double> cols_;      // the block's columns (rows_to_columns)
@@ -2047,15 +2077,10 @@ class Block {
 
 namespace detail {
 
-bool approximate_rows_covers(const SurfaceApproximationOptions& o) {
-  if (o.tolerance) return o.weights.empty() && !o.periodic[0] && !o.periodic[1];
-  return true;
-}
-
 ApproxRows approximate_rows(const GridBlock& given, const SurfaceApproximationOptions& o, const RowTeam& team,
                             const std::function<void()>& release) {
   constexpr std::size_t R = 2;
-  INTERPATCH_ASSERT(given.rank == 2 && approximate_rows_covers(o));
+  INTERPATCH_ASSERT(given.rank == 2);
 
   // Missing points (NaN); closed directions, whose closing line is looked for only
   // where none is missing (closed_data).
@@ -2188,7 +2213,8 @@ ApproxRows approximate_rows(const GridBlock& given, const SurfaceApproximationOp
   if (o.tolerance) {
     // The knots grow and are pruned on every process alike (solve_tolerance), the
     // fits and measures on the blocks (Block).
-    const Block whole(team, shape, nullptr, pts, b.first, b.count, !fill);
+    const Block whole(team, shape, nullptr, pts, b.first, b.count, uniform, nullptr,
+                      weights.empty() ? nullptr : weights.values().data() + std::min(base, weights.size()));
     solve_tolerance<R>(f, whole, *o.tolerance, {});
     return net_rows(f, team);
   }

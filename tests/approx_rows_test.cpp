@@ -208,34 +208,75 @@ PointGrid surface(std::mt19937_64& g, std::size_t n, std::size_t m, int closed, 
   return q;
 }
 
+// A random grid (closed along u or v, or open: `closed` -1), its closing line repeated
+// or not, with random degrees; centripetal parameters in every 4th trial.
+struct RandomGrid {
+  PointGrid q;
+  SurfaceApproximationOptions o;
+  bool repeat = false;
+};
+RandomGrid random_grid(std::mt19937_64& g, std::size_t n, std::size_t m, int closed, int trial) {
+  RandomGrid r;
+  r.repeat = closed >= 0 && g() % 2 == 0;
+  r.q = surface(g, n, m, std::max(closed, 0), r.repeat);
+  if (closed >= 0) r.o.periodic[static_cast<std::size_t>(closed)] = true;
+  r.o.degree = {static_cast<int>(2 + g() % 3), static_cast<int>(2 + g() % 2)};
+  r.o.param = trial % 4 == 3 ? Parametrization::centripetal : Parametrization::chord;
+  return r;
+}
+
+// Weights with some 0 (when `weighted`), and on some grids holes: a block of NaN (not
+// with a repeated closing line: one is looked for only without missing points).
+void weights_and_holes(std::mt19937_64& g, PointGrid& q, SurfaceApproximationOptions& o, bool weighted, bool repeat) {
+  const std::size_t n = q.extent(0), m = q.extent(1);
+  if (weighted) {
+    o.weights = Grid<double, 2>({n, m});
+    for (double& w : o.weights.values()) w = g() % 9 == 0 ? 0.0 : test::uniform(g, 0.2, 3.0);
+  }
+  if (!repeat && g() % 4 == 0)
+    for (std::size_t i = n / 3; i < n / 3 + 4; ++i)
+      for (std::size_t j = 1; j < 4; ++j) q(i, j).x = std::numeric_limits<double>::quiet_NaN();
+}
+
+// The split's control points and knots equal the whole grid's, bit for bit, on P
+// processes.
+void expect_single_process_bits(const PointGrid& q, const SurfaceApproximationOptions& o, const BSplineSurface& whole,
+                                std::size_t P) {
+  SCOPED_TRACE(P);
+  const BSplineSurface unit = whole.mapped(0.0, 1.0, 0.0, 1.0);
+  const PointGrid& cp = whole.control_points();
+  const Split s = approximate_split(q, o, P);
+  ASSERT_EQ(s.error, "");
+  ASSERT_EQ(s.rows.size(), cp.size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < cp.size(); ++i) differ += same_bits(s.rows[i], cp.data()[i]) ? 0 : 1;
+  EXPECT_EQ(differ, 0u);
+  EXPECT_EQ(s.last.knots[0].values(), unit.knots_u().values());
+  EXPECT_EQ(s.last.knots[1].values(), unit.knots_v().values());
+  EXPECT_EQ(s.last.knots[0].periodic(), o.periodic[0]);
+  EXPECT_EQ(s.last.knots[1].periodic(), o.periodic[1]);
+}
+
 // Random grids, options and splits: weights with zeros, holes, closed directions of
-// odd and even degree (the closing line repeated or not), every way but a tolerance;
+// odd and even degree (the closing line repeated or not), every way but a tolerance
+// (ToleranceWithWeightsAndClosedDirectionsGivesTheSingleProcessBits);
 // the split's control points equal the whole grid's bit for bit.
 TEST(ApproximateRows, EveryProcessCountGivesTheSingleProcessBits) {
   auto g = test::rng(19);
-  const double nan_v = std::numeric_limits<double>::quiet_NaN();
   for (int trial = 0; trial < 24; ++trial) {
     SCOPED_TRACE(trial);
     const std::size_t n = 20 + g() % 50, m = 8 + g() % 20;
     const int closed = static_cast<int>(g() % 3) - 1;  // -1 open, 0 u, 1 v
-    const bool repeat = closed >= 0 && g() % 2 == 0;
-    PointGrid q = surface(g, n, m, std::max(closed, 0), repeat);
-    SurfaceApproximationOptions o;
-    if (closed >= 0) o.periodic[static_cast<std::size_t>(closed)] = true;
-    o.degree = {static_cast<int>(2 + g() % 3), static_cast<int>(2 + g() % 2)};
-    o.param = trial % 4 == 3 ? Parametrization::centripetal : Parametrization::chord;
+    RandomGrid r = random_grid(g, n, m, closed, trial);
+    PointGrid& q = r.q;
+    SurfaceApproximationOptions& o = r.o;
+    const bool repeat = r.repeat;
     // Smoothing "auto" fits some 30 times: on a few grids, one split.
     const int way = trial % 8 == 5 ? 2 : trial % 2;
     if (way == 0) o.control_points = std::array<int, 2>{static_cast<int>(5 + g() % (n / 2 - 4)), static_cast<int>(4 + g() % (m - 4))};
     if (way == 1) o.smoothing = std::pow(10.0, -1.0 - static_cast<double>(g() % 6));
     if (way == 2) o.auto_smoothing = true;
-    if (g() % 3 != 0) {  // weights, some 0
-      o.weights = Grid<double, 2>({n, m});
-      for (double& w : o.weights.values()) w = g() % 9 == 0 ? 0.0 : test::uniform(g, 0.2, 3.0);
-    }
-    if (!repeat && g() % 4 == 0)  // holes: a block (a closing line is looked for only without)
-      for (std::size_t i = n / 3; i < n / 3 + 4; ++i)
-        for (std::size_t j = 1; j < 4; ++j) q(i, j).x = nan_v;
+    weights_and_holes(g, q, o, g() % 3 != 0, repeat);
     std::optional<BSplineSurface> whole;
     try {
       whole = approximate_surface(q, o).surface;
@@ -245,20 +286,7 @@ TEST(ApproximateRows, EveryProcessCountGivesTheSingleProcessBits) {
       for (std::size_t P = 1; P <= 4; ++P) EXPECT_EQ(approximate_split(q, o, P).error, e.what());
       continue;
     }
-    const BSplineSurface unit = whole->mapped(0.0, 1.0, 0.0, 1.0);
-    const PointGrid& cp = whole->control_points();
-    for (std::size_t P = way == 2 ? 3 : 1; P <= (way == 2 ? 3u : 4u); ++P) {
-      SCOPED_TRACE(P);
-      const Split s = approximate_split(q, o, P);
-      ASSERT_EQ(s.error, "");
-      ASSERT_EQ(s.rows.size(), cp.size());
-      std::size_t differ = 0;
-      for (std::size_t i = 0; i < cp.size(); ++i) differ += same_bits(s.rows[i], cp.data()[i]) ? 0 : 1;
-      EXPECT_EQ(differ, 0u);
-      EXPECT_EQ(s.last.knots[0].values(), unit.knots_u().values());
-      EXPECT_EQ(s.last.knots[1].values(), unit.knots_v().values());
-      EXPECT_EQ(s.last.knots[0].periodic(), closed == 0);
-    }
+    for (std::size_t P = way == 2 ? 3 : 1; P <= (way == 2 ? 3u : 4u); ++P) expect_single_process_bits(q, o, *whole, P);
   }
 }
 
@@ -283,6 +311,60 @@ TEST(ApproximateRows, ClosedUWithFewControlRowsAcrossEveryProcess) {
       for (std::size_t i = 0; i < cp.size(); ++i) EXPECT_TRUE(same_bits(s.rows[i], cp.data()[i])) << P << " processes, " << i;
     }
   }
+}
+
+// A fit to a tolerance with weights (zeros among them), holes and closed directions
+// (the closing line repeated or not): knots grow and are pruned on every process as
+// in one, and the split's control points equal the whole grid's bit for bit.
+TEST(ApproximateRows, ToleranceWithWeightsAndClosedDirectionsGivesTheSingleProcessBits) {
+  auto g = test::rng(31);
+  std::array<int, 3> grown{};  // fits whose knots grew, per kind: weights, closed u, closed v
+  for (int trial = 0; trial < 15; ++trial) {
+    SCOPED_TRACE(trial);
+    const std::size_t n = 24 + g() % 40, m = 12 + g() % 24;
+    const int closed = trial % 3 - 1;  // -1 open, 0 u, 1 v
+    RandomGrid r = random_grid(g, n, m, closed, trial);
+    PointGrid& q = r.q;
+    SurfaceApproximationOptions& o = r.o;
+    const bool repeat = r.repeat;
+    // The surface's noise reaches 0.003 · √3: the tighter tolerances stop where no
+    // interval can split any more, the looser ones within the tolerance.
+    o.tolerance = std::array<double, 3>{0.03, 0.01, 0.004}[g() % 3];
+    weights_and_holes(g, q, o, closed < 0 || g() % 3 != 0, repeat);  // on the open grids weights always
+    std::optional<SurfaceApproximation> whole;
+    try {
+      whole = approximate_surface(q, o);
+    } catch (const error& e) {
+      for (std::size_t P = 1; P <= 3; ++P) EXPECT_EQ(approximate_split(q, o, P).error, e.what());
+      continue;
+    }
+    const std::vector<int>& c = whole->report.control_points;
+    // More control points than the fit starts from (degree + 1): the knots grew.
+    if (c[0] > o.degree[0].value_or(3) + 1 || c[1] > o.degree[1].value_or(3) + 1) ++grown[static_cast<std::size_t>(closed + 1)];
+    // Each grid on 2 or 3 processes and on 4 (the last ones' blocks small or empty).
+    expect_single_process_bits(q, o, whole->surface, 2 + static_cast<std::size_t>(trial % 2));
+    expect_single_process_bits(q, o, whole->surface, 4);
+  }
+  for (const int k : grown) EXPECT_GE(k, 3);
+}
+
+// A fit to a tolerance with weights along a closed u on a grid of 2^18 points or more:
+// the knots first grow on the thinned grid (blocks of every 4th row and column, with
+// their weights), then on the whole one.
+TEST(ApproximateRows, ToleranceOnAThinnedGridWithWeightsAndAClosedU) {
+  auto g = test::rng(37);
+  const std::size_t n = 520, m = 512;
+  const PointGrid q = surface(g, n, m, 0, false);
+  SurfaceApproximationOptions o;
+  o.periodic = {true, false};
+  o.tolerance = 0.01;  // beyond the noise (0.003 · √3 at most): reached with few knots
+  o.weights = Grid<double, 2>({n, m});
+  for (double& w : o.weights.values()) w = g() % 7 == 0 ? 0.0 : test::uniform(g, 0.5, 2.0);
+  const SurfaceApproximation whole = approximate_surface(q, o);
+  EXPECT_LE(whole.report.max_error, *o.tolerance);
+  // Knots grew past the starting net (degree + 1 = 4 control points each way).
+  EXPECT_GT(whole.report.control_points[0] + whole.report.control_points[1], 8);
+  expect_single_process_bits(q, o, whole.surface, 3);
 }
 
 // A closing line that nearly repeats the first is refused, by one process, with the

@@ -2,10 +2,8 @@
 // Surface approximation (approximate_surface) of a grid held in blocks of whole rows
 // by the processes of a RowTeam (src/mpi/): the same control points, bit for bit, as
 // the single process finds, every sum over the data made in the single process's
-// order. Covered: a given number of control points and smoothing (a number or
-// "auto"), with missing points (NaN), weights, open and closed directions; a fit to
-// a tolerance with missing points, open directions and no weights. The other fits to
-// a tolerance run in one process.
+// order: a given number of control points, smoothing (a number or "auto") and a fit
+// to a tolerance, with missing points (NaN), weights, open and closed directions.
 
 #include <array>
 #include <cstddef>
@@ -19,9 +17,6 @@
 
 namespace interpatch::detail {
 
-/// Whether approximate_rows covers these options.
-[[nodiscard]] bool approximate_rows_covers(const SurfaceApproximationOptions& o);
-
 /// The fitted surface, its control rows split evenly between the processes.
 struct ApproxRows {
   std::array<int, 2> degree{};
@@ -31,8 +26,8 @@ struct ApproxRows {
   std::vector<Vec3> rows;            ///< its control rows, C order
 };
 
-/// The approximation of the grid `b` (rows may hold NaN: missing points), the
-/// options covered (approximate_rows_covers). Errors as approximate_surface's.
+/// The approximation of the grid `b` (rows may hold NaN: missing points). Errors as
+/// approximate_surface's.
 /// Along a closed u, b.ends must hold the whole grid's rows 0, 1, n−2, n−1; a closed
 /// v's closing column, when left out, is left out of b's rows in place.
 /// `release` is called once the block's points are read no more: the caller may

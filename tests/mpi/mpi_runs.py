@@ -7,7 +7,8 @@ degree, collapsed rows (poles), every parametrization, float32 and big-endian
 input, Fortran-order input, surfaces and volumes, and approximations (a given number of control points,
 the separable fit and the sparse one with holes, smoothing, smoothing "auto", a
 tolerance on a grid large enough to be thinned and on small ones; weights with
-zeros; closed u and v, the closing line left out or none), each
+zeros; closed u and v, the closing line left out or none; a tolerance with weights
+and closed directions), each
 checked to have run split; every output must equal the single process's, byte for
 byte. Then the failures: a missing points file, a NaN in the last process's rows,
 bad options, a closing line that nearly repeats the first, an output in a missing
@@ -141,6 +142,21 @@ def weighted_closed_cases(rng):
          "weights": (0.5 + rng.random((45, 25))).round(3).tolist()}, "21", [3]
 
 
+def tolerance_weighted_closed_cases(rng):
+    """(name, points, options, eval grid, process counts): the fit to a tolerance with weights
+    (zeros among them, with holes) and along closed u and v, each on one split of the rows."""
+    w = 0.2 + 2 * rng.random((60, 45))
+    w[10:14, 5:30] = 0  # zero weights beside the holes
+    yield "approximate tolerance, weights with zeros and holes", holes(bumps((60, 45), rng), rng), \
+        {"tolerance": 2e-3, "weights": w.round(3).tolist()}, "29", [3]
+    # grid()'s noise reaches 0.01 per coordinate: a tolerance above it.
+    yield "approximate tolerance closed u (closing row left out), weights, even degree", grid((50, 20), rng, close=0), \
+        {"periodic": [True, False], "degree": [2, 3], "tolerance": 0.02,
+         "weights": (0.5 + rng.random((51, 20))).round(3).tolist()}, "31", [4]
+    yield "approximate tolerance closed v (tube, closing column left out)", grid((45, 24), rng, close=1), \
+        {"periodic": [False, True], "degree": [3, 4], "tolerance": 2e-3}, "21", [2]
+
+
 def bumps(shape, rng):
     """A smooth sheet with a narrow bump and noise of 5e-4: knots grow where the bump is, and a
     tolerance of 2e-3 is reached (the noise of grid() would stop it short)."""
@@ -264,7 +280,8 @@ def main():
             check(split_ran(d, "spec.json"), f"{name}: not split between the processes")
             same_outputs(d, name, "spec.json", eval_grid, processes)
             print("ok:", name, flush=True)
-    for name, points, options, eval_grid, processes in weighted_closed_cases(rng):
+    for name, points, options, eval_grid, processes in itertools.chain(weighted_closed_cases(rng),
+                                                                      tolerance_weighted_closed_cases(rng)):
         with tempfile.TemporaryDirectory() as d:
             np.save(os.path.join(d, "points.npy"), points)
             with open(os.path.join(d, "spec.json"), "w") as f:
