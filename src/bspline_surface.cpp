@@ -182,19 +182,19 @@ namespace detail {
 using VTable = PackedBasis;
 VTable v_table(const KnotVector& kv, std::span<const double> vs) { return packed(bases(kv, vs, 0, "v"), kv.degree()); }
 
-// The points of a polynomial surface at every u of `us` and the v parameters of `vt`.
-void evaluate_rows_on(const KnotVector& ku_, const KnotVector& kv_, const RowWindow& net, std::span<const double> us,
+// The points of a polynomial surface at the u parameters of the basis rows `bu` and
+// the v parameters of `vt`.
+void evaluate_rows_on(const KnotVector& ku_, const KnotVector& kv_, const RowWindow& net, const std::vector<Basis>& bu,
                       const VTable& vt, std::span<Vec3> out, const progress_callback& progress) {
-  const auto bu = bases(ku_, us, 0, "u");
   const int p = ku_.degree(), q = kv_.degree();
   const std::size_t ncv = net.row_size;
   const std::size_t nv = vt.spans.size();
   // One parallel region: opening one costs microseconds with pinned threads but up
   // to milliseconds on a loaded machine, where the idle thread spins. Progress is
   // reported by the calling thread (thread 0) from a shared row count.
-  [[maybe_unused]] const bool threads = us.size() * (nv + ncv) >= parallel_min_work;
+  [[maybe_unused]] const bool threads = bu.size() * (nv + ncv) >= parallel_min_work;
   std::atomic<std::size_t> done{0};
-  const auto nu = static_cast<long long>(us.size());
+  const auto nu = static_cast<long long>(bu.size());
   const std::size_t row_doubles = 3 * ncv;
   // A periodic v: the row's first q points repeated after it, so that spans past
   // the last control point read on (sample_row never wraps).
@@ -214,7 +214,7 @@ void evaluate_rows_on(const KnotVector& ku_, const KnotVector& kv_, const RowWin
       // Not &out[i * nv].x: with no v values there is no element to index.
       sample_row(vt.spans.data(), vt.weights.data(), q, nv, row.data(), reinterpret_cast<double*>(out.data() + i * nv));
       const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
-      if (progress && reporter && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(us.size()));
+      if (progress && reporter && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(bu.size()));
     }
   }
   if (progress) progress(1.0);
@@ -224,8 +224,8 @@ void evaluate_rows_on(const KnotVector& ku_, const KnotVector& kv_, const RowWin
 // window (the whole net, or the rows one process of a split run holds).
 void evaluate_surface_rows(const KnotVector& ku_, const KnotVector& kv_, const RowWindow& net, std::span<const double> us,
                            std::span<const double> vs, std::span<Vec3> out, const progress_callback& progress) {
-  for (const double u : us) check_parameter(ku_, u, "u");  // u first, then v, as every evaluation checks
-  evaluate_rows_on(ku_, kv_, net, us, v_table(kv_, vs), out, progress);
+  const auto bu = bases(ku_, us, 0, "u");  // u checked first, then v, as every evaluation checks
+  evaluate_rows_on(ku_, kv_, net, bu, v_table(kv_, vs), out, progress);
 }
 
 }  // namespace detail
@@ -240,8 +240,8 @@ class PolynomialRows final : public Surface::Rows {
   void evaluate_into(std::span<const double> us, std::span<Vec3> out, const progress_callback& progress) const override {
     detail::check_output_size(out.size(), {us.size(), nv_}, "surface evaluation");
     const auto& cp = s_.control_points();
-    detail::evaluate_rows_on(s_.knots_u(), s_.knots_v(), {cp.data(), 0, cp.extent(0), cp.extent(0), cp.extent(1)}, us,
-                             table_, out, progress);
+    detail::evaluate_rows_on(s_.knots_u(), s_.knots_v(), {cp.data(), 0, cp.extent(0), cp.extent(0), cp.extent(1)},
+                             bases(s_.knots_u(), us, 0, "u"), table_, out, progress);
   }
 
  private:

@@ -564,8 +564,9 @@ std::vector<BSplineCurve> place_curves(const Prepared& n, const Arrangement& r, 
     const std::size_t j = r.order[az][k];
     const BSplineCurve& given = n.input[az][j];
     try {
-      std::vector<double> at = detail::check_params(along[j].knots());
-      const std::vector<Vec3> line = detail::points_at(along[j], at), g = detail::points_at(G[k], at);
+      const std::vector<double> own = detail::check_params(along[j].knots());
+      const std::vector<Vec3> line = detail::points_at(along[j], own), g = detail::points_at(G[k], own);
+      std::vector<double> at = own;
       if (closed)
         for (double& u : at) u -= std::floor(u);
       // A curve taken as given is its line's curve: its points are those already
@@ -575,7 +576,6 @@ std::vector<BSplineCurve> place_curves(const Prepared& n, const Arrangement& r, 
         want = detail::points_at(given, at);
       } else {
         want = line;
-        const std::vector<double> own = detail::check_params(along[j].knots());
         for (std::size_t i = 0; i < at.size(); ++i)
           if (at[i] != own[i]) want[i] = given.point(at[i]);
       }

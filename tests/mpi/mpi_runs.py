@@ -272,16 +272,9 @@ def main():
                 check(split_ran(d, "spec.json"), f"{name}: not split between the processes")
             same_outputs(d, name, "spec.json", eval_grid, *processes)
             print("ok:", name, flush=True)
-    for name, points, options, eval_grid, processes in itertools.chain(approximate_cases(rng), tolerance_cases(rng)):
-        with tempfile.TemporaryDirectory() as d:
-            np.save(os.path.join(d, "points.npy"), points)
-            with open(os.path.join(d, "spec.json"), "w") as f:
-                json.dump(dict({"type": "approximate", "points": {"npy": "points.npy"}}, **options), f)
-            check(split_ran(d, "spec.json"), f"{name}: not split between the processes")
-            same_outputs(d, name, "spec.json", eval_grid, processes)
-            print("ok:", name, flush=True)
-    for name, points, options, eval_grid, processes in itertools.chain(weighted_closed_cases(rng),
-                                                                      tolerance_weighted_closed_cases(rng)):
+    approximations = itertools.chain(approximate_cases(rng), tolerance_cases(rng), weighted_closed_cases(rng),
+                                     tolerance_weighted_closed_cases(rng))
+    for name, points, options, eval_grid, processes in approximations:
         with tempfile.TemporaryDirectory() as d:
             np.save(os.path.join(d, "points.npy"), points)
             with open(os.path.join(d, "spec.json"), "w") as f:
