@@ -71,6 +71,8 @@ demo: build
 test-release: build
 	ctest --preset release -j $(JOBS)
 
+# The sanitizer build at -O1 with line tables alone (CMakePresets.json): half the compile
+# time of -O2 -g, and the reports still name every function, file and line.
 test-asan: viewer-deps
 	cmake --preset asan
 	cmake --build --preset asan -j $(JOBS)
