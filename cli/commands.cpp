@@ -85,6 +85,11 @@ std::span<const double> flat_points(const Vec3* p, std::size_t n) {
   return {&p->x, 3 * n};
 }
 
+// The float64 triples of a .npy block as the points they hold.
+std::span<Vec3> points_of(std::span<double> values) {
+  return {reinterpret_cast<Vec3*>(values.data()), values.size() / 3};
+}
+
 // An evaluation grid written to .npy block by block along u: evaluate(us, out) fills
 // out with the points of the u values `us` (per_row points each), npy_block_rows of
 // them at a time, so the whole grid is never held in memory.
@@ -335,9 +340,8 @@ void write_mesh(io::Construction& c, const fs::path& out, const Resolution& res)
   constexpr double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  // every construction is over the unit square
   const std::vector<double> us = linspace(u0, u1, res.nu), vs = linspace(v0, v1, res.nv);
   ProgressLine progress("meshing");
-  const io::SurfaceMesh mesh = io::sample_mesh(s, us, vs, progress.callback());
+  io::write_surface_mesh(out, s, us, vs, progress.callback());  // a .vts a block at a time
   progress.clear();
-  io::write_surface_mesh(out, mesh);
 }
 
 void write_eval(io::Construction& c, const fs::path& out, const Resolution& grid) {
@@ -350,8 +354,10 @@ void write_eval(io::Construction& c, const fs::path& out, const Resolution& grid
   if (lower_extension(out) == ".npy") {
     const std::size_t shape[3] = {grid.nu, grid.nv, 3};
     const auto rows = s.rows(params[1]);  // what depends on v alone, once for every block
-    write_npy_by_rows(out, shape, params[0], grid.nv, progress.callback(),
-                      [&](std::span<const double> us, std::span<Vec3> points) { rows->evaluate_into(us, points); });
+    // A few rows of points a call, on both threads, while the block before is written.
+    io::write_npy_rows(out, shape, [&](std::size_t first, std::size_t count, std::span<double> values) {
+      rows->evaluate_into(std::span<const double>(params[0]).subspan(first, count), points_of(values));
+    }, progress.callback());
     progress.clear();
     return;
   }

@@ -42,11 +42,27 @@ namespace detail {
 // unit_normal's up to rounding. Any other point (a pole, huge or tiny partials, NaN)
 // goes to unit_normal.
 INTERPATCH_KERNEL void unit_normals(const Vec3* su, const Vec3* sv, const Vec3* suv, std::size_t n, Vec3* out) {
-  std::size_t j = 0;
 #if defined(__GNUC__)
   using v4 = double __attribute__((vector_size(32)));
-  for (; j + 4 <= n; j += 4) {
-    const Vec3 *a = su + j, *b = sv + j;
+  // The last n % 4 points go through the lanes too, beside copies of the last one:
+  // a point's normal is the same wherever it falls in the span (a mesh written a
+  // block of columns at a time gets the bits of the whole grid at once).
+  Vec3 pa[4], pb[4], pc[4], po[4];
+  for (std::size_t j = 0; j < n; j += 4) {
+    const std::size_t m = std::min<std::size_t>(4, n - j);
+    const Vec3 *a = su + j, *b = sv + j, *c = suv + j;
+    Vec3* o = out + j;
+    if (m < 4) {
+      for (std::size_t k = 0; k < 4; ++k) {
+        pa[k] = a[std::min(k, m - 1)];
+        pb[k] = b[std::min(k, m - 1)];
+        pc[k] = c[std::min(k, m - 1)];
+      }
+      a = pa;
+      b = pb;
+      c = pc;
+      o = po;
+    }
     const v4 ax = {a[0].x, a[1].x, a[2].x, a[3].x}, ay = {a[0].y, a[1].y, a[2].y, a[3].y}, az = {a[0].z, a[1].z, a[2].z, a[3].z};
     const v4 bx = {b[0].x, b[1].x, b[2].x, b[3].x}, by = {b[0].y, b[1].y, b[2].y, b[3].y}, bz = {b[0].z, b[1].z, b[2].z, b[3].z};
     const v4 nx = ay * bz - az * by, ny = az * bx - ax * bz, nz = ax * by - ay * bx;
@@ -60,26 +76,28 @@ INTERPATCH_KERNEL void unit_normals(const Vec3* su, const Vec3* sv, const Vec3* 
     constexpr double top = std::numeric_limits<double>::max();
     const auto plain = (len2 >= 0x1p-900) & (len2 <= top) & (big2 <= top) & (len2 > 1e-20 * (big2 * big2));
     const v4 ox = nx / len, oy = ny / len, oz = nz / len;
-    for (int k = 0; k < 4; ++k) {
+    for (std::size_t k = 0; k < m; ++k) {
       if (plain[k]) {
-        out[j + static_cast<std::size_t>(k)] = {ox[k], oy[k], oz[k]};
+        o[k] = {ox[k], oy[k], oz[k]};
       } else {
         SurfaceDerivatives d{};
         d.su = a[k];
         d.sv = b[k];
-        d.suv = suv[j + static_cast<std::size_t>(k)];
-        out[j + static_cast<std::size_t>(k)] = unit_normal(d);
+        d.suv = c[k];
+        o[k] = unit_normal(d);
       }
     }
+    if (m < 4) std::copy_n(po, m, out + j);
   }
-#endif
-  for (; j < n; ++j) {
+#else
+  for (std::size_t j = 0; j < n; ++j) {
     SurfaceDerivatives d{};
     d.su = su[j];
     d.sv = sv[j];
     d.suv = suv[j];
     out[j] = unit_normal(d);
   }
+#endif
 }
 
 }  // namespace detail

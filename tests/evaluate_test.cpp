@@ -58,7 +58,7 @@ TEST(Curvature, SingularFirstFormGivesNaN) {
 // rounding (the lanes may use fused multiply-adds: a few ulps of a unit vector, held
 // to 4e-16), and at poles, nearly parallel partials, partials of 1e±200 and NaN
 // (which go to unit_normal itself) bit for bit; any count of points, the last few
-// outside the blocks of four.
+// outside the blocks of four, which get the same bits as inside them.
 TEST(UnitNormals, AreThoseOfUnitNormal) {
   auto g = test::rng(31);
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
@@ -86,6 +86,15 @@ TEST(UnitNormals, AreThoseOfUnitNormal) {
       d.sv = sv[j];
       d.suv = suv[j];
       const Vec3 want = unit_normal(d);
+      // The point alone, and in a span starting anywhere before it (a mesh's block of
+      // columns): the same bits as in the whole span.
+      Vec3 alone{};
+      detail::unit_normals(&su[j], &sv[j], &suv[j], 1, &alone);
+      const std::size_t from = j - std::min<std::size_t>(j, g() % 6);
+      std::vector<Vec3> part(j + 1 - from);
+      detail::unit_normals(&su[from], &sv[from], &suv[from], part.size(), part.data());
+      EXPECT_EQ(std::memcmp(&alone, &out[j], sizeof alone), 0) << "point " << j << " of " << n << " alone";
+      EXPECT_EQ(std::memcmp(&part.back(), &out[j], sizeof alone), 0) << "point " << j << " of " << n << " from " << from;
       if (kind[j] == 0) {
         EXPECT_LE(norm(out[j] - want), 4e-16) << "point " << j << " of " << n;
       } else {  // NaN included: the same bits

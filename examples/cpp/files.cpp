@@ -171,6 +171,20 @@ void npy_blocks() {
   std::printf("ramp.npy written a row at a time: %zu values\n", ramp.data.size());
 }
 
+void npy_rows() {
+  const std::size_t shape[2] = {1000, 1000};
+  interpatch::io::write_npy_rows("ramp.npy", shape, [](std::size_t first, std::size_t count, std::span<double> out) {
+    for (std::size_t i = 0; i < count; ++i)
+      for (std::size_t j = 0; j < 1000; ++j) out[i * 1000 + j] = double(first + i) + 0.001 * double(j);
+  });
+  const interpatch::io::NpyArray ramp = interpatch::io::read_npy("ramp.npy");
+  example::expect(ramp.shape == std::vector<std::size_t>{1000, 1000}, "ramp.npy has shape {1000, 1000}");
+  for (std::size_t i = 0; i < 1000; i += 37)
+    for (std::size_t j = 0; j < 1000; j += 101)
+      example::expect(ramp.data[i * 1000 + j] == double(i) + 0.001 * double(j), "ramp.npy holds row i, column j");
+  std::printf("ramp.npy made by rows on every thread: %zu values\n", ramp.data.size());
+}
+
 void meshes() {
   const interpatch::BlendedSurface patch =
       interpatch::bilinear({0, 0, 0}, {0, 1, 0.5}, {1, 0, 0.5}, {1, 1, 0});  // a saddle
@@ -186,6 +200,13 @@ void meshes() {
   example::expect(vertices == 64 * 64, "patch.obj has 64 × 64 vertices");
   example::expect(faces == 63 * 63, "patch.obj has a quad per grid cell");
   std::printf("patch.obj: %zu vertices, %zu quads\n", vertices, faces);
+
+  // A large mesh straight from the surface: a .vts is written a block at a time.
+  const auto t1000 = interpatch::linspace(0, 1, 1000);
+  interpatch::io::write_surface_mesh("patch.vts", surface, t1000, t1000);  // 10^6 points and normals
+  interpatch::io::write_surface_mesh("whole.vts", interpatch::io::sample_mesh(surface, t1000, t1000));
+  example::expect(read_text("patch.vts") == read_text("whole.vts"), "patch.vts has the bytes of the mesh sampled whole");
+  std::printf("patch.vts: %zu bytes, written a block of columns at a time\n", read_text("patch.vts").size());
 }
 
 void step_files(const fs::path& examples) {
@@ -273,6 +294,7 @@ int main() {
     npy_arrays();
     npy_bytes();
     npy_blocks();
+    npy_rows();
     meshes();
     step_files(INTERPATCH_EXAMPLES_DIR);
     iges_files(INTERPATCH_EXAMPLES_DIR);

@@ -10,13 +10,16 @@
 #include <cstring>
 #include <limits>
 #include <ostream>
+#include <sstream>
 #include <string>
 
 #include "detail/parallel.hpp"
+#include "detail/pipeline.hpp"
 #include "detail/text.hpp"
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/evaluate.hpp"
 #include "interpatch/io/atomic_file.hpp"
+#include "interpatch/memory.hpp"
 
 namespace interpatch::io {
 namespace fs = std::filesystem;
@@ -406,10 +409,12 @@ void write_legacy_vtk(std::ostream& os, const Structured& g) {
   s.flush();
 }
 
-/// VTK XML StructuredGrid with the arrays as raw appended little-endian data, each
-/// preceded by its byte count as UInt64 (header_type), so grids of any size fit.
-void write_vts(std::ostream& os, const Structured& g) {
-  const std::uint64_t n = g.size();
+/// The XML of a .vts file before its appended data (up to the "_" that opens it)
+/// and after it. The arrays are raw appended little-endian data, each preceded by
+/// its byte count as UInt64 (header_type), so grids of any size fit: the normals
+/// (when there are vectors), the jacobian (scalars), then the points.
+std::string vts_head(std::size_t nu, std::size_t nv, std::size_t nw, bool vectors, bool scalars) {
+  const std::uint64_t n = std::uint64_t{nu} * nv * nw;
   const std::uint64_t vec_bytes = 24 * n, scal_bytes = 8 * n;
   std::uint64_t offset = 0;
   auto next_offset = [&](std::uint64_t bytes) {
@@ -417,10 +422,9 @@ void write_vts(std::ostream& os, const Structured& g) {
     offset += 8 + bytes;
     return o;
   };
+  std::ostringstream os;
   Sink s(os);
-  auto extent = [&]() {
-    s.text("0 ").uint(g.nu - 1).text(" 0 ").uint(g.nv - 1).text(" 0 ").uint(g.nw - 1);
-  };
+  auto extent = [&]() { s.text("0 ").uint(nu - 1).text(" 0 ").uint(nv - 1).text(" 0 ").uint(nw - 1); };
   s.text("<?xml version=\"1.0\"?>\n"
          "<VTKFile type=\"StructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
          "  <StructuredGrid WholeExtent=\"");
@@ -428,15 +432,15 @@ void write_vts(std::ostream& os, const Structured& g) {
   s.text("\">\n    <Piece Extent=\"");
   extent();
   s.text("\">\n      <PointData");
-  if (g.vectors) s.text(" Normals=\"Normals\"");
-  if (g.scalars) s.text(" Scalars=\"jacobian\"");
+  if (vectors) s.text(" Normals=\"Normals\"");
+  if (scalars) s.text(" Scalars=\"jacobian\"");
   s.text(">\n");
-  if (g.vectors) {
+  if (vectors) {
     s.text("        <DataArray type=\"Float64\" Name=\"Normals\" NumberOfComponents=\"3\" format=\"appended\" offset=\"")
         .uint(next_offset(vec_bytes))
         .text("\"/>\n");
   }
-  if (g.scalars) {
+  if (scalars) {
     s.text("        <DataArray type=\"Float64\" Name=\"jacobian\" NumberOfComponents=\"1\" format=\"appended\" offset=\"")
         .uint(next_offset(scal_bytes))
         .text("\"/>\n");
@@ -445,6 +449,18 @@ void write_vts(std::ostream& os, const Structured& g) {
          "        <DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" format=\"appended\" offset=\"")
       .uint(next_offset(vec_bytes))
       .text("\"/>\n      </Points>\n    </Piece>\n  </StructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _");
+  s.flush();
+  return std::move(os).str();
+}
+
+constexpr std::string_view vts_tail = "\n  </AppendedData>\n</VTKFile>\n";
+
+/// VTK XML StructuredGrid (vts_head), the arrays i fastest.
+void write_vts(std::ostream& os, const Structured& g) {
+  const std::uint64_t n = g.size();
+  const std::uint64_t vec_bytes = 24 * n, scal_bytes = 8 * n;
+  Sink s(os);
+  s.text(vts_head(g.nu, g.nv, g.nw, g.vectors != nullptr, g.scalars != nullptr));
   auto vec_array = [&](const Vec3* v) {
     s.little(vec_bytes);
     g.runs_i_fastest(v, [&](std::span<const Vec3> run) { s.points(run, std::endian::little); });
@@ -458,7 +474,7 @@ void write_vts(std::ostream& os, const Structured& g) {
     });
   }
   vec_array(g.points);
-  s.text("\n  </AppendedData>\n</VTKFile>\n");
+  s.text(vts_tail);
   s.flush();
 }
 
@@ -638,34 +654,135 @@ void write_volume_mesh(const fs::path& path, const PointGrid3& points, const Gri
   write_structured(path, ext, s);
 }
 
-SurfaceMesh sample_mesh(const Surface& surface, std::span<const double> us, std::span<const double> vs,
-                        const progress_callback& progress) {
-  const std::size_t nu = us.size(), nv = vs.size();
-  SurfaceMesh mesh{PointGrid({nu, nv}, for_overwrite), PointGrid({nu, nv}, for_overwrite), {false, false}};
-  surface.evaluate_normals_into(us, vs, std::span<Vec3>(mesh.points.data(), mesh.points.size()),
-                                std::span<Vec3>(mesh.normals.data(), mesh.normals.size()), progress);
-  // A direction in which a B-spline surface is periodic and the samples span one
-  // whole period closes: its last row (column) is its first again, points and
-  // normals copied so that every format sees one seam.
+namespace {
+
+// A direction in which a B-spline surface is periodic and the samples span one
+// whole period closes: its last row (column) is its first again.
+std::array<bool, 2> closed_directions(const Surface& surface, std::span<const double> us, std::span<const double> vs) {
+  std::array<bool, 2> closed = {false, false};
   if (const auto* b = dynamic_cast<const BSplineSurface*>(&surface)) {
     const auto domain = b->domain();
     for (const std::size_t a : {0u, 1u}) {
       const std::span<const double> t = a == 0 ? us : vs;
       const double period = domain[a].second - domain[a].first;
       // Parameters made by linspace over a period end on its ends to an ulp or so.
-      mesh.closed[a] = b->periodic()[a] && t.size() >= 2 &&
-                       std::abs(std::abs(t.back() - t.front()) - period) <= 1e-12 * period;
-    }
-    for (std::size_t j = 0; mesh.closed[0] && j < nv; ++j) {
-      mesh.points(nu - 1, j) = mesh.points(0, j);
-      mesh.normals(nu - 1, j) = mesh.normals(0, j);
-    }
-    for (std::size_t i = 0; mesh.closed[1] && i < nu; ++i) {
-      mesh.points(i, nv - 1) = mesh.points(i, 0);
-      mesh.normals(i, nv - 1) = mesh.normals(i, 0);
+      closed[a] = b->periodic()[a] && t.size() >= 2 && std::abs(std::abs(t.back() - t.front()) - period) <= 1e-12 * period;
     }
   }
+  return closed;
+}
+
+// Points written little-endian, turned in place first where the machine is not.
+void write_little(std::ostream& os, Vec3* p, std::size_t n) {
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "a point is three doubles");
+  auto* bytes = reinterpret_cast<char*>(p);
+  if constexpr (std::endian::native != std::endian::little)
+    for (std::size_t d = 0; d < n * sizeof(Vec3); d += sizeof(double)) std::reverse(bytes + d, bytes + d + sizeof(double));
+  os.write(bytes, static_cast<std::streamsize>(n * sizeof(Vec3)));
+}
+
+// The .vts of a surface's mesh (points and normals) without the mesh in memory:
+// blocks of whole columns (v values), each a run of both arrays, i fastest. Every
+// thread evaluates a few rows of the block and puts them in the file's order while
+// the block before is written at its two places in the file; the bytes are those
+// of write_surface_mesh(path, sample_mesh(...)).
+void stream_vts(const fs::path& path, const Surface& surface, std::span<const double> us, std::span<const double> vs,
+                const progress_callback& progress) {
+  const std::size_t nu = us.size(), nv = vs.size(), n = nu * nv;
+  const std::array<bool, 2> closed = closed_directions(surface, us, vs);
+  const std::string head = vts_head(nu, nv, 1, true, false);
+  const std::uint64_t vec_bytes = std::uint64_t{24} * n;
+  const std::uint64_t normals_at = head.size() + 8, points_at = normals_at + vec_bytes + 8, tail_at = points_at + vec_bytes;
+  // About 2^16 points a block (3 MiB of points and normals), pieces of about 2^12.
+  constexpr std::size_t block_points = std::size_t{1} << 16, piece_points = std::size_t{1} << 12;
+  const std::size_t block_cols = std::clamp<std::size_t>(block_points / nu, 1, nv);
+  const std::size_t piece_rows = std::max<std::size_t>(1, piece_points / block_cols);
+  const std::size_t blocks = (nv + block_cols - 1) / block_cols, pieces = (nu + piece_rows - 1) / piece_rows;
+  require_memory(4 * block_cols * nu + 2 * nu, sizeof(Vec3), "the blocks of the mesh '" + path.string() + "'");
+  std::vector<Vec3> points[2], normals[2];
+  for (int k = 0; k < 2; ++k) {
+    points[k].resize(block_cols * nu);
+    normals[k].resize(block_cols * nu);
+  }
+  std::vector<Vec3> first_points, first_normals;  // column 0, for the last of a surface closed in v
+  const auto columns = [&](std::size_t b) { return std::pair(b * block_cols, std::min(block_cols, nv - b * block_cols)); };
+  const auto make = [&](std::size_t b, std::size_t p) {
+    const auto [j0, m] = columns(b);
+    const std::size_t i0 = p * piece_rows, k = std::min(piece_rows, nu - i0);
+    std::vector<Vec3> P(k * m), N(k * m);
+    surface.evaluate_normals_into(us.subspan(i0, k), vs.subspan(j0, m), P, N);
+    Vec3 *to_p = points[b % 2].data(), *to_n = normals[b % 2].data();
+    for (std::size_t i = 0; i < k; ++i)
+      for (std::size_t j = 0; j < m; ++j) {
+        to_p[j * nu + i0 + i] = P[i * m + j];
+        to_n[j * nu + i0 + i] = N[i * m + j];
+      }
+  };
+  const auto write = [&](std::ostream& os, std::size_t b) {
+    const auto [j0, m] = columns(b);
+    Vec3 *P = points[b % 2].data(), *N = normals[b % 2].data();
+    for (std::size_t j = 0; closed[0] && j < m; ++j) {
+      P[j * nu + nu - 1] = P[j * nu];
+      N[j * nu + nu - 1] = N[j * nu];
+    }
+    if (closed[1] && b == 0) {
+      first_points.assign(P, P + nu);
+      first_normals.assign(N, N + nu);
+    }
+    if (closed[1] && j0 + m == nv) {
+      std::copy(first_points.begin(), first_points.end(), P + (m - 1) * nu);
+      std::copy(first_normals.begin(), first_normals.end(), N + (m - 1) * nu);
+    }
+    os.seekp(static_cast<std::streamoff>(normals_at + std::uint64_t{24} * j0 * nu));
+    write_little(os, N, m * nu);
+    os.seekp(static_cast<std::streamoff>(points_at + std::uint64_t{24} * j0 * nu));
+    write_little(os, P, m * nu);
+    if (progress) progress(static_cast<double>(j0 + m) / static_cast<double>(nv));
+  };
+  write_atomically(path, [&](std::ostream& os) {
+    Sink s(os);
+    s.text(head).little(vec_bytes);
+    s.flush();
+    detail::pipeline(
+        blocks, n >= detail::parallel_min_work / 16, [&](std::size_t) { return pieces; }, make,
+        [&](std::size_t b) { write(os, b); });
+    os.seekp(static_cast<std::streamoff>(points_at - 8));
+    s.little(vec_bytes);
+    s.flush();
+    os.seekp(static_cast<std::streamoff>(tail_at));
+    s.text(vts_tail);
+    s.flush();
+  }, tail_at + vts_tail.size());
+}
+
+}  // namespace
+
+SurfaceMesh sample_mesh(const Surface& surface, std::span<const double> us, std::span<const double> vs,
+                        const progress_callback& progress) {
+  const std::size_t nu = us.size(), nv = vs.size();
+  SurfaceMesh mesh{PointGrid({nu, nv}, for_overwrite), PointGrid({nu, nv}, for_overwrite), {false, false}};
+  surface.evaluate_normals_into(us, vs, std::span<Vec3>(mesh.points.data(), mesh.points.size()),
+                                std::span<Vec3>(mesh.normals.data(), mesh.normals.size()), progress);
+  // Points and normals of the last row (column) of a closed direction are copied
+  // from the first, so that every format sees one seam.
+  mesh.closed = closed_directions(surface, us, vs);
+  for (std::size_t j = 0; mesh.closed[0] && j < nv; ++j) {
+    mesh.points(nu - 1, j) = mesh.points(0, j);
+    mesh.normals(nu - 1, j) = mesh.normals(0, j);
+  }
+  for (std::size_t i = 0; mesh.closed[1] && i < nu; ++i) {
+    mesh.points(i, nv - 1) = mesh.points(i, 0);
+    mesh.normals(i, nv - 1) = mesh.normals(i, 0);
+  }
   return mesh;
+}
+
+void write_surface_mesh(const fs::path& path, const Surface& surface, std::span<const double> us,
+                        std::span<const double> vs, const progress_callback& progress) {
+  const std::string ext = lower_extension(path);
+  check_extension(path, ext, surface_formats, "surface");
+  if (ext != ".vts" || us.empty() || vs.empty()) return write_surface_mesh(path, sample_mesh(surface, us, vs, progress));
+  stream_vts(path, surface, us, vs, progress);
 }
 
 }  // namespace interpatch::io

@@ -17,6 +17,7 @@
 #include <string>
 #include <string_view>
 
+#include "detail/pipeline.hpp"
 #include "detail/text.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/memory.hpp"
@@ -575,6 +576,47 @@ void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::si
                      " came as ", values.size(), " values");
       internal::write_values(os, values.data(), n);
     }
+  }, bytes);
+}
+
+void write_npy_rows(const fs::path& path, std::span<const std::size_t> shape, const NpyRowsMaker& make,
+                    const progress_callback& progress) {
+  const std::vector<std::size_t> dims(shape.begin(), shape.end());
+  if (dims.empty()) detail::fail(errc::size_mismatch, "cannot write '", path.string(), "' by rows: the shape has no axis");
+  const std::size_t count = element_count(path, dims);
+  const std::size_t rows = dims[0], per_row = rows == 0 ? 0 : count / rows;
+  // About 2^19 values (4 MiB) a block: still in the cache when it is written, and
+  // pieces of about 2^15 values, 16 a block, for the threads to share.
+  constexpr std::size_t block_values = std::size_t{1} << 19, piece_values = std::size_t{1} << 15;
+  const std::size_t block_rows = std::max<std::size_t>(1, block_values / std::max<std::size_t>(per_row, 1));
+  const std::size_t piece_rows = std::max<std::size_t>(1, piece_values / std::max<std::size_t>(per_row, 1));
+  const std::size_t blocks = (rows + block_rows - 1) / block_rows;
+  const std::string header = internal::npy_header("<f8", dims);
+  const std::uintmax_t bytes = count <= (std::numeric_limits<std::uintmax_t>::max() - header.size()) / sizeof(double)
+                                   ? header.size() + count * sizeof(double)
+                                   : 0;
+  const std::size_t held = std::min(block_rows, rows) * per_row;
+  require_memory(2 * held, sizeof(double), "the blocks of '" + path.string() + "'");
+  std::vector<double> buffers[2] = {std::vector<double>(held), std::vector<double>(held)};
+  const auto block_span = [&](std::size_t b) {
+    const std::size_t r0 = b * block_rows;
+    return std::pair(r0, std::min(block_rows, rows - r0));
+  };
+  write_atomically(path, [&](std::ostream& os) {
+    os.write(header.data(), static_cast<std::streamsize>(header.size()));
+    detail::pipeline(
+        blocks, count >= detail::parallel_min_work / 4,
+        [&](std::size_t b) { return (block_span(b).second + piece_rows - 1) / piece_rows; },
+        [&](std::size_t b, std::size_t p) {
+          const auto [r0, n] = block_span(b);
+          const std::size_t first = p * piece_rows, k = std::min(piece_rows, n - first);
+          make(r0 + first, k, std::span<double>(buffers[b % 2]).subspan(first * per_row, k * per_row));
+        },
+        [&](std::size_t b) {
+          const auto [r0, n] = block_span(b);
+          internal::write_values(os, buffers[b % 2].data(), n * per_row);
+          if (progress) progress(static_cast<double>(r0 + n) / static_cast<double>(rows));
+        });
   }, bytes);
 }
 

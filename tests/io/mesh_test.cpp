@@ -18,8 +18,13 @@
 #include <string>
 #include <vector>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/evaluate.hpp"
+#include "interpatch/patches.hpp"
 #include "io/closed_shapes.hpp"
 #include "temp_dir.hpp"
 #include "test_util.hpp"
@@ -826,6 +831,57 @@ TEST(Mesh, SampleMeshClosesWhereTheSamplesSpanAPeriod) {
       EXPECT_EQ(m.normals(i, nv - 1), m.normals(i, 0));
     }
   }
+}
+
+// write_surface_mesh from the surface writes a .vts a block of columns at a time on
+// every thread; its bytes are those of the mesh sampled whole and written: closed in
+// u, v or both (the seam copied into the right blocks), a pole row, a blended
+// surface; one block, several with a short last one, a single row or column; 1, 2
+// and 3 threads. The other formats go through sample_mesh.
+TEST(Mesh, SurfaceVtsWrittenByBlocksHasTheBytesOfTheWholeMesh) {
+  TempDir dir;
+  const BSplineSurface torus = test::closed_surface({true, true}, 8);
+  const BSplineSurface pipe = test::closed_surface({false, true}, 9, true);
+  const BSplineSurface ring = test::closed_surface({true, false}, 10);
+  const BlendedSurface pole = bilinear({0, 0, 0}, {0, 0, 0}, {1, 0, 0.5}, {1, 1, 0});  // the row u = 0 is a point
+  struct Case {
+    const Surface* s;
+    double u0, u1, v0, v1;
+    std::size_t nu, nv;
+  };
+  const Case cases[] = {{&torus, 0, 1, 0.5, 2.5, 1000, 70},  {&torus, 0.3, 1.3, 0.5, 2.5, 7, 13000},
+                        {&pipe, 0, 1, 0.5, 2.5, 301, 299},   {&ring, 0, 1, 0.5, 2.5, 5, 6},
+                        {&pole, 0, 1, 0, 1, 333, 401},       {&pole, 0, 1, 0, 1, 1, 5},
+                        {&pole, 0, 1, 0, 1, 5, 1},           {&torus, 0, 1, 0.5, 2.5, 70000, 2}};
+#ifdef _OPENMP
+  const int before = omp_get_max_threads();
+  omp_set_dynamic(0);
+#endif
+  for (const Case& c : cases) {
+    const auto us = linspace(c.u0, c.u1, c.nu), vs = linspace(c.v0, c.v1, c.nv);
+    write_surface_mesh(dir / "whole.vts", sample_mesh(*c.s, us, vs));
+    const std::string want = read_bytes(dir / "whole.vts");
+    for (const int threads : {1, 2, 3}) {
+#ifdef _OPENMP
+      omp_set_num_threads(threads);
+#endif
+      write_surface_mesh(dir / "blocks.vts", *c.s, us, vs);
+      EXPECT_TRUE(read_bytes(dir / "blocks.vts") == want) << c.nu << " x " << c.nv << ", " << threads << " threads";
+    }
+    write_surface_mesh(dir / "m.obj", *c.s, us, vs);
+    write_surface_mesh(dir / "whole.obj", sample_mesh(*c.s, us, vs));
+    EXPECT_TRUE(read_bytes(dir / "m.obj") == read_bytes(dir / "whole.obj")) << c.nu << " x " << c.nv;
+  }
+#ifdef _OPENMP
+  omp_set_num_threads(before);
+#endif
+  EXPECT_ERRC(write_surface_mesh(dir / "m.vts", pole, std::vector<double>{0, 1.5}, std::vector<double>{0, 1}),
+              out_of_domain, "");
+  EXPECT_ERRC(write_surface_mesh(dir / "m.dat", pole, std::vector<double>{0, 1}, std::vector<double>{0, 1}), wrong_type,
+              "unknown surface mesh format '.dat'");
+  EXPECT_ERRC(write_surface_mesh(dir / "m.vts", pole, std::vector<double>{}, std::vector<double>{0, 1}), size_mismatch,
+              "no points");
+  EXPECT_FALSE(fs::exists(dir / "m.vts"));
 }
 
 TEST(Mesh, ClosedMeshWhoseLastRowIsNotTheFirstIsRefused) {

@@ -70,6 +70,21 @@ struct SurfaceMesh {
 ///   too_large (more than 2^32 - 1 STL triangles), file_unwritable.
 void write_surface_mesh(const std::filesystem::path& path, const SurfaceMesh& mesh);
 
+/// The mesh of a surface on the grid us × vs written as
+/// write_surface_mesh(path, sample_mesh(surface, us, vs, progress)) writes it, the
+/// same bytes. A .vts is written without the mesh in memory: a block of columns
+/// at a time, evaluated by every thread while the block before is written (memory
+/// for two blocks of about 2^16 points); the other formats sample the mesh first.
+///
+/// Example:
+/// @code
+///   const auto t = interpatch::linspace(0, 1, 1000);
+///   interpatch::io::write_surface_mesh("patch.vts", surface, t, t);  // 10^6 points and normals
+/// @endcode
+/// @throws error as sample_mesh and write_surface_mesh.
+void write_surface_mesh(const std::filesystem::path& path, const Surface& surface, std::span<const double> us,
+                        std::span<const double> vs, const progress_callback& progress = {});
+
 /// Writes a structured NU × NV × NW grid of points (a volume mesh, first index
 /// along u) to .vtk (legacy STRUCTURED_GRID), .vts or .xyz (Plot3D); `jacobian`,
 /// if not empty, is written as a point field named "jacobian". Plot3D grid files

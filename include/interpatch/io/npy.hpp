@@ -9,6 +9,8 @@
 #include <string_view>
 #include <vector>
 
+#include "interpatch/progress.hpp"
+
 namespace interpatch::io {
 
 /// An array read from .npy: shape and values as float64 in C order.
@@ -92,5 +94,31 @@ using NpyProducer = std::function<std::span<const double>(std::size_t first, std
 /// the file is then left as it was.
 void write_npy(const std::filesystem::path& path, std::span<const std::size_t> shape, std::size_t block,
                const NpyProducer& produce);
+
+/// Makes the rows [first, first + count) of an array's first axis, in C order, into
+/// `out` (count times the values of one row). Called on several threads at once,
+/// each call for rows no other call makes.
+using NpyRowsMaker = std::function<void(std::size_t first, std::size_t count, std::span<double> out)>;
+
+/// Writes as write_npy, the rows of the array's first axis made by `make`: a block
+/// of about 2^19 values at a time, made a few rows a call by every thread while the
+/// block before it is written, so that the making and the writing overlap. Memory
+/// for two blocks, never for the whole array. The bytes do not depend on the
+/// threads as long as make's values do not. `progress`, if given, gets the fraction
+/// written after each block.
+///
+/// Example:
+/// @code
+///   const std::size_t shape[2] = {1000, 1000};
+///   interpatch::io::write_npy_rows("ramp.npy", shape, [](std::size_t first, std::size_t count, std::span<double> out) {
+///     for (std::size_t i = 0; i < count; ++i)
+///       for (std::size_t j = 0; j < 1000; ++j) out[i * 1000 + j] = double(first + i) + 0.001 * double(j);
+///   });
+/// @endcode
+/// @throws error file_unwritable, size_mismatch (an overflowing shape, or one of no
+/// axis), and whatever `make` throws (for the first rows, when several calls
+/// throw); the file is then left as it was.
+void write_npy_rows(const std::filesystem::path& path, std::span<const std::size_t> shape, const NpyRowsMaker& make,
+                    const progress_callback& progress = {});
 
 }  // namespace interpatch::io
