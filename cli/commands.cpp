@@ -74,37 +74,14 @@ std::optional<std::size_t> point_count(const Resolution& r) {
   return n;
 }
 
-// The u values of a .npy evaluation block: about 2^17 points (3 MiB), work enough
-// for both threads and still in the cache when it is written; at least one u value.
-std::size_t npy_block_rows(std::size_t per_row) { return std::max<std::size_t>(1, (std::size_t{1} << 17) / per_row); }
-
-// Points as float64 triples in C order, for .npy: a grid's own memory (Vec3 is
-// three doubles), written without a copy.
-std::span<const double> flat_points(const Vec3* p, std::size_t n) {
-  static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 grids are written as arrays of doubles");
-  return {&p->x, 3 * n};
-}
+// The u values of a .npy evaluation block, as io::write_npy_rows makes them: about
+// 2^17 points (3 MiB), at least one u value; it holds two blocks.
+std::size_t npy_block_rows(std::size_t per_row) { return std::max<std::size_t>(1, (std::size_t{1} << 19) / (3 * per_row)); }
 
 // The float64 triples of a .npy block as the points they hold.
 std::span<Vec3> points_of(std::span<double> values) {
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 grids are written as arrays of doubles");
   return {reinterpret_cast<Vec3*>(values.data()), values.size() / 3};
-}
-
-// An evaluation grid written to .npy block by block along u: evaluate(us, out) fills
-// out with the points of the u values `us` (per_row points each), npy_block_rows of
-// them at a time, so the whole grid is never held in memory.
-template <class Evaluate>
-void write_npy_by_rows(const fs::path& out, std::span<const std::size_t> shape, std::span<const double> us,
-                       std::size_t per_row, const progress_callback& progress, const Evaluate& evaluate) {
-  const std::size_t rows = npy_block_rows(per_row);
-  std::vector<Vec3> block(std::min(rows, us.size()) * per_row);
-  io::write_npy(out, shape, 3 * rows * per_row, [&](std::size_t first, std::size_t count) {
-    const std::size_t r0 = first / (3 * per_row), n = count / (3 * per_row);
-    const std::span<Vec3> points(block.data(), n * per_row);
-    evaluate(us.subspan(r0, n), points);
-    if (progress) progress(static_cast<double>(r0 + n) / static_cast<double>(us.size()));
-    return flat_points(points.data(), points.size());
-  });
 }
 
 void mesh_volume(const io::Construction& c, const fs::path& out, const Resolution& res) {
@@ -123,10 +100,10 @@ void eval_volume(const io::Construction& c, const fs::path& out, const Resolutio
   ProgressLine progress("evaluating");
   if (lower_extension(out) == ".npy") {
     const std::size_t shape[4] = {grid.nu, grid.nv, grid.nw, 3};
-    write_npy_by_rows(out, shape, params[0], grid.nv * grid.nw, progress.callback(),
-                      [&](std::span<const double> us, std::span<Vec3> points) {
-                        v.evaluate_into(us, params[1], params[2], points);
-                      });
+    // A few u values a call, on both threads, while the block before is written.
+    io::write_npy_rows(out, shape, [&](std::size_t first, std::size_t count, std::span<double> values) {
+      v.evaluate_into(std::span<const double>(params[0]).subspan(first, count), params[1], params[2], points_of(values));
+    }, progress.callback());
     progress.clear();
     return;
   }
@@ -291,14 +268,14 @@ void require_eval_room(const Resolution& grid, const fs::path& out) {
       throw error(errc::too_large, what + ": more bytes than a file can hold");
     io::check_disk_space(out, *points * sizeof(Vec3) + 4096, what);
     const std::size_t per_row = *points / grid.nu;
-    require_memory(std::min(npy_block_rows(per_row), grid.nu) * per_row, sizeof(Vec3), what + ", a block of u values");
+    require_memory(2 * std::min(npy_block_rows(per_row), grid.nu) * per_row, sizeof(Vec3), what + ", two blocks of u values");
     return;
   }
   // The points, plus the text of a row for .csv.
   require_memory(*points, sizeof(Vec3) + 8, what);
 }
 
-void require_mesh_memory(const Resolution& res) {
+void require_mesh_room(const Resolution& res, const fs::path& out) {
   const std::string what = "mesh of " + resolution_text(res) + " vertices";
   if (res.nw) {
     constexpr std::size_t limit = std::size_t{1} << 21;
@@ -310,6 +287,15 @@ void require_mesh_memory(const Resolution& res) {
   }
   if (res.nu >= (std::size_t{1} << 32) || res.nv >= (std::size_t{1} << 32))
     throw error(errc::too_large, what + ": more vertices than can be addressed");
+  if (lower_extension(out) == ".vts") {
+    // Written a block of columns at a time: the disk space of the file (points and
+    // normals, 48 bytes a vertex, and at most a few kilobytes of XML).
+    const std::size_t n = res.nu * res.nv;
+    if (n > (std::numeric_limits<std::size_t>::max() - 4096) / (2 * sizeof(Vec3)))
+      throw error(errc::too_large, what + ": more bytes than a file can hold");
+    io::check_disk_space(out, n * 2 * sizeof(Vec3) + 4096, what);
+    return;
+  }
   // Points and normals, plus room for the writers' faces (two triangles per vertex in STL).
   require_memory(res.nu * res.nv, 2 * sizeof(Vec3) + 2 * 50, what);
 }
@@ -402,12 +388,12 @@ int mesh_command(const Input& in, const fs::path& out, std::string_view res_text
   const std::optional<Resolution> given = res_text.empty() ? std::nullopt : std::optional(parse_resolution(res_text));
   check_mesh_output(out);
   io::check_writable(out);
-  if (given) require_mesh_memory(*given);
+  if (given) require_mesh_room(*given, out);
   // A mesh samples the construction; its exact form is made only if that costs less.
   io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}});
   const Resolution res = given ? *given : (io::is_volume(c) ? default_volume_resolution : default_surface_resolution);
   check_mesh_kind(c, out, res);
-  if (!given) require_mesh_memory(res);
+  if (!given) require_mesh_room(res, out);
   write_mesh(c, out, res);
   report_warnings(c);
   return 0;

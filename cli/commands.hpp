@@ -106,7 +106,10 @@ void check_view_output(const std::filesystem::path& out);
 /// output's disk (it is written a block at a time, and a block must fit in memory)
 /// or whose .csv text cannot be made in memory.
 void require_eval_room(const Resolution& grid, const std::filesystem::path& out);
-void require_mesh_memory(const Resolution& res);
+/// Refuse (error too_large) a mesh whose points and normals cannot be held in memory,
+/// or, for a surface's .vts (written a block of columns at a time), whose file cannot
+/// fit on the output's disk.
+void require_mesh_room(const Resolution& res, const std::filesystem::path& out);
 
 /// Refuse (usage_error) a resolution or a mesh format that does not fit the kind of
 /// the construction: NUxNVxNW for a surface, NUxNV or .obj/.stl/.ply for a volume.
