@@ -71,8 +71,10 @@ demo: build
 test-release: build
 	ctest --preset release -j $(JOBS)
 
-# The sanitizer build at -O1 with line tables alone (CMakePresets.json): half the compile
-# time of -O2 -g, and the reports still name every function, file and line.
+# The sanitizer build with line tables alone (-g1, CMakePresets.json): three quarters of
+# the compile time of -g, and the reports still name every function, file and line. It
+# stays at -O2: tests compare networks with fixtures made at -O3, and -O1 rounds a knot
+# differently enough to change a merge.
 test-asan: viewer-deps
 	cmake --preset asan
 	cmake --build --preset asan -j $(JOBS)
