@@ -75,8 +75,8 @@ std::optional<std::size_t> point_count(const Resolution& r) {
 }
 
 // The u values of a .npy evaluation block, as io::write_npy_rows makes them: about
-// 2^17 points (3 MiB), at least one u value; it holds two blocks.
-std::size_t npy_block_rows(std::size_t per_row) { return std::max<std::size_t>(1, (std::size_t{1} << 19) / (3 * per_row)); }
+// 2^17 values (1 MiB), at least 2 u values; it holds two blocks.
+std::size_t npy_block_rows(std::size_t per_row) { return std::max<std::size_t>(2, (std::size_t{1} << 17) / (3 * per_row)); }
 
 // The float64 triples of a .npy block as the points they hold.
 std::span<Vec3> points_of(std::span<double> values) {

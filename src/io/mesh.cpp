@@ -693,17 +693,16 @@ void stream_vts(const fs::path& path, const Surface& surface, std::span<const do
   const std::string head = vts_head(nu, nv, 1, true, false);
   const std::uint64_t vec_bytes = std::uint64_t{24} * n;
   const std::uint64_t normals_at = head.size() + 8, points_at = normals_at + vec_bytes + 8, tail_at = points_at + vec_bytes;
-  // About 2^16 points a block (3 MiB of points and normals), pieces of about 2^12.
-  constexpr std::size_t block_points = std::size_t{1} << 16, piece_points = std::size_t{1} << 12;
+  // About 2^15 points a block (1.5 MiB of points and normals), pieces of about 2^11:
+  // few fresh pages (write_npy_rows).
+  constexpr std::size_t block_points = std::size_t{1} << 15, piece_points = std::size_t{1} << 11;
   const std::size_t block_cols = std::clamp<std::size_t>(block_points / nu, 1, nv);
   const std::size_t piece_rows = std::max<std::size_t>(1, piece_points / block_cols);
   const std::size_t blocks = (nv + block_cols - 1) / block_cols, pieces = (nu + piece_rows - 1) / piece_rows;
   require_memory(4 * block_cols * nu + 2 * nu, sizeof(Vec3), "the blocks of the mesh '" + path.string() + "'");
-  std::vector<Vec3> points[2], normals[2];
-  for (int k = 0; k < 2; ++k) {
-    points[k].resize(block_cols * nu);
-    normals[k].resize(block_cols * nu);
-  }
+  // Column j of a block, i fastest; not zeroed (every element is written).
+  PointGrid points[2] = {PointGrid({block_cols, nu}, for_overwrite), PointGrid({block_cols, nu}, for_overwrite)};
+  PointGrid normals[2] = {PointGrid({block_cols, nu}, for_overwrite), PointGrid({block_cols, nu}, for_overwrite)};
   std::vector<Vec3> first_points, first_normals;  // column 0, for the last of a surface closed in v
   const auto columns = [&](std::size_t b) { return std::pair(b * block_cols, std::min(block_cols, nv - b * block_cols)); };
   const auto make = [&](std::size_t b, std::size_t p) {

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -585,10 +586,13 @@ void write_npy_rows(const fs::path& path, std::span<const std::size_t> shape, co
   if (dims.empty()) detail::fail(errc::size_mismatch, "cannot write '", path.string(), "' by rows: the shape has no axis");
   const std::size_t count = element_count(path, dims);
   const std::size_t rows = dims[0], per_row = rows == 0 ? 0 : count / rows;
-  // About 2^19 values (4 MiB) a block: still in the cache when it is written, and
-  // pieces of about 2^15 values, 16 a block, for the threads to share.
-  constexpr std::size_t block_values = std::size_t{1} << 19, piece_values = std::size_t{1} << 15;
-  const std::size_t block_rows = std::max<std::size_t>(1, block_values / std::max<std::size_t>(per_row, 1));
+  // About 2^17 values (1 MiB) a block, in pieces of about 2^13 for the threads to
+  // share: still in the cache when it is written, and few fresh pages (on the
+  // machine of docs/BENCHMARKS.md blocks of 4 MiB cost more in page faults than the
+  // overlap gains). At least 2 rows a block, so that the threads share rows as large
+  // as a volume's.
+  constexpr std::size_t block_values = std::size_t{1} << 17, piece_values = std::size_t{1} << 13;
+  const std::size_t block_rows = std::max<std::size_t>(2, block_values / std::max<std::size_t>(per_row, 1));
   const std::size_t piece_rows = std::max<std::size_t>(1, piece_values / std::max<std::size_t>(per_row, 1));
   const std::size_t blocks = (rows + block_rows - 1) / block_rows;
   const std::string header = internal::npy_header("<f8", dims);
@@ -597,7 +601,9 @@ void write_npy_rows(const fs::path& path, std::span<const std::size_t> shape, co
                                    : 0;
   const std::size_t held = std::min(block_rows, rows) * per_row;
   require_memory(2 * held, sizeof(double), "the blocks of '" + path.string() + "'");
-  std::vector<double> buffers[2] = {std::vector<double>(held), std::vector<double>(held)};
+  // Not zeroed: the threads' first writes touch the pages.
+  const std::unique_ptr<double[]> buffers[2] = {std::make_unique_for_overwrite<double[]>(held),
+                                                std::make_unique_for_overwrite<double[]>(held)};
   const auto block_span = [&](std::size_t b) {
     const std::size_t r0 = b * block_rows;
     return std::pair(r0, std::min(block_rows, rows - r0));
@@ -610,11 +616,11 @@ void write_npy_rows(const fs::path& path, std::span<const std::size_t> shape, co
         [&](std::size_t b, std::size_t p) {
           const auto [r0, n] = block_span(b);
           const std::size_t first = p * piece_rows, k = std::min(piece_rows, n - first);
-          make(r0 + first, k, std::span<double>(buffers[b % 2]).subspan(first * per_row, k * per_row));
+          make(r0 + first, k, std::span<double>(buffers[b % 2].get() + first * per_row, k * per_row));
         },
         [&](std::size_t b) {
           const auto [r0, n] = block_span(b);
-          internal::write_values(os, buffers[b % 2].data(), n * per_row);
+          internal::write_values(os, buffers[b % 2].get(), n * per_row);
           if (progress) progress(static_cast<double>(r0 + n) / static_cast<double>(rows));
         });
   }, bytes);

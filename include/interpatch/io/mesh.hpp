@@ -74,12 +74,12 @@ void write_surface_mesh(const std::filesystem::path& path, const SurfaceMesh& me
 /// write_surface_mesh(path, sample_mesh(surface, us, vs, progress)) writes it, the
 /// same bytes. A .vts is written without the mesh in memory: a block of columns
 /// at a time, evaluated by every thread while the block before is written (memory
-/// for two blocks of about 2^16 points); the other formats sample the mesh first.
+/// for two blocks of about 2^15 points); the other formats sample the mesh first.
 ///
 /// Example:
 /// @code
-///   const auto t = interpatch::linspace(0, 1, 1000);
-///   interpatch::io::write_surface_mesh("patch.vts", surface, t, t);  // 10^6 points and normals
+///   const auto t1000 = interpatch::linspace(0, 1, 1000);
+///   interpatch::io::write_surface_mesh("patch.vts", surface, t1000, t1000);  // 10^6 points and normals
 /// @endcode
 /// @throws error as sample_mesh and write_surface_mesh.
 void write_surface_mesh(const std::filesystem::path& path, const Surface& surface, std::span<const double> us,

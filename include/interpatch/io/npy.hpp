@@ -101,7 +101,7 @@ void write_npy(const std::filesystem::path& path, std::span<const std::size_t> s
 using NpyRowsMaker = std::function<void(std::size_t first, std::size_t count, std::span<double> out)>;
 
 /// Writes as write_npy, the rows of the array's first axis made by `make`: a block
-/// of about 2^19 values at a time, made a few rows a call by every thread while the
+/// of about 2^17 values (at least 2 rows) at a time, made a few rows a call by every thread while the
 /// block before it is written, so that the making and the writing overlap. Memory
 /// for two blocks, never for the whole array. The bytes do not depend on the
 /// threads as long as make's values do not. `progress`, if given, gets the fraction
