@@ -392,72 +392,115 @@ Grid<SurfaceDerivatives, 2> BlendedSurface::evaluate_derivatives(std::span<const
   return out;
 }
 
+namespace {
+
+// Points and normals of a blended surface on a grid us × vs. Per u, each factor with
+// its derivatives: F[i][k] (f_k) and P[i][l] (the factor of g_l), as
+// evaluate_derivatives makes them. Per v, lines of values and of first derivatives:
+// A[d][k][j] = a_k^(d)(v_j), G[d][l][j] = g_l^(d)(v_j) three times over. Row i of a
+// rectangle: S and its partials su (f', P'), sv (a', g') and suv (both), each summed
+// by the kernel of evaluate_into from column j0 on, then the normal of every point
+// (the kernel and the normals give a point the same bits wherever the rectangle
+// starts).
+class BlendedNormalGrid final : public Surface::NormalGrid {
+ public:
+  BlendedNormalGrid(std::shared_ptr<const detail::BlendedTerms> terms, std::span<const double> us,
+                    std::span<const double> vs)
+      : t_(std::move(terms)), nu_(us.size()), nv_(vs.size()) {
+    const auto& T = *t_;
+    detail::check_unit_parameters(us, "u");
+    detail::check_unit_parameters(vs, "v");
+    const std::size_t L = T.g.size(), KA = T.a.size();
+    u_factors(T, us, F_, P_);
+    for (std::size_t d = 0; d < 2; ++d) {
+      A_[d].resize(KA * nv_);
+      G_[d].resize(L * 3 * nv_);
+    }
+    for (std::size_t j = 0; j < nv_; ++j) {
+      const double v = clamped(vs[j]);
+      for (std::size_t l = 0; l < L; ++l) {
+        double g[3];
+        T.g[l].eval(v, g);
+        for (std::size_t d = 0; d < 2; ++d)
+          for (std::size_t c = 0; c < 3; ++c) G_[d][(l * nv_ + j) * 3 + c] = g[d];
+      }
+      for (std::size_t k = 0; k < KA; ++k) {
+        const D3 a = eval(T.a[k], v);
+        for (std::size_t d = 0; d < 2; ++d) A_[d][k * nv_ + j] = a.v[d];
+      }
+    }
+  }
+
+  void evaluate_into(std::size_t i0, std::size_t ni, std::size_t j0, std::size_t nj, std::span<Vec3> points,
+                     std::span<Vec3> normals) const override {
+    evaluate_into(i0, ni, j0, nj, points, normals, {});
+  }
+
+  void evaluate_into(std::size_t i0, std::size_t ni, std::size_t j0, std::size_t nj, std::span<Vec3> points,
+                     std::span<Vec3> normals, const progress_callback& progress) const {
+    const auto& T = *t_;
+    detail::check_rectangle(i0, ni, j0, nj, nu_, nv_);
+    detail::check_output_size(points.size(), {ni, nj}, "surface evaluation (points)");
+    detail::check_output_size(normals.size(), {ni, nj}, "surface evaluation (normals)");
+    const std::size_t nv = nv_, K = T.f.size(), L = T.g.size(), KA = T.a.size();
+    if (ni == 0 || nj == 0) {
+      if (progress) progress(1.0);
+      return;
+    }
+    const auto rows = static_cast<long long>(ni);
+    std::atomic<std::size_t> done{0};
+#pragma omp parallel if (ni * nj * (KA + L) * 4 >= detail::parallel_min_work)
+    {
+      std::vector<detail::LineTerm> lines(KA);
+      std::vector<detail::PointTerm> terms;
+      terms.reserve(L);
+      std::array<std::vector<Vec3>, 3> partial{std::vector<Vec3>(nj), std::vector<Vec3>(nj), std::vector<Vec3>(nj)};
+      // The row's sum of derivative order du in u and dv in v into o.
+      const auto sum = [&](std::size_t i, std::size_t du, std::size_t dv, Vec3* o) {
+        for (std::size_t k = 0; k < KA; ++k) lines[k] = {F_[i * K + k].v[du], &A_[dv][k * nv + j0].x};
+        terms.clear();
+        for (std::size_t l = 0; l < L; ++l) terms.emplace_back(G_[dv].data() + (l * nv + j0) * 3, P_[i * L + l].v[du]);
+        detail::sum_terms(&o->x, nj, lines, terms);
+      };
+#pragma omp for schedule(static, 16)
+      for (long long ri = 0; ri < rows; ++ri) {
+        const auto r = static_cast<std::size_t>(ri), i = i0 + r;
+        sum(i, 0, 0, points.data() + r * nj);
+        sum(i, 1, 0, partial[0].data());
+        sum(i, 0, 1, partial[1].data());
+        sum(i, 1, 1, partial[2].data());
+        detail::unit_normals(partial[0].data(), partial[1].data(), partial[2].data(), nj, normals.data() + r * nj);
+        const std::size_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
+        if (progress && detail::thread_index() == 0 && n % 64 == 0) progress(static_cast<double>(n) / static_cast<double>(ni));
+      }
+    }
+    if (progress) progress(1.0);
+  }
+
+ private:
+  std::shared_ptr<const detail::BlendedTerms> t_;
+  std::size_t nu_, nv_;
+  std::vector<S3> F_;
+  std::vector<D3> P_;
+  std::array<std::vector<Vec3>, 2> A_;
+  std::array<std::vector<double>, 2> G_;
+};
+
+}  // namespace
+
+std::unique_ptr<Surface::NormalGrid> BlendedSurface::normal_grid(std::span<const double> us,
+                                                                 std::span<const double> vs) const {
+  if (!t_->gregory.empty()) return Surface::normal_grid(us, vs);
+  return std::make_unique<BlendedNormalGrid>(t_, us, vs);
+}
+
 void BlendedSurface::evaluate_normals_into(std::span<const double> us, std::span<const double> vs,
                                            std::span<Vec3> points, std::span<Vec3> normals,
                                            const progress_callback& progress) const {
-  const auto& T = *t_;
-  if (!T.gregory.empty()) return Surface::evaluate_normals_into(us, vs, points, normals, progress);
+  if (!t_->gregory.empty()) return Surface::evaluate_normals_into(us, vs, points, normals, progress);
   detail::check_output_size(points.size(), {us.size(), vs.size()}, "surface evaluation (points)");
   detail::check_output_size(normals.size(), {us.size(), vs.size()}, "surface evaluation (normals)");
-  detail::check_unit_parameters(us, "u");
-  detail::check_unit_parameters(vs, "v");
-  const std::size_t nu = us.size(), nv = vs.size(), K = T.f.size(), L = T.g.size(), KA = T.a.size();
-  if (nu == 0 || nv == 0) {
-    if (progress) progress(1.0);
-    return;
-  }
-  // Per u, each factor with its derivatives: F[i][k] (f_k) and P[i][l] (the factor
-  // of g_l), as evaluate_derivatives makes them. Per v, lines of values and of first
-  // derivatives: A[d][k][j] = a_k^(d)(v_j), G[d][l][j] = g_l^(d)(v_j) three times over.
-  std::vector<S3> F;
-  std::vector<D3> P;
-  u_factors(T, us, F, P);
-  std::array<std::vector<Vec3>, 2> A{std::vector<Vec3>(KA * nv), std::vector<Vec3>(KA * nv)};
-  std::array<std::vector<double>, 2> G{std::vector<double>(L * 3 * nv), std::vector<double>(L * 3 * nv)};
-  for (std::size_t j = 0; j < nv; ++j) {
-    const double v = clamped(vs[j]);
-    for (std::size_t l = 0; l < L; ++l) {
-      double g[3];
-      T.g[l].eval(v, g);
-      for (std::size_t d = 0; d < 2; ++d)
-        for (std::size_t c = 0; c < 3; ++c) G[d][(l * nv + j) * 3 + c] = g[d];
-    }
-    for (std::size_t k = 0; k < KA; ++k) {
-      const D3 a = eval(T.a[k], v);
-      for (std::size_t d = 0; d < 2; ++d) A[d][k * nv + j] = a.v[d];
-    }
-  }
-  // Row i: S and its partials su (f', P'), sv (a', g') and suv (both), each summed by
-  // the kernel of evaluate_into, then the normal of every point of the row.
-  const auto rows = static_cast<long long>(nu);
-  std::atomic<std::size_t> done{0};
-#pragma omp parallel if (nu * nv * (KA + L) * 4 >= detail::parallel_min_work)
-  {
-    std::vector<detail::LineTerm> lines(KA);
-    std::vector<detail::PointTerm> terms;
-    terms.reserve(L);
-    std::array<std::vector<Vec3>, 3> partial{std::vector<Vec3>(nv), std::vector<Vec3>(nv), std::vector<Vec3>(nv)};
-    // The row's sum of derivative order du in u and dv in v into o.
-    const auto sum = [&](std::size_t i, std::size_t du, std::size_t dv, Vec3* o) {
-      for (std::size_t k = 0; k < KA; ++k) lines[k] = {F[i * K + k].v[du], &A[dv][k * nv].x};
-      terms.clear();
-      for (std::size_t l = 0; l < L; ++l) terms.emplace_back(G[dv].data() + l * 3 * nv, P[i * L + l].v[du]);
-      detail::sum_terms(&o->x, nv, lines, terms);
-    };
-#pragma omp for schedule(static, 16)
-    for (long long ri = 0; ri < rows; ++ri) {
-      const auto i = static_cast<std::size_t>(ri);
-      Vec3* row = points.data() + i * nv;
-      sum(i, 0, 0, row);
-      sum(i, 1, 0, partial[0].data());
-      sum(i, 0, 1, partial[1].data());
-      sum(i, 1, 1, partial[2].data());
-      detail::unit_normals(partial[0].data(), partial[1].data(), partial[2].data(), nv, normals.data() + i * nv);
-      const std::size_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
-      if (progress && detail::thread_index() == 0 && n % 64 == 0) progress(static_cast<double>(n) / static_cast<double>(nu));
-    }
-  }
-  if (progress) progress(1.0);
+  BlendedNormalGrid(t_, us, vs).evaluate_into(0, us.size(), 0, vs.size(), points, normals, progress);
 }
 
 bool BlendedSurface::has_exact_form() const noexcept {

@@ -63,6 +63,30 @@ std::unique_ptr<Surface::Rows> Surface::rows(std::span<const double> vs) const {
   return std::make_unique<DirectRows>(*this, vs);
 }
 
+namespace {
+
+// A rectangle of the grid by the surface's evaluate_normals_into, the parameters kept.
+class DirectNormalGrid final : public Surface::NormalGrid {
+ public:
+  DirectNormalGrid(const Surface& s, std::span<const double> us, std::span<const double> vs)
+      : s_(s), us_(us.begin(), us.end()), vs_(vs.begin(), vs.end()) {}
+  void evaluate_into(std::size_t i0, std::size_t ni, std::size_t j0, std::size_t nj, std::span<Vec3> points,
+                     std::span<Vec3> normals) const override {
+    detail::check_rectangle(i0, ni, j0, nj, us_.size(), vs_.size());
+    s_.evaluate_normals_into(std::span(us_).subspan(i0, ni), std::span(vs_).subspan(j0, nj), points, normals);
+  }
+
+ private:
+  const Surface& s_;
+  std::vector<double> us_, vs_;
+};
+
+}  // namespace
+
+std::unique_ptr<Surface::NormalGrid> Surface::normal_grid(std::span<const double> us, std::span<const double> vs) const {
+  return std::make_unique<DirectNormalGrid>(*this, us, vs);
+}
+
 void Surface::evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
                             const progress_callback& progress) const {
   detail::check_output_size(out.size(), {us.size(), vs.size()}, "surface evaluation");

@@ -328,6 +328,25 @@ void expect_normals_of_the_derivatives(const Surface& s, std::span<const double>
   }
   EXPECT_TRUE(same_bits(bp, points));
   EXPECT_TRUE(same_bits(bn, normals));
+  // Rectangles of the normal grid, columns starting anywhere (a mesh's blocks of
+  // columns): the same bits as the whole, and nothing beyond the grid.
+  const auto grid = s.normal_grid(us, vs);
+  const std::size_t nu = us.size(), nv = vs.size();
+  for (const auto [i0, ni, j0, nj] : {std::array<std::size_t, 4>{0, nu, 0, nv}, {0, nu, 3, 5}, {7, 9, 1, 1},
+                                      {2, 1, 0, nv}, {nu - 3, 3, nv - 6, 6}, {5, 0, 4, 3}}) {
+    std::vector<Vec3> rp(ni * nj, garbage), rn(ni * nj, garbage);
+    grid->evaluate_into(i0, ni, j0, nj, rp, rn);
+    for (std::size_t i = 0; i < ni; ++i)
+      for (std::size_t j = 0; j < nj; ++j) {
+        const std::size_t q = (i0 + i) * nv + j0 + j;
+        ASSERT_EQ(std::memcmp(&rp[i * nj + j], &points[q], sizeof(Vec3)), 0) << "rectangle at " << i0 << ", " << j0;
+        ASSERT_EQ(std::memcmp(&rn[i * nj + j], &normals[q], sizeof(Vec3)), 0) << "rectangle at " << i0 << ", " << j0;
+      }
+  }
+  std::vector<Vec3> two(2), three(3);
+  EXPECT_ERRC(grid->evaluate_into(nu - 1, 2, 0, 1, two, two), out_of_domain, "beyond the grid");
+  EXPECT_ERRC(grid->evaluate_into(0, 1, nv, 1, two, two), out_of_domain, "beyond the grid");
+  EXPECT_ERRC(grid->evaluate_into(0, 1, 0, 2, three, two), size_mismatch, "");
 }
 
 TEST(EvaluateInto, NormalsAreThoseOfTheDerivatives) {

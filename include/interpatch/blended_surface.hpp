@@ -50,6 +50,11 @@ class BlendedSurface final : public Surface {
   /// (Gregory-corrected patches: Surface::evaluate_normals_into.) @throws error out_of_domain, size_mismatch.
   void evaluate_normals_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> points,
                              std::span<Vec3> normals, const progress_callback& progress = {}) const override;
+  /// The grid us × vs with every function of u and of v and their first derivatives
+  /// evaluated here, once; each rectangle then costs its sums and normals.
+  /// (Gregory-corrected patches: Surface::normal_grid.) @throws error out_of_domain.
+  [[nodiscard]] std::unique_ptr<NormalGrid> normal_grid(std::span<const double> us,
+                                                        std::span<const double> vs) const override;
   /// Points and derivatives up to second order at every (us[i], vs[j]), the same
   /// way: each factor with its derivatives once per parameter, then short sums per
   /// point (Gregory-corrected patches point by point). @throws error out_of_domain, too_large.

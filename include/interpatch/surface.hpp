@@ -81,6 +81,27 @@ class Surface {
   /// evaluates its functions of v here, once. @throws error out_of_domain, here or from
   /// Rows::evaluate_into.
   [[nodiscard]] virtual std::unique_ptr<Rows> rows(std::span<const double> vs) const;
+  /// Points and unit normals on one grid us × vs, a rectangle of it at a time (a mesh
+  /// written a block of columns at a time): Surface::normal_grid() works out once
+  /// what depends on u alone and on v alone, which evaluate_normals_into() of each
+  /// rectangle would work out again.
+  class NormalGrid {
+   public:
+    virtual ~NormalGrid() = default;
+    /// evaluate_normals_into(us[i0, i0 + ni), vs[j0, j0 + nj), points, normals) with
+    /// the us and vs given to normal_grid(): the same bits as the whole grid's points
+    /// and normals there, whatever the rectangle. Calls on different threads at once
+    /// are safe. @throws error out_of_domain (a rectangle beyond the grid);
+    /// size_mismatch when either output's size is not ni * nj.
+    virtual void evaluate_into(std::size_t i0, std::size_t ni, std::size_t j0, std::size_t nj, std::span<Vec3> points,
+                               std::span<Vec3> normals) const = 0;
+  };
+  /// The grid us × vs (both copied) for NormalGrid::evaluate_into() of rectangle after
+  /// rectangle; the surface must outlive the result. A blended surface evaluates its
+  /// functions of u and of v, with their derivatives, here, once.
+  /// @throws error out_of_domain, here or from NormalGrid::evaluate_into.
+  [[nodiscard]] virtual std::unique_ptr<NormalGrid> normal_grid(std::span<const double> us,
+                                                                std::span<const double> vs) const;
   /// Points and derivatives at every (us[i], vs[j]). @throws error out_of_domain, too_large.
   [[nodiscard]] virtual Grid<SurfaceDerivatives, 2> evaluate_derivatives(std::span<const double> us,
                                                                          std::span<const double> vs) const;

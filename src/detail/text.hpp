@@ -95,6 +95,15 @@ inline void check_output_size(std::size_t got, std::initializer_list<std::size_t
          overflow ? std::string("more than can be addressed") : std::to_string(want));
 }
 
+/// Refuses a rectangle [i0, i0 + ni) × [j0, j0 + nj) that does not lie in a grid of
+/// nu × nv (Surface::NormalGrid).
+inline void check_rectangle(std::size_t i0, std::size_t ni, std::size_t j0, std::size_t nj, std::size_t nu,
+                            std::size_t nv) {
+  if (i0 > nu || ni > nu - i0 || j0 > nv || nj > nv - j0)
+    fail(errc::out_of_domain, "rows ", i0, " to ", i0 + ni, " and columns ", j0, " to ", j0 + nj,
+         " are beyond the grid of ", nu, "x", nv);
+}
+
 }  // namespace interpatch::detail
 
 // Internal invariants: checked in debug builds, compiled out in release.

@@ -704,12 +704,13 @@ void stream_vts(const fs::path& path, const Surface& surface, std::span<const do
   PointGrid points[2] = {PointGrid({block_cols, nu}, for_overwrite), PointGrid({block_cols, nu}, for_overwrite)};
   PointGrid normals[2] = {PointGrid({block_cols, nu}, for_overwrite), PointGrid({block_cols, nu}, for_overwrite)};
   std::vector<Vec3> first_points, first_normals;  // column 0, for the last of a surface closed in v
+  const auto grid = surface.normal_grid(us, vs);  // what depends on u alone or v alone, once
   const auto columns = [&](std::size_t b) { return std::pair(b * block_cols, std::min(block_cols, nv - b * block_cols)); };
   const auto make = [&](std::size_t b, std::size_t p) {
     const auto [j0, m] = columns(b);
     const std::size_t i0 = p * piece_rows, k = std::min(piece_rows, nu - i0);
     std::vector<Vec3> P(k * m), N(k * m);
-    surface.evaluate_normals_into(us.subspan(i0, k), vs.subspan(j0, m), P, N);
+    grid->evaluate_into(i0, k, j0, m, P, N);
     Vec3 *to_p = points[b % 2].data(), *to_n = normals[b % 2].data();
     for (std::size_t i = 0; i < k; ++i)
       for (std::size_t j = 0; j < m; ++j) {
