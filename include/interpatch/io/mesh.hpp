@@ -74,7 +74,8 @@ void write_surface_mesh(const std::filesystem::path& path, const SurfaceMesh& me
 /// write_surface_mesh(path, sample_mesh(surface, us, vs, progress)) writes it, the
 /// same bytes. A .vts is written without the mesh in memory: a block of columns
 /// at a time, evaluated by every thread while the block before is written (memory
-/// for two blocks of about 2^15 points); the other formats sample the mesh first.
+/// for two blocks of about 2^15 points; `progress` is then called from one thread at
+/// a time, not always the calling one); the other formats sample the mesh first.
 ///
 /// Example:
 /// @code

@@ -105,7 +105,7 @@ using NpyRowsMaker = std::function<void(std::size_t first, std::size_t count, st
 /// block before it is written, so that the making and the writing overlap. Memory
 /// for two blocks, never for the whole array. The bytes do not depend on the
 /// threads as long as make's values do not. `progress`, if given, gets the fraction
-/// written after each block.
+/// written after each block, from one thread at a time but not always the calling one.
 ///
 /// Example:
 /// @code
