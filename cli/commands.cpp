@@ -74,10 +74,6 @@ std::optional<std::size_t> point_count(const Resolution& r) {
   return n;
 }
 
-// The u values of a .npy evaluation block, as io::write_npy_rows makes them: about
-// 2^17 values (1 MiB), at least 2 u values; it holds two blocks.
-std::size_t npy_block_rows(std::size_t per_row) { return std::max<std::size_t>(2, (std::size_t{1} << 17) / (3 * per_row)); }
-
 // The float64 triples of a .npy block as the points they hold.
 std::span<Vec3> points_of(std::span<double> values) {
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 grids are written as arrays of doubles");
@@ -268,7 +264,7 @@ void require_eval_room(const Resolution& grid, const fs::path& out) {
       throw error(errc::too_large, what + ": more bytes than a file can hold");
     io::check_disk_space(out, *points * sizeof(Vec3) + 4096, what);
     const std::size_t per_row = *points / grid.nu;
-    require_memory(2 * std::min(npy_block_rows(per_row), grid.nu) * per_row, sizeof(Vec3), what + ", two blocks of u values");
+    require_memory(io::write_npy_rows_held(grid.nu, 3 * per_row), sizeof(double), what + ", two blocks of u values");
     return;
   }
   // The points, plus the text of a row for .csv.

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <ostream>
 #include <sstream>
 #include <string>
@@ -29,6 +30,12 @@ namespace {
 // ---------------------------------------------------------------------------
 // Output in bounded chunks: text and binary values are gathered in a buffer of
 // about a megabyte and handed to the stream, so no file is ever built in memory.
+
+// Native doubles turned in place into the given byte order.
+void to_byte_order(char* bytes, std::size_t size, std::endian order) {
+  if (order != std::endian::native)
+    for (std::size_t d = 0; d < size; d += sizeof(double)) std::reverse(bytes + d, bytes + d + sizeof(double));
+}
 
 class Sink {
  public:
@@ -85,8 +92,7 @@ class Sink {
     static_assert(sizeof(Vec3) == 3 * sizeof(double), "a point is three doubles");
     const std::size_t at = buf_.size();
     buf_.append(reinterpret_cast<const char*>(p.data()), p.size() * sizeof(Vec3));
-    if (order != std::endian::native)
-      for (std::size_t d = at; d < buf_.size(); d += sizeof(double)) std::reverse(&buf_[d], &buf_[d] + sizeof(double));
+    to_byte_order(buf_.data() + at, buf_.size() - at, order);
     maybe_flush();
     return *this;
   }
@@ -676,8 +682,7 @@ std::array<bool, 2> closed_directions(const Surface& surface, std::span<const do
 void write_little(std::ostream& os, Vec3* p, std::size_t n) {
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "a point is three doubles");
   auto* bytes = reinterpret_cast<char*>(p);
-  if constexpr (std::endian::native != std::endian::little)
-    for (std::size_t d = 0; d < n * sizeof(Vec3); d += sizeof(double)) std::reverse(bytes + d, bytes + d + sizeof(double));
+  to_byte_order(bytes, n * sizeof(Vec3), std::endian::little);
   os.write(bytes, static_cast<std::streamsize>(n * sizeof(Vec3)));
 }
 
@@ -709,8 +714,9 @@ void stream_vts(const fs::path& path, const Surface& surface, std::span<const do
   const auto make = [&](std::size_t b, std::size_t p) {
     const auto [j0, m] = columns(b);
     const std::size_t i0 = p * piece_rows, k = std::min(piece_rows, nu - i0);
-    std::vector<Vec3> P(k * m), N(k * m);
-    grid->evaluate_into(i0, k, j0, m, P, N);
+    // The piece's rows in the grid's order (not zeroed), then put in the file's.
+    const auto P = std::make_unique_for_overwrite<Vec3[]>(k * m), N = std::make_unique_for_overwrite<Vec3[]>(k * m);
+    grid->evaluate_into(i0, k, j0, m, std::span(P.get(), k * m), std::span(N.get(), k * m));
     Vec3 *to_p = points[b % 2].data(), *to_n = normals[b % 2].data();
     for (std::size_t i = 0; i < k; ++i)
       for (std::size_t j = 0; j < m; ++j) {

@@ -580,27 +580,42 @@ void write_npy(const fs::path& path, std::span<const std::size_t> shape, std::si
   }, bytes);
 }
 
+namespace {
+
+// About 2^17 values (1 MiB) a block of write_npy_rows, in pieces of about 2^13 for
+// the threads to share: still in the cache when it is written, and few fresh pages
+// (on the machine of docs/BENCHMARKS.md blocks of 4 MiB cost more in page faults
+// than the overlap gains). At least 2 rows a block, so that the threads share rows
+// as large as a volume's.
+std::size_t block_rows_of(std::size_t per_row) {
+  return std::max<std::size_t>(2, (std::size_t{1} << 17) / std::max<std::size_t>(per_row, 1));
+}
+std::size_t piece_rows_of(std::size_t per_row) {
+  return std::max<std::size_t>(1, (std::size_t{1} << 13) / std::max<std::size_t>(per_row, 1));
+}
+
+}  // namespace
+
+std::size_t write_npy_rows_held(std::size_t rows, std::size_t per_row) noexcept {
+  const std::size_t n = std::min(block_rows_of(per_row), rows);
+  return per_row != 0 && n > std::numeric_limits<std::size_t>::max() / 2 / per_row ? std::numeric_limits<std::size_t>::max()
+                                                                                    : 2 * n * per_row;
+}
+
 void write_npy_rows(const fs::path& path, std::span<const std::size_t> shape, const NpyRowsMaker& make,
                     const progress_callback& progress) {
   const std::vector<std::size_t> dims(shape.begin(), shape.end());
   if (dims.empty()) detail::fail(errc::size_mismatch, "cannot write '", path.string(), "' by rows: the shape has no axis");
   const std::size_t count = element_count(path, dims);
   const std::size_t rows = dims[0], per_row = rows == 0 ? 0 : count / rows;
-  // About 2^17 values (1 MiB) a block, in pieces of about 2^13 for the threads to
-  // share: still in the cache when it is written, and few fresh pages (on the
-  // machine of docs/BENCHMARKS.md blocks of 4 MiB cost more in page faults than the
-  // overlap gains). At least 2 rows a block, so that the threads share rows as large
-  // as a volume's.
-  constexpr std::size_t block_values = std::size_t{1} << 17, piece_values = std::size_t{1} << 13;
-  const std::size_t block_rows = std::max<std::size_t>(2, block_values / std::max<std::size_t>(per_row, 1));
-  const std::size_t piece_rows = std::max<std::size_t>(1, piece_values / std::max<std::size_t>(per_row, 1));
+  const std::size_t block_rows = block_rows_of(per_row), piece_rows = piece_rows_of(per_row);
   const std::size_t blocks = (rows + block_rows - 1) / block_rows;
   const std::string header = internal::npy_header("<f8", dims);
   const std::uintmax_t bytes = count <= (std::numeric_limits<std::uintmax_t>::max() - header.size()) / sizeof(double)
                                    ? header.size() + count * sizeof(double)
                                    : 0;
+  require_memory(write_npy_rows_held(rows, per_row), sizeof(double), "the blocks of '" + path.string() + "'");
   const std::size_t held = std::min(block_rows, rows) * per_row;
-  require_memory(2 * held, sizeof(double), "the blocks of '" + path.string() + "'");
   // Not zeroed: the threads' first writes touch the pages.
   const std::unique_ptr<double[]> buffers[2] = {std::make_unique_for_overwrite<double[]>(held),
                                                 std::make_unique_for_overwrite<double[]>(held)};

@@ -17,6 +17,10 @@
 #include <utility>
 #include <vector>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "npy_util.hpp"
 #include "temp_dir.hpp"
 #include "test_util.hpp"
@@ -539,14 +543,21 @@ TEST(Npy, WriteFromAProducerOfAWrongCountIsSizeMismatchAndKeepsTheOldFile) {
   }
 }
 
+// The exception of a caller's producer or row maker.
+struct producer_failed : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// keep.npy in `dir`, a file a failed write must leave as it is: its bytes.
+std::string kept_file(const TempDir& dir, const std::vector<std::size_t>& shape) {
+  write_npy(dir / "keep.npy", shape, iota_values(shape[0] * shape[1]));
+  return read_bytes(dir / "keep.npy");
+}
+
 TEST(Npy, WriteFromAProducerThatThrowsPassesItOnAndKeepsTheOldFile) {
-  struct producer_failed : std::runtime_error {
-    using std::runtime_error::runtime_error;
-  };
   TempDir dir;
   const std::vector<std::size_t> shape = {1000, 3};
-  write_npy(dir / "keep.npy", shape, iota_values(3000));
-  const std::string old = read_bytes(dir / "keep.npy");
+  const std::string old = kept_file(dir, shape);
   std::vector<double> block;
   const auto failing_at = [&](std::size_t at, auto failure) {
     return NpyProducer([&block, at, failure](std::size_t first, std::size_t count) {
@@ -589,6 +600,82 @@ TEST(Npy, WriteFromAProducerInBlocksOfNothingIsSizeMismatch) {
   EXPECT_ERRC(write_npy(dir / "new.npy", shape, 0, produce), size_mismatch, "new.npy");
   EXPECT_FALSE(called);
   EXPECT_TRUE(read_bytes(dir / "keep.npy") == old);
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"keep.npy"});
+}
+
+// --- Rows made on every thread while the block before is written ---------------------
+
+// write_npy_rows gives the bytes of write_npy, every row made once, on 1, 2 and 3
+// threads: many blocks of small rows, rows larger than a block (two a block), one
+// row, no row, a single axis.
+TEST(Npy, WriteByRowsGivesTheBytesOfWriteFromData) {
+  TempDir dir;
+  auto g = test::rng(15);
+  const std::vector<std::vector<std::size_t>> shapes{{5000, 7, 3}, {5, 100003}, {1, 4}, {0, 3}, {70001}};
+#ifdef _OPENMP
+  const int before = omp_get_max_threads();
+  omp_set_dynamic(0);
+#endif
+  for (const auto& shape : shapes) {
+    std::size_t count = 1;
+    for (std::size_t d : shape) count *= d;
+    const std::size_t per_row = shape[0] == 0 ? 0 : count / shape[0];
+    std::vector<double> data(count);
+    for (double& v : data) v = test::uniform(g, -1e3, 1e3);
+    write_npy(dir / "whole.npy", shape, data);
+    const std::string expected = read_bytes(dir / "whole.npy");
+    for (const int threads : {1, 2, 3}) {
+#ifdef _OPENMP
+      omp_set_num_threads(threads);
+#endif
+      SCOPED_TRACE(std::to_string(count) + " values, " + std::to_string(threads) + " threads");
+      std::vector<std::atomic<int>> made(shape[0]);
+      write_npy_rows(dir / "rows.npy", shape, [&](std::size_t first, std::size_t n, std::span<double> out) {
+        ASSERT_EQ(out.size(), n * per_row);
+        for (std::size_t r = first; r < first + n; ++r) made[r].fetch_add(1);
+        std::copy_n(data.begin() + static_cast<std::ptrdiff_t>(first * per_row), n * per_row, out.begin());
+      });
+      EXPECT_TRUE(read_bytes(dir / "rows.npy") == expected);
+      EXPECT_TRUE(std::all_of(made.begin(), made.end(), [](const std::atomic<int>& m) { return m.load() == 1; }));
+    }
+  }
+#ifdef _OPENMP
+  omp_set_num_threads(before);
+#endif
+  // Two blocks held: of 2^17 values each, or of 2 rows when a row is larger.
+  EXPECT_EQ(write_npy_rows_held(1000, 3000), 2 * 43 * 3000u);
+  EXPECT_EQ(write_npy_rows_held(5, 100003), 2 * 2 * 100003u);
+  EXPECT_EQ(write_npy_rows_held(1, 4), 2 * 1 * 4u);
+  EXPECT_EQ(write_npy_rows_held(0, 3), 0u);
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"rows.npy", "whole.npy"}));
+}
+
+// A row maker that throws: its exception passes on unchanged, the one for the first
+// rows when rows in several blocks fail on several threads at once (the one a run on
+// one thread meets), and the old file stays; a shape of no axis is size_mismatch.
+TEST(Npy, WriteByRowsThatThrowsPassesOnTheFirstRowsFailureAndKeepsTheOldFile) {
+  TempDir dir;
+  const std::vector<std::size_t> shape = {20000, 3};
+  const std::string old = kept_file(dir, shape);
+  for (const std::size_t from : {std::size_t{0}, std::size_t{9000}, std::size_t{19999}}) {
+    SCOPED_TRACE(from);
+    try {
+      write_npy_rows(dir / "keep.npy", shape, [&](std::size_t first, std::size_t n, std::span<double> out) {
+        std::fill(out.begin(), out.end(), 1.0);
+        if (first + n > from) throw producer_failed("rows from " + std::to_string(std::max(first, from)));
+      });
+      ADD_FAILURE() << "expected the maker's exception";
+    } catch (const producer_failed& e) {
+      EXPECT_EQ(std::string(e.what()), "rows from " + std::to_string(from));
+    }
+    EXPECT_TRUE(read_bytes(dir / "keep.npy") == old);
+    EXPECT_EQ(dir.entries(), std::vector<std::string>{"keep.npy"});
+  }
+  EXPECT_ERRC(write_npy_rows(dir / "new.npy", shape,
+                             [](std::size_t, std::size_t, std::span<double>) { throw error(errc::out_of_domain, "u = 2"); }),
+              out_of_domain, "u = 2");
+  EXPECT_ERRC(write_npy_rows(dir / "new.npy", std::vector<std::size_t>{}, [](std::size_t, std::size_t, std::span<double>) {}),
+              size_mismatch, "cannot write '" + (dir / "new.npy").string() + "' by rows: the shape has no axis");
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"keep.npy"});
 }
 

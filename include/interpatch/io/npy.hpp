@@ -121,4 +121,9 @@ using NpyRowsMaker = std::function<void(std::size_t first, std::size_t count, st
 void write_npy_rows(const std::filesystem::path& path, std::span<const std::size_t> shape, const NpyRowsMaker& make,
                     const progress_callback& progress = {});
 
+/// The doubles write_npy_rows holds while it writes an array of `rows` rows of
+/// `per_row` values each (its two blocks), for a caller that refuses the work before
+/// starting it when they do not fit in memory.
+[[nodiscard]] std::size_t write_npy_rows_held(std::size_t rows, std::size_t per_row) noexcept;
+
 }  // namespace interpatch::io
