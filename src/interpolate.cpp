@@ -613,7 +613,7 @@ class GridChords {
       team.run([&] { check_block_finite(b); });
       return;
     }
-    INTERPATCH_ASSERT(b.first % rows_per_chunk == 0);
+    INTERPATCH_ASSERT(b.first % rows_per_chunk == 0 && R >= 2);
     const Vec3* q = b.data;
     const std::size_t chunks = (b.count + rows_per_chunk - 1) / rows_per_chunk;
     team.run([&] {
@@ -626,12 +626,11 @@ class GridChords {
     std::vector<std::vector<double>> part(chunks * R);
     line_length_.assign(R, {});
     for (std::size_t a = 1; a < R; ++a) line_length_[a].assign(b.count * g.lines(a), 0.0);
-    std::vector<std::size_t> bad(chunks, no_point);
     const auto nchunks = static_cast<long long>(chunks);
 #pragma omp parallel if (b.count * M >= detail::parallel_min_work / 4)
     {
       std::vector<double> scratch(scratch_size());
-#pragma omp for schedule(static)
+#pragma omp for schedule(static) nowait
       for (long long ci = 0; ci < nchunks; ++ci) {
         const auto c = static_cast<std::size_t>(ci);
         part[c * R].assign(M, 0.0);
@@ -639,10 +638,6 @@ class GridChords {
         const std::size_t r1 = std::min(b.count, (c + 1) * rows_per_chunk);
         for (std::size_t r = c * rows_per_chunk; r < r1; ++r) {  // local rows; b.first + r in the grid
           const Vec3* row = q + r * M;
-          if (const std::size_t m = detail::first_non_finite(row, M); m < M) {
-            bad[c] = r * M + m;
-            break;
-          }
           if (b.first + r > 0) {
             chord_lengths(r == 0 ? b.before : row - M, row, M, scratch.data(), param, root_);
             double* t0 = part[c * R].data();
@@ -654,9 +649,12 @@ class GridChords {
         }
       }
     }
+    // A NaN or an infinity makes the length of its line along v NaN or infinite
+    // (every point is on one, with a chord to a neighbour): only then are the points
+    // searched for the first of them.
     team.run([&] {
-      for (std::size_t c = 0; c < chunks; ++c)
-        if (bad[c] != no_point) fail_not_finite(q[bad[c]], g, b.first * M + bad[c]);
+      const auto& len = line_length_[1];
+      if (std::any_of(len.begin(), len.end(), [](double l) { return !std::isfinite(l); })) check_block_finite(b);
     });
     team.run([&] {
       for (std::size_t a = 1; a < R; ++a) check_lengths(line_length_[a], a);
@@ -749,8 +747,6 @@ class GridChords {
   }
 
  private:
-  static constexpr std::size_t no_point = static_cast<std::size_t>(-1);
-
   // Lines longer than the largest double: chords or their sums overflowed.
   static void check_lengths(const std::vector<double>& lengths, std::size_t a) {
     if (std::all_of(lengths.begin(), lengths.end(), [](double l) { return l <= std::numeric_limits<double>::max(); }))
@@ -891,13 +887,16 @@ namespace {
 struct GridSolution {
   std::vector<KnotVector> knots;           // one per axis
   std::vector<std::vector<double>> params;  // one per axis
+  bool finite = false;                      // the control points are known to be finite
 };
 
 using detail::AxisSolver;
 
 void solve_axis(const AxisSolver& lu, double* data, const std::size_t* shape, std::size_t rank, std::size_t axis,
-                std::size_t components, bool parallel = true) {
-  std::visit([&](const auto& s) { detail::solve_along_axis(s, data, shape, rank, axis, components, parallel); }, lu);
+                std::size_t components, bool parallel = true, bool* non_finite = nullptr) {
+  std::visit(
+      [&](const auto& s) { detail::solve_along_axis(s, data, shape, rank, axis, components, parallel, non_finite); },
+      lu);
 }
 
 KnotVector axis_knots(std::span<const double> params, int degree, bool closed) {
@@ -946,9 +945,9 @@ AxisSolver factor_axis(const KnotVector& knots, std::span<const double> params, 
   }
 }
 
-void solve_columns(const AxisSolver& lu, double* data, std::size_t n, std::size_t width) {
+void solve_columns(const AxisSolver& lu, double* data, std::size_t n, std::size_t width, bool* non_finite) {
   const std::size_t shape[2] = {n, width};
-  solve_axis(lu, data, shape, 2, 0, 1);
+  solve_axis(lu, data, shape, 2, 0, 1, true, non_finite);
 }
 
 Closing block_closing(const GridBlock& b, std::size_t axis, std::span<const Vec3* const> ends, bool refuse,
@@ -1169,6 +1168,17 @@ template void drop_last_line<3>(Grid<Vec3, 3>&, std::size_t);
 template void insert_seam<2>(Grid<Vec3, 2>&, std::size_t, KnotVector&, double);
 template void insert_seam<3>(Grid<Vec3, 3>&, std::size_t, KnotVector&, double);
 
+// The B-splines of solved control nets: the scan for NaN and infinities is left out
+// when the solve has made it.
+struct SolvedNet {
+  static BSplineSurface surface(KnotVector ku, KnotVector kv, PointGrid cp, bool finite) {
+    return {std::move(ku), std::move(kv), std::move(cp), {}, !finite};
+  }
+  static BSplineVolume volume(KnotVector ku, KnotVector kv, KnotVector kw, PointGrid3 cp, bool finite) {
+    return {std::move(ku), std::move(kv), std::move(kw), std::move(cp), {}, !finite};
+  }
+};
+
 }  // namespace detail
 
 namespace {
@@ -1216,11 +1226,19 @@ GridSolution solve_grid(Grid<Vec3, Rank>& points, const std::array<std::optional
   GridSolution r{std::move(rows.knots), std::move(rows.params)};
   const AxisSolver lu0 = detail::factor_axis(r.knots[0], r.params[0], 0);
   Vec3* data = points.data();
-  detail::solve_columns(lu0, &data->x, g.n[0], 3 * g.row);
+  // The solution is looked at for NaN and infinities as it is made (a solve can
+  // overflow), so that the B-spline need not read it again; a solution scaled back,
+  // or re-anchored at a seam, is read again there.
+  bool non_finite = true;
+  detail::solve_columns(lu0, &data->x, g.n[0], 3 * g.row, &non_finite);
+  r.finite = !non_finite && shift == 0;
   if (shift != 0) scale_points(data, points.size(), shift);
   // Closed axes of even degree start their period at their first parameter.
   for (std::size_t a = 0; a < Rank; ++a)
-    if (periodic[a] && p[a] % 2 == 0) detail::insert_seam(points, a, r.knots[a], r.params[a].front());
+    if (periodic[a] && p[a] % 2 == 0) {
+      detail::insert_seam(points, a, r.knots[a], r.params[a].front());
+      r.finite = false;
+    }
   for (std::size_t a = 0; a < Rank; ++a)
     if (dropped[a]) r.params[a].push_back(r.params[a].front() + 1.0);
   if (progress) progress(1.0);
@@ -1235,14 +1253,15 @@ Closing grid_closing(const PointGrid3& points, int axis) { return grid_closing_o
 SurfaceInterpolation interpolate_surface(PointGrid points, const SurfaceInterpolationOptions& options) {
   GridSolution s = solve_grid<2>(points, {options.degree_u, options.degree_v}, options.param, options.progress, "surface",
                                  options.periodic);
-  return {BSplineSurface(std::move(s.knots[0]), std::move(s.knots[1]), std::move(points)), std::move(s.params[0]),
-          std::move(s.params[1])};
+  return {detail::SolvedNet::surface(std::move(s.knots[0]), std::move(s.knots[1]), std::move(points), s.finite),
+          std::move(s.params[0]), std::move(s.params[1])};
 }
 
 VolumeInterpolation interpolate_volume(PointGrid3 points, const VolumeInterpolationOptions& options) {
   GridSolution s = solve_grid<3>(points, {options.degree_u, options.degree_v, options.degree_w}, options.param,
                                  options.progress, "volume", options.periodic);
-  return {BSplineVolume(std::move(s.knots[0]), std::move(s.knots[1]), std::move(s.knots[2]), std::move(points)),
+  return {detail::SolvedNet::volume(std::move(s.knots[0]), std::move(s.knots[1]), std::move(s.knots[2]),
+                                    std::move(points), s.finite),
           std::move(s.params[0]), std::move(s.params[1]), std::move(s.params[2])};
 }
 

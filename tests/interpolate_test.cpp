@@ -1,5 +1,8 @@
 #include "interpatch/interpolate.hpp"
 
+#include <cmath>
+#include <string>
+
 #include "interpatch/evaluate.hpp"
 #include "test_util.hpp"
 
@@ -384,6 +387,84 @@ TEST(InterpolateVolume, InvalidInput) {
     for (std::size_t k = 0; k < 5; ++k)
       for (std::size_t j = 0; j < 3; ++j) flat(i, j, k) = flat(i, 0, k);  // nothing varies along v
   EXPECT_ERRC((void)interpolate_volume(flat), zero_chord, "every line of the grid along v has zero length");
+}
+
+// The chord sums find a NaN or an infinity by the length of its line along v (not
+// by a scan of every row): whatever the point, coordinate, value and
+// parametrization, the error names the first bad point in storage order, as the
+// scan would, on grids large enough for the chord pass to run on both threads.
+TEST(InterpolateSurface, NonFinitePointIsNamedWhereverItIs) {
+  auto g = test::rng(91);
+  const PointGrid q = test::random_grid(g, 700, 400);
+  const std::size_t places[][2] = {{0, 0}, {0, 399}, {699, 0}, {699, 399}, {350, 17}, {64, 200}};
+  for (const Parametrization param : {Parametrization::uniform, Parametrization::chord, Parametrization::centripetal}) {
+    SurfaceInterpolationOptions o;
+    o.param = param;
+    for (const auto& at : places)
+      for (int c = 0; c < 3; ++c)
+        for (const double bad : {NAN, INFINITY, -INFINITY}) {
+          PointGrid b = q;
+          b(at[0], at[1])[c] = bad;
+          EXPECT_ERRC((void)interpolate_surface(b, o), not_finite,
+                      "point [" + std::to_string(at[0]) + "][" + std::to_string(at[1]) + "] is");
+        }
+    PointGrid two = q;  // a late row (the second thread's) and an early one
+    two(600, 5).z = NAN;
+    two(3, 390).x = INFINITY;
+    EXPECT_ERRC((void)interpolate_surface(two, o), not_finite, "point [3][390] is");
+  }
+}
+
+TEST(InterpolateVolume, NonFinitePointIsNamedWhereverItIs) {
+  auto g = test::rng(92);
+  const auto q = random_grid3(g, 70, 60, 50, 0.3);
+  const std::size_t places[][3] = {{0, 0, 0}, {69, 59, 49}, {0, 59, 0}, {69, 0, 49}, {35, 30, 25}};
+  for (const Parametrization param : {Parametrization::uniform, Parametrization::chord}) {
+    VolumeInterpolationOptions o;
+    o.param = param;
+    for (const auto& at : places)
+      for (const double bad : {NAN, -INFINITY}) {
+        PointGrid3 b = q;
+        b(at[0], at[1], at[2]).y = bad;
+        EXPECT_ERRC((void)interpolate_volume(b, o), not_finite,
+                    "point [" + std::to_string(at[0]) + "][" + std::to_string(at[1]) + "][" + std::to_string(at[2]) +
+                        "] is");
+      }
+  }
+}
+
+// A solve that overflows is refused, whichever pass overflows: the pass along u
+// looks at its solution for NaN and infinities as it makes it, and the B-spline
+// reads it again only when that pass found one (or when the solution is scaled back
+// afterwards: extreme data measured by chords, whose other coordinates are large too
+// so that the grid's lines keep their lengths when scaled down).
+TEST(InterpolateSurface, SolutionBeyondTheLargestDoubleIsRefused) {
+  constexpr double big = 1.5e308;
+  for (const Parametrization param : {Parametrization::uniform, Parametrization::chord}) {
+    SurfaceInterpolationOptions o;
+    o.param = param;
+    for (const bool along_u : {true, false}) {
+      PointGrid zig({9, 8});
+      for (std::size_t i = 0; i < 9; ++i)
+        for (std::size_t j = 0; j < 8; ++j) {
+          const std::size_t k = along_u ? i : j;
+          zig(i, j) = {1e300 * static_cast<double>(i), 1e300 * static_cast<double>(j), (k % 2 == 0 ? big : -big)};
+        }
+      SCOPED_TRACE(along_u ? "zig-zag along u" : "zig-zag along v");
+      EXPECT_ERRC((void)interpolate_surface(zig, o), not_finite, "control point [");
+      PointGrid3 zig3({9, 8, 7});
+      for (std::size_t i = 0; i < 9; ++i)
+        for (std::size_t j = 0; j < 8; ++j)
+          for (std::size_t l = 0; l < 7; ++l) {
+            const std::size_t k = along_u ? i : l;
+            zig3(i, j, l) = {1e300 * static_cast<double>(i), 1e300 * (static_cast<double>(j) + 0.1 * static_cast<double>(l)),
+                             (k % 2 == 0 ? big : -big)};
+          }
+      VolumeInterpolationOptions o3;
+      o3.param = param;
+      EXPECT_ERRC((void)interpolate_volume(zig3, o3), not_finite, "control point [");
+    }
+  }
 }
 
 }  // namespace

@@ -15,6 +15,10 @@
 
 namespace interpatch {
 
+namespace detail {
+struct SolvedNet;
+}  // namespace detail
+
 /// S(u,v) = Σ_i Σ_j N_i(u) N_j(v) w_ij P_ij / Σ_i Σ_j N_i(u) N_j(v) w_ij.
 /// Control points are an (n+1) × (m+1) grid, first index along u. Valid by
 /// construction; evaluation never allocates per point. A direction whose knot vector
@@ -83,6 +87,12 @@ class BSplineSurface final : public Surface {
   [[nodiscard]] BSplineSurface clamped() const;
 
  private:
+  friend struct detail::SolvedNet;
+  // The public constructor's checks; the scan of the control points for NaN and
+  // infinities only with `scan` (an interpolation looks at its solution as it
+  // solves).
+  BSplineSurface(KnotVector knots_u, KnotVector knots_v, PointGrid control_points, Grid<double, 2> weights, bool scan);
+
   KnotVector ku_, kv_;
   PointGrid cp_;
   Grid<double, 2> w_;

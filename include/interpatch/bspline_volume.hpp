@@ -15,6 +15,10 @@
 
 namespace interpatch {
 
+namespace detail {
+struct SolvedNet;
+}  // namespace detail
+
 /// Highest derivative order in each direction BSplineVolume::derivative() takes.
 inline constexpr int max_volume_derivative = 3;
 
@@ -102,6 +106,11 @@ class BSplineVolume final : public Volume {
   [[nodiscard]] BSplineVolume mapped(double u0, double u1, double v0, double v1, double w0, double w1) const;
 
  private:
+  friend struct detail::SolvedNet;
+  // As BSplineSurface's: the scan of the control points only with `scan`.
+  BSplineVolume(KnotVector knots_u, KnotVector knots_v, KnotVector knots_w, PointGrid3 control_points,
+                Grid<double, 3> weights, bool scan);
+
   KnotVector ku_, kv_, kw_;
   PointGrid3 cp_;
   Grid<double, 3> w_;

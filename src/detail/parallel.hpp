@@ -36,36 +36,40 @@ inline std::size_t thread_count() noexcept {
 #endif
 }
 
+/// Whether any of n doubles is a NaN or an infinity, scanned without a branch (x * 0
+/// is 0 for a finite x, NaN otherwise; the comparisons vectorize).
+inline bool has_non_finite(const double* d, std::size_t n) noexcept {
+  std::size_t t = 0;
+  bool bad = false;
+#if defined(__GNUC__)
+  // Two doubles a vector: the comparison the baseline processor (SSE2) has.
+  using v2 = double __attribute__((vector_size(16)));
+  using m2 = long long __attribute__((vector_size(16)));
+  m2 any = {0, 0};
+  for (; t + 2 <= n; t += 2) {
+    v2 x;
+    std::memcpy(&x, d + t, sizeof x);
+    any |= (x * 0.0) != 0.0;
+  }
+  bad = (any[0] | any[1]) != 0;
+#endif
+  for (; t < n; ++t) bad |= d[t] * 0.0 != 0.0;
+  return bad;
+}
+
 /// Index of the first point with a NaN or infinite coordinate, `count` if none:
 /// both threads scan a large array, and the first in storage order is the one found
 /// whatever the thread count.
 inline std::size_t first_non_finite(const Vec3* p, std::size_t count) noexcept {
-  // Pieces of 1024 points, each scanned without a branch (x * 0 is 0 for a finite x,
-  // NaN otherwise; the comparisons vectorize), and only a piece that has one is
-  // searched point by point.
+  // Pieces of 1024 points, each scanned by has_non_finite, and only a piece that has
+  // one is searched point by point.
   constexpr std::size_t piece = 1024;
   const auto pieces = static_cast<long long>((count + piece - 1) / piece);
   long long first = static_cast<long long>(count);
 #pragma omp parallel for schedule(static) reduction(min : first) if (count >= parallel_min_work)
   for (long long k = 0; k < pieces; ++k) {
     const std::size_t i0 = static_cast<std::size_t>(k) * piece, n = std::min(piece, count - i0);
-    const double* d = &p[i0].x;
-    std::size_t t = 0;
-    bool bad = false;
-#if defined(__GNUC__)
-    // Two doubles a vector: the comparison the baseline processor (SSE2) has.
-    using v2 = double __attribute__((vector_size(16)));
-    using m2 = long long __attribute__((vector_size(16)));
-    m2 any = {0, 0};
-    for (; t + 2 <= 3 * n; t += 2) {
-      v2 x;
-      std::memcpy(&x, d + t, sizeof x);
-      any |= (x * 0.0) != 0.0;
-    }
-    bad = (any[0] | any[1]) != 0;
-#endif
-    for (; t < 3 * n; ++t) bad |= d[t] * 0.0 != 0.0;
-    if (!bad) continue;
+    if (!has_non_finite(&p[i0].x, 3 * n)) continue;
     for (std::size_t i = i0; i < i0 + n; ++i)
       if (!is_finite(p[i])) {
         if (static_cast<long long>(i) < first) first = static_cast<long long>(i);

@@ -367,7 +367,9 @@ std::vector<std::size_t> read_npy_data(std::istream& in, const NpyHeader& h, std
 
   if (!fortran && dt.kind == 'f' && dt.size == 8) {
     // The common case: the file's bytes are the result, up to byte order.
-    if (bulk) bulk(reinterpret_cast<char*>(out), count * 8, file_size - count * 8);
+    // In pieces only in the native byte order: what a bulk read's visitor sees are
+    // then the values.
+    if (bulk && native) bulk(reinterpret_cast<char*>(out), count * 8, file_size - count * 8);
     else read_exact(in, reinterpret_cast<char*>(out), count * 8, name);
     if (!native) {
       for (std::size_t k = 0; k < count; ++k) out[k] = std::bit_cast<double>(byteswap(std::bit_cast<std::uint64_t>(out[k])));
@@ -413,7 +415,7 @@ std::vector<std::size_t> read_npy_data(std::istream& in, const NpyHeader& h, std
 // checksum of each piece is taken while the piece is still in the cache, and the
 // pieces' checksums are combined in order afterwards.
 void read_pieces(const fs::path& path, const std::string& name, char* dst, std::size_t n, std::uint64_t offset,
-                 std::uint32_t* crc) {
+                 std::uint32_t* crc, const PieceVisitor& visit) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) fail_read(name, errno);
   constexpr std::size_t piece = std::size_t{1} << 20;
@@ -435,6 +437,7 @@ void read_pieces(const fs::path& path, const std::string& name, char* dst, std::
       at += static_cast<std::size_t>(got);
     }
     if (crc && at == end) sums[static_cast<std::size_t>(k)] = crc32_serial(dst + begin, end - begin);
+    if (visit && at == end) visit(dst + begin, end - begin);
   }
   ::close(fd);
   if (const int e = failure.load(); e != 0) fail_read(name, e);
@@ -496,7 +499,10 @@ std::vector<std::size_t> read_npy_stream(std::istream& in, std::uint64_t file_si
 
 }  // namespace
 
-std::vector<std::size_t> read_npy_into(const fs::path& path, const NpyDestination& destination) {
+namespace internal {
+
+std::vector<std::size_t> read_npy_visiting(const fs::path& path, const NpyDestination& destination,
+                                           const PieceVisitor& visit) {
   std::ifstream in = detail::open_input(path);
   in.seekg(0, std::ios::end);
   const auto end = in.tellg();
@@ -504,8 +510,14 @@ std::vector<std::size_t> read_npy_into(const fs::path& path, const NpyDestinatio
   if (end < 0 || !in) fail_read(path.string(), errno);
   return read_npy_stream(in, static_cast<std::uint64_t>(end), path.string(), destination,
                          [&](char* dst, std::size_t n, std::uint64_t offset) {
-                           internal::read_pieces(path, path.string(), dst, n, offset);
+                           read_pieces(path, path.string(), dst, n, offset, nullptr, visit);
                          });
+}
+
+}  // namespace internal
+
+std::vector<std::size_t> read_npy_into(const fs::path& path, const NpyDestination& destination) {
+  return internal::read_npy_visiting(path, destination, {});
 }
 
 namespace {

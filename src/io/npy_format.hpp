@@ -61,12 +61,24 @@ std::vector<std::size_t> read_npy_data(std::istream& in, const NpyHeader& h, std
                                        const NpyDestination& destination, const BulkRead& bulk = {},
                                        bool integers = false);
 
+/// Called by read_pieces on the thread that read a piece, while it is still in the
+/// cache: `bytes` points at the piece in the destination, `n` bytes long, a multiple
+/// of 8 when the whole read is.
+using PieceVisitor = std::function<void(const char* bytes, std::size_t n)>;
+
 /// Reads n bytes at `offset` of a file into dst, both threads at once in pieces of
 /// 1 MiB (pread). With `crc`, also the CRC-32 of the bytes read, each piece's
-/// computed while it is still in the cache.
+/// computed while it is still in the cache; with `visit`, called on every piece
+/// read whole.
 /// @throws error file_unreadable (naming `name`).
 void read_pieces(const std::filesystem::path& path, const std::string& name, char* dst, std::size_t n,
-                 std::uint64_t offset, std::uint32_t* crc = nullptr);
+                 std::uint64_t offset, std::uint32_t* crc = nullptr, const PieceVisitor& visit = {});
+
+/// read_npy_into, and `visit` on the pieces of float64 values as they are read, when
+/// the file's data are read in pieces (C order, native byte order); the pieces it
+/// was given add up to the whole data block exactly when they were.
+std::vector<std::size_t> read_npy_visiting(const std::filesystem::path& path, const NpyDestination& destination,
+                                           const PieceVisitor& visit);
 
 /// The preamble and header of a little-endian C-order array of the given dtype
 /// ('<f8', '<i8', '|b1'), format version 1.0 (2.0 for a rank too large for it),

@@ -19,6 +19,7 @@
 #include "interpatch/interpolate.hpp"
 #include "interpatch/io/json_out.hpp"
 #include "interpatch/io/npy.hpp"
+#include "npy_util.hpp"
 #include "temp_dir.hpp"
 #include "test_util.hpp"
 
@@ -540,6 +541,67 @@ TEST(SpecErrors, NpyFileProblems) {
   write_text(dir / "garbage.npy", "not an npy file at all");
   const json garbage = {{"type", "interpolate"}, {"points", {{"npy", "garbage.npy"}}}};
   EXPECT_ERRC((void)build(garbage, dir.path()), malformed_file, "/points: ");
+}
+
+// A large .npy is looked at for NaN and infinities piece by piece as it is read (1
+// MiB pieces, on both threads): a bad value anywhere, at the first or last value
+// or a piece's first, is named as a scan of the whole grid names it; the first in
+// storage order when there are several. A big-endian file is not read in pieces
+// and is scanned whole. Approximation still takes NaN as a missing point.
+TEST(SpecErrors, NonFiniteInALargeNpyIsFoundWhereverItIs) {
+  TempDir dir;
+  constexpr std::size_t n = 640, m = 600, values = n * m * 3;  // 9.2 MB: nine pieces, read in parallel
+  const std::size_t shape[3] = {n, m, 3};
+  std::vector<double> data(values);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < m; ++j) {
+      double* p = &data[3 * (i * m + j)];
+      p[0] = static_cast<double>(i) + 0.25 * std::sin(0.1 * static_cast<double>(j));
+      p[1] = static_cast<double>(j);
+      p[2] = std::cos(0.05 * static_cast<double>(i + j));
+    }
+  const json spec = {{"type", "interpolate"}, {"points", {{"npy", "g.npy"}}}};
+  write_npy(dir / "g.npy", shape, data);
+  EXPECT_NO_THROW((void)build(spec, dir.path()));
+  const auto pointer = [&](std::size_t k) {
+    return "/points/" + std::to_string(k / 3 / m) + "/" + std::to_string(k / 3 % m) + "/" + std::to_string(k % 3);
+  };
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  constexpr std::size_t piece = (std::size_t{1} << 20) / sizeof(double);
+  for (const std::size_t k : {std::size_t{0}, piece - 1, piece, 5 * piece + 7, values - 1})
+    for (const double bad : {nan, inf, -inf}) {
+      std::vector<double> d = data;
+      d[k] = bad;
+      write_npy(dir / "g.npy", shape, d);
+      const std::string shown = std::isnan(bad) ? "nan" : bad > 0 ? "inf" : "-inf";
+      EXPECT_ERRC((void)build(spec, dir.path()), not_finite,
+                  pointer(k) + ": coordinate " + "xyz"[k % 3] + " is " + shown + " (in g.npy)");
+    }
+  std::vector<double> two = data;  // one in a late piece, read first by the second thread, one in an early piece
+  two[8 * piece + 1] = nan;
+  two[2 * piece + 4] = inf;
+  write_npy(dir / "g.npy", shape, two);
+  EXPECT_ERRC((void)build(spec, dir.path()), not_finite, pointer(2 * piece + 4) + ": coordinate ");
+
+  // Big-endian, bytes swapped by hand: read whole, then scanned.
+  std::vector<double> swapped = data;
+  swapped[3 * (7 * m + 11) + 1] = nan;
+  std::string payload = test::f8(swapped);
+  for (std::size_t k = 0; k < payload.size(); k += 8) std::reverse(payload.begin() + static_cast<long>(k), payload.begin() + static_cast<long>(k) + 8);
+  write_text(dir / "big.npy", test::npy_bytes(">f8", "(640, 600, 3)", payload));
+  const json big = {{"type", "interpolate"}, {"points", {{"npy", "big.npy"}}}};
+  EXPECT_ERRC((void)build(big, dir.path()), not_finite, "/points/7/11/1: coordinate y is nan (in big.npy)");
+
+  // NaN marks a missing point for approximation; an infinity is still refused.
+  std::vector<double> holes = data;
+  holes[3 * (300 * m + 200)] = nan;
+  holes[values - 2] = nan;
+  write_npy(dir / "g.npy", shape, holes);
+  const json approx = {{"type", "approximate"}, {"points", {{"npy", "g.npy"}}}, {"control_points", {40, 40}}};
+  EXPECT_NO_THROW((void)build(approx, dir.path()));
+  holes[3 * (600 * m + 2) + 2] = -inf;
+  write_npy(dir / "g.npy", shape, holes);
+  EXPECT_ERRC((void)build(approx, dir.path()), not_finite, "/points/600/2/2: coordinate z is -inf (in g.npy)");
 }
 
 TEST(SpecErrors, CsvFileProblems) {

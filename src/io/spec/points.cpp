@@ -1,6 +1,7 @@
 // Point arrays in a spec: nested lists, {"npy": file} and {"csv": file, "shape"}.
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -9,6 +10,7 @@
 #include "interpatch/io/csv.hpp"
 #include "interpatch/io/npy.hpp"
 #include "interpatch/memory.hpp"
+#include "io/npy_format.hpp"
 #include "io/spec/reader.hpp"
 #include "io/spec/forms.hpp"
 
@@ -131,8 +133,18 @@ PointArray npy_points(const json& obj, std::size_t rank, std::string_view ptr, C
   // exactly a grid of Vec3.
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "points are read as triples of doubles");
   PointArray out;
+  // Each piece is looked at for NaN and infinities as it is read; the points are
+  // scanned again, to find and name the first, only when a piece has one or the
+  // file was not read in pieces.
+  std::atomic<bool> piece_not_finite{false};
+  std::atomic<std::size_t> bytes_seen{0};
+  const internal::PieceVisitor visit = [&](const char* bytes, std::size_t n) {
+    if (detail::has_non_finite(reinterpret_cast<const double*>(bytes), n / sizeof(double)))
+      piece_not_finite.store(true, std::memory_order_relaxed);
+    bytes_seen.fetch_add(n, std::memory_order_relaxed);
+  };
   const std::vector<std::size_t> full = at(ptr, [&] {
-    return read_npy_into(ctx.resolve(file), [&](std::span<const std::size_t> shape, std::size_t count) {
+    return internal::read_npy_visiting(ctx.resolve(file), [&](std::span<const std::size_t> shape, std::size_t count) {
       const std::vector<std::size_t> s(shape.begin(), shape.end());
       if (s.size() != rank + 1 || s.back() != 3)
         fail(errc::size_mismatch, file, " has shape ", shape_text(s), "; expected ", expected_shape(rank), ", ",
@@ -141,10 +153,11 @@ PointArray npy_points(const json& obj, std::size_t rank, std::string_view ptr, C
         if (s[ax] == 0) fail(errc::too_few_points, file, " has shape ", shape_text(s), ", no points");
       resize_for_overwrite(out.points, count / 3);
       return &out.points.data()->x;
-    });
+    }, visit);
   });
   out.shape.assign(full.begin(), full.end() - 1);
-  check_finite_points(out.shape, out.points, ptr, file, missing_allowed);
+  if (piece_not_finite.load() || bytes_seen.load() != out.points.size() * sizeof(Vec3))
+    check_finite_points(out.shape, out.points, ptr, file, missing_allowed);
   return out;
 }
 
