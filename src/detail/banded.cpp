@@ -30,6 +30,7 @@ bool BandedLU::factor() {
     for (int i = k + 1; i <= last; ++i)
       if (std::abs(at(i, k)) > best) { best = std::abs(at(i, k)); p = i; }
     piv_[static_cast<std::size_t>(k)] = p;
+    swapped_ = swapped_ || p != k;
     if (!(best > tiny)) { failed_row_ = k; return false; }
     const int jlast = std::min(n_ - 1, k + kuu);
     if (p != k)
@@ -45,7 +46,96 @@ bool BandedLU::factor() {
   return true;
 }
 
-INTERPATCH_KERNEL void BandedLU::solve(double* b, std::size_t width, std::size_t stride) const noexcept {
+namespace {
+
+// dst[c] = (dst[c] − Σ_t coef[t] src[t][c]) (· inv with Scale), the terms taken in
+// order: the operations, and so the bits, of T updates dst[c] −= coef[t] src[t][c]
+// one after another (and dst[c] *= inv), with one store instead of T + Scale.
+template <int T, bool Scale>
+[[gnu::always_inline]] inline void update_row(double* __restrict dst, const double* const* src, const double* coef,
+                                              double inv, std::size_t width) noexcept {
+  const double* s[T > 0 ? T : 1];
+  double l[T > 0 ? T : 1];
+  for (int t = 0; t < T; ++t) {
+    s[t] = src[t];
+    l[t] = coef[t];
+  }
+  for (std::size_t c = 0; c < width; ++c) {
+    double v = dst[c];
+    for (int t = 0; t < T; ++t) v -= l[t] * s[t][c];
+    if constexpr (Scale) v *= inv;
+    dst[c] = v;
+  }
+}
+
+// The `count` updates of a row in groups of at most four, then the scaling.
+[[gnu::always_inline]] inline void update_row(double* dst, const double* const* src, const double* coef, int count,
+                                              bool scale, double inv, std::size_t width) noexcept {
+  for (; count > 4; count -= 4, src += 4, coef += 4) update_row<4, false>(dst, src, coef, inv, width);
+  switch (count * 2 + (scale ? 1 : 0)) {
+    case 1: update_row<0, true>(dst, src, coef, inv, width); break;
+    case 2: update_row<1, false>(dst, src, coef, inv, width); break;
+    case 3: update_row<1, true>(dst, src, coef, inv, width); break;
+    case 4: update_row<2, false>(dst, src, coef, inv, width); break;
+    case 5: update_row<2, true>(dst, src, coef, inv, width); break;
+    case 6: update_row<3, false>(dst, src, coef, inv, width); break;
+    case 7: update_row<3, true>(dst, src, coef, inv, width); break;
+    case 8: update_row<4, false>(dst, src, coef, inv, width); break;
+    case 9: update_row<4, true>(dst, src, coef, inv, width); break;
+    default: break;  // 0: nothing to do
+  }
+}
+
+}  // namespace
+
+// Row i of the forward sweep takes its updates from rows k < i in increasing k, as
+// the sweep by columns gives them to it; row k of the back substitution its
+// updates from rows j > k in increasing j, then the division: every number goes
+// through the same operations as there. Zero entries are skipped as there (a zero
+// times an infinity would be a NaN).
+INTERPATCH_KERNEL void BandedLU::solve_by_rows(double* b, std::size_t width, std::size_t stride) const noexcept {
+  const int kuu = kl_ + ku_;
+  auto row = [&](int i) { return b + static_cast<std::size_t>(i) * stride; };
+  constexpr int most = 64;  // terms gathered at once; a wider band in several passes
+  const double* src[most];
+  double coef[most];
+  for (int i = 1; i < n_; ++i) {
+    int count = 0;
+    for (int k = std::max(0, i - kl_); k < i; ++k) {
+      const double l = at(i, k);
+      if (l == 0.0) continue;
+      src[count] = row(k);
+      coef[count++] = l;
+      if (count == most) {
+        update_row(row(i), src, coef, count, false, 1.0, width);
+        count = 0;
+      }
+    }
+    update_row(row(i), src, coef, count, false, 1.0, width);
+  }
+  for (int k = n_ - 1; k >= 0; --k) {
+    const int jlast = std::min(n_ - 1, k + kuu);
+    int count = 0;
+    for (int j = k + 1; j <= jlast; ++j) {
+      const double u = at(k, j);
+      if (u == 0.0) continue;
+      src[count] = row(j);
+      coef[count++] = u;
+      if (count == most) {
+        update_row(row(k), src, coef, count, false, 1.0, width);
+        count = 0;
+      }
+    }
+    update_row(row(k), src, coef, count, true, 1.0 / at(k, k), width);
+  }
+}
+
+void BandedLU::solve(double* b, std::size_t width, std::size_t stride) const noexcept {
+  if (swapped_) solve_by_columns(b, width, stride);
+  else solve_by_rows(b, width, stride);
+}
+
+INTERPATCH_KERNEL void BandedLU::solve_by_columns(double* b, std::size_t width, std::size_t stride) const noexcept {
   const int kuu = kl_ + ku_;
   auto row = [&](int i) { return b + static_cast<std::size_t>(i) * stride; };
   for (int k = 0; k < n_; ++k) {

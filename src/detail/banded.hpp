@@ -26,8 +26,19 @@ class BandedLU {
   [[nodiscard]] int failed_row() const noexcept { return failed_row_; }
 
   /// Solves A X = B in place. B has n rows; row i starts at b + i*stride and
-  /// holds `width` doubles, one per right-hand side.
+  /// holds `width` doubles, one per right-hand side. By rows when factor() swapped
+  /// none, else by columns.
   void solve(double* b, std::size_t width, std::size_t stride) const noexcept;
+
+  /// The sweeps column by column: each elimination step updates the rows below
+  /// (back substitution: each row its own updates), one pass over a row per update.
+  void solve_by_columns(double* b, std::size_t width, std::size_t stride) const noexcept;
+  /// The sweeps row by row, each row finished in one pass (its updates in registers,
+  /// one store): the same operations in the same order, so the same bits, as
+  /// solve_by_columns; only when factor() swapped no rows.
+  void solve_by_rows(double* b, std::size_t width, std::size_t stride) const noexcept;
+  /// Whether factor() swapped rows.
+  [[nodiscard]] bool swapped() const noexcept { return swapped_; }
 
  private:
   [[nodiscard]] std::size_t idx(int i, int j) const noexcept {
@@ -37,6 +48,7 @@ class BandedLU {
   std::vector<double> a_;
   std::vector<int> piv_;
   int failed_row_ = -1;
+  bool swapped_ = false;  // factor() swapped rows
 };
 
 /// A cyclic banded matrix: row i has its entries near column i + h modulo n, for
