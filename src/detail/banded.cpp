@@ -99,35 +99,26 @@ INTERPATCH_KERNEL void BandedLU::solve_by_rows(double* b, std::size_t width, std
   constexpr int most = 64;  // terms gathered at once; a wider band in several passes
   const double* src[most];
   double coef[most];
-  for (int i = 1; i < n_; ++i) {
+  // Row r's updates from the rows of B in [first, last] with a nonzero entry in row
+  // r of the factors, in increasing order; then, with `divide`, the division by the
+  // diagonal. Inlined, so that it is compiled for this clone's processor (a lambda
+  // left as a function of its own would not be, and would round otherwise).
+  auto finish_row = [&](int r, int first, int last, bool divide) __attribute__((always_inline)) {
     int count = 0;
-    for (int k = std::max(0, i - kl_); k < i; ++k) {
-      const double l = at(i, k);
-      if (l == 0.0) continue;
-      src[count] = row(k);
-      coef[count++] = l;
-      if (count == most) {
-        update_row(row(i), src, coef, count, false, 1.0, width);
-        count = 0;
-      }
-    }
-    update_row(row(i), src, coef, count, false, 1.0, width);
-  }
-  for (int k = n_ - 1; k >= 0; --k) {
-    const int jlast = std::min(n_ - 1, k + kuu);
-    int count = 0;
-    for (int j = k + 1; j <= jlast; ++j) {
-      const double u = at(k, j);
-      if (u == 0.0) continue;
+    for (int j = first; j <= last; ++j) {
+      const double e = at(r, j);
+      if (e == 0.0) continue;
       src[count] = row(j);
-      coef[count++] = u;
+      coef[count++] = e;
       if (count == most) {
-        update_row(row(k), src, coef, count, false, 1.0, width);
+        update_row(row(r), src, coef, count, false, 1.0, width);
         count = 0;
       }
     }
-    update_row(row(k), src, coef, count, true, 1.0 / at(k, k), width);
-  }
+    update_row(row(r), src, coef, count, divide, divide ? 1.0 / at(r, r) : 1.0, width);
+  };
+  for (int i = 1; i < n_; ++i) finish_row(i, std::max(0, i - kl_), i - 1, false);
+  for (int k = n_ - 1; k >= 0; --k) finish_row(k, k + 1, std::min(n_ - 1, k + kuu), true);
 }
 
 void BandedLU::solve(double* b, std::size_t width, std::size_t stride) const noexcept {
