@@ -448,13 +448,10 @@ constexpr double pole_ratio = 1e-14;
 // The flag does not look at single components: that would cost more than it saves.)
 INTERPATCH_KERNEL void chord_lengths(const Vec3* a, const Vec3* b, std::size_t count, double* out, Parametrization param,
                                      double root) {
-  for (std::size_t i = 0; i < count; ++i) {
-    const double dx = b[i].x - a[i].x, dy = b[i].y - a[i].y, dz = b[i].z - a[i].z;
-    out[i] = dx * dx + dy * dy + dz * dz;
-  }
   unsigned out_of_range = 0;  // not a bool: g++ 12 vectorizes the loop with an unsigned or-reduction only
   for (std::size_t i = 0; i < count; ++i) {
-    const double c = std::sqrt(out[i]);
+    const double dx = b[i].x - a[i].x, dy = b[i].y - a[i].y, dz = b[i].z - a[i].z;
+    const double c = std::sqrt(dx * dx + dy * dy + dz * dz);
     out[i] = c;
     out_of_range |= static_cast<unsigned>(c <= 0x1p-450) | static_cast<unsigned>(c >= 0x1p511);
   }
