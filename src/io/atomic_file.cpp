@@ -106,12 +106,14 @@ class fd_buffer : public std::streambuf {
 
   std::streamsize xsputn(const char* s, std::streamsize n) override {
     const auto room = static_cast<std::streamsize>(epptr() - pptr());
-    if (n <= room) {
+    // Small writes gather in the buffer. Large blocks bypass it, even when they would
+    // fit: a copy through it costs about as much as the write itself, and it falls
+    // on the thread that writes while the others compute.
+    if (n <= room && n < large) {
       if (n > 0) std::memcpy(pptr(), s, static_cast<std::size_t>(n));  // s may be null for nothing (an empty array)
       pbump(static_cast<int>(n));
       return n;
     }
-    // Large blocks bypass the buffer.
     if (!drain() || !write_all(s, static_cast<std::size_t>(n))) return 0;
     return n;
   }
@@ -169,6 +171,8 @@ class fd_buffer : public std::streambuf {
     }
     return true;
   }
+
+  static constexpr std::streamsize large = std::streamsize{64} << 10;  // bytes written without the buffer
 
   int fd_;
   bool durable_;

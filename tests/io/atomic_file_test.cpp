@@ -105,6 +105,31 @@ TEST(AtomicFile, LargeOutputInManyPieces) {
   EXPECT_TRUE(read_text(dir / "big.txt") == expected);
 }
 
+// Writes of every size interleaved: small ones gather in the buffer, large ones
+// (from 64 KiB, even when the buffer has room for them) go straight to the file
+// after what the buffer holds; the bytes land in the order written, and a seek back
+// into them (as a ZIP writer does to fill in a header) still lands where it should.
+TEST(AtomicFile, LargeWritesBetweenSmallOnesKeepTheirOrder) {
+  TempDir dir;
+  auto g = test::rng(32);
+  std::string expected;
+  const std::size_t sizes[] = {10, 70000, 5, (1u << 20) - 3, 100, 65535, 65536, 1, 3u << 20, 7, 200000, 0, 64};
+  for (const std::size_t n : sizes)
+    for (std::size_t k = 0; k < n; ++k) expected += static_cast<char>('a' + g() % 26);
+  write_atomically(dir / "mixed.bin", [&](std::ostream& os) {
+    std::size_t pos = 0;
+    for (const std::size_t n : sizes) {
+      os.write(expected.data() + pos, static_cast<std::streamsize>(n));
+      pos += n;
+    }
+    os.seekp(12);  // inside the first large block
+    os.write("XYZ", 3);
+    os.seekp(0, std::ios::end);
+  });
+  expected.replace(12, 3, "XYZ");
+  EXPECT_TRUE(read_text(dir / "mixed.bin") == expected);
+}
+
 TEST(AtomicFile, ThrowingWriterLeavesNoFile) {
   TempDir dir;
   EXPECT_THROW(write_atomically(dir / "out.txt",
