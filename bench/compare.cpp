@@ -1050,7 +1050,10 @@ std::optional<ProcessResult> run_program(const std::string& self, const std::str
 
 // Times whole processes in turn: each program once untimed (page cache, and the size
 // of its output), then `runs` rounds in which every program runs once, so that all
-// of them see the same machine from minute to minute. Each output is removed before
+// of them see the same machine from minute to minute. Round r starts with program
+// r mod the count, so that no program always follows the same one: on this virtual
+// machine a process that has just freed much memory (SISL's, 170 MiB) slows the
+// first touches of fresh memory of the process after it. Each output is removed before
 // its run and checked after it. Rounds stop early once they have taken `budget`
 // seconds. A program that fails is dropped (and listed among the skipped). The rows
 // go to g_rows and the console; they are returned in the order of `programs`.
@@ -1068,7 +1071,8 @@ std::vector<Row> time_in_turn(const std::string& self, const std::string& job, s
   int done = 0;
   std::vector<bool> failed(programs.size(), false);
   for (; done < runs && (done == 0 || spent < budget); ++done)
-    for (std::size_t k = 0; k < programs.size(); ++k) {
+    for (std::size_t i = 0; i < programs.size(); ++i) {
+      const std::size_t k = (i + static_cast<std::size_t>(done)) % programs.size();
       if (failed[k]) continue;
       const auto r = run_program(self, job, n, programs[k]);
       if (!r) {

@@ -621,7 +621,11 @@ void write_npy_rows(const fs::path& path, std::span<const std::size_t> shape, co
   const std::size_t count = element_count(path, dims);
   const std::size_t rows = dims[0], per_row = rows == 0 ? 0 : count / rows;
   const std::size_t block_rows = block_rows_of(per_row), piece_rows = piece_rows_of(per_row);
-  const std::size_t blocks = (rows + block_rows - 1) / block_rows;
+  // The first block is an eighth of the others: nothing is written until it is made,
+  // with the first touches of its pages; every block after it is made while the one
+  // before is written.
+  const std::size_t first_rows = std::min(rows, std::max<std::size_t>(1, block_rows / 8));
+  const std::size_t blocks = rows == 0 ? 0 : 1 + (rows - first_rows + block_rows - 1) / block_rows;
   const std::string header = internal::npy_header("<f8", dims);
   const std::uintmax_t bytes = count <= (std::numeric_limits<std::uintmax_t>::max() - header.size()) / sizeof(double)
                                    ? header.size() + count * sizeof(double)
@@ -632,7 +636,8 @@ void write_npy_rows(const fs::path& path, std::span<const std::size_t> shape, co
   const std::unique_ptr<double[]> buffers[2] = {std::make_unique_for_overwrite<double[]>(held),
                                                 std::make_unique_for_overwrite<double[]>(held)};
   const auto block_span = [&](std::size_t b) {
-    const std::size_t r0 = b * block_rows;
+    if (b == 0) return std::pair(std::size_t{0}, first_rows);
+    const std::size_t r0 = first_rows + (b - 1) * block_rows;
     return std::pair(r0, std::min(block_rows, rows - r0));
   };
   write_atomically(path, [&](std::ostream& os) {
