@@ -283,9 +283,9 @@ void require_mesh_room(const Resolution& res, const fs::path& out) {
   }
   if (res.nu >= (std::size_t{1} << 32) || res.nv >= (std::size_t{1} << 32))
     throw error(errc::too_large, what + ": more vertices than can be addressed");
-  if (lower_extension(out) == ".vts") {
+  if (const std::string ext = lower_extension(out); ext == ".vts" || ext == ".vtk") {
     // Written a block of columns at a time: the disk space of the file (points and
-    // normals, 48 bytes a vertex, and at most a few kilobytes of XML).
+    // normals, 48 bytes a vertex, and at most a few kilobytes of XML or header).
     const std::size_t n = res.nu * res.nv;
     if (n > (std::numeric_limits<std::size_t>::max() - 4096) / (2 * sizeof(Vec3)))
       throw error(errc::too_large, what + ": more bytes than a file can hold");
@@ -322,7 +322,7 @@ void write_mesh(io::Construction& c, const fs::path& out, const Resolution& res)
   constexpr double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  // every construction is over the unit square
   const std::vector<double> us = linspace(u0, u1, res.nu), vs = linspace(v0, v1, res.nv);
   ProgressLine progress("meshing");
-  io::write_surface_mesh(out, s, us, vs, progress.callback());  // a .vts a block at a time
+  io::write_surface_mesh(out, s, us, vs, progress.callback());  // a .vts or .vtk a block at a time
   progress.clear();
 }
 

@@ -39,43 +39,47 @@ void to_byte_order(char* bytes, std::size_t size, std::endian order) {
 
 class Sink {
  public:
-  explicit Sink(std::ostream& os) : os_(os) { buf_.reserve(limit + 256); }
+  /// Gathers about a megabyte, then hands it to the stream.
+  explicit Sink(std::ostream& os) : os_(&os), buf_(&own_) { own_.reserve(limit + 256); }
+  /// Appends to `out` and never flushes: a piece of a file made on a thread of its own.
+  explicit Sink(std::string& out) : buf_(&out) {}
   Sink(const Sink&) = delete;
   Sink& operator=(const Sink&) = delete;
   ~Sink() = default;
 
   void flush() {
-    os_.write(buf_.data(), static_cast<std::streamsize>(buf_.size()));
-    buf_.clear();
+    if (!os_) return;
+    os_->write(buf_->data(), static_cast<std::streamsize>(buf_->size()));
+    buf_->clear();
   }
 
   Sink& text(std::string_view s) {
-    buf_ += s;
+    *buf_ += s;
     maybe_flush();
     return *this;
   }
   Sink& ch(char c) {
-    buf_ += c;
+    *buf_ += c;
     return *this;
   }
   Sink& uint(std::uint64_t v) {
     char b[24];
     const auto r = std::to_chars(b, b + sizeof b, v);
-    buf_.append(b, r.ptr);
+    buf_->append(b, r.ptr);
     return *this;
   }
   /// Shortest text that reads back as the same double.
   Sink& shortest(double v) {
     char b[32];
     const auto r = std::to_chars(b, b + sizeof b, v);
-    buf_.append(b, r.ptr);
+    buf_->append(b, r.ptr);
     return *this;
   }
   /// "%.17g", independent of the locale.
   Sink& digits17(double v) {
     char b[32];
     const auto r = std::to_chars(b, b + sizeof b, v, std::chars_format::general, 17);
-    buf_.append(b, r.ptr);
+    buf_->append(b, r.ptr);
     return *this;
   }
   template <class T>
@@ -87,12 +91,15 @@ class Sink {
     return bytes(v, std::endian::big);
   }
   void end_record() { maybe_flush(); }
-  /// Points, three doubles each, in the given byte order: a run at a time.
-  Sink& points(std::span<const Vec3> p, std::endian order) {
-    static_assert(sizeof(Vec3) == 3 * sizeof(double), "a point is three doubles");
-    const std::size_t at = buf_.size();
-    buf_.append(reinterpret_cast<const char*>(p.data()), p.size() * sizeof(Vec3));
-    to_byte_order(buf_.data() + at, buf_.size() - at, order);
+  /// Values (points, three doubles each, or doubles) p[0], p[stride], ..., n of
+  /// them, in the given byte order.
+  template <class T>
+  Sink& gather(const T* p, std::size_t n, std::size_t stride, std::endian order) {
+    const std::size_t at = buf_->size();
+    buf_->resize(at + n * sizeof(T));
+    char* to = buf_->data() + at;
+    for (std::size_t i = 0; i < n; ++i) std::memcpy(to + i * sizeof(T), p + i * stride, sizeof(T));
+    to_byte_order(to, n * sizeof(T), order);
     maybe_flush();
     return *this;
   }
@@ -103,17 +110,53 @@ class Sink {
     char b[sizeof(T)];
     std::memcpy(b, &v, sizeof(T));
     if (order != std::endian::native) std::reverse(b, b + sizeof(T));
-    buf_.append(b, sizeof(T));
+    buf_->append(b, sizeof(T));
     return *this;
   }
   void maybe_flush() {
-    if (buf_.size() >= limit) flush();
+    if (os_ && buf_->size() >= limit) flush();
   }
 
   static constexpr std::size_t limit = std::size_t{1} << 20;
-  std::ostream& os_;
-  std::string buf_;
+  std::ostream* os_ = nullptr;
+  std::string own_;
+  std::string* buf_;
 };
+
+/// Writes records 0 .. count − 1 to `os` in order, record(sink, r) putting record r
+/// into the sink: the bytes of that loop. Every thread turns a block of records into
+/// bytes, a piece of about 64 KiB each into a buffer of its own, while one thread
+/// writes the block before (detail::pipeline): text and packed binary cost more to
+/// make than to write. `record_bytes` is about what one record takes.
+template <class Record>
+void write_records(std::ostream& os, std::size_t count, std::size_t record_bytes, Record&& record) {
+  constexpr std::size_t piece_bytes = std::size_t{1} << 16, block_pieces = 16;
+  const std::size_t per_piece = std::max<std::size_t>(1, piece_bytes / std::max<std::size_t>(1, record_bytes));
+  const std::size_t per_block = per_piece * block_pieces;
+  const std::size_t blocks = (count + per_block - 1) / per_block;
+  // Two blocks of pieces alive at once: block b's in buffers[b % 2].
+  std::array<std::vector<std::string>, 2> buffers;
+  for (auto& b : buffers) b.resize(block_pieces);
+  const auto pieces = [&](std::size_t b) {
+    const std::size_t left = count - b * per_block;
+    return std::min(block_pieces, (left + per_piece - 1) / per_piece);
+  };
+  const auto make = [&](std::size_t b, std::size_t p) {
+    std::string& out = buffers[b % 2][p];
+    out.clear();
+    Sink s(out);
+    const std::size_t first = b * per_block + p * per_piece, last = std::min(count, first + per_piece);
+    for (std::size_t r = first; r < last; ++r) record(s, r);
+  };
+  const auto write = [&](std::size_t b) {
+    const std::size_t n = pieces(b);
+    for (std::size_t p = 0; p < n; ++p) {
+      const std::string& out = buffers[b % 2][p];
+      os.write(out.data(), static_cast<std::streamsize>(out.size()));
+    }
+  };
+  detail::pipeline(blocks, count * record_bytes >= 4 * piece_bytes, pieces, make, write);
+}
 
 std::string lower_extension(const fs::path& path) {
   std::string ext = path.extension().string();
@@ -201,20 +244,26 @@ std::size_t cell_corners(const Vertices& v, std::size_t i, std::size_t j, Corner
   return n >= 3 ? n : 0;
 }
 
-template <class F>
-void for_each_face(const Vertices& v, F&& f) {
+/// The cells of the grid, (nu − 1) × (nv − 1) of them, cell r at row r / (nv − 1)
+/// and column r % (nv − 1): the records of the formats' face lists.
+std::size_t cell_count(const Vertices& v) {
   const std::size_t nu = v.grid().extent(0), nv = v.grid().extent(1);
-  if (nu < 2 || nv < 2) return;
-  Corner c[4];
-  for (std::size_t i = 0; i + 1 < nu; ++i)
-    for (std::size_t j = 0; j + 1 < nv; ++j)
-      if (const std::size_t n = cell_corners(v, i, j, c); n != 0) f(c, n);
+  return nu < 2 || nv < 2 ? 0 : (nu - 1) * (nv - 1);
 }
 
-/// The triangles of a face (a fan from its first corner), skipping those of zero area.
+/// Calls f(corners, n) for the face of cell r, if it has one.
 template <class F>
-void for_each_triangle(const Vertices& v, F&& f) {
-  for_each_face(v, [&](const Corner* c, std::size_t n) {
+void cell_face(const Vertices& v, std::size_t r, F&& f) {
+  const std::size_t cols = v.grid().extent(1) - 1;
+  Corner c[4];
+  if (const std::size_t n = cell_corners(v, r / cols, r % cols, c); n != 0) f(c, n);
+}
+
+/// Calls f(a, b, c, normal) for the triangles of cell r's face (a fan from its
+/// first corner), skipping those of zero area.
+template <class F>
+void cell_triangles(const Vertices& v, std::size_t r, F&& f) {
+  cell_face(v, r, [&](const Corner* c, std::size_t n) {
     for (std::size_t k = 1; k + 1 < n; ++k) {
       const Vec3& a = *c[0].point;
       const Vec3& b = *c[k].point;
@@ -226,6 +275,19 @@ void for_each_triangle(const Vertices& v, F&& f) {
   });
 }
 
+/// How many of the cells' faces (count_triangles false) or triangles there are;
+/// every thread counts cells.
+std::uint64_t count_faces(const Vertices& v, bool count_triangles) {
+  const std::size_t cells = cell_count(v);
+  std::uint64_t count = 0;
+#pragma omp parallel for schedule(static) reduction(+ : count) if (cells >= detail::parallel_min_work / 16)
+  for (std::size_t r = 0; r < cells; ++r) {
+    if (count_triangles) cell_triangles(v, r, [&](const Vec3&, const Vec3&, const Vec3&, const Vec3&) { ++count; });
+    else cell_face(v, r, [&](const Corner*, std::size_t) { ++count; });
+  }
+  return count;
+}
+
 /// " (closed in u and v: ...)" for the formats' comment lines, or nothing.
 std::string closed_note(const SurfaceMesh& m) {
   if (!m.closed[0] && !m.closed[1]) return {};
@@ -234,54 +296,58 @@ std::string closed_note(const SurfaceMesh& m) {
 }
 
 // ---------------------------------------------------------------------------
-// Surface-only formats.
+// Surface-only formats. Each list of records (vertices, faces, ...) is made by
+// every thread, a block at a time (write_records).
 
 // Vertices, normals and faces share numbers; texture coordinates are one per grid
 // point, so that the cells across a seam still run up to u (v) = 1.
 void write_obj(std::ostream& os, const SurfaceMesh& m) {
   const PointGrid& g = m.points;
   const Vertices vx(m);
-  const std::size_t nu = g.extent(0), nv = g.extent(1);
+  const std::size_t nu = g.extent(0), nv = g.extent(1), cols = vx.cols();
   const bool normals = !m.normals.empty();
-  Sink s(os);
-  s.text("# interpatch surface mesh: ").uint(vx.rows()).text(" x ").uint(vx.cols()).text(" vertices, first index along u");
-  s.text(closed_note(m)).ch('\n');
-  vx.each([&](std::size_t i, std::size_t j) {
-    const Vec3& p = g(i, j);
-    s.text("v ").shortest(p.x).ch(' ').shortest(p.y).ch(' ').shortest(p.z).ch('\n');
-    s.end_record();
-  });
-  for (std::size_t i = 0; i < nu; ++i) {
-    const double u = nu > 1 ? static_cast<double>(i) / static_cast<double>(nu - 1) : 0.0;
-    for (std::size_t j = 0; j < nv; ++j) {
-      const double v = nv > 1 ? static_cast<double>(j) / static_cast<double>(nv - 1) : 0.0;
-      s.text("vt ").shortest(u).ch(' ').shortest(v).ch('\n');
-      s.end_record();
-    }
+  {
+    Sink s(os);
+    s.text("# interpatch surface mesh: ").uint(vx.rows()).text(" x ").uint(vx.cols()).text(" vertices, first index along u");
+    s.text(closed_note(m)).ch('\n');
+    s.flush();
   }
-  if (normals) {
-    vx.each([&](std::size_t i, std::size_t j) {
-      const Vec3& n = m.normals(i, j);
-      s.text("vn ").shortest(n.x).ch(' ').shortest(n.y).ch(' ').shortest(n.z).ch('\n');
-      s.end_record();
+  const auto vector_lines = [&](const char* tag, const PointGrid& from) {
+    write_records(os, vx.count(), 60, [&](Sink& s, std::size_t r) {
+      const Vec3& p = from(r / cols, r % cols);
+      s.text(tag).shortest(p.x).ch(' ').shortest(p.y).ch(' ').shortest(p.z).ch('\n');
     });
-  }
-  for_each_face(vx, [&](const Corner* c, std::size_t n) {
-    s.ch('f');
-    for (std::size_t k = 0; k < n; ++k) {
-      const std::size_t v = c[k].vertex + 1;  // OBJ counts from 1; v and vn share the index
-      s.ch(' ').uint(v).ch('/').uint(c[k].grid + 1);
-      if (normals) s.ch('/').uint(v);
+  };
+  vector_lines("v ", g);
+  // Texture coordinates i / (nu − 1), j / (nv − 1): each one's text made once.
+  const auto fractions = [](std::size_t n) {
+    std::vector<std::string> t(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      Sink s(t[i]);
+      s.shortest(n > 1 ? static_cast<double>(i) / static_cast<double>(n - 1) : 0.0);
     }
-    s.ch('\n');
-    s.end_record();
+    return t;
+  };
+  const std::vector<std::string> tu = fractions(nu), tv = fractions(nv);
+  write_records(os, nu * nv, 30, [&](Sink& s, std::size_t r) {
+    s.text("vt ").text(tu[r / nv]).ch(' ').text(tv[r % nv]).ch('\n');
   });
-  s.flush();
+  if (normals) vector_lines("vn ", m.normals);
+  write_records(os, cell_count(vx), 40, [&](Sink& s, std::size_t r) {
+    cell_face(vx, r, [&](const Corner* c, std::size_t n) {
+      s.ch('f');
+      for (std::size_t k = 0; k < n; ++k) {
+        const std::size_t v = c[k].vertex + 1;  // OBJ counts from 1; v and vn share the index
+        s.ch(' ').uint(v).ch('/').uint(c[k].grid + 1);
+        if (normals) s.ch('/').uint(v);
+      }
+      s.ch('\n');
+    });
+  });
 }
 
 std::uint32_t stl_triangle_count(const SurfaceMesh& m, const fs::path& path) {
-  std::uint64_t count = 0;
-  for_each_triangle(Vertices(m), [&](const Vec3&, const Vec3&, const Vec3&, const Vec3&) { ++count; });
+  const std::uint64_t count = count_faces(Vertices(m), true);
   if (count > std::numeric_limits<std::uint32_t>::max()) {
     detail::fail(errc::too_large, "cannot write ", quoted(path), ": ", count,
                  " triangles; binary STL holds at most 4294967295");
@@ -290,62 +356,68 @@ std::uint32_t stl_triangle_count(const SurfaceMesh& m, const fs::path& path) {
 }
 
 void write_stl(std::ostream& os, const SurfaceMesh& m, std::uint32_t triangles) {
-  Sink s(os);
-  // Must not start with "solid": readers take that for ASCII STL.
-  char header[80];
-  std::memset(header, ' ', sizeof header);
-  const char title[] = "interpatch binary STL surface mesh";
-  std::memcpy(header, title, sizeof title - 1);
-  s.text(std::string_view(header, sizeof header));
-  s.little(triangles);
+  {
+    Sink s(os);
+    // Must not start with "solid": readers take that for ASCII STL.
+    char header[80];
+    std::memset(header, ' ', sizeof header);
+    const char title[] = "interpatch binary STL surface mesh";
+    std::memcpy(header, title, sizeof title - 1);
+    s.text(std::string_view(header, sizeof header));
+    s.little(triangles);
+    s.flush();
+  }
+  const Vertices vx(m);
   auto f32 = [](double v) { return static_cast<float>(v); };
-  for_each_triangle(Vertices(m), [&](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n) {
-    const Vec3 unit = n / norm(n);
-    s.little(f32(unit.x)).little(f32(unit.y)).little(f32(unit.z));
-    for (const Vec3* p : {&a, &b, &c}) s.little(f32(p->x)).little(f32(p->y)).little(f32(p->z));
-    s.little(std::uint16_t{0});
-    s.end_record();
+  write_records(os, cell_count(vx), 100, [&](Sink& s, std::size_t r) {
+    cell_triangles(vx, r, [&](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n) {
+      const Vec3 unit = n / norm(n);
+      s.little(f32(unit.x)).little(f32(unit.y)).little(f32(unit.z));
+      for (const Vec3* p : {&a, &b, &c}) s.little(f32(p->x)).little(f32(p->y)).little(f32(p->z));
+      s.little(std::uint16_t{0});
+    });
   });
-  s.flush();
 }
 
 void write_ply(std::ostream& os, const SurfaceMesh& m) {
   const Vertices vx(m);
+  const std::size_t cols = vx.cols();
   const bool normals = !m.normals.empty();
-  std::uint64_t faces = 0;
-  for_each_face(vx, [&](const Corner*, std::size_t) { ++faces; });
+  const std::uint64_t faces = count_faces(vx, false);
   const bool fits_int = vx.count() <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
-
-  Sink s(os);
-  s.text("ply\nformat binary_little_endian 1.0\ncomment interpatch surface mesh ")
-      .uint(vx.rows())
-      .text(" x ")
-      .uint(vx.cols())
-      .text(", first index along u")
-      .text(closed_note(m))
-      .text("\nelement vertex ")
-      .uint(vx.count())
-      .text("\nproperty double x\nproperty double y\nproperty double z\n");
-  if (normals) s.text("property double nx\nproperty double ny\nproperty double nz\n");
-  s.text("element face ").uint(faces).text("\nproperty list uchar ").text(fits_int ? "int" : "uint").text(" vertex_indices\nend_header\n");
-  vx.each([&](std::size_t i, std::size_t j) {
+  {
+    Sink s(os);
+    s.text("ply\nformat binary_little_endian 1.0\ncomment interpatch surface mesh ")
+        .uint(vx.rows())
+        .text(" x ")
+        .uint(vx.cols())
+        .text(", first index along u")
+        .text(closed_note(m))
+        .text("\nelement vertex ")
+        .uint(vx.count())
+        .text("\nproperty double x\nproperty double y\nproperty double z\n");
+    if (normals) s.text("property double nx\nproperty double ny\nproperty double nz\n");
+    s.text("element face ").uint(faces).text("\nproperty list uchar ").text(fits_int ? "int" : "uint").text(" vertex_indices\nend_header\n");
+    s.flush();
+  }
+  write_records(os, vx.count(), normals ? 48 : 24, [&](Sink& s, std::size_t r) {
+    const std::size_t i = r / cols, j = r % cols;
     const Vec3& p = m.points(i, j);
     s.little(p.x).little(p.y).little(p.z);
     if (normals) {
       const Vec3& n = m.normals(i, j);
       s.little(n.x).little(n.y).little(n.z);
     }
-    s.end_record();
   });
-  for_each_face(vx, [&](const Corner* c, std::size_t n) {
-    s.little(static_cast<std::uint8_t>(n));
-    for (std::size_t k = 0; k < n; ++k) {
-      if (fits_int) s.little(static_cast<std::int32_t>(c[k].vertex));
-      else s.little(static_cast<std::uint32_t>(c[k].vertex));
-    }
-    s.end_record();
+  write_records(os, cell_count(vx), 17, [&](Sink& s, std::size_t r) {
+    cell_face(vx, r, [&](const Corner* c, std::size_t n) {
+      s.little(static_cast<std::uint8_t>(n));
+      for (std::size_t k = 0; k < n; ++k) {
+        if (fits_int) s.little(static_cast<std::int32_t>(c[k].vertex));
+        else s.little(static_cast<std::uint32_t>(c[k].vertex));
+      }
+    });
   });
-  s.flush();
 }
 
 // ---------------------------------------------------------------------------
@@ -359,60 +431,59 @@ struct Structured {
   const char* kind = "surface";
 
   [[nodiscard]] std::size_t size() const noexcept { return nu * nv * nw; }
-
-  /// Visits the C-order index of every point with i fastest, then j, then k: the
-  /// order of VTK and Plot3D files.
-  template <class F>
-  void each_i_fastest(F&& f) const {
-    for (std::size_t k = 0; k < nw; ++k)
-      for (std::size_t j = 0; j < nv; ++j)
-        for (std::size_t i = 0; i < nu; ++i) f((i * nv + j) * nw + k);
+  /// The C-order index of the point the file holds at place t, i fastest, then j,
+  /// then k: the order of VTK and Plot3D files.
+  [[nodiscard]] std::size_t at(std::size_t t) const noexcept {
+    const std::size_t i = t % nu, rest = t / nu;
+    return (i * nv + rest % nv) * nw + rest / nv;
   }
 
-  /// The points of `v` (C order, as `points`) in the order of each_i_fastest, handed
-  /// to f a run at a time. A surface's (nw 1) are gathered eight columns at once, so
-  /// that the grid is read row after row rather than with a stride of a whole row.
-  template <class F>
-  void runs_i_fastest(const Vec3* v, F&& f) const {
-    if (nw != 1) {
-      each_i_fastest([&](std::size_t q) { f(std::span<const Vec3>(v + q, 1)); });
-      return;
-    }
-    constexpr std::size_t columns = 8;
-    std::vector<Vec3> t(columns * nu);
-    for (std::size_t j0 = 0; j0 < nv; j0 += columns) {
-      const std::size_t nc = std::min(columns, nv - j0);
-      for (std::size_t i = 0; i < nu; ++i)
-        for (std::size_t c = 0; c < nc; ++c) t[c * nu + i] = v[i * nv + j0 + c];
-      for (std::size_t c = 0; c < nc; ++c) f(std::span<const Vec3>(t.data() + c * nu, nu));
-    }
+  /// The values of `v` (C order, as `points`; T is Vec3 or double) in the order of
+  /// the files, in the given byte order: a line of nu values along i at a time, the
+  /// lines made by every thread.
+  template <class T>
+  void write_lines(std::ostream& os, const T* v, std::endian order) const {
+    const std::size_t stride = nv * nw;
+    write_records(os, nv * nw, nu * sizeof(T), [&](Sink& s, std::size_t line) {
+      s.gather(v + at(line * nu), nu, stride, order);
+    });
   }
 };
 
-void write_legacy_vtk(std::ostream& os, const Structured& g) {
-  Sink s(os);
+// Legacy VTK: the head before the points, and what stands between the points and
+// the point data.
+std::string legacy_vtk_head(std::size_t nu, std::size_t nv, std::size_t nw, std::string_view kind) {
+  std::string head;
+  Sink s(head);
   s.text("# vtk DataFile Version 3.0\ninterpatch ")
-      .text(g.kind)
+      .text(kind)
       .text(" grid\nBINARY\nDATASET STRUCTURED_GRID\nDIMENSIONS ")
-      .uint(g.nu).ch(' ').uint(g.nv).ch(' ').uint(g.nw)
-      .text("\nPOINTS ").uint(g.size()).text(" double\n");
-  g.runs_i_fastest(g.points, [&](std::span<const Vec3> run) { s.points(run, std::endian::big); });
-  s.ch('\n');
-  if (g.vectors || g.scalars) s.text("POINT_DATA ").uint(g.size()).ch('\n');
+      .uint(nu).ch(' ').uint(nv).ch(' ').uint(nw)
+      .text("\nPOINTS ").uint(nu * nv * nw).text(" double\n");
+  return head;
+}
+
+std::string legacy_vtk_point_data(std::size_t size, bool vectors, bool scalars) {
+  std::string text = "\n";
+  Sink s(text);
+  if (vectors || scalars) s.text("POINT_DATA ").uint(size).ch('\n');
+  if (vectors) s.text("NORMALS normals double\n");
+  return text;
+}
+
+void write_legacy_vtk(std::ostream& os, const Structured& g) {
+  os << legacy_vtk_head(g.nu, g.nv, g.nw, g.kind);
+  g.write_lines(os, g.points, std::endian::big);
+  os << legacy_vtk_point_data(g.size(), g.vectors != nullptr, g.scalars != nullptr);
   if (g.vectors) {
-    s.text("NORMALS normals double\n");
-    g.runs_i_fastest(g.vectors, [&](std::span<const Vec3> run) { s.points(run, std::endian::big); });
-    s.ch('\n');
+    g.write_lines(os, g.vectors, std::endian::big);
+    os << '\n';
   }
   if (g.scalars) {
-    s.text("SCALARS jacobian double 1\nLOOKUP_TABLE default\n");
-    g.each_i_fastest([&](std::size_t q) {
-      s.big(g.scalars[q]);
-      s.end_record();
-    });
-    s.ch('\n');
+    os << "SCALARS jacobian double 1\nLOOKUP_TABLE default\n";
+    g.write_lines(os, g.scalars, std::endian::big);
+    os << '\n';
   }
-  s.flush();
 }
 
 /// The XML of a .vts file before its appended data (up to the "_" that opens it)
@@ -428,8 +499,8 @@ std::string vts_head(std::size_t nu, std::size_t nv, std::size_t nw, bool vector
     offset += 8 + bytes;
     return o;
   };
-  std::ostringstream os;
-  Sink s(os);
+  std::string head;
+  Sink s(head);
   auto extent = [&]() { s.text("0 ").uint(nu - 1).text(" 0 ").uint(nv - 1).text(" 0 ").uint(nw - 1); };
   s.text("<?xml version=\"1.0\"?>\n"
          "<VTKFile type=\"StructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
@@ -455,73 +526,57 @@ std::string vts_head(std::size_t nu, std::size_t nv, std::size_t nw, bool vector
          "        <DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" format=\"appended\" offset=\"")
       .uint(next_offset(vec_bytes))
       .text("\"/>\n      </Points>\n    </Piece>\n  </StructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _");
-  s.flush();
-  return std::move(os).str();
+  return head;
 }
 
 constexpr std::string_view vts_tail = "\n  </AppendedData>\n</VTKFile>\n";
 
+/// An appended array's byte count, as the .vts holds it before the array.
+std::string vts_count(std::uint64_t bytes) {
+  std::string count;
+  Sink(count).little(bytes);
+  return count;
+}
+
 /// VTK XML StructuredGrid (vts_head), the arrays i fastest.
 void write_vts(std::ostream& os, const Structured& g) {
   const std::uint64_t n = g.size();
-  const std::uint64_t vec_bytes = 24 * n, scal_bytes = 8 * n;
-  Sink s(os);
-  s.text(vts_head(g.nu, g.nv, g.nw, g.vectors != nullptr, g.scalars != nullptr));
-  auto vec_array = [&](const Vec3* v) {
-    s.little(vec_bytes);
-    g.runs_i_fastest(v, [&](std::span<const Vec3> run) { s.points(run, std::endian::little); });
-  };
-  if (g.vectors) vec_array(g.vectors);
-  if (g.scalars) {
-    s.little(scal_bytes);
-    g.each_i_fastest([&](std::size_t q) {
-      s.little(g.scalars[q]);
-      s.end_record();
-    });
+  os << vts_head(g.nu, g.nv, g.nw, g.vectors != nullptr, g.scalars != nullptr);
+  if (g.vectors) {
+    os << vts_count(24 * n);
+    g.write_lines(os, g.vectors, std::endian::little);
   }
-  vec_array(g.points);
-  s.text(vts_tail);
-  s.flush();
+  if (g.scalars) {
+    os << vts_count(8 * n);
+    g.write_lines(os, g.scalars, std::endian::little);
+  }
+  os << vts_count(24 * n);
+  g.write_lines(os, g.points, std::endian::little);
+  os << vts_tail;
+}
+
+/// Plot3D's ASCII values, four to a line: the first n of place(t), i fastest.
+template <class Value>
+void write_plot3d_values(std::ostream& os, std::size_t n, Value&& value) {
+  write_records(os, n, 24, [&](Sink& s, std::size_t t) {
+    if (t % 4 != 0) s.ch(' ');
+    s.digits17(value(t));
+    if (t % 4 == 3 || t + 1 == n) s.ch('\n');
+  });
 }
 
 /// Plot3D grid file, ASCII, 3D, multi-grid with one grid, whole (not planes): the
 /// block count, the dimensions, then every x (i fastest), every y, every z.
 void write_plot3d(std::ostream& os, const Structured& g) {
-  Sink s(os);
-  s.text("1\n").uint(g.nu).ch(' ').uint(g.nv).ch(' ').uint(g.nw).ch('\n');
-  for (int c = 0; c < 3; ++c) {
-    std::size_t col = 0;
-    g.each_i_fastest([&](std::size_t q) {
-      if (col) s.ch(' ');
-      s.digits17(g.points[q][c]);
-      if (++col == 4) {
-        s.ch('\n');
-        col = 0;
-      }
-      s.end_record();
-    });
-    if (col) s.ch('\n');
-  }
-  s.flush();
+  Sink(os).text("1\n").uint(g.nu).ch(' ').uint(g.nv).ch(' ').uint(g.nw).ch('\n').flush();
+  for (int c = 0; c < 3; ++c) write_plot3d_values(os, g.size(), [&](std::size_t t) { return g.points[g.at(t)][c]; });
 }
 
 /// Plot3D function file (multi-grid, ASCII): the block count, "ni nj nk nvars",
 /// then the values, i fastest.
 void write_plot3d_function(std::ostream& os, const Structured& g) {
-  Sink s(os);
-  s.text("1\n").uint(g.nu).ch(' ').uint(g.nv).ch(' ').uint(g.nw).text(" 1\n");
-  std::size_t col = 0;
-  g.each_i_fastest([&](std::size_t q) {
-    if (col) s.ch(' ');
-    s.digits17(g.scalars[q]);
-    if (++col == 4) {
-      s.ch('\n');
-      col = 0;
-    }
-    s.end_record();
-  });
-  if (col) s.ch('\n');
-  s.flush();
+  Sink(os).text("1\n").uint(g.nu).ch(' ').uint(g.nv).ch(' ').uint(g.nw).text(" 1\n").flush();
+  write_plot3d_values(os, g.size(), [&](std::size_t t) { return g.scalars[g.at(t)]; });
 }
 
 template <std::size_t N>
@@ -678,26 +733,57 @@ std::array<bool, 2> closed_directions(const Surface& surface, std::span<const do
   return closed;
 }
 
-// Points written little-endian, turned in place first where the machine is not.
-void write_little(std::ostream& os, Vec3* p, std::size_t n) {
+// Points written in the given byte order, turned in place first where the machine's
+// is another.
+void write_in_order(std::ostream& os, Vec3* p, std::size_t n, std::endian order) {
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "a point is three doubles");
   auto* bytes = reinterpret_cast<char*>(p);
-  to_byte_order(bytes, n * sizeof(Vec3), std::endian::little);
+  to_byte_order(bytes, n * sizeof(Vec3), order);
   os.write(bytes, static_cast<std::streamsize>(n * sizeof(Vec3)));
 }
 
-// The .vts of a surface's mesh (points and normals) without the mesh in memory:
-// blocks of whole columns (v values), each a run of both arrays, i fastest. Every
-// thread evaluates a few rows of the block and puts them in the file's order while
-// the block before is written at its two places in the file; the bytes are those
-// of write_surface_mesh(path, sample_mesh(...)).
-void stream_vts(const fs::path& path, const Surface& surface, std::span<const double> us, std::span<const double> vs,
-                const progress_callback& progress) {
+/// Where the two arrays of a structured surface file (.vts, .vtk) go, and the
+/// bytes that stand around them: what stream_structured writes.
+struct ArrayLayout {
+  std::uint64_t points_at = 0, normals_at = 0, size = 0;
+  std::endian order = std::endian::little;
+  std::vector<std::pair<std::uint64_t, std::string>> texts;  // (offset, bytes)
+};
+
+/// The layout write_vts gives a surface's points and normals.
+ArrayLayout vts_layout(std::size_t nu, std::size_t nv) {
+  const std::uint64_t vec_bytes = std::uint64_t{24} * nu * nv;
+  std::string head = vts_head(nu, nv, 1, true, false) + vts_count(vec_bytes);
+  ArrayLayout l;
+  l.normals_at = head.size();
+  l.points_at = l.normals_at + vec_bytes + 8;
+  l.size = l.points_at + vec_bytes + vts_tail.size();
+  l.texts = {{0, std::move(head)}, {l.points_at - 8, vts_count(vec_bytes)}, {l.points_at + vec_bytes, std::string(vts_tail)}};
+  return l;
+}
+
+/// The layout write_legacy_vtk gives them.
+ArrayLayout legacy_vtk_layout(std::size_t nu, std::size_t nv) {
+  const std::uint64_t vec_bytes = std::uint64_t{24} * nu * nv;
+  std::string head = legacy_vtk_head(nu, nv, 1, "surface"), between = legacy_vtk_point_data(nu * nv, true, false);
+  ArrayLayout l;
+  l.order = std::endian::big;
+  l.points_at = head.size();
+  l.normals_at = l.points_at + vec_bytes + between.size();
+  l.size = l.normals_at + vec_bytes + 1;
+  l.texts = {{0, std::move(head)}, {l.points_at + vec_bytes, std::move(between)}, {l.normals_at + vec_bytes, "\n"}};
+  return l;
+}
+
+// A .vts or .vtk of a surface's mesh (points and normals) without the mesh in
+// memory: blocks of whole columns (v values), each a run of both arrays, i fastest.
+// Every thread evaluates a few rows of the block and puts them in the file's order
+// while the block before is written at its two places in the file; the bytes are
+// those of write_surface_mesh(path, sample_mesh(...)).
+void stream_structured(const fs::path& path, const ArrayLayout& layout, const Surface& surface,
+                       std::span<const double> us, std::span<const double> vs, const progress_callback& progress) {
   const std::size_t nu = us.size(), nv = vs.size(), n = nu * nv;
   const std::array<bool, 2> closed = closed_directions(surface, us, vs);
-  const std::string head = vts_head(nu, nv, 1, true, false);
-  const std::uint64_t vec_bytes = std::uint64_t{24} * n;
-  const std::uint64_t normals_at = head.size() + 8, points_at = normals_at + vec_bytes + 8, tail_at = points_at + vec_bytes;
   // About 2^15 points a block (1.5 MiB of points and normals), pieces of about 2^11:
   // few fresh pages (write_npy_rows).
   constexpr std::size_t block_points = std::size_t{1} << 15, piece_points = std::size_t{1} << 11;
@@ -739,26 +825,22 @@ void stream_vts(const fs::path& path, const Surface& surface, std::span<const do
       std::copy(first_points.begin(), first_points.end(), P + (m - 1) * nu);
       std::copy(first_normals.begin(), first_normals.end(), N + (m - 1) * nu);
     }
-    os.seekp(static_cast<std::streamoff>(normals_at + std::uint64_t{24} * j0 * nu));
-    write_little(os, N, m * nu);
-    os.seekp(static_cast<std::streamoff>(points_at + std::uint64_t{24} * j0 * nu));
-    write_little(os, P, m * nu);
+    os.seekp(static_cast<std::streamoff>(layout.normals_at + std::uint64_t{24} * j0 * nu));
+    write_in_order(os, N, m * nu, layout.order);
+    os.seekp(static_cast<std::streamoff>(layout.points_at + std::uint64_t{24} * j0 * nu));
+    write_in_order(os, P, m * nu, layout.order);
     if (progress) progress(static_cast<double>(j0 + m) / static_cast<double>(nv));
   };
   write_atomically(path, [&](std::ostream& os) {
-    Sink s(os);
-    s.text(head).little(vec_bytes);
-    s.flush();
+    os << layout.texts.front().second;
     detail::pipeline(
         blocks, n >= detail::parallel_min_work / 16, [&](std::size_t) { return pieces; }, make,
         [&](std::size_t b) { write(os, b); });
-    os.seekp(static_cast<std::streamoff>(points_at - 8));
-    s.little(vec_bytes);
-    s.flush();
-    os.seekp(static_cast<std::streamoff>(tail_at));
-    s.text(vts_tail);
-    s.flush();
-  }, tail_at + vts_tail.size());
+    for (std::size_t t = 1; t < layout.texts.size(); ++t) {
+      os.seekp(static_cast<std::streamoff>(layout.texts[t].first));
+      os << layout.texts[t].second;
+    }
+  }, layout.size);
 }
 
 }  // namespace
@@ -787,8 +869,10 @@ void write_surface_mesh(const fs::path& path, const Surface& surface, std::span<
                         std::span<const double> vs, const progress_callback& progress) {
   const std::string ext = lower_extension(path);
   check_extension(path, ext, surface_formats, "surface");
-  if (ext != ".vts" || us.empty() || vs.empty()) return write_surface_mesh(path, sample_mesh(surface, us, vs, progress));
-  stream_vts(path, surface, us, vs, progress);
+  if (us.empty() || vs.empty() || (ext != ".vts" && ext != ".vtk"))
+    return write_surface_mesh(path, sample_mesh(surface, us, vs, progress));
+  stream_structured(path, ext == ".vts" ? vts_layout(us.size(), vs.size()) : legacy_vtk_layout(us.size(), vs.size()),
+                    surface, us, vs, progress);
 }
 
 }  // namespace interpatch::io

@@ -166,15 +166,56 @@ class Cursor {
 
 // --- Surface formats --------------------------------------------------------------------
 
+/// The sizes the surface-format tests run at: a few cells, and a mesh whose lists of
+/// records (vertices, normals, faces, coordinates) are each made in several blocks
+/// of pieces, shared by the threads (write_records: pieces of 64 KiB, blocks of 16).
+constexpr std::array<std::array<std::size_t, 2>, 2> format_sizes = {{{5, 6}, {301, 257}}};
+
+/// The file at `path` that write() makes, written on 1, 2 and 3 threads: the same
+/// bytes every time (checked here, for the file beside it too when there is one),
+/// returned once.
+template <class Write>
+std::string written_on_every_thread_count(const fs::path& path, Write&& write) {
+  fs::path beside = path;
+  beside.replace_extension(".f");  // a Plot3D function file
+  std::string first, first_beside;
+#ifdef _OPENMP
+  const int before = omp_get_max_threads();
+  omp_set_dynamic(0);
+  for (const int threads : {1, 2, 3}) {
+    omp_set_num_threads(threads);
+#else
+  for (const int threads : {1}) {
+#endif
+    write();
+    std::string bytes = read_bytes(path), bytes_beside = fs::exists(beside) ? read_bytes(beside) : "";
+    if (threads == 1) {
+      first = std::move(bytes);
+      first_beside = std::move(bytes_beside);
+    } else {
+      EXPECT_TRUE(bytes == first) << path << " on " << threads << " threads is not the file of one thread";
+      EXPECT_TRUE(bytes_beside == first_beside) << beside << " on " << threads << " threads";
+    }
+  }
+#ifdef _OPENMP
+  omp_set_num_threads(before);
+#endif
+  return first;
+}
+
+std::string written_on_every_thread_count(const fs::path& path, const SurfaceMesh& m) {
+  return written_on_every_thread_count(path, [&] { write_surface_mesh(path, m); });
+}
+
+
 TEST(Mesh, ObjHasVerticesUvNormalsAndQuadsWithPoleTriangles) {
   TempDir dir;
-  const std::size_t nu = 5, nv = 6;
+  for (const auto [nu, nv] : format_sizes) {
   const SurfaceMesh m = cap(nu, nv);
-  write_surface_mesh(dir / "cap.obj", m);
   std::vector<Vec3> v, vn;
   std::vector<std::array<double, 2>> vt;
   std::vector<std::vector<std::size_t>> faces;
-  for (const auto& l : lines(read_bytes(dir / "cap.obj"))) {
+  for (const auto& l : lines(written_on_every_thread_count(dir / "cap.obj", m))) {
     const auto t = tokens(l);
     if (t.empty() || t[0] == "#") continue;
     if (t[0] == "v") {
@@ -208,10 +249,11 @@ TEST(Mesh, ObjHasVerticesUvNormalsAndQuadsWithPoleTriangles) {
       const std::size_t q = i * nv + j;
       EXPECT_EQ(v[q], m.points(i, j)) << q;  // shortest round-trip text: exact
       EXPECT_EQ(vn[q], m.normals(i, j)) << q;
-      EXPECT_EQ(vt[q][0], static_cast<double>(i) / (nu - 1));
-      EXPECT_EQ(vt[q][1], static_cast<double>(j) / (nv - 1));
+      EXPECT_EQ(vt[q][0], static_cast<double>(i) / static_cast<double>(nu - 1));
+      EXPECT_EQ(vt[q][1], static_cast<double>(j) / static_cast<double>(nv - 1));
     }
   EXPECT_EQ(faces, expected_faces(nu, nv, 1));
+  }
 }
 
 TEST(Mesh, ObjWithoutNormalsAndFullyDegenerateCellsDropped) {
@@ -240,10 +282,9 @@ TEST(Mesh, ObjWithoutNormalsAndFullyDegenerateCellsDropped) {
 
 TEST(Mesh, StlIsBinaryWithOrientedUnitNormalsAndNoDegenerateTriangles) {
   TempDir dir;
-  const std::size_t nu = 5, nv = 6;
+  for (const auto [nu, nv] : format_sizes) {
   const SurfaceMesh m = cap(nu, nv);
-  write_surface_mesh(dir / "cap.stl", m);
-  const std::string s = read_bytes(dir / "cap.stl");
+  const std::string s = written_on_every_thread_count(dir / "cap.stl", m);
   ASSERT_GE(s.size(), 84u);
   const std::string header = s.substr(0, 80);
   EXPECT_NE(header.substr(0, 5), "solid");  // would read as ASCII STL
@@ -277,6 +318,7 @@ TEST(Mesh, StlIsBinaryWithOrientedUnitNormalsAndNoDegenerateTriangles) {
     EXPECT_GT(dot(geo / norm(geo), n), 0.9999) << t;
     EXPECT_GT(n.z, 0.0) << t;  // S_u x S_v points up on this cap
   }
+  }
 }
 
 TEST(Mesh, StlDropsZeroAreaTriangles) {
@@ -300,10 +342,9 @@ TEST(Mesh, StlDropsZeroAreaTriangles) {
 
 TEST(Mesh, PlyBinaryLittleEndianWithNormalsAndFaces) {
   TempDir dir;
-  const std::size_t nu = 5, nv = 6;
+  for (const auto [nu, nv] : format_sizes) {
   const SurfaceMesh m = cap(nu, nv);
-  write_surface_mesh(dir / "cap.ply", m);
-  const std::string s = read_bytes(dir / "cap.ply");
+  const std::string s = written_on_every_thread_count(dir / "cap.ply", m);
   const auto end = s.find("end_header\n");
   ASSERT_NE(end, std::string::npos);
   std::vector<std::string> header;
@@ -312,7 +353,7 @@ TEST(Mesh, PlyBinaryLittleEndianWithNormalsAndFaces) {
   const auto faces = expected_faces(nu, nv, 1);
   const std::vector<std::string> want = {"ply",
                                          "format binary_little_endian 1.0",
-                                         "element vertex 30",
+                                         "element vertex " + std::to_string(nu * nv),
                                          "property double x",
                                          "property double y",
                                          "property double z",
@@ -334,6 +375,7 @@ TEST(Mesh, PlyBinaryLittleEndianWithNormalsAndFaces) {
     for (std::size_t k = 0; k < f.size(); ++k, off += 4) EXPECT_EQ(le<std::int32_t>(s, off), static_cast<std::int32_t>(f[k]));
   }
   EXPECT_EQ(off, s.size());
+  }
 }
 
 TEST(Mesh, PlyWithoutNormals) {
@@ -397,10 +439,9 @@ VtkGrid read_legacy_vtk(const std::string& s) {
 
 TEST(Mesh, LegacyVtkStructuredGridBigEndianUFastest) {
   TempDir dir;
-  const std::size_t nu = 5, nv = 6;
+  for (const auto [nu, nv] : format_sizes) {
   const SurfaceMesh m = cap(nu, nv);
-  write_surface_mesh(dir / "cap.vtk", m);
-  const VtkGrid g = read_legacy_vtk(read_bytes(dir / "cap.vtk"));
+  const VtkGrid g = read_legacy_vtk(written_on_every_thread_count(dir / "cap.vtk", m));
   EXPECT_EQ(g.dims, (std::array<std::size_t, 3>{nu, nv, 1}));
   ASSERT_EQ(g.points.size(), nu * nv);
   ASSERT_EQ(g.normals.size(), nu * nv);
@@ -410,6 +451,7 @@ TEST(Mesh, LegacyVtkStructuredGridBigEndianUFastest) {
       EXPECT_EQ(g.normals[i + nu * j], m.normals(i, j));
     }
   EXPECT_TRUE(g.scalars.empty());
+  }
 }
 
 /// Arrays of a VTK XML StructuredGrid written with raw appended data.
@@ -463,11 +505,10 @@ VtsGrid read_vts(const std::string& s) {
 
 TEST(Mesh, VtsAppendedRawStructuredGrid) {
   TempDir dir;
-  const std::size_t nu = 5, nv = 6;
+  for (const auto [nu, nv] : format_sizes) {
   const SurfaceMesh m = cap(nu, nv);
-  write_surface_mesh(dir / "cap.vts", m);
-  const std::string s = read_bytes(dir / "cap.vts");
-  EXPECT_NE(s.find("WholeExtent=\"0 4 0 5 0 0\""), std::string::npos);
+  const std::string s = written_on_every_thread_count(dir / "cap.vts", m);
+  EXPECT_NE(s.find("WholeExtent=\"0 " + std::to_string(nu - 1) + " 0 " + std::to_string(nv - 1) + " 0 0\""), std::string::npos);
   const VtsGrid g = read_vts(s);
   ASSERT_EQ(g.arrays.count("Points"), 1u);
   ASSERT_EQ(g.arrays.count("Normals"), 1u);
@@ -481,6 +522,7 @@ TEST(Mesh, VtsAppendedRawStructuredGrid) {
       EXPECT_EQ((Vec3{p[q], p[q + 1], p[q + 2]}), m.points(i, j));
       EXPECT_EQ((Vec3{n[q], n[q + 1], n[q + 2]}), m.normals(i, j));
     }
+  }
 }
 
 /// The single grid of a Plot3D ASCII multi-grid file.
@@ -509,14 +551,25 @@ Plot3d read_plot3d(const std::string& text) {
 
 TEST(Mesh, Plot3dAsciiWholeMultiGrid) {
   TempDir dir;
-  const std::size_t nu = 5, nv = 6;
+  for (const auto [nu, nv] : format_sizes) {
   const SurfaceMesh m = cap(nu, nv);
-  write_surface_mesh(dir / "cap.xyz", m);
-  const Plot3d g = read_plot3d(read_bytes(dir / "cap.xyz"));
+  const std::string text = written_on_every_thread_count(dir / "cap.xyz", m);
+  const Plot3d g = read_plot3d(text);
   EXPECT_EQ(g.dims, (std::array<std::size_t, 3>{nu, nv, 1}));
+  ASSERT_EQ(g.points.size(), nu * nv);
   for (std::size_t j = 0; j < nv; ++j)
     for (std::size_t i = 0; i < nu; ++i) EXPECT_EQ(g.points[i + nu * j], m.points(i, j));  // 17 digits: exact
+  // Four values a line, each coordinate starting a line of its own.
+  const auto l = lines(text);
+  const std::size_t per_coordinate = (nu * nv + 3) / 4;
+  ASSERT_EQ(l.size(), 2 + 3 * per_coordinate);
+  for (std::size_t k = 2; k < l.size(); ++k) {
+    const std::size_t in_coordinate = (k - 2) % per_coordinate;
+    const std::size_t want = in_coordinate + 1 < per_coordinate || nu * nv % 4 == 0 ? 4 : nu * nv % 4;
+    EXPECT_EQ(tokens(l[k]).size(), want) << "line " << k;
+  }
   EXPECT_EQ(dir.count(), 1u);  // no function file without a field
+  }
 }
 
 TEST(Mesh, ExtensionIsCaseInsensitive) {
@@ -833,11 +886,11 @@ TEST(Mesh, SampleMeshClosesWhereTheSamplesSpanAPeriod) {
   }
 }
 
-// write_surface_mesh from the surface writes a .vts a block of columns at a time on
-// every thread; its bytes are those of the mesh sampled whole and written: closed in
-// u, v or both (the seam copied into the right blocks), a pole row, a blended
-// surface; one block, several with a short last one, a single row or column; 1, 2
-// and 3 threads. The other formats go through sample_mesh.
+// write_surface_mesh from the surface writes a .vts or a legacy .vtk a block of
+// columns at a time on every thread; its bytes are those of the mesh sampled whole
+// and written: closed in u, v or both (the seam copied into the right blocks), a pole
+// row, a blended surface; one block, several with a short last one, a single row or
+// column; 1, 2 and 3 threads. The other formats go through sample_mesh.
 TEST(Mesh, SurfaceVtsWrittenByBlocksHasTheBytesOfTheWholeMesh) {
   TempDir dir;
   const BSplineSurface torus = test::closed_surface({true, true}, 8);
@@ -859,14 +912,16 @@ TEST(Mesh, SurfaceVtsWrittenByBlocksHasTheBytesOfTheWholeMesh) {
 #endif
   for (const Case& c : cases) {
     const auto us = linspace(c.u0, c.u1, c.nu), vs = linspace(c.v0, c.v1, c.nv);
-    write_surface_mesh(dir / "whole.vts", sample_mesh(*c.s, us, vs));
-    const std::string want = read_bytes(dir / "whole.vts");
-    for (const int threads : {1, 2, 3}) {
+    for (const std::string ext : {".vts", ".vtk"}) {
+      write_surface_mesh(dir / ("whole" + ext), sample_mesh(*c.s, us, vs));
+      const std::string want = read_bytes(dir / ("whole" + ext));
+      for (const int threads : {1, 2, 3}) {
 #ifdef _OPENMP
-      omp_set_num_threads(threads);
+        omp_set_num_threads(threads);
 #endif
-      write_surface_mesh(dir / "blocks.vts", *c.s, us, vs);
-      EXPECT_TRUE(read_bytes(dir / "blocks.vts") == want) << c.nu << " x " << c.nv << ", " << threads << " threads";
+        write_surface_mesh(dir / ("blocks" + ext), *c.s, us, vs);
+        EXPECT_TRUE(read_bytes(dir / ("blocks" + ext)) == want) << ext << ", " << c.nu << " x " << c.nv << ", " << threads << " threads";
+      }
     }
     write_surface_mesh(dir / "m.obj", *c.s, us, vs);
     write_surface_mesh(dir / "whole.obj", sample_mesh(*c.s, us, vs));
@@ -877,6 +932,9 @@ TEST(Mesh, SurfaceVtsWrittenByBlocksHasTheBytesOfTheWholeMesh) {
 #endif
   EXPECT_ERRC(write_surface_mesh(dir / "m.vts", pole, std::vector<double>{0, 1.5}, std::vector<double>{0, 1}),
               out_of_domain, "");
+  EXPECT_ERRC(write_surface_mesh(dir / "m.vtk", pole, std::vector<double>{0, 1.5}, std::vector<double>{0, 1}),
+              out_of_domain, "");
+  EXPECT_FALSE(fs::exists(dir / "m.vtk"));
   EXPECT_ERRC(write_surface_mesh(dir / "m.dat", pole, std::vector<double>{0, 1}, std::vector<double>{0, 1}), wrong_type,
               "unknown surface mesh format '.dat'");
   EXPECT_ERRC(write_surface_mesh(dir / "m.vts", pole, std::vector<double>{}, std::vector<double>{0, 1}), size_mismatch,
@@ -962,6 +1020,41 @@ TEST(Mesh, VolumePlot3dWithFunctionFile) {
   for (std::size_t k = 0; k < 5; ++k)
     for (std::size_t j = 0; j < 4; ++j)
       for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(number(f[5 + i + 3 * (j + 4 * k)]), jac(i, j, k));
+}
+
+// A volume grid whose lines along i (the files' records) are made in several blocks:
+// every point and value in place, the same bytes on 1, 2 and 3 threads.
+TEST(Mesh, LargeVolumeGridsOnEveryThreadCount) {
+  TempDir dir;
+  const std::size_t nu = 61, nv = 53, nw = 47;
+  Grid<double, 3> jac;
+  const PointGrid3 g = box(nu, nv, nw, &jac);
+  const auto at = [&](std::size_t i, std::size_t j, std::size_t k) { return i + nu * (j + nv * k); };
+  const auto write = [&](const char* name) {
+    return written_on_every_thread_count(dir / name, [&] { write_volume_mesh(dir / name, g, jac); });
+  };
+  const VtkGrid vtk = read_legacy_vtk(write("box.vtk"));
+  const VtsGrid vts = read_vts(write("box.vts"));
+  const Plot3d xyz = read_plot3d(write("box.xyz"));
+  const auto f = tokens(read_bytes(dir / "box.f"));
+  ASSERT_EQ(vtk.points.size(), nu * nv * nw);
+  ASSERT_EQ(vtk.scalars.size(), nu * nv * nw);
+  ASSERT_EQ(vts.arrays.at("Points").size(), 3 * nu * nv * nw);
+  ASSERT_EQ(vts.arrays.at("jacobian").size(), nu * nv * nw);
+  ASSERT_EQ(xyz.points.size(), nu * nv * nw);
+  ASSERT_EQ(f.size(), 5 + nu * nv * nw);
+  const auto& p = vts.arrays.at("Points");
+  std::size_t wrong = 0;  // counted, not reported point by point: 150 000 points
+  for (std::size_t k = 0; k < nw; ++k)
+    for (std::size_t j = 0; j < nv; ++j)
+      for (std::size_t i = 0; i < nu; ++i) {
+        const std::size_t q = at(i, j, k);
+        wrong += vtk.points[q] != g(i, j, k) || vtk.scalars[q] != jac(i, j, k) ||
+                 (Vec3{p[3 * q], p[3 * q + 1], p[3 * q + 2]}) != g(i, j, k) ||
+                 vts.arrays.at("jacobian")[q] != jac(i, j, k) || xyz.points[q] != g(i, j, k) ||
+                 number(f[5 + q]) != jac(i, j, k);
+      }
+  EXPECT_EQ(wrong, 0u);
 }
 
 // --- Errors -------------------------------------------------------------------------

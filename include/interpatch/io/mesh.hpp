@@ -44,7 +44,9 @@ struct SurfaceMesh {
 [[nodiscard]] bool is_mesh_format(std::string_view extension) noexcept;
 
 /// Writes the mesh atomically in the format named by the path's extension (case
-/// does not matter). Faces are the grid cells, counterclockwise in (u, v) so that
+/// does not matter). Every thread turns a block of its vertices, normals, faces or
+/// coordinates into the format's bytes while the block before is written; the
+/// bytes do not depend on the number of threads. Faces are the grid cells, counterclockwise in (u, v) so that
 /// their normals point along S_u x S_v. A cell with two coincident corners (next to
 /// a pole row) is written as a triangle, a cell with no area left is dropped; STL
 /// splits quads into two triangles and drops those of zero area. Structured
@@ -72,10 +74,12 @@ void write_surface_mesh(const std::filesystem::path& path, const SurfaceMesh& me
 
 /// The mesh of a surface on the grid us × vs written as
 /// write_surface_mesh(path, sample_mesh(surface, us, vs, progress)) writes it, the
-/// same bytes. A .vts is written without the mesh in memory: a block of columns
-/// at a time, evaluated by every thread while the block before is written (memory
-/// for two blocks of about 2^15 points; `progress` is then called from one thread at
-/// a time, not always the calling one); the other formats sample the mesh first.
+/// same bytes. A .vts or a legacy .vtk is written without the mesh in memory: a
+/// block of columns at a time, evaluated by every thread while the block before is
+/// written (memory for two blocks of about 2^15 points; `progress` is then called
+/// from one thread at a time, not always the calling one); the other formats sample
+/// the mesh first (.obj, .ply and .stl number their vertices and faces across the
+/// whole grid).
 ///
 /// Example:
 /// @code
