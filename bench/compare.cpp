@@ -29,6 +29,7 @@
 //   eval_coons_volume        eval --grid 200, six faces interpolating 128² grids
 //   eval_hermite_volume, eval_trilinear  eval --grid 200 (eight corners: no data files)
 //   mesh                     mesh --res 1000x1000 of eval_coons's spec, to .vts
+//   mesh_formats             the same mesh to .vtk, .ply, .stl, .obj and .xyz
 //   build_npz                build -o .npz of an --npz-size² interpolation (8192²: a
 //                            1.6 GB .npy), and eval --grid of the same spec; peak RSS
 //                            against input + output bytes
@@ -61,6 +62,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
@@ -74,6 +76,7 @@
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <locale>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -159,7 +162,7 @@ int max_threads() {
 const std::vector<std::string> process_jobs{"eval_interpolate",   "eval_coons",          "eval_coons_hermite",
                                             "eval_gordon",        "eval_network",        "eval_interpolate_volume",
                                             "eval_coons_volume",  "eval_hermite_volume", "eval_trilinear",
-                                            "mesh",               "build_npz"};
+                                            "mesh",               "mesh_formats",        "build_npz"};
 
 struct Options {
   std::vector<std::size_t> sizes{256, 1024, 2048, 4096};
@@ -205,7 +208,7 @@ const char* usage =
     "--jobs processes stands for the whole-process jobs of every construction:\n"
     "  eval_interpolate, eval_coons, eval_coons_hermite, eval_gordon, eval_network,\n"
     "  eval_interpolate_volume, eval_coons_volume, eval_hermite_volume, eval_trilinear,\n"
-    "  mesh, build_npz (each may be named alone). Every job runs by default.\n";
+    "  mesh, mesh_formats, build_npz (each may be named alone). Every job runs by default.\n";
 
 Options parse(int argc, char** argv) {
   Options o;
@@ -1622,33 +1625,179 @@ std::pair<std::vector<double>, std::vector<double>> read_vts(const fs::path& pat
   return {array("Points"), array("Normals")};
 }
 
+// A surface mesh's points and normals (three doubles each) as a file holds them,
+// and the order of its vertices: u fastest (the structured formats) or v fastest
+// (the vertex lists of .obj and .ply). Empty points when the file is not of the form
+// interpatch writes.
+struct MeshRead {
+  std::vector<double> points, normals;
+  bool u_fastest = true;
+};
+
+std::string file_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {(std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()};
+}
+
+template <class T>
+T from_bytes(const std::string& s, std::size_t at, std::endian order) {
+  char b[sizeof(T)];
+  std::memcpy(b, s.data() + at, sizeof(T));
+  if (order != std::endian::native) std::reverse(b, b + sizeof(T));
+  T v;
+  std::memcpy(&v, b, sizeof(T));
+  return v;
+}
+
+// Legacy VTK: big-endian points after "POINTS n double", normals after "NORMALS".
+MeshRead read_legacy_vtk(const fs::path& path, std::size_t n) {
+  const std::string s = file_bytes(path);
+  MeshRead m;
+  auto array = [&](const std::string& line, std::vector<double>& out) {
+    const std::size_t at = s.find(line);
+    if (at == std::string::npos || at + line.size() + 24 * n > s.size()) return;
+    out.resize(3 * n);
+    for (std::size_t k = 0; k < 3 * n; ++k) out[k] = from_bytes<double>(s, at + line.size() + 8 * k, std::endian::big);
+  };
+  array("POINTS " + std::to_string(n) + " double\n", m.points);
+  array("NORMALS normals double\n", m.normals);
+  return m;
+}
+
+// PLY, binary little endian: each vertex x y z nx ny nz as doubles after the header.
+MeshRead read_ply(const fs::path& path, std::size_t n) {
+  const std::string s = file_bytes(path);
+  MeshRead m;
+  m.u_fastest = false;
+  const std::size_t at = s.find("end_header\n");
+  if (s.find("element vertex " + std::to_string(n) + "\n") == std::string::npos || at == std::string::npos ||
+      at + 11 + 48 * n > s.size())
+    return m;
+  for (std::size_t q = 0; q < n; ++q)
+    for (std::size_t c = 0; c < 6; ++c)
+      (c < 3 ? m.points : m.normals).push_back(from_bytes<double>(s, at + 11 + 48 * q + 8 * c, std::endian::little));
+  return m;
+}
+
+// Binary STL: the corners of every triangle (single precision); the facet normals
+// are the triangles', not the surface's, and are left out. `triangles` is what the
+// header must count.
+MeshRead read_stl(const fs::path& path, std::size_t triangles) {
+  const std::string s = file_bytes(path);
+  MeshRead m;
+  if (s.size() != 84 + 50 * triangles || from_bytes<std::uint32_t>(s, 80, std::endian::little) != triangles) return m;
+  for (std::size_t t = 0; t < triangles; ++t)
+    for (std::size_t c = 0; c < 9; ++c) m.points.push_back(from_bytes<float>(s, 84 + 50 * t + 12 + 4 * c, std::endian::little));
+  return m;
+}
+
+// Wavefront OBJ: the "v" and "vn" lines.
+MeshRead read_obj(const fs::path& path) {
+  std::ifstream in(path);
+  MeshRead m;
+  m.u_fastest = false;
+  for (std::string line; std::getline(in, line);) {
+    const bool v = line.rfind("v ", 0) == 0, vn = line.rfind("vn ", 0) == 0;
+    if (!v && !vn) continue;
+    std::istringstream fields(line.substr(v ? 2 : 3));
+    fields.imbue(std::locale::classic());
+    for (int c = 0; c < 3; ++c) {
+      double x = std::numeric_limits<double>::quiet_NaN();
+      fields >> x;
+      (v ? m.points : m.normals).push_back(x);
+    }
+  }
+  return m;
+}
+
+// Plot3D, ASCII, one grid: every x, every y, every z, u fastest.
+MeshRead read_plot3d(const fs::path& path, std::size_t n) {
+  std::ifstream in(path);
+  in.imbue(std::locale::classic());
+  MeshRead m;
+  std::size_t grids = 0, ni = 0, nj = 0, nk = 0;
+  in >> grids >> ni >> nj >> nk;
+  if (grids != 1 || ni * nj * nk != n) return m;
+  std::vector<double> v(3 * n);
+  for (double& x : v) in >> x;
+  if (!in) return m;
+  m.points.resize(3 * n);
+  for (std::size_t q = 0; q < n; ++q)
+    for (std::size_t c = 0; c < 3; ++c) m.points[3 * q + c] = v[c * n + q];
+  return m;
+}
+
+// The check of a mesh of the Coons patch of write_coons_data on k × k vertices:
+// every point on the surface, every normal the surface's (to the error of the
+// boundary curves), the corners in place. Without normals (STL), no normal check;
+// without an order (STL's triangles), no corner check.
+double mesh_error(const MeshRead& m, std::size_t k, double diag, bool corners_in_place) {
+  const ib::GraphSurface shape{};
+  const auto corners = corners_of(shape);
+  const auto& p = m.points;
+  const std::size_t n = p.size() / 3;
+  if (p.empty() || (!m.normals.empty() && m.normals.size() != p.size()) ||
+      !std::all_of(p.begin(), p.end(), [](double x) { return std::isfinite(x); }))
+    return 1.0;
+  double e = 0;
+  if (corners_in_place) {
+    if (n != k * k) return 1.0;
+    // Corner (u, v) = (1, 0) is vertex k − 1 when u is fastest, vertex k(k − 1) when v is.
+    const std::size_t u1v0 = m.u_fastest ? k - 1 : k * (k - 1), u0v1 = m.u_fastest ? k * (k - 1) : k - 1;
+    e = std::max({dist(corners[0], p.data()), dist(corners[2], p.data() + 3 * u1v0), dist(corners[1], p.data() + 3 * u0v1),
+                  dist(corners[3], p.data() + 3 * (k * k - 1))}) / diag;
+  }
+  for (std::size_t q = 0; q < n; ++q) {
+    e = std::max(e, shape.height_error(p.data() + 3 * q) / diag);
+    if (!m.normals.empty()) e = std::max(e, dist(shape.normal_above(p[3 * q], p[3 * q + 1]), m.normals.data() + 3 * q));
+  }
+  return e;
+}
+
 void job_mesh(const Options& o, const std::string& self, const fs::path& dir) {
   const std::size_t m = o.coons_points, k = o.eval_points;
   const auto d = write_coons_data(dir, m);
-  const ib::GraphSurface shape{};
-  const auto corners = corners_of(shape);
-  // Every point on the surface, every normal the surface's (to the error of the
-  // boundary curves), the corners in place (u fastest).
   // The normals' error (a difference of unit vectors) reaches 7e-8 at the corners,
   // where the boundary curves' derivatives are least accurate.
   auto check = [=](const fs::path& out) {
     const auto [points, normals] = read_vts(out, k * k);
-    if (points.empty() || normals.empty() ||
-        !std::all_of(points.begin(), points.end(), [](double x) { return std::isfinite(x); }))
-      return 1.0;
-    double e = std::max({dist(corners[0], points.data()), dist(corners[2], points.data() + 3 * (k - 1)),
-                         dist(corners[1], points.data() + 3 * k * (k - 1)), dist(corners[3], points.data() + 3 * (k * k - 1))}) / d.diag;
-    for (std::size_t q = 0; q < k * k; ++q) {
-      const double* p = points.data() + 3 * q;
-      e = std::max({e, shape.height_error(p) / d.diag, dist(shape.normal_above(p[0], p[1]), normals.data() + 3 * q)});
-    }
-    return e;
+    return mesh_error({points, normals, true}, k, d.diag, true);
   };
   const std::string res = std::to_string(k) + "x" + std::to_string(k);
   run_process_job(o, self,
                   {"mesh", "mesh of the linear Coons patch (eval_coons's spec), " + res + " vertices with normals, .vts",
                    m, dir, d.inputs, {"mesh", d.spec.string(), "--res", res, "-o", (dir / "interpatch_out.vts").string()},
                    dir / "interpatch_out.vts", check, 1e-6});
+}
+
+// The same mesh in the other formats, each against pure I/O of the bytes it writes.
+void job_mesh_formats(const Options& o, const std::string& self, const fs::path& dir) {
+  const std::size_t m = o.coons_points, k = o.eval_points, n = k * k, triangles = 2 * (k - 1) * (k - 1);
+  const auto d = write_coons_data(dir, m);
+  const std::string res = std::to_string(k) + "x" + std::to_string(k);
+  struct Format {
+    const char* ext;
+    const char* what;
+    std::function<MeshRead(const fs::path&)> read;
+  };
+  const Format formats[] = {
+      {".vtk", "legacy VTK, binary, points and normals", [=](const fs::path& f) { return read_legacy_vtk(f, n); }},
+      {".ply", "binary PLY, vertices with normals, quads", [=](const fs::path& f) { return read_ply(f, n); }},
+      {".stl", "binary STL, two triangles a cell", [=](const fs::path& f) { return read_stl(f, triangles); }},
+      {".obj", "Wavefront OBJ text: vertices, texture coordinates, normals, quads", [](const fs::path& f) { return read_obj(f); }},
+      {".xyz", "Plot3D ASCII, coordinates as the shortest text that reads back exactly", [=](const fs::path& f) { return read_plot3d(f, n); }},
+  };
+  for (const Format& f : formats) {
+    const fs::path out = dir / (std::string("interpatch_out") + f.ext);
+    const bool stl = std::string_view(f.ext) == ".stl";
+    // STL holds single precision: its points are on the surface to 6e-8 of their size
+    // (float rounding), within the tolerance of the normals' error (7e-8, job mesh).
+    auto check = [=, read = f.read](const fs::path& file) { return mesh_error(read(file), k, d.diag, !stl); };
+    run_process_job(o, self,
+                    {std::string("mesh") + f.ext, "mesh of the linear Coons patch, " + res + " vertices, " + f.what, m, dir,
+                     d.inputs, {"mesh", d.spec.string(), "--res", res, "-o", out.string()}, out, check, 1e-6});
+    fs::remove(out);
+  }
 }
 
 void job_build_npz(const Options& o, const std::string& self, const fs::path& dir) {
@@ -1721,6 +1870,7 @@ void job_processes(const Options& o, const std::string& self) {
     else if (name == "eval_hermite_volume") job_eval_hermite_volume(o, self, dir);
     else if (name == "eval_trilinear") job_eval_trilinear(o, self, dir);
     else if (name == "mesh") job_mesh(o, self, dir);
+    else if (name == "mesh_formats") job_mesh_formats(o, self, dir);
     else job_build_npz(o, self, dir);
   }
 }

@@ -558,7 +558,7 @@ TEST(Mesh, Plot3dAsciiWholeMultiGrid) {
   EXPECT_EQ(g.dims, (std::array<std::size_t, 3>{nu, nv, 1}));
   ASSERT_EQ(g.points.size(), nu * nv);
   for (std::size_t j = 0; j < nv; ++j)
-    for (std::size_t i = 0; i < nu; ++i) EXPECT_EQ(g.points[i + nu * j], m.points(i, j));  // 17 digits: exact
+    for (std::size_t i = 0; i < nu; ++i) EXPECT_EQ(g.points[i + nu * j], m.points(i, j));  // shortest round-trip text: exact
   // Four values a line, each coordinate starting a line of its own.
   const auto l = lines(text);
   const std::size_t per_coordinate = (nu * nv + 3) / 4;
