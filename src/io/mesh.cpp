@@ -88,7 +88,6 @@ class Sink {
   Sink& big(T v) {
     return bytes(v, std::endian::big);
   }
-  void end_record() { maybe_flush(); }
   /// Values (points, three doubles each, or doubles) p[0], p[stride], ..., n of
   /// them, in the given byte order.
   template <class T>
@@ -212,12 +211,6 @@ class Vertices {
   [[nodiscard]] std::size_t cols() const noexcept { return cols_; }
   [[nodiscard]] std::size_t count() const noexcept { return rows_ * cols_; }
   [[nodiscard]] const PointGrid& grid() const noexcept { return g_; }
-  /// Visits every vertex written, in order, with its row and column.
-  template <class F>
-  void each(F&& f) const {
-    for (std::size_t i = 0; i < rows_; ++i)
-      for (std::size_t j = 0; j < cols_; ++j) f(i, j);
-  }
   /// The row (column) of vertices grid row (column) i stands for: i itself, or 0 for
   /// the last one of a closed direction.
   [[nodiscard]] std::size_t row(std::size_t i) const noexcept { return i == rows_ ? 0 : i; }
