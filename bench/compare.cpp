@@ -1600,12 +1600,17 @@ void job_eval_trilinear(const Options& o, const std::string& self, const fs::pat
                    volume_check(volume_grid, diagonal(c.data(), c.size()), &ib::TrilinearBlock::point), 1e-12});
 }
 
+// A whole file.
+std::string file_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {(std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()};
+}
+
 // The points and normals of a surface mesh in a .vts (VTK XML, raw appended arrays,
 // UInt64 byte counts, u index fastest), as interpatch writes them; empty when the
 // file is not of that form.
 std::pair<std::vector<double>, std::vector<double>> read_vts(const fs::path& path, std::size_t points) {
-  std::ifstream in(path, std::ios::binary);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text = file_bytes(path);
   const std::size_t data = text.find("<AppendedData encoding=\"raw\">");
   const std::size_t start = data == std::string::npos ? data : text.find('_', data);
   auto array = [&](const std::string& name) {
@@ -1633,11 +1638,6 @@ struct MeshRead {
   std::vector<double> points, normals;
   bool u_fastest = true;
 };
-
-std::string file_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {(std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()};
-}
 
 template <class T>
 T from_bytes(const std::string& s, std::size_t at, std::endian order) {

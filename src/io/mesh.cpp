@@ -121,10 +121,11 @@ class Sink {
 };
 
 /// Writes records 0 .. count − 1 to `os` in order, record(sink, r) putting record r
-/// into the sink: the bytes of that loop; returns how many bytes that was. Every thread turns a block of records into
-/// bytes, a piece of about 64 KiB each into a buffer of its own, while one thread
-/// writes the block before (detail::pipeline): text and packed binary cost more to
-/// make than to write. `record_bytes` is about what one record takes.
+/// into the sink: the bytes of that loop; returns how many bytes that was. Every
+/// thread turns a block of records into bytes, a piece of about 64 KiB each into a
+/// buffer of its own, while one thread writes the block before (detail::pipeline):
+/// text and packed binary cost more to make than to write. `record_bytes` is about
+/// what one record takes.
 template <class Record>
 std::uint64_t write_records(std::ostream& os, std::size_t count, std::size_t record_bytes, Record&& record) {
   constexpr std::size_t piece_bytes = std::size_t{1} << 16, block_pieces = 16;
@@ -565,8 +566,8 @@ void write_vts(std::ostream& os, const Structured& g) {
 }
 
 /// Plot3D's ASCII values, four to a line: value(t) for t < n, i fastest. Each is the
-/// shortest text that reads back as the same double (a third of the time of 17
-/// digits, and shorter).
+/// shortest text that reads back as the same double: exact, and no longer than 17
+/// digits.
 template <class Value>
 void write_plot3d_values(std::ostream& os, std::size_t n, Value&& value) {
   write_records(os, n, 20, [&](Sink& s, std::size_t t) {
