@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "detail/collocation.hpp"
+#include "detail/parallel.hpp"
 #include "detail/text.hpp"
 
 namespace interpatch {
@@ -344,29 +345,19 @@ std::vector<BSplineCurve> make_compatible(std::span<const BSplineCurve> curves) 
   std::vector<BSplineCurve> out;
   out.reserve(curves.size());
   for (const auto& c : curves) out.push_back(c.elevated(p - c.degree()));
-  // Each curve refined on its own, the curves shared between the threads (an
-  // exception must not leave the parallel loop: the first in order is rethrown).
-  const auto count = static_cast<long long>(out.size());
-  std::vector<std::exception_ptr> failed(out.size());
-#pragma omp parallel for schedule(dynamic) if (count > 1)
-  for (long long k = 0; k < count; ++k) {
-    auto& c = out[static_cast<std::size_t>(k)];
-    try {
-      std::vector<double> missing;
-      const auto have = c.knots().interior_breaks();
-      std::size_t j = 0;
-      for (const auto& [t, m] : merged) {
-        while (j < have.size() && have[j].first < t) ++j;
-        const int h = j < have.size() && have[j].first == t ? have[j].second : 0;
-        missing.insert(missing.end(), static_cast<std::size_t>(m - h), t);
-      }
-      if (!missing.empty()) c = c.refined(missing);
-    } catch (...) {
-      failed[static_cast<std::size_t>(k)] = std::current_exception();
+  // Each curve refined on its own, the curves shared between the threads.
+  detail::parallel_for(out.size(), out.size() > 1, detail::Share::one_by_one, [&](std::size_t k) {
+    auto& c = out[k];
+    std::vector<double> missing;
+    const auto have = c.knots().interior_breaks();
+    std::size_t j = 0;
+    for (const auto& [t, m] : merged) {
+      while (j < have.size() && have[j].first < t) ++j;
+      const int h = j < have.size() && have[j].first == t ? have[j].second : 0;
+      missing.insert(missing.end(), static_cast<std::size_t>(m - h), t);
     }
-  }
-  for (const std::exception_ptr& e : failed)
-    if (e) std::rethrow_exception(e);
+    if (!missing.empty()) c = c.refined(missing);
+  });
   return out;
 }
 

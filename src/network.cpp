@@ -9,6 +9,7 @@
 #include <string>
 
 #include "blended_terms.hpp"
+#include "detail/parallel.hpp"
 #include "detail/text.hpp"
 #include "interpatch/evaluate.hpp"
 #include "interpatch/interpolate.hpp"
@@ -67,6 +68,18 @@ double control_diagonal(const CurveNetwork& n) {
           hi[k] = std::max(hi[k], p[k]);
         }
   return norm(hi - lo);
+}
+
+// How far apart two evaluations of the same point can round: a few units in the last
+// place of the largest coordinate. A small part far from the origin (0.1 across at
+// 1e8, where doubles are 1.5e-8 apart) cannot be held to 1e-7 of its diagonal: its
+// curves, interpolated and evaluated there, meet only to a few of those steps.
+double rounding_floor(const CurveNetwork& n) {
+  double m = 0;
+  for (const auto* list : {&n.u_curves, &n.v_curves})
+    for (const auto& c : *list)
+      for (const Vec3& p : c.control_points()) m = std::max({m, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+  return 16 * std::numeric_limits<double>::epsilon() * m;
 }
 
 // Cardinal functions φ_i(t_k) = δ_ik over the node parameters t; periodic over
@@ -188,6 +201,10 @@ struct Prepared {
   std::array<std::vector<bool>, 2> reshaped;       // along[a][j] is not input[a][j] (closed with a C0 seam)
   double tol = 0;       // how far curves may miss each other (NetworkOptions::tolerance)
   double diagonal = 0;  // of the control points' bounding box
+  double rounding = 0;  // rounding_floor
+  double strict = 0;    // 1e-7 of the diagonal, or the rounding floor where that is larger
+  // How near curves must be, how near a fit: the tolerance, never below the rounding.
+  [[nodiscard]] double fit() const { return std::max(std::min(tol, strict), rounding); }
   std::vector<std::string> notes;
   std::function<std::string(int, std::size_t)> curve_name;
   [[nodiscard]] std::string name(int family, std::size_t index) const {
@@ -199,7 +216,9 @@ Prepared prepare(const CurveNetwork& n, const NetworkOptions& o) {
   check_counts(n);
   Prepared r;
   r.diagonal = control_diagonal(n);
-  const double tol = r.tol = o.tolerance ? *o.tolerance : 1e-7 * r.diagonal;
+  r.rounding = rounding_floor(n);
+  r.strict = std::max(1e-7 * r.diagonal, r.rounding);
+  const double tol = r.tol = o.tolerance ? *o.tolerance : r.strict;
   r.closed = n.periodic;
   r.curve_name = o.curve_name;
   r.input = {on_unit(n.u_curves), on_unit(n.v_curves)};
@@ -420,7 +439,7 @@ void arrange(const Prepared& n, Arrangement& r, int a, const std::vector<double>
 
 Arrangement arrangement(const Prepared& n, const CurveNetwork& net) {
   Arrangement r;
-  const double strict = std::min(n.tol, 1e-7 * n.diagonal);
+  const double strict = n.fit();
   r.keep = 1e-3 * strict;
   r.snap = strict;
   const auto& U = n.along[0];
@@ -542,7 +561,7 @@ std::vector<BSplineCurve> place_curves(const Prepared& n, const Arrangement& r, 
   const auto az = static_cast<std::size_t>(a), bz = 1 - az;
   const auto& along = n.along[az];
   const bool closed = n.closed[az];
-  const double target = 0.5 * std::min(n.tol, 1e-7 * n.diagonal);
+  const double target = 0.5 * n.fit();
   std::vector<std::optional<BSplineCurve>> out(along.size());
   std::vector<std::size_t> redo;  // positions of the curves to re-express
   std::vector<detail::FitJob> jobs;
@@ -555,39 +574,29 @@ std::vector<BSplineCurve> place_curves(const Prepared& n, const Arrangement& r, 
   }
   // How far each kept curve's line of the surface is from the given curve: a few
   // points per knot interval, the curves shared between the threads.
-  const auto count = static_cast<long long>(along.size());
-  std::vector<std::exception_ptr> failed(along.size());  // an exception must not leave the parallel loop
-#pragma omp parallel for schedule(dynamic) if (count > 1)
-  for (long long kk = 0; kk < count; ++kk) {
-    const auto k = static_cast<std::size_t>(kk);
-    if (!mine.keep[k]) continue;
+  detail::parallel_for(along.size(), along.size() > 1, detail::Share::one_by_one, [&](std::size_t k) {
+    if (!mine.keep[k]) return;
     const std::size_t j = r.order[az][k];
     const BSplineCurve& given = n.input[az][j];
-    try {
-      const std::vector<double> own = detail::check_params(along[j].knots());
-      const std::vector<Vec3> line = detail::points_at(along[j], own), g = detail::points_at(G[k], own);
-      std::vector<double> at = own;
-      if (closed)
-        for (double& u : at) u -= std::floor(u);
-      // A curve taken as given is its line's curve: its points are those already
-      // found, but where a closed curve's parameter wrapped.
-      std::vector<Vec3> want;
-      if (n.reshaped[az][j]) {
-        want = detail::points_at(given, at);
-      } else {
-        want = line;
-        for (std::size_t i = 0; i < at.size(); ++i)
-          if (at[i] != own[i]) want[i] = given.point(at[i]);
-      }
-      double d = 0;
-      for (std::size_t i = 0; i < at.size(); ++i) d = std::max(d, distance(line[i] + g[i], want[i]));
-      report[j].distance = d;
-    } catch (...) {
-      failed[k] = std::current_exception();
+    const std::vector<double> own = detail::check_params(along[j].knots());
+    const std::vector<Vec3> line = detail::points_at(along[j], own), g = detail::points_at(G[k], own);
+    std::vector<double> at = own;
+    if (closed)
+      for (double& u : at) u -= std::floor(u);
+    // A curve taken as given is its line's curve: its points are those already
+    // found, but where a closed curve's parameter wrapped.
+    std::vector<Vec3> want;
+    if (n.reshaped[az][j]) {
+      want = detail::points_at(given, at);
+    } else {
+      want = line;
+      for (std::size_t i = 0; i < at.size(); ++i)
+        if (at[i] != own[i]) want[i] = given.point(at[i]);
     }
-  }
-  for (const std::exception_ptr& e : failed)
-    if (e) std::rethrow_exception(e);
+    double d = 0;
+    for (std::size_t i = 0; i < at.size(); ++i) d = std::max(d, distance(line[i] + g[i], want[i]));
+    report[j].distance = d;
+  });
   for (std::size_t k = 0; k < along.size(); ++k) {
     const std::size_t j = r.order[az][k];
     const BSplineCurve& given = n.input[az][j];
@@ -675,7 +684,7 @@ Built build(const CurveNetwork& network, const NetworkOptions& options, bool fit
       c.map.period = n.closed[az] ? hi - lo : 0.0;
     }
   }
-  const double strict = 1e-7 * n.diagonal;
+  const double strict = n.strict;
   std::vector<std::string> far;
   for (int a = 0; a < 2; ++a) {
     const auto& reports = a == 0 ? rep.u_curves : rep.v_curves;
@@ -751,8 +760,9 @@ Built build(const CurveNetwork& network, const NetworkOptions& options, bool fit
   if (!far.empty()) {
     std::string s;
     for (const auto& f : far) s += (s.empty() ? "" : ", ") + f;
-    t->notes.push_back(detail::cat("the surface departs from ", s, ": more than 1e-7 of the diagonal (", strict,
-                                   "); the tolerance ", n.tol, " lets curves miss each other by that much"));
+    t->notes.push_back(detail::cat("the surface departs from ", s, ": more than ",
+                                   n.strict > 1e-7 * n.diagonal ? "the rounding of its coordinates" : "1e-7 of the diagonal",
+                                   " (", strict, "); the tolerance ", n.tol, " lets curves miss each other by that much"));
   }
   return {BlendedSurface(std::move(t)), std::move(rep)};
 }

@@ -23,6 +23,14 @@ double wrap_unit(double t) {
   return r < 1.0 ? r : 0.0;  // a tiny negative t rounds to 1
 }
 
+// A curve's parameter for the surface's: in a closed direction a value just past an
+// end (rounding in the map, or an open curve whose ends meet) is taken around the
+// curve, not refused as outside [0, 1]; in an open one it is held at the end.
+double on_curve(double x, bool closed) {
+  if (!closed) return std::clamp(x, 0.0, 1.0);
+  return x >= 0.0 && x <= 1.0 ? x : wrap_unit(x);
+}
+
 // Gauss–Newton on F(s, t) = U(s) − V(t) from (s, t).
 // With `hold`, a parameter at an open curve's end that a step would push past it is
 // held there, and the other moves alone.
@@ -429,8 +437,7 @@ OneFit fit_one(const BSplineCurve& c, const Reparametrization& map, const std::v
   const std::size_t n = sites.size(), w = rational ? 4 : 3;
   std::vector<double> b(n * w);
   for (std::size_t k = 0; k < n; ++k) {
-    const double x = map(closed ? wrap_unit(sites[k]) : sites[k]);
-    const double y = closed ? x : std::clamp(x, 0.0, 1.0);
+    const double y = on_curve(map(closed ? wrap_unit(sites[k]) : sites[k]), closed);
     // A rational curve in homogeneous coordinates: Σ N w P and Σ N w.
     const Vec3 q = c.point(y);
     const double wy = rational ? den->point(y).x : 1.0;
@@ -528,7 +535,7 @@ Checked check_fit(const FitJob& job, const BSplineCurve& fit, const std::vector<
   for (std::size_t i = 0; i + 1 < sp.size(); ++i) {
     for (int q = 0; q <= (i + 2 == sp.size() ? 4 : 3); ++q) {
       const double u = sp[i] + (sp[i + 1] - sp[i]) * q / 4;
-      const double x = job.map(u), y = closed ? x : std::clamp(x, 0.0, 1.0);
+      const double y = on_curve(job.map(u), closed);
       const Vec3 d = fit.point(u), c = job.c->point(y);
       const double here = distance(d, c);
       err[i] = std::max(err[i], here);
@@ -629,22 +636,18 @@ std::optional<std::vector<Refit>> fit_group(const std::vector<FitJob>& jobs, con
       while (h < 60 && std::ldexp(static_cast<double>(interior.size()), h + 1) <= static_cast<double>(all)) ++h;
       give_up = target * std::pow(8.0, h);
     }
-    // Every curve fitted and checked, in parallel: fit_one does not throw, and the
-    // check only reads.
+    // Every curve fitted and checked, in parallel (the check only reads).
     const auto sp = spans_of(interior);
     std::vector<OneFit> fits(m);
     std::vector<std::vector<double>> err(m, std::vector<double>(sp.size(), 0.0));
     std::vector<Checked> checked(m);
     std::atomic<bool> stop{false};
-    const auto count = static_cast<long long>(m);
-#pragma omp parallel for schedule(dynamic, 1) if (m * sp.size() * span_work >= parallel_min_work)
-    for (long long jj = 0; jj < count; ++jj) {
-      const auto j = static_cast<std::size_t>(jj);
+    parallel_for(m, m * sp.size() * span_work >= parallel_min_work, Share::one_by_one, [&](std::size_t j) {
       const FitJob& job = jobs[members[j]];
-      if (stop) continue;
+      if (stop) return;
       fits[j] = fit_one(*job.c, job.map, nodes, closed, interior);
       if (fits[j].curve) checked[j] = check_fit(job, *fits[j].curve, sp, closed, target, give_up, err[j], stop);
-    }
+    });
     // Whether some curve was too far to go on is the same on any number of threads:
     // the curve that stopped the others stops the check on one thread as well.
     if (stop) return std::nullopt;
@@ -768,19 +771,9 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
   if (m * union_of_own.size() * span_work <= merge_work)
     return std::move(*fit_group(jobs, family, union_of_own, nodes, closed, target, 0, nullptr));
   std::vector<std::optional<Refit>> fitted(m);
-  std::vector<std::exception_ptr> thrown(m);
-  const auto count = static_cast<long long>(m);
-#pragma omp parallel for schedule(dynamic, 1) if (all * span_work >= parallel_min_work)
-  for (long long jj = 0; jj < count; ++jj) {
-    const auto j = static_cast<std::size_t>(jj);
-    try {
-      fitted[j] = std::move(fit_group(jobs, {j}, own[j], nodes, closed, target, 0, &union_of_own)->front());
-    } catch (...) {
-      thrown[j] = std::current_exception();
-    }
-  }
-  for (const auto& e : thrown)
-    if (e) std::rethrow_exception(e);
+  parallel_for(m, all * span_work >= parallel_min_work, Share::one_by_one, [&](std::size_t j) {
+    fitted[j] = std::move(fit_group(jobs, {j}, own[j], nodes, closed, target, 0, &union_of_own)->front());
+  });
   std::vector<Refit> out;
   out.reserve(m);
   for (auto& f : fitted) out.push_back(std::move(*f));

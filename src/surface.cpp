@@ -47,13 +47,10 @@ void Surface::evaluate_normals_into(std::span<const double> us, std::span<const 
   for (std::size_t i0 = 0; i0 < nu; i0 += block) {
     const std::size_t nb = std::min(block, nu - i0);
     const auto d = evaluate_derivatives(us.subspan(i0, nb), vs);
-    const auto cells = static_cast<long long>(nb * nv);
-#pragma omp parallel for schedule(static) if (nb * nv >= detail::parallel_min_work / 16)
-    for (long long c = 0; c < cells; ++c) {
-      const auto q = static_cast<std::size_t>(c);
+    detail::parallel_for(nb * nv, nb * nv >= detail::parallel_min_work / 16, detail::Share::blocks, [&](std::size_t q) {
       points[i0 * nv + q] = d.data()[q].s;
       normals[i0 * nv + q] = unit_normal(d.data()[q]);
-    }
+    });
     if (progress) progress(static_cast<double>(i0 + nb) / static_cast<double>(nu));
   }
   if (progress && nu == 0) progress(1.0);
@@ -93,13 +90,14 @@ void Surface::evaluate_into(std::span<const double> us, std::span<const double> 
   detail::check_unit_parameters(us, "u");
   detail::check_unit_parameters(vs, "v");
   const std::size_t nv = vs.size();
-  const auto nu = static_cast<long long>(us.size());
-  for (long long r0 = 0; r0 < nu; r0 += 64) {
-    const long long r1 = std::min(nu, r0 + 64);
-#pragma omp parallel for schedule(static) if (us.size() * nv >= detail::parallel_min_work / 16)
-    for (long long i = r0; i < r1; ++i)
-      for (std::size_t j = 0; j < nv; ++j)
-        out[static_cast<std::size_t>(i) * nv + j] = point(us[static_cast<std::size_t>(i)], vs[j]);
+  // point() of a surface of the user's own may throw: through parallel_for.
+  const std::size_t nu = us.size();
+  for (std::size_t r0 = 0; r0 < nu; r0 += 64) {
+    const std::size_t r1 = std::min(nu, r0 + 64);
+    detail::parallel_for(r1 - r0, nu * nv >= detail::parallel_min_work / 16, detail::Share::blocks, [&](std::size_t k) {
+      const std::size_t i = r0 + k;
+      for (std::size_t j = 0; j < nv; ++j) out[i * nv + j] = point(us[i], vs[j]);
+    });
     if (progress) progress(static_cast<double>(r1) / static_cast<double>(nu));
   }
 }
@@ -110,11 +108,10 @@ Grid<SurfaceDerivatives, 2> Surface::evaluate_derivatives(std::span<const double
   detail::check_unit_parameters(vs, "v");
   require_memory(us.size() * vs.size(), sizeof(SurfaceDerivatives), "surface derivative grid");
   Grid<SurfaceDerivatives, 2> out({us.size(), vs.size()}, for_overwrite);
-  const auto nu = static_cast<long long>(us.size());
-#pragma omp parallel for schedule(static) if (us.size() * vs.size() >= detail::parallel_min_work / 16)
-  for (long long i = 0; i < nu; ++i)
-    for (std::size_t j = 0; j < vs.size(); ++j)
-      out(static_cast<std::size_t>(i), j) = derivatives(us[static_cast<std::size_t>(i)], vs[j]);
+  detail::parallel_for(us.size(), us.size() * vs.size() >= detail::parallel_min_work / 16, detail::Share::blocks,
+                       [&](std::size_t i) {
+                         for (std::size_t j = 0; j < vs.size(); ++j) out(i, j) = derivatives(us[i], vs[j]);
+                       });
   return out;
 }
 

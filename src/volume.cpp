@@ -42,13 +42,12 @@ void check_grid(const Volume& v, std::span<const double> us, std::span<const dou
 // which are thread-safe and allocation-free.
 template <class At>
 void pointwise(std::size_t nu, std::size_t nv, std::size_t nw, const progress_callback& progress, const At& at) {
-  const auto n = static_cast<long long>(nu);
-  for (long long r0 = 0; r0 < n; r0 += 16) {
-    const long long r1 = std::min(n, r0 + 16);
-#pragma omp parallel for schedule(static) if (nu * nv * nw >= detail::parallel_min_work / 16)
-    for (long long i = r0; i < r1; ++i)
+  for (std::size_t r0 = 0; r0 < nu; r0 += 16) {
+    const std::size_t r1 = std::min(nu, r0 + 16);
+    detail::parallel_for(r1 - r0, nu * nv * nw >= detail::parallel_min_work / 16, detail::Share::blocks, [&](std::size_t r) {
       for (std::size_t j = 0; j < nv; ++j)
-        for (std::size_t k = 0; k < nw; ++k) at(static_cast<std::size_t>(i), j, k);
+        for (std::size_t k = 0; k < nw; ++k) at(r0 + r, j, k);
+    });
     if (progress) progress(static_cast<double>(r1) / static_cast<double>(nu));
   }
 }

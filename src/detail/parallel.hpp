@@ -5,8 +5,12 @@
 // never change a result: every number is computed by the same operations.
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <cstring>
+#include <exception>
+#include <limits>
+#include <mutex>
 
 #include "interpatch/vec3.hpp"
 
@@ -34,6 +38,74 @@ inline std::size_t thread_count() noexcept {
 #else
   return 1;
 #endif
+}
+
+/// What went wrong on the threads of a parallel loop, carried out of it: an exception
+/// that leaves an OpenMP region calls std::terminate (an abort, on one thread too).
+/// Each iteration runs through `attempt`, which catches; the exception of the lowest
+/// index is kept, so the error reported is the same on any number of threads.
+class ParallelFailure {
+ public:
+  /// Runs f() for index i unless an index below i already failed; catches what f throws.
+  template <class F>
+  void attempt(std::size_t i, F&& f) noexcept {
+    if (i > first_.load(std::memory_order_relaxed)) return;
+    try {
+      f();
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      if (i < first_.load(std::memory_order_relaxed)) {
+        error_ = std::current_exception();
+        first_.store(i, std::memory_order_relaxed);
+      }
+    }
+  }
+  /// Whether some iteration has failed (the others may stop early).
+  bool failed() const noexcept { return first_.load(std::memory_order_relaxed) != none; }
+  /// Rethrows the kept exception, outside the region.
+  void rethrow() const {
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  static constexpr std::size_t none = std::numeric_limits<std::size_t>::max();
+  std::atomic<std::size_t> first_{none};
+  std::mutex mutex_;
+  std::exception_ptr error_;
+};
+
+/// How the iterations of parallel_for are shared: `blocks`, one contiguous block a
+/// thread (even work); `one_by_one`, each iteration to the next free thread (uneven work).
+enum class Share { blocks, one_by_one };
+
+/// body(i) for i in [0, n), on every thread when `parallel`. An exception thrown by
+/// body is caught on its thread and the one of the lowest index rethrown after the
+/// loop; iterations above a failed one are skipped. Every parallel loop of interpatch
+/// whose body can throw goes through this.
+template <class F>
+void parallel_for(std::size_t n, bool parallel, Share share, F&& body) {
+  ParallelFailure failure;
+  const auto count = static_cast<long long>(n);
+  if (share == Share::one_by_one) {
+#pragma omp parallel for schedule(dynamic, 1) if (parallel && n > 1)
+    for (long long k = 0; k < count; ++k) failure.attempt(static_cast<std::size_t>(k), [&] { body(static_cast<std::size_t>(k)); });
+  } else {
+#pragma omp parallel for schedule(static) if (parallel && n > 1)
+    for (long long k = 0; k < count; ++k) failure.attempt(static_cast<std::size_t>(k), [&] { body(static_cast<std::size_t>(k)); });
+  }
+  failure.rethrow();
+}
+
+/// body(thread, threads) once on each thread of a parallel region (once, as thread 0
+/// of 1, when not `parallel`), for regions that share their work themselves: the
+/// body must contain no barrier or worksharing construct that a failed thread would
+/// leave the others waiting at. Exceptions as in parallel_for, by thread.
+template <class F>
+void parallel_threads(bool parallel, F&& body) {
+  ParallelFailure failure;
+#pragma omp parallel if (parallel)
+  failure.attempt(static_cast<std::size_t>(thread_index()), [&] { body(static_cast<std::size_t>(thread_index()), thread_count()); });
+  failure.rethrow();
 }
 
 /// Whether any of n doubles is a NaN or an infinity, scanned without a branch (x * 0

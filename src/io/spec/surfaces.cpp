@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 
+#include "detail/parallel.hpp"
 #include "interpatch/coons.hpp"
 #include "interpatch/evaluate.hpp"
 #include "interpatch/network.hpp"
@@ -133,9 +134,7 @@ std::vector<CurveRead> read_curves(const std::vector<const json*>& items, const 
     }
     return out;
   }
-  const auto count = static_cast<long long>(n);
-#pragma omp parallel for schedule(dynamic)
-  for (long long k = 0; k < count; ++k) read(static_cast<std::size_t>(k));
+  interpatch::detail::parallel_for(n, true, interpatch::detail::Share::one_by_one, read);
   return out;
 }
 
