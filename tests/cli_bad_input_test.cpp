@@ -129,10 +129,19 @@ const char* const grid_file = "s.json";
 std::vector<Row> rows() {
   const std::string grid = grid_spec().dump();
   const std::string vol = example("trilinear").dump();
+  const std::string overflowing = json{{"type", "coons"},
+                                       {"boundary",
+                                        {{"v0", line({-1e308, -1e308, 0}, {1e308, -1e308, 0})},
+                                         {"v1", line({-1e308, 1e308, 0}, {1e308, 1e308, 1e308})},
+                                         {"u0", line({-1e308, -1e308, 0}, {-1e308, 1e308, 0})},
+                                         {"u1", line({1e308, -1e308, 0}, {1e308, 1e308, 1e308})}}}}
+                                      .dump();
   std::vector<Row> t = {
       // invalid JSON, types, fields
       {"InvalidJson", {{grid_file, "{\"type\": \"interpolate\",\n  \"points\": [[[0,0,0]],]\n}"}},
        {"build", grid_file, "-o", "out.json"}, 3, R"(s\.json:2:24: invalid JSON)", errc::invalid_json},
+      // a device that never ends: parsed as it is read, refused at its first byte
+      {"SpecFromADeviceOfZeros", {}, {"info", "/dev/zero"}, 3, R"(/dev/zero:1:1: invalid JSON)", errc::invalid_json},
       // bytes that are not text, and nesting beyond reason: quoted short and printable
       {"BinarySpec", {{grid_file, std::string("\x89PNG\r\n\x1a\n\0\0\0\rIHDR\xff\xfe", 18) + std::string(5000, '\x01')}},
        {"info", grid_file}, 3, R"(s\.json:1:1: invalid JSON: .*\\x89)", errc::invalid_json},
@@ -373,6 +382,20 @@ std::vector<Row> rows() {
        R"(cannot write 'out\.npy': it is a directory)", errc::file_unwritable, false},
       {"OutputCheckedBeforeTheSpec", {{grid_file, "{"}}, {"build", grid_file, "-o", "missing/out.json"}, 4,
        R"(cannot write 'missing/out\.json')", errc::file_unwritable, false},
+      // a construction whose arithmetic overflows: corners near 1e308, whose differences
+      // are infinite; refused at the first sample that is not finite, every output
+      {"EvalOverflowsToNpy", {{grid_file, overflowing}}, {"eval", grid_file, "--grid", "5", "-o", "out.npy"}, 3,
+       R"('out\.npy': the value at \[[0-9, ]+\] is -?(nan|inf): the construction's arithmetic left the range of a double)",
+       errc::not_finite, false},
+      {"EvalOverflowsToCsv", {{grid_file, overflowing}}, {"eval", grid_file, "--grid", "5", "-o", "out.csv"}, 3,
+       R"('out\.csv': the value at \[[0-9, ]+\] is -?(nan|inf))", errc::not_finite, false},
+      {"MeshOverflowsToObj", {{grid_file, overflowing}}, {"mesh", grid_file, "--res", "5x5", "-o", "out.obj"}, 3,
+       R"(the (points|normals) of 'out\.obj': the value at \[[0-9, ]+\] is -?(nan|inf))", errc::not_finite, false},
+      {"MeshOverflowsToVts", {{grid_file, overflowing}}, {"mesh", grid_file, "--res", "5x5", "-o", "out.vts"}, 3,
+       R"(the (points|normals) of 'out\.vts': the value at \[[0-9, ]+\] is -?(nan|inf))", errc::not_finite, false},
+      // the page shows the exact form's control net, which overflows first
+      {"ViewOverflows", {{grid_file, overflowing}}, {"view", grid_file, "-o", "out.html"}, 3,
+       R"(control point \[0\]\[0\] is \(-?nan)", errc::not_finite, false},
       // too large: refused before allocating. The bytes needed are an estimate that may
   // change; what stays is the size asked for, the bytes needed and the bytes available.
       {"EvalGridTooLarge", {{grid_file, grid}}, {"eval", grid_file, "--grid", "1000000", "-o", "out.npy"}, 5,

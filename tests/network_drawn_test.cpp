@@ -608,6 +608,98 @@ void expect_same_bits(const BSplineSurface& a, const BSplineSurface& b, const st
 // The fixtures were built by the version before networks as drawn (tools/reference/
 // make_network_legacy.py): their curves cross at common parameters, given or found,
 // so every curve is kept and the exact form is what it was, bit for bit.
+// Sections that are open polylines whose last point stops 1e-8 short of the first (a
+// closed direction all the same), crossed by straight lines through their corners: a
+// section's parameter for the surface's could land just past its end, which was
+// refused as outside [0, 1] on a thread of the parallel refit, and the exception
+// leaving the region aborted the process.
+TEST(NetworkDrawn, ClosedPolylineSectionsWhoseEndsNearlyMeet) {
+  auto g = test::rng(360);
+  for (int trial = 0; trial < 16; ++trial) {
+    const auto corners = static_cast<std::size_t>(test::uniform(g, 3, 8));
+    const auto sections = static_cast<std::size_t>(test::uniform(g, 2, 5));
+    std::vector<double> angle;
+    for (std::size_t i = 0; i < corners; ++i)
+      angle.push_back(2 * pi * (static_cast<double>(i) + test::uniform(g, 0.1, 0.9)) / static_cast<double>(corners));
+    std::vector<std::vector<Vec3>> ring(sections);
+    for (std::size_t k = 0; k < sections; ++k) {
+      for (double a : angle) {
+        const double r = 1 + 0.3 * test::uniform(g, 0, 1);
+        ring[k].push_back({r * std::cos(a), r * std::sin(a), static_cast<double>(k)});
+      }
+      ring[k].push_back(ring[k][0] + Vec3{1e-8, 0, 0});
+    }
+    CurveNetwork n;
+    n.periodic = {true, false};
+    CurveInterpolationOptions polyline;
+    polyline.degree = 1;
+    for (const auto& r : ring) n.u_curves.push_back(interpolate_curve(r, polyline).curve);
+    for (std::size_t i = 0; i < corners; ++i) {
+      std::vector<Vec3> line;
+      for (const auto& r : ring) line.push_back(r[i]);
+      n.v_curves.push_back(interpolate_curve(line, polyline).curve);
+    }
+    for (auto m : kMethods) {
+      const std::string what = "trial " + std::to_string(trial) + " " + method_name(m);
+      const NetworkSurface s = network_surface(n, {m, {}, {}});
+      const NetworkReport& r = s.report;
+      const double strict = strict_of(r);
+      EXPECT_LE(r.max_gap, 2e-8) << what;  // the 1e-8 short closing point, and rounding
+      // The corners, where both families put them; then every section along its line
+      // at 401 points (the polylines' kinks make the surface creased along the lines,
+      // where projecting by Newton steps would stall: measured along the line instead).
+      for (std::size_t j = 0; j < sections; ++j)
+        for (std::size_t i = 0; i < corners; ++i)
+          EXPECT_LE(distance(s.surface.point(r.u_params[i], r.v_params[j]), ring[j][i]), strict) << what;
+      for (std::size_t j = 0; j < sections; ++j)
+        for (double t : linspace(0, 1, 401)) {
+          const Vec3 on = s.surface.point(t, r.v_params[j]);
+          ASSERT_TRUE(is_finite(on)) << what;
+          EXPECT_LE(distance(on, n.u_curves[j].point(r.u_curves[j].map(t))), strict) << what << " section " << j;
+        }
+    }
+  }
+}
+
+// Curves through points of a smooth part far from the origin: at 1e8 doubles are
+// 1.5e-8 apart, and two curves interpolated there meet only to a few such steps, more
+// than 1e-7 of a small part's diagonal. Refused as curves that do not meet (0.1
+// across) or as a re-expression that found no knots (1 across); the floor of the
+// tolerance is now the rounding of the coordinates.
+TEST(NetworkDrawn, ASmallPartFarFromTheOriginBuilds) {
+  for (const double size : {1.0, 0.1})
+    for (const double offset : {1e8, -3e7, 1e6}) {
+      const auto f = [&](double u, double v) {
+        return Vec3{offset + size * u, offset + size * v, offset + size * 0.3 * std::sin(3 * u + 2 * v)};
+      };
+      CurveNetwork n;
+      // Crossings at points of both curves' data (multiples of 1/20).
+      const std::vector<double> us = linspace(0, 1, 5), vs{0, 0.35, 0.65, 1};
+      for (double v : vs) {
+        std::vector<Vec3> q;
+        for (double t : linspace(0, 1, 21)) q.push_back(f(t, v));
+        n.u_curves.push_back(interpolate_curve(q).curve);
+      }
+      for (double u : us) {
+        std::vector<Vec3> q;
+        for (double t : linspace(0, 1, 21)) q.push_back(f(u, t));
+        n.v_curves.push_back(interpolate_curve(q).curve);
+      }
+      for (auto m : kMethods) {
+        const std::string what = "size " + std::to_string(size) + " at " + std::to_string(offset) + " " + method_name(m);
+        const NetworkSurface s = network_surface(n, {m, {}, {}});
+        // The part's own corners, where the curves cross: within the rounding floor,
+        // 16 units in the last place of the largest coordinate.
+        const double floor = 16 * std::numeric_limits<double>::epsilon() * std::abs(offset) * 1.01;
+        for (std::size_t j = 0; j < vs.size(); ++j)
+          for (std::size_t i = 0; i < us.size(); ++i)
+            EXPECT_LE(distance(s.surface.point(s.report.u_params[i], s.report.v_params[j]), f(us[i], vs[j])),
+                      std::max(1e-7 * s.report.diagonal, floor))
+                << what;
+      }
+    }
+}
+
 TEST(NetworkDrawn, CommonParametersBuildBitForBitAsBefore) {
   const std::filesystem::path dir = std::filesystem::path(INTERPATCH_TEST_DATA) / "network_legacy";
   std::vector<std::filesystem::path> specs;

@@ -15,6 +15,7 @@
 
 #include "detail/text.hpp"
 #include "interpatch/io/atomic_file.hpp"
+#include "io/finite.hpp"
 #include "io/input_stream.hpp"
 
 namespace interpatch::io {
@@ -233,6 +234,10 @@ void write_csv_grid(const fs::path& path, std::span<const std::vector<double>> p
                  " points, ", points.size(), " given");
   }
 
+  std::vector<std::size_t> shape;
+  for (const auto& p : params) shape.push_back(p.size());
+  shape.push_back(3);
+  internal::require_finite(&points.data()->x, 3 * points.size(), 0, shape, "'" + path.string() + "'");
   write_atomically(path, [&](std::ostream& os) {
     static constexpr const char* names[] = {"u", "v", "w"};
     std::string out;

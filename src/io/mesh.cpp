@@ -21,6 +21,7 @@
 #include "interpatch/evaluate.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/memory.hpp"
+#include "io/finite.hpp"
 
 namespace interpatch::io {
 namespace fs = std::filesystem;
@@ -686,6 +687,10 @@ void write_surface_mesh(const fs::path& path, const SurfaceMesh& mesh) {
                  mesh.normals.extent(1), " normals for ", g.extent(0), " x ", g.extent(1), " points");
   }
   check_closed(path, mesh);
+  const std::size_t shape[3] = {g.extent(0), g.extent(1), 3};
+  internal::require_finite(&g.data()->x, 3 * g.size(), 0, shape, "the points of " + quoted(path));
+  if (!mesh.normals.empty())
+    internal::require_finite(&mesh.normals.data()->x, 3 * g.size(), 0, shape, "the normals of " + quoted(path));
 
   if (ext == ".obj") {
     write_atomically(path, [&](std::ostream& os) { write_obj(os, mesh); });
@@ -717,6 +722,10 @@ void write_volume_mesh(const fs::path& path, const PointGrid3& points, const Gri
                  " x ", jacobian.extent(1), " x ", jacobian.extent(2), " for ", points.extent(0), " x ",
                  points.extent(1), " x ", points.extent(2), " points");
   }
+  const std::size_t shape[4] = {points.extent(0), points.extent(1), points.extent(2), 3};
+  internal::require_finite(&points.data()->x, 3 * points.size(), 0, shape, "the points of " + quoted(path));
+  if (!jacobian.empty())
+    internal::require_finite(jacobian.data(), jacobian.size(), 0, std::span(shape).first(3), "the jacobians of " + quoted(path));
   Structured s;
   s.nu = points.extent(0);
   s.nv = points.extent(1);
@@ -802,12 +811,20 @@ void stream_structured(const fs::path& path, const ArrayLayout& layout, const Su
   std::vector<Vec3> first_points, first_normals;  // column 0, for the last of a surface closed in v
   const auto grid = surface.normal_grid(us, vs);  // what depends on u alone or v alone, once
   const auto columns = [&](std::size_t b) { return std::pair(b * block_cols, std::min(block_cols, nv - b * block_cols)); };
+  const std::string points_of = "the points of " + quoted(path), normals_of = "the normals of " + quoted(path);
   const auto make = [&](std::size_t b, std::size_t p) {
     const auto [j0, m] = columns(b);
     const std::size_t i0 = p * piece_rows, k = std::min(piece_rows, nu - i0);
     // The piece's rows in the grid's order (not zeroed), then put in the file's.
     const auto P = std::make_unique_for_overwrite<Vec3[]>(k * m), N = std::make_unique_for_overwrite<Vec3[]>(k * m);
     grid->evaluate_into(i0, k, j0, m, std::span(P.get(), k * m), std::span(N.get(), k * m));
+    // Points and normals of rows i0.. and columns j0..: named by their place in the mesh.
+    for (std::size_t i = 0; i < k; ++i) {
+      const std::size_t shape[3] = {nu, nv, 3};
+      const std::size_t first = ((i0 + i) * nv + j0) * 3;
+      internal::require_finite(&P[i * m].x, 3 * m, first, shape, points_of);
+      internal::require_finite(&N[i * m].x, 3 * m, first, shape, normals_of);
+    }
     Vec3 *to_p = points[b % 2].data(), *to_n = normals[b % 2].data();
     for (std::size_t i = 0; i < k; ++i)
       for (std::size_t j = 0; j < m; ++j) {

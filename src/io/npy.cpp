@@ -23,6 +23,7 @@
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/memory.hpp"
 #include "io/crc32.hpp"
+#include "io/finite.hpp"
 #include "io/input_stream.hpp"
 #include "io/npy_format.hpp"
 
@@ -652,6 +653,7 @@ void write_npy_rows(const fs::path& path, std::span<const std::size_t> shape, co
         },
         [&](std::size_t b) {
           const auto [r0, n] = block_span(b);
+          internal::require_finite(buffers[b % 2].get(), n * per_row, r0 * per_row, dims, "'" + path.string() + "'");
           internal::write_values(os, buffers[b % 2].get(), n * per_row);
           if (progress) progress(static_cast<double>(r0 + n) / static_cast<double>(rows));
         });

@@ -20,6 +20,7 @@
 #include "interpatch/io/json_out.hpp"
 #include "interpatch/memory.hpp"
 #include "interpatch/volume.hpp"
+#include "io/finite.hpp"
 #include "io/viewer_assets.hpp"
 
 namespace interpatch::io {
@@ -211,8 +212,12 @@ ojson surface_json(const Surface& s, const std::array<std::size_t, 3>& res) {
     for (std::size_t k = 0; k < d.size(); ++k) {
       const SurfaceDerivatives& x = d.data()[k];
       const Curvature k2 = curvature(x);
+      const Vec3 normal = unit_normal(x);
+      const std::size_t shape[3] = {res[0], res[1], 3}, first = (i0 * res[1] + k) * 3;
+      internal::require_finite(&x.s.x, 3, first, shape, "the surface's points on the page");
+      internal::require_finite(&normal.x, 3, first, shape, "the surface's normals on the page");
       points.push(x.s);
-      normals.push(unit_normal(x));
+      normals.push(normal);
       gaussian.push(k2.gaussian);
       mean.push(k2.mean);
     }
@@ -228,6 +233,8 @@ ojson volume_json(const Volume& v, const std::array<std::size_t, 3>& res) {
   const std::vector<double> us = linspace(0, 1, res[0]), vs = linspace(0, 1, res[1]), ws = linspace(0, 1, res[2]);
   const VolumeJacobians j = v.evaluate_jacobians(us, vs, ws);
   const std::size_t n = j.points.size();
+  const std::size_t shape[4] = {res[0], res[1], res[2], 3};
+  internal::require_finite(&j.points.data()->x, 3 * n, 0, shape, "the volume's points on the page");
   Float32Base64 points(3 * n), det(n);
   for (std::size_t k = 0; k < n; ++k) {
     points.push(j.points.data()[k]);

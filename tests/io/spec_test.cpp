@@ -1,10 +1,13 @@
 #include "interpatch/io/spec.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +15,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cli_specs.hpp"
@@ -426,6 +430,45 @@ TEST(SpecErrors, InvalidJsonNamesLineAndColumn) {
   EXPECT_ERRC((void)parse_json("{\n \"a\": [1,\n 2,, 3]}", "x.json"), invalid_json, "x.json:3:4:");
   EXPECT_ERRC((void)parse_json("", "x.json"), invalid_json, "x.json:1:1:");
   EXPECT_ERRC((void)parse_json("{\"type\": \"interpolate\"", "x.json"), invalid_json, "x.json:1:");
+}
+
+// A spec that is not a regular file is parsed as it is read: a device of zeros fails
+// at its first byte instead of being read forever.
+TEST(SpecErrors, ADeviceThatIsNotJsonFailsAtItsFirstByte) {
+  EXPECT_ERRC((void)read_json_file("/dev/zero"), invalid_json, "/dev/zero:1:1: invalid JSON");
+}
+
+// A stream that never ends and never stops being valid JSON (white space here, a
+// program writing `[1,` forever in the wild) is refused at max_streamed_spec_bytes.
+TEST(SpecErrors, AStreamThatNeverEndsIsRefusedAtTheLimit) {
+  const test::TempDir dir;
+  const std::filesystem::path fifo = dir / "endless.json";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const auto before = std::signal(SIGPIPE, SIG_IGN);  // the writer learns of the close by EPIPE
+  std::thread writer([&] {
+    const int fd = open(fifo.c_str(), O_WRONLY);
+    if (fd < 0) return;
+    const std::string spaces(std::size_t{1} << 16, ' ');
+    // Bounded, so that a reader that failed to stop cannot hang the test: twice the limit.
+    for (std::size_t sent = 0; sent < 2 * io::max_streamed_spec_bytes;) {
+      const ssize_t n = write(fd, spaces.data(), spaces.size());
+      if (n <= 0) break;
+      sent += static_cast<std::size_t>(n);
+    }
+    close(fd);
+  });
+  EXPECT_ERRC((void)read_json_file(fifo), too_large, "at most 256 MiB");
+  writer.join();
+  std::signal(SIGPIPE, before);
+}
+
+// A regular file is measured before it is read.
+TEST(SpecErrors, ASpecFileOverTheLimitIsRefusedUnread) {
+  const test::TempDir dir;
+  const std::filesystem::path big = dir / "big.json";
+  { std::ofstream(big) << "{}"; }
+  std::filesystem::resize_file(big, io::max_spec_bytes + 1);  // sparse: no disk taken
+  EXPECT_ERRC((void)read_json_file(big), too_large, "more than the 1024 MiB a spec may be");
 }
 
 TEST(SpecErrors, NonFiniteLiteralsNameLineAndColumn) {

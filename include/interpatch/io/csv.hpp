@@ -48,7 +48,8 @@ namespace interpatch::io {
 /// holds one parameter list per axis; points.size() is the product of their sizes.
 /// Numbers are written with 17 significant digits, so they read back exactly.
 /// Written atomically. @throws error file_unwritable, size_mismatch (params.size()
-/// not 1..3, or points.size() not the product of the parameter counts).
+/// not 1..3, or points.size() not the product of the parameter counts), not_finite
+/// (a point with NaN or infinity: an evaluation that overflowed, refused unwritten).
 void write_csv_grid(const std::filesystem::path& path, std::span<const std::vector<double>> params,
                     std::span<const Vec3> points);
 

@@ -69,7 +69,8 @@ struct SurfaceMesh {
 ///   not of the points' shape, or closed in a direction with fewer than 2 samples),
 ///   closing_gap (closed in a direction whose last row or column is not the first
 ///   again, to 1e-9 of the bounding-box diagonal; the message names the point),
-///   too_large (more than 2^32 - 1 STL triangles), file_unwritable.
+///   too_large (more than 2^32 - 1 STL triangles), not_finite (a point or normal
+///   with NaN or infinity, named by its index; nothing written), file_unwritable.
 void write_surface_mesh(const std::filesystem::path& path, const SurfaceMesh& mesh);
 
 /// The mesh of a surface on the grid us × vs written as
@@ -96,7 +97,8 @@ void write_surface_mesh(const std::filesystem::path& path, const Surface& surfac
 /// hold coordinates only, so for .xyz the field goes to a Plot3D function file
 /// beside it (same name, extension .f: block count, "ni nj nk 1", values).
 /// @throws error wrong_type (unknown extension, or a surface-only format),
-///   size_mismatch (no points, or a jacobian of another shape), file_unwritable.
+///   size_mismatch (no points, or a jacobian of another shape), not_finite (a point
+///   or determinant with NaN or infinity; nothing written), file_unwritable.
 void write_volume_mesh(const std::filesystem::path& path, const PointGrid3& points,
                        const Grid<double, 3>& jacobian = {});
 

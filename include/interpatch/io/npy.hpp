@@ -115,9 +115,11 @@ using NpyRowsMaker = std::function<void(std::size_t first, std::size_t count, st
 ///       for (std::size_t j = 0; j < 1000; ++j) out[i * 1000 + j] = double(first + i) + 0.001 * double(j);
 ///   });
 /// @endcode
+/// It writes evaluations, which are finite: a value that is NaN or infinite (a
+/// construction whose arithmetic overflowed) is refused, naming its index.
 /// @throws error file_unwritable, size_mismatch (an overflowing shape, or one of no
-/// axis), and whatever `make` throws (for the first rows, when several calls
-/// throw); the file is then left as it was.
+/// axis), not_finite, and whatever `make` throws (for the first rows, when several
+/// calls throw); the file is then left as it was.
 void write_npy_rows(const std::filesystem::path& path, std::span<const std::size_t> shape, const NpyRowsMaker& make,
                     const progress_callback& progress = {});
 

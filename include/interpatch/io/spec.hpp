@@ -196,7 +196,16 @@ struct SpecForm {
 ///   not_finite (a NaN/Infinity literal or a number too large for a double, with line and column).
 [[nodiscard]] nlohmann::json parse_json(std::string_view text, std::string_view source = "spec");
 
-/// Reads and parses a JSON file. @throws error file_unreadable, and what parse_json throws.
+/// The most bytes of JSON a spec file may hold; larger point sets go in .npy or .csv files.
+inline constexpr std::size_t max_spec_bytes = std::size_t{1} << 30;
+/// The most bytes read from a spec that is not a regular file (a pipe, a device), which
+/// has no size to check before reading and may never end.
+inline constexpr std::size_t max_streamed_spec_bytes = std::size_t{256} << 20;
+
+/// Reads and parses a JSON file. A pipe or device is parsed as it is read, so text
+/// that is not JSON fails at its first bad byte.
+/// @throws error file_unreadable; too_large (a file over max_spec_bytes, a stream over
+///   max_streamed_spec_bytes, or text that cannot fit in memory); and what parse_json throws.
 [[nodiscard]] nlohmann::json read_json_file(const std::filesystem::path& path);
 
 /// Builds the construction a parsed spec describes. File references inside the spec

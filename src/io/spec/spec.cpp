@@ -131,9 +131,13 @@ std::vector<SpecForm> spec_forms() {
   return v;
 }
 
-json parse_json(std::string_view text, std::string_view source) {
+namespace {
+
+// Why nlohmann refused `text` (all that was read, up to the byte it stopped at), as
+// interpatch's error with line and column.
+[[noreturn]] void fail_unparsed(std::string_view text, std::string_view source) {
   try {
-    return json::parse(text.begin(), text.end());
+    throw;
   } catch (const json::parse_error& e) {
     // e.byte is the 1-based offset of the last character read.
     std::size_t pos = e.byte == 0 ? 0 : std::min<std::size_t>(e.byte - 1, text.size());
@@ -169,6 +173,62 @@ json parse_json(std::string_view text, std::string_view source) {
   }
 }
 
+// The characters of a stream for nlohmann's parser, one at a time, kept in `text` for
+// the error's line and column; past `limit` bytes, too_large. A pipe or a device has
+// no size to check before reading and may never end (/dev/zero, `yes`): the parser
+// stops at its first bad byte, and a stream of valid JSON that goes on stops here.
+class BoundedChars {
+ public:
+  using iterator_category = std::input_iterator_tag;
+  using value_type = char;
+  using difference_type = std::ptrdiff_t;
+  using pointer = const char*;
+  using reference = const char&;
+
+  BoundedChars() = default;
+  BoundedChars(std::streambuf* in, std::string* text, std::size_t limit, std::string_view source)
+      : in_(in), text_(text), limit_(limit), source_(source) {
+    take();
+  }
+  const char& operator*() const { return text_->back(); }
+  BoundedChars& operator++() {
+    take();
+    return *this;
+  }
+  void operator++(int) { take(); }
+  bool operator==(const BoundedChars& o) const { return at_end() == o.at_end(); }
+
+ private:
+  bool at_end() const { return in_ == nullptr; }
+  void take() {
+    if (in_ == nullptr) return;
+    const auto c = in_->sbumpc();
+    if (std::streambuf::traits_type::eq_int_type(c, std::streambuf::traits_type::eof())) {
+      in_ = nullptr;
+      return;
+    }
+    if (text_->size() >= limit_)
+      fail(errc::too_large, source_, ": a spec read from a pipe or device is at most ", limit_ >> 20,
+           " MiB of JSON, and this one goes on past that; large point sets go in .npy or .csv files");
+    text_->push_back(std::streambuf::traits_type::to_char_type(c));
+  }
+
+  std::streambuf* in_ = nullptr;
+  std::string* text_ = nullptr;
+  std::size_t limit_ = 0;
+  std::string_view source_;
+};
+
+}  // namespace
+
+json parse_json(std::string_view text, std::string_view source) {
+  try {
+    return json::parse(text.begin(), text.end());
+  } catch (const std::exception&) {
+    fail_unparsed(text, source);
+  }
+}
+
 json read_json_file(const std::filesystem::path& path) {
   std::error_code ec;
   const std::string name = path.string();
@@ -176,7 +236,20 @@ json read_json_file(const std::filesystem::path& path) {
   if (std::filesystem::is_directory(path, ec)) fail(errc::file_unreadable, name, ": cannot read: it is a directory");
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(errc::file_unreadable, name, ": cannot open: ", std::strerror(errno));
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    std::string text;
+    try {
+      return json::parse(BoundedChars(in.rdbuf(), &text, max_streamed_spec_bytes, name), BoundedChars());
+    } catch (const error&) {
+      throw;
+    } catch (const std::exception&) {
+      fail_unparsed(text, name);
+    }
+  }
   const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > max_spec_bytes)
+    fail(errc::too_large, name, ": a JSON spec of ", size, " bytes is more than the ", max_spec_bytes >> 20,
+         " MiB a spec may be; large point sets go in .npy or .csv files");
   // The parsed document takes a few times the text; refuse what cannot fit.
   if (!ec) require_memory(static_cast<std::size_t>(size), 4, cat(name, ": a JSON spec of ", size, " bytes"));
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
