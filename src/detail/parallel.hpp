@@ -5,9 +5,12 @@
 // never change a result: every number is computed by the same operations.
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <cstring>
+#include <exception>
 
+#include "interpatch/progress.hpp"
 #include "interpatch/vec3.hpp"
 
 #ifdef _OPENMP
@@ -35,6 +38,34 @@ inline std::size_t thread_count() noexcept {
   return 1;
 #endif
 }
+
+/// Progress reported from inside a parallel region by the calling thread (thread 0).
+/// A callback may throw to stop the work (progress.hpp), but no exception may leave
+/// a parallel region: the first is kept, every thread's remaining iterations see
+/// stopped() and skip their work, and rethrow() after the region throws it.
+class RegionProgress {
+ public:
+  explicit RegionProgress(const progress_callback& progress) noexcept : progress_(progress) {}
+  void report(double fraction) noexcept {
+    if (!progress_ || stopped()) return;
+    try {
+      progress_(fraction);
+    } catch (...) {
+      error_ = std::current_exception();  // thread 0 alone reports
+      stop_.store(true, std::memory_order_relaxed);
+    }
+  }
+  [[nodiscard]] bool stopped() const noexcept { return stop_.load(std::memory_order_relaxed); }
+  /// After the region: what a callback threw, if it did.
+  void rethrow() const {
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  const progress_callback& progress_;
+  std::exception_ptr error_;
+  std::atomic<bool> stop_{false};
+};
 
 /// Whether any of n doubles is a NaN or an infinity, scanned without a branch (x * 0
 /// is 0 for a finite x, NaN otherwise; the comparisons vectorize).
