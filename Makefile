@@ -14,6 +14,7 @@ SHELL := /bin/bash
 #   python3-matplotlib               make bench draws docs/bench_interpolation.png
 #   pybind11-dev python3-dev         the Python module (import interpatch)
 #   python3-pytest                   its test suite
+#   python3-hypothesis               its fuzz tests: random arrays into the constructors (tests/python/test_fuzz.py)
 #   libocct-*-dev                    OpenCASCADE reads back the STEP and IGES files (tests) and races us (make bench)
 #   libsisl-dev                      SISL races us in make bench
 #   clang libclang-rt-14-dev libomp-14-dev   libFuzzer (with its OpenMP) runs the fuzz targets of make test
@@ -27,7 +28,7 @@ DEBS := cmake ninja-build g++ pkg-config python3 libcli11-dev nlohmann-json3-dev
         libgtest-dev libgmock-dev libbenchmark-dev python3-numpy python3-vtk9 python3-matplotlib \
         libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
         libocct-foundation-dev libsisl-dev python3-scipy clang libclang-rt-14-dev libomp-14-dev \
-        pybind11-dev python3-pybind11 python3-dev python3-pytest \
+        pybind11-dev python3-pybind11 python3-dev python3-pytest python3-hypothesis \
         libeigen3-dev chromium chromium-driver python3-selenium $(if $(shell command -v npm),,nodejs npm) \
         libopenmpi-dev openmpi-bin
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)

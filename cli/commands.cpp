@@ -52,11 +52,6 @@ std::optional<std::size_t> parse_count(std::string_view s) {
   return v;
 }
 
-std::string resolution_text(const Resolution& r) {
-  std::string t = std::to_string(r.nu) + "x" + std::to_string(r.nv);
-  return r.nw ? t + "x" + std::to_string(r.nw) : t;
-}
-
 // A shape as NumPy prints it: (4, 3), (5,).
 std::string shape_text(const std::vector<std::size_t>& shape) {
   std::string s = "(";
@@ -64,30 +59,10 @@ std::string shape_text(const std::vector<std::size_t>& shape) {
   return s + (shape.size() == 1 ? ",)" : ")");
 }
 
-// The number of points of a grid, or nullopt when it overflows a size_t.
-std::optional<std::size_t> point_count(const Resolution& r) {
-  std::size_t n = 1;
-  for (const std::size_t c : {r.nu, r.nv, r.nw ? r.nw : std::size_t{1}}) {
-    if (c != 0 && n > std::numeric_limits<std::size_t>::max() / c) return std::nullopt;
-    n *= c;
-  }
-  return n;
-}
-
 // The float64 triples of a .npy block as the points they hold.
 std::span<Vec3> points_of(std::span<double> values) {
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 grids are written as arrays of doubles");
   return {reinterpret_cast<Vec3*>(values.data()), values.size() / 3};
-}
-
-void mesh_volume(const io::Construction& c, const fs::path& out, const Resolution& res) {
-  const Volume& v = io::volume_evaluator(c);
-  // Every construction is over the unit cube.
-  const std::vector<double> us = linspace(0, 1, res.nu), vs = linspace(0, 1, res.nv), ws = linspace(0, 1, res.nw);
-  ProgressLine progress("meshing");
-  const VolumeJacobians j = v.evaluate_jacobians(us, vs, ws, progress.callback());
-  progress.clear();
-  io::write_volume_mesh(out, j.points, j.determinants);
 }
 
 void eval_volume(const io::Construction& c, const fs::path& out, const Resolution& grid) {
@@ -106,6 +81,17 @@ void eval_volume(const io::Construction& c, const fs::path& out, const Resolutio
   const PointGrid3 g = v.evaluate(params[0], params[1], params[2], progress.callback());
   progress.clear();
   io::write_csv_grid(out, params, std::span<const Vec3>(g.data(), g.size()));
+}
+
+// The io library's checks of usage (formats, counts) throw error; on the command
+// line what they refuse is bad usage (exit 2).
+template <class Check>
+void as_usage(const Check& check) {
+  try {
+    check();
+  } catch (const error& e) {
+    throw usage_error(e.what());
+  }
 }
 
 }  // namespace
@@ -138,8 +124,7 @@ std::vector<std::size_t> parse_counts(std::string_view text, const CountsOption&
                 std::string(fields.size() == 2 ? o.surface_example : o.volume_example));
     counts.push_back(*n);
   }
-  if (std::any_of(counts.begin(), counts.end(), [](std::size_t n) { return n < 2; }))
-    throw bad("a " + std::string(o.noun) + " needs at least 2 " + std::string(o.unit) + " along each direction");
+  as_usage([&] { io::check_counts(counts, o, std::string(o.name) + " '" + std::string(text) + "'"); });
   return counts;
 }
 
@@ -153,19 +138,12 @@ std::vector<std::size_t> parse_grid(std::string_view text) { return parse_counts
 Resolution grid_resolution(const std::vector<std::size_t>& counts, const io::Construction& c) {
   if (counts.size() == 1) return {counts[0], counts[0], io::is_volume(c) ? counts[0] : 0};
   const Resolution grid{counts.at(0), counts.at(1), counts.size() == 3 ? counts[2] : 0};
-  check_counts_kind(c, grid_option, grid);
+  cli::check_counts_kind(c, grid_option, grid);
   return grid;
 }
 
 void check_counts_kind(const io::Construction& c, const CountsOption& o, const Resolution& counts) {
-  const std::string given = std::string(o.name) + " '" + resolution_text(counts) + "': ";
-  const std::string k_or = o.single ? "K or " : "";
-  if (!io::is_volume(c) && counts.nw)
-    throw usage_error(given + "a surface " + std::string(o.noun) + " takes " + k_or + "two counts, " +
-                      std::string(o.surface_form) + " (" + std::string(o.volume_form) + " is for volumes)");
-  if (io::is_volume(c) && !counts.nw)
-    throw usage_error(given + c.type + " is a volume; its " + std::string(o.noun) + " takes " + k_or + "three counts, " +
-                      std::string(o.volume_form) + " (e.g. " + std::string(o.volume_example) + ")");
+  as_usage([&] { io::check_counts_kind(c, o, counts); });
 }
 
 Input parse_input(const fs::path& spec, std::string_view shape) {
@@ -223,111 +201,24 @@ nlohmann::json data_file_spec(const Input& in) {
   return {{"type", shape && shape->size() == 4 ? "interpolate_volume" : "interpolate"}, {"points", {{"npy", file}}}};
 }
 
-void check_build_output(const fs::path& out) {
-  const std::string ext = lower_extension(out);
-  if (ext == ".json" || ext == ".npz" || ext == ".step" || ext == ".stp" || ext == ".igs" || ext == ".iges") return;
-  throw usage_error("cannot tell the output format of '" + out.string() +
-                    "': build writes .json, .npz (NumPy), .step/.stp (STEP AP214) or .igs/.iges (IGES 5.3)");
-}
-
-void check_mesh_output(const fs::path& out) {
-  if (io::is_mesh_format(out.extension().string())) return;
-  throw usage_error("cannot tell the mesh format of '" + out.string() + "': use .obj, .stl, .ply, .vtk, .vts or .xyz");
-}
-
-void check_eval_output(const fs::path& out) {
-  const std::string ext = lower_extension(out);
-  if (ext == ".npy" || ext == ".csv") return;
-  throw usage_error("cannot tell the output format of '" + out.string() + "': eval writes .npy or .csv");
-}
-
-void check_info_output(const fs::path& out) {
-  if (lower_extension(out) == ".json") return;
-  throw usage_error("cannot tell the output format of '" + out.string() + "': info writes .json");
-}
-
-void check_view_output(const fs::path& out) {
-  if (io::is_view_format(out.extension().string())) return;
-  throw usage_error("cannot tell the output format of '" + out.string() + "': view writes .html (or .htm)");
-}
-
-void require_eval_room(const Resolution& grid, const fs::path& out) {
-  constexpr std::size_t beyond = std::numeric_limits<std::size_t>::max();  // parse_count's "too large to count"
-  const bool uncountable = grid.nu == beyond || grid.nv == beyond || grid.nw == beyond;
-  const std::string what = "evaluation grid " + (uncountable ? std::string("beyond 2^64") : resolution_text(grid));
-  const std::optional<std::size_t> points = point_count(grid);
-  if (uncountable || !points) throw error(errc::too_large, what + ": more points than can be addressed");
-  if (lower_extension(out) == ".npy") {
-    // Evaluated and written a block at a time: the disk space of the whole file (the
-    // header is at most a few hundred bytes), the memory of one block.
-    if (*points > (std::numeric_limits<std::size_t>::max() - 4096) / sizeof(Vec3))
-      throw error(errc::too_large, what + ": more bytes than a file can hold");
-    io::check_disk_space(out, *points * sizeof(Vec3) + 4096, what);
-    const std::size_t per_row = *points / grid.nu;
-    require_memory(io::write_npy_rows_held(grid.nu, 3 * per_row), sizeof(double), what + ", two blocks of u values");
-    return;
-  }
-  // The points, plus the text of a row for .csv.
-  require_memory(*points, sizeof(Vec3) + 8, what);
-}
-
-void require_mesh_room(const Resolution& res, const fs::path& out) {
-  const std::string what = "mesh of " + resolution_text(res) + " vertices";
-  if (res.nw) {
-    constexpr std::size_t limit = std::size_t{1} << 21;
-    if (res.nu >= limit || res.nv >= limit || res.nw >= limit)
-      throw error(errc::too_large, what + ": more vertices than can be addressed");
-    // Points and Jacobian determinants, plus the text of a vertex in the ASCII formats.
-    require_memory(res.nu * res.nv * res.nw, sizeof(Vec3) + sizeof(double) + 80, what);
-    return;
-  }
-  if (res.nu >= (std::size_t{1} << 32) || res.nv >= (std::size_t{1} << 32))
-    throw error(errc::too_large, what + ": more vertices than can be addressed");
-  if (const std::string ext = lower_extension(out); ext == ".vts" || ext == ".vtk") {
-    // Written a block of columns at a time: the disk space of the file (points and
-    // normals, 48 bytes a vertex, and at most a few kilobytes of XML or header).
-    const std::size_t n = res.nu * res.nv;
-    if (n > (std::numeric_limits<std::size_t>::max() - 4096) / (2 * sizeof(Vec3)))
-      throw error(errc::too_large, what + ": more bytes than a file can hold");
-    io::check_disk_space(out, n * 2 * sizeof(Vec3) + 4096, what);
-    return;
-  }
-  // Points and normals, plus room for the writers' faces (two triangles per vertex in STL).
-  require_memory(res.nu * res.nv, 2 * sizeof(Vec3) + 2 * 50, what);
-}
+void check_build_output(const fs::path& out) { as_usage([&] { io::check_build_output(out); }); }
+void check_mesh_output(const fs::path& out) { as_usage([&] { io::check_mesh_output(out); }); }
+void check_eval_output(const fs::path& out) { as_usage([&] { io::check_eval_output(out); }); }
+void check_info_output(const fs::path& out) { as_usage([&] { io::check_info_output(out); }); }
+void check_view_output(const fs::path& out) { as_usage([&] { io::check_view_output(out); }); }
 
 void check_mesh_kind(const io::Construction& c, const fs::path& out, const Resolution& res) {
-  const std::string ext = lower_extension(out);
-  if (io::is_volume(c) && ext != ".vts" && ext != ".vtk" && ext != ".xyz")
-    throw usage_error("'" + out.string() + "': " + c.type + " is a volume; " + ext +
-                      " holds surfaces only, a volume mesh is written to .vts, .vtk or .xyz (Plot3D)");
-  check_counts_kind(c, res_option, res);
-}
-
-void write_build(const io::Construction& c, const fs::path& out) {
-  if (!c.exact) throw error(errc::no_exact_form, c.type + ": " + c.no_exact_form);
-  const std::string ext = lower_extension(out);
-  // The product (STEP) or file (IGES) is named after the output file.
-  const std::string name = out.stem().string();
-  if (ext == ".step" || ext == ".stp") return io::write_step(out, *c.exact, {.name = name, .time_stamp = {}});
-  if (ext == ".igs" || ext == ".iges") return io::write_iges(out, *c.exact, {.name = out.filename().string(), .time_stamp = {}});
-  if (ext == ".npz") return io::write_exact_npz(out, *c.exact);
-  io::write_exact_json(out, *c.exact);
+  as_usage([&] { io::check_mesh_kind(c, out, res, res_option); });
 }
 
 void write_mesh(io::Construction& c, const fs::path& out, const Resolution& res) {
   check_mesh_kind(c, out, res);
-  if (io::is_volume(c)) return mesh_volume(c, out, res);
-  const Surface& s = io::evaluator(c, res.nu * res.nv, io::Sample::derivatives);
-  constexpr double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  // every construction is over the unit square
-  const std::vector<double> us = linspace(u0, u1, res.nu), vs = linspace(v0, v1, res.nv);
   ProgressLine progress("meshing");
-  io::write_surface_mesh(out, s, us, vs, progress.callback());  // a .vts or .vtk a block at a time
-  progress.clear();
+  io::write_mesh(c, out, res, res_option, progress.callback());
 }
 
 void write_eval(io::Construction& c, const fs::path& out, const Resolution& grid) {
-  check_counts_kind(c, grid_option, grid);
+  cli::check_counts_kind(c, grid_option, grid);
   if (io::is_volume(c)) return eval_volume(c, out, grid);
   const Surface& s = io::evaluator(c, grid.nu * grid.nv, io::Sample::points);
   constexpr double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  // every construction is over the unit square
@@ -374,7 +265,7 @@ void report_warnings(const io::Construction& c) {
 int build_command(const Input& in, const fs::path& out) {
   check_build_output(out);
   io::check_writable(out);
-  const io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = false, .arrays = {}});
+  io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = false, .arrays = {}});
   write_build(c, out);
   report_warnings(c);
   return 0;
@@ -440,7 +331,7 @@ int view_command(const Input& in, const fs::path& out, std::string_view res_text
   const io::Construction c = build_input(in);
   io::ViewOptions options;
   if (given) {
-    check_counts_kind(c, view_res_option, *given);
+    cli::check_counts_kind(c, view_res_option, *given);
     options.resolution = {given->nu, given->nv, given->nw};
   }
   options.title = in.path.stem().string();

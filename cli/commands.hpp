@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "interpatch/io/outputs.hpp"
 #include "interpatch/io/spec.hpp"
 
 namespace interpatch::cli {
@@ -24,27 +25,15 @@ class usage_error : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Points (or vertices) per direction of a mesh or an evaluation grid; nw is 0 for
-/// a surface.
-struct Resolution {
-  std::size_t nu = 64, nv = 64, nw = 0;
-};
+using io::CountsOption;
+using io::default_surface_resolution;
+using io::default_volume_resolution;
+using io::require_eval_room;
+using io::require_mesh_room;
+using io::Resolution;
+using io::write_build;
 
-/// The default resolutions: 64x64 for a surface, 33x33x33 for a volume.
-inline constexpr Resolution default_surface_resolution{64, 64, 0};
-inline constexpr Resolution default_volume_resolution{33, 33, 33};
-
-/// An option that takes counts along each direction, NUxNV or NUxNVxNW: what its
-/// messages call it and, for --grid, whether one count K stands for every direction.
-struct CountsOption {
-  std::string_view name;      ///< "--res"
-  std::string_view noun;      ///< what the counts make: "mesh"
-  std::string_view unit;      ///< what they count: "vertices"
-  std::string_view surface_form, volume_form;  ///< "NUxNV", "NUxNVxNW"
-  std::string_view surface_example, volume_example;  ///< "64x64", "33x33x33"
-  bool single = false;        ///< "K" accepted: K along every direction
-};
-
+/// The command line's options of counts, as their messages name them.
 inline constexpr CountsOption res_option{"--res", "mesh", "vertices", "NUxNV", "NUxNVxNW", "64x64", "33x33x33"};
 inline constexpr CountsOption grid_option{"--grid", "grid", "points", "NUxNV", "NUxNVxNW", "100x50", "17x17x17", true};
 inline constexpr CountsOption view_res_option{"--res", "view", "samples", "NUxNV", "NUxNVxNW", "257x257", "33x33x33"};
@@ -68,7 +57,7 @@ std::vector<std::size_t> parse_grid(std::string_view text);
 Resolution grid_resolution(const std::vector<std::size_t>& counts, const io::Construction& c);
 
 /// Refuse (usage_error) counts of `option` whose number does not fit the kind of the
-/// construction: three for a surface, two for a volume.
+/// construction: three for a surface, two for a volume (io::check_counts_kind).
 void check_counts_kind(const io::Construction& c, const CountsOption& option, const Resolution& counts);
 
 /// What SPEC names on the command line: a spec (.json, or any other extension), or a
@@ -94,29 +83,22 @@ Input parse_input(const std::filesystem::path& spec, std::string_view shape);
 /// spec. @throws error size_mismatch (a .npy of a rank other than 3 or 4).
 nlohmann::json data_file_spec(const Input& in);
 
-/// Refuse an output format the command does not write (usage_error), then an output
-/// path that cannot be written (error file_unwritable), before any work.
+/// Refuse (usage_error) an output format the command does not write, before any work
+/// (io::check_build_output, ...).
 void check_build_output(const std::filesystem::path& out);
 void check_mesh_output(const std::filesystem::path& out);
 void check_eval_output(const std::filesystem::path& out);
 void check_info_output(const std::filesystem::path& out);
 void check_view_output(const std::filesystem::path& out);
 
-/// Refuse (error too_large) an evaluation grid whose .npy file cannot fit on the
-/// output's disk (it is written a block at a time, and a block must fit in memory)
-/// or whose .csv text cannot be made in memory.
-void require_eval_room(const Resolution& grid, const std::filesystem::path& out);
-/// Refuse (error too_large) a mesh whose points and normals cannot be held in memory,
-/// or, for a surface's .vts (written a block of columns at a time), whose file cannot
-/// fit on the output's disk.
-void require_mesh_room(const Resolution& res, const std::filesystem::path& out);
+/// require_eval_room and require_mesh_room (io/outputs.hpp) refuse (error too_large)
+/// work too large for this machine before any work.
 
 /// Refuse (usage_error) a resolution or a mesh format that does not fit the kind of
 /// the construction: NUxNVxNW for a surface, NUxNV or .obj/.stl/.ply for a volume.
 void check_mesh_kind(const io::Construction& c, const std::filesystem::path& out, const Resolution& res);
 
-/// The outputs, from a built construction.
-void write_build(const io::Construction& c, const std::filesystem::path& out);
+/// The outputs, from a built construction: write_build (io/outputs.hpp), and these.
 /// Meshes and evaluations sample through the cheaper exact evaluator
 /// (io::evaluator), which may make the exact form of `c`.
 void write_mesh(io::Construction& c, const std::filesystem::path& out, const Resolution& res);

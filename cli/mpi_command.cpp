@@ -338,7 +338,7 @@ OutputRows output_rows(const MpiRequest& r, const Plan& plan, const mpi::Team& t
       c.type = type;
       if constexpr (D == 3) c.exact = BSplineVolume(KnotVector::bezier(1), KnotVector::bezier(1), KnotVector::bezier(1), PointGrid3({2, 2, 2}));
       else c.exact = BSplineSurface(KnotVector::bezier(1), KnotVector::bezier(1), PointGrid({2, 2}));
-      check_counts_kind(c, grid_option, grid);
+      cli::check_counts_kind(c, grid_option, grid);
     }
     require_eval_room(grid, r.out);
   });

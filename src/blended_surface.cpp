@@ -317,6 +317,7 @@ class BlendedRows final : public Surface::Rows {
     }
     const auto rows = static_cast<long long>(nu);
     std::atomic<std::size_t> done{0};
+    detail::RegionProgress report(progress);
 #pragma omp parallel if (nu * nv * (KA + L) >= detail::parallel_min_work)
     {
       std::vector<detail::LineTerm> lines(KA);
@@ -324,15 +325,17 @@ class BlendedRows final : public Surface::Rows {
       points.reserve(L);
 #pragma omp for schedule(static, 16)
       for (long long ri = 0; ri < rows; ++ri) {
+        if (report.stopped()) continue;  // a progress callback stopped the work
         const auto i = static_cast<std::size_t>(ri);
         for (std::size_t k = 0; k < KA; ++k) lines[k] = {F[i * K + k], &A_[k * nv].x};
         points.clear();
         for (std::size_t l = 0; l < L; ++l) points.emplace_back(G_.data() + l * 3 * nv, P[i * L + l]);
         detail::sum_terms(&out[i * nv].x, nv, lines, points);
         const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
-        if (progress && detail::thread_index() == 0 && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(nu));
+        if (detail::thread_index() == 0 && d % 64 == 0) report.report(static_cast<double>(d) / static_cast<double>(nu));
       }
     }
+    report.rethrow();
     if (progress) progress(1.0);
   }
 
@@ -449,6 +452,7 @@ class BlendedNormalGrid final : public Surface::NormalGrid {
     }
     const auto rows = static_cast<long long>(ni);
     std::atomic<std::size_t> done{0};
+    detail::RegionProgress report(progress);
 #pragma omp parallel if (ni * nj * (KA + L) * 4 >= detail::parallel_min_work)
     {
       std::vector<detail::LineTerm> lines(KA);
@@ -464,6 +468,7 @@ class BlendedNormalGrid final : public Surface::NormalGrid {
       };
 #pragma omp for schedule(static, 16)
       for (long long ri = 0; ri < rows; ++ri) {
+        if (report.stopped()) continue;  // a progress callback stopped the work
         const auto r = static_cast<std::size_t>(ri), i = i0 + r;
         sum(i, 0, 0, points.data() + r * nj);
         sum(i, 1, 0, partial[0].data());
@@ -471,9 +476,10 @@ class BlendedNormalGrid final : public Surface::NormalGrid {
         sum(i, 1, 1, partial[2].data());
         detail::unit_normals(partial[0].data(), partial[1].data(), partial[2].data(), nj, normals.data() + r * nj);
         const std::size_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
-        if (progress && detail::thread_index() == 0 && n % 64 == 0) progress(static_cast<double>(n) / static_cast<double>(ni));
+        if (detail::thread_index() == 0 && n % 64 == 0) report.report(static_cast<double>(n) / static_cast<double>(ni));
       }
     }
+    report.rethrow();
     if (progress) progress(1.0);
   }
 

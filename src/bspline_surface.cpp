@@ -198,6 +198,7 @@ void evaluate_rows_on(const KnotVector& ku_, const KnotVector& kv_, const RowWin
   // reported by the calling thread (thread 0) from a shared row count.
   [[maybe_unused]] const bool threads = bu.size() * (nv + ncv) >= parallel_min_work;
   std::atomic<std::size_t> done{0};
+  detail::RegionProgress report(progress);
   const auto nu = static_cast<long long>(bu.size());
   const std::size_t row_doubles = 3 * ncv;
   // A periodic v: the row's first q points repeated after it, so that spans past
@@ -210,6 +211,7 @@ void evaluate_rows_on(const KnotVector& ku_, const KnotVector& kv_, const RowWin
     const bool reporter = detail::thread_index() == 0;
 #pragma omp for schedule(static, 16)
     for (long long ri = 0; ri < nu; ++ri) {
+      if (report.stopped()) continue;  // a progress callback stopped the work
       const auto i = static_cast<std::size_t>(ri);
       const Basis& b = bu[i];
       for (int a = 0; a <= p; ++a) rows[a] = &net.row(static_cast<std::size_t>(ku_.wrap_index(b.span - p + a)))->x;
@@ -218,9 +220,10 @@ void evaluate_rows_on(const KnotVector& ku_, const KnotVector& kv_, const RowWin
       // Not &out[i * nv].x: with no v values there is no element to index.
       sample_row(vt.spans.data(), vt.weights.data(), q, nv, row.data(), reinterpret_cast<double*>(out.data() + i * nv));
       const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
-      if (progress && reporter && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(bu.size()));
+      if (reporter && d % 64 == 0) report.report(static_cast<double>(d) / static_cast<double>(bu.size()));
     }
   }
+  report.rethrow();
   if (progress) progress(1.0);
 }
 
@@ -275,6 +278,7 @@ void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const d
   const std::size_t nv = vs.size();
   [[maybe_unused]] const bool threads = us.size() * (nv + ncv) >= detail::parallel_min_work;
   std::atomic<std::size_t> done{0};
+  detail::RegionProgress report(progress);
   const auto nu = static_cast<long long>(us.size());
 #pragma omp parallel if (threads)
   {
@@ -284,6 +288,7 @@ void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const d
     const bool reporter = detail::thread_index() == 0;
 #pragma omp for schedule(static, 16)
     for (long long ri = 0; ri < nu; ++ri) {
+      if (report.stopped()) continue;  // a progress callback stopped the work
       const auto i = static_cast<std::size_t>(ri);
       const Basis& b = bu[i];
       for (std::size_t l = 0; l < ncv; ++l) {
@@ -313,9 +318,10 @@ void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const d
         o[j] = rat ? Vec3{x / w, y / w, z / w} : Vec3{x, y, z};
       }
       const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
-      if (progress && reporter && d % 64 == 0) progress(static_cast<double>(d) / static_cast<double>(us.size()));
+      if (reporter && d % 64 == 0) report.report(static_cast<double>(d) / static_cast<double>(us.size()));
     }
   }
+  report.rethrow();
   if (progress) progress(1.0);
 }
 

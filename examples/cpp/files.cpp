@@ -253,6 +253,28 @@ void view_pages(const fs::path& examples) {
   std::printf("coons.html: a viewer page of %zu bytes\n", page.size());
 }
 
+// The checks every front door makes of an output (io/outputs.hpp): counts of at
+// least 2, named as the caller's option writes them, and a mesh written after them.
+// Runs after view_pages, which put coons.json here.
+void output_checks() {
+  try {
+    constexpr interpatch::io::CountsOption res{"--res", "mesh", "vertices", "NUxNV", "NUxNVxNW", "64x64", "33x33x33"};
+    const std::size_t n[] = {0, 5};
+    interpatch::io::check_counts(n, res);  // "--res '0x5': a mesh needs at least 2 vertices along each direction"
+    example::expect(false, "check_counts refuses 0 vertices");
+  } catch (const interpatch::error& e) {
+    example::expect(e.code() == interpatch::errc::too_few_points, "0 vertices: too_few_points");
+    example::expect(std::string_view(e.what()).starts_with("--res '0x5': a mesh needs"), "the message names --res '0x5'");
+    std::printf("refused: %s\n", e.what());
+  }
+  interpatch::io::Construction c = interpatch::io::build_file("coons.json");
+  constexpr interpatch::io::CountsOption res{"res", "mesh", "vertices", "(nu, nv)", "(nu, nv, nw)", "(64, 64)",
+                                             "(33, 33, 33)", false, " (", ", ", ")"};
+  interpatch::io::write_mesh(c, "patch.vts", {200, 100, 0}, res);  // "res (0, 5): ..." for {0, 5, 0}
+  example::expect(fs::file_size("patch.vts") > 200 * 100 * 48, "patch.vts holds 200 x 100 points and normals");
+  std::printf("patch.vts: a mesh of 200 x 100 vertices\n");
+}
+
 // The exact form as a NumPy archive (io/npz.hpp): written, read back from the file
 // and from bytes in memory, the same surface each time. Runs after iges_files, which
 // put terrain.json here.
@@ -300,5 +322,6 @@ int main() {
     iges_files(INTERPATCH_EXAMPLES_DIR);
     npz_files();
     view_pages(INTERPATCH_EXAMPLES_DIR);
+    output_checks();
   });
 }

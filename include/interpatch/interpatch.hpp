@@ -11,6 +11,7 @@
 #include "interpatch/io/mesh.hpp"
 #include "interpatch/io/npy.hpp"
 #include "interpatch/io/npz.hpp"
+#include "interpatch/io/outputs.hpp"
 #include "interpatch/io/spec.hpp"
 #include "interpatch/io/step.hpp"
 #include "interpatch/io/view.hpp"

@@ -7,8 +7,10 @@
 
 namespace interpatch {
 
-/// Called with the fraction of the work done, 0..1, from the calling thread; it
-/// must not throw (it may run inside a parallel region).
+/// Called with the fraction of the work done, 0..1, from the calling thread. It may
+/// throw to stop the work (the Python module does when Ctrl-C is pressed): the work
+/// stops at its next report, makes no result, and the exception propagates to the
+/// caller unchanged.
 using progress_callback = std::function<void(double)>;
 
 }  // namespace interpatch

@@ -12,7 +12,10 @@ _Params = Union[Sequence[float], npt.ArrayLike]
 _Path = Union[str, PathLike[str]]
 
 class Error(ValueError):
-    """Bad input; .code names the problem (e.g. 'zero_chord'), the message the place and size."""
+    """Bad input; .code names the problem (e.g. 'zero_chord'), the message the place and size:
+    the argument (`points: ...`) or the spec's JSON Pointer (`/points/3/1/2: value is nan`).
+    Arrays of complex, bool, object or text dtype are refused ('wrong_type'), as are masked
+    entries where nothing may be missing. Ctrl-C during a long call raises KeyboardInterrupt."""
     code: str
 
 ERROR_CODES: tuple[str, ...]
@@ -27,7 +30,10 @@ class Construction:
         with the arrays the construction was built from as they are now: it keeps them, not a copy."""
     def write(self, path: _Path, res: Optional[Sequence[int]] = None) -> None:
         """.json .npz .step .igs (the exact form), .obj .ply .stl .vtk .vts .xyz (a mesh of res vertices)
-        or .html (a viewer page of res samples, as `interpatch view` writes it)."""
+        or .html (a viewer page of res samples, as `interpatch view` writes it). Checked before any
+        work as the command line checks it: res (nu, nv) for a surface, (nu, nv, nw) for a volume, each
+        at least 2 ('too_few_points', 'size_mismatch'); a mesh too large for the memory or the
+        disk ('too_large'); res with another format, or an unknown format ('wrong_type')."""
     @property
     def params_u(self) -> Optional[_Array]: ...
     @property
@@ -48,7 +54,8 @@ class Surface(Construction):
     def curvature(self, u: float, v: float) -> dict[str, float]:
         """{'gaussian', 'mean', 'k1', 'k2'}."""
     def to_bspline(self) -> dict[str, Any]:
-        """{'degree': (p, q), 'knots_u', 'knots_v', 'control_points' (nu, nv, 3), 'weights' (nu, nv) or None, 'periodic'}."""
+        """{'degree': (p, q), 'knots_u', 'knots_v', 'control_points' (nu, nv, 3), 'weights' (nu, nv) or None, 'periodic'};
+        the arrays are read-only views of the construction's memory (copy them to change them)."""
 
 class Volume(Construction):
     """A volume over [0, 1]³."""
@@ -58,7 +65,8 @@ class Volume(Construction):
         """(points (..., 3), det J (len(us), len(vs), len(ws)))."""
     def point(self, u: float, v: float, w: float) -> _Array: ...
     def to_bspline(self) -> dict[str, Any]:
-        """{'degree': (p, q, r), 'knots_u', 'knots_v', 'knots_w', 'control_points' (n0, n1, n2, 3), 'weights', 'periodic'}."""
+        """{'degree': (p, q, r), 'knots_u', 'knots_v', 'knots_w', 'control_points' (n0, n1, n2, 3), 'weights', 'periodic'};
+        read-only views of the construction's memory."""
 
 class Curve:
     """A curve of a spec: interpolate_curve, bspline_curve, hermite_curve or line."""
@@ -67,10 +75,12 @@ _CurveLike = Union[Curve, npt.ArrayLike]
 
 def build(spec: Union[dict[str, Any], _Path], base_dir: _Path = ".",
           arrays: Optional[dict[str, npt.ArrayLike]] = None) -> Union[Surface, Volume]:
-    """A spec as a dict (arrays named {"array": NAME}) or the path of a spec file, built."""
+    """A spec as a dict (arrays named {"array": NAME}) or the path of a spec file, built; anything
+    else is refused ('wrong_type'). Every array in `arrays` must be named by the spec, and a field
+    names an array or a file, not both. A masked array's masked points are missing (NaN)."""
 def interpolate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int], None] = None,
                         param: Optional[str] = None, periodic: Optional[Sequence[bool]] = None) -> Surface:
-    """Through a grid of points, shape (n, m, 3)."""
+    """Through a grid of points, shape (n, m, 3), every one present (a masked entry is refused)."""
 def interpolate_volume(points: npt.ArrayLike, degree: Union[int, Sequence[int], None] = None,
                        param: Optional[str] = None, periodic: Optional[Sequence[bool]] = None) -> Volume:
     """Through a grid of points, shape (n, m, l, 3)."""
@@ -78,13 +88,13 @@ def approximate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int],
                         param: Optional[str] = None, periodic: Optional[Sequence[bool]] = None,
                         control_points: Union[int, Sequence[int], None] = None, tolerance: Optional[float] = None,
                         smoothing: Union[float, str, None] = None, weights: Optional[npt.ArrayLike] = None) -> Surface:
-    """Near a grid of points, shape (n, m, 3), NaN marking missing points; exactly one of
+    """Near a grid of points, shape (n, m, 3), NaN (or a masked entry) marking missing points; exactly one of
     control_points, tolerance, smoothing (a number or "auto")."""
 def approximate_volume(points: npt.ArrayLike, degree: Union[int, Sequence[int], None] = None,
                        param: Optional[str] = None, periodic: Optional[Sequence[bool]] = None,
                        control_points: Union[int, Sequence[int], None] = None, tolerance: Optional[float] = None,
                        smoothing: Union[float, str, None] = None, weights: Optional[npt.ArrayLike] = None) -> Volume:
-    """Near a grid of points, shape (n, m, l, 3), NaN marking missing points."""
+    """Near a grid of points, shape (n, m, l, 3), NaN (or a masked entry) marking missing points."""
 def approximate_curve(points: npt.ArrayLike, degree: Optional[int] = None, param: Optional[str] = None,
                       periodic: bool = False, control_points: Optional[int] = None, tolerance: Optional[float] = None,
                       smoothing: Union[float, str, None] = None, weights: Optional[npt.ArrayLike] = None) -> Curve:

@@ -16,14 +16,15 @@
 #include <string>
 #include <vector>
 
-#include "commands.hpp"
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/error.hpp"
 #include "interpatch/evaluate.hpp"
 #include "interpatch/io/json_out.hpp"
 #include "interpatch/io/mesh.hpp"
+#include "interpatch/io/outputs.hpp"
 #include "interpatch/io/spec.hpp"
 #include "interpatch/io/view.hpp"
+#include "inputs.hpp"
 
 namespace py = pybind11;
 namespace ip = interpatch;
@@ -42,32 +43,22 @@ py::array_t<double> owning_array(std::unique_ptr<Owner> owner, double* data, std
   return py::array_t<double>(shape, data, free_it);
 }
 
-// Parameters from any sequence or array of numbers, as float64.
-std::vector<double> params(const py::handle& x) {
-  const auto a = py::array_t<double, py::array::forcecast>::ensure(x);
-  if (!a) throw ip::error(ip::errc::wrong_type, "expected a sequence of numbers");
-  if (a.ndim() != 1) throw ip::error(ip::errc::size_mismatch, "expected a 1-D sequence of parameters, got " + std::to_string(a.ndim()) + " dimensions");
-  const auto r = a.unchecked<1>();
-  std::vector<double> out(static_cast<std::size_t>(r.shape(0)));
-  for (py::ssize_t i = 0; i < r.shape(0); ++i) out[static_cast<std::size_t>(i)] = r(i);
-  return out;
+using ip::python::interruptible;
+using ip::python::params;
+using ip::python::point_array;
+
+// A NumPy array over memory the construction owns, which nothing may write: the
+// construction checked its numbers once, when it was built.
+py::array_t<double> read_only(py::array_t<double> a) {
+  a.attr("setflags")(py::arg("write") = false);
+  return a;
 }
 
-// A point array of any float dtype and memory order, shape (..., 3), as the library
-// stores points (float64 triples in C order): the one copy an input costs.
-std::shared_ptr<ip::io::PointArray> point_array(const py::handle& x, const std::string& name) {
-  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(x);
-  if (!a) throw ip::error(ip::errc::wrong_type, name + ": expected an array of points, shape (..., 3)");
-  if (a.ndim() < 2 || a.shape(a.ndim() - 1) != 3) {
-    std::string shape;
-    for (py::ssize_t k = 0; k < a.ndim(); ++k) shape += (k ? ", " : "") + std::to_string(a.shape(k));
-    throw ip::error(ip::errc::size_mismatch, name + ": expected an array of points of shape (..., 3), got (" + shape + ")");
-  }
-  std::vector<std::size_t> shape;
-  for (py::ssize_t k = 0; k + 1 < a.ndim(); ++k) shape.push_back(static_cast<std::size_t>(a.shape(k)));
-  py::gil_scoped_release free;  // `a` keeps the memory alive
-  return std::make_shared<ip::io::PointArray>(ip::io::copy_point_array(a.data(), std::move(shape)));
-}
+// res as Python's write() names it in messages.
+constexpr ip::io::CountsOption mesh_res{"res", "mesh", "vertices", "(nu, nv)", "(nu, nv, nw)", "(64, 64)", "(33, 33, 33)",
+                                        false, " (", ", ", ")"};
+constexpr ip::io::CountsOption view_res{"res", "view", "samples", "(nu, nv)", "(nu, nv, nw)", "(257, 257)", "(33, 33, 33)",
+                                        false, " (", ", ", ")"};
 
 // The arrays a construction was built from, as the caller gave them (the data points
 // its DataSets lend: BuildOptions::borrow_arrays).
@@ -105,40 +96,43 @@ class PyBuilt {
 
   // Written as the commands write: .json .npz .step/.stp .igs/.iges (the exact form),
   // a mesh (.obj .ply .stl .vtk .vts .xyz) of `res` vertices, or a viewer page (.html)
-  // of `res` samples.
-  void write(const std::filesystem::path& path, const std::optional<std::vector<std::size_t>>& res) const {
-    namespace cli = ip::cli;
+  // of `res` samples; checked as the command line checks them (io/outputs.hpp).
+  void write(const py::handle& path_in, const py::handle& res_in) const {
+    namespace io = ip::io;
+    const std::filesystem::path path = ip::python::path_arg(path_in, "write: the path is a str or an os.PathLike");
+    const std::string ext = path.extension().string();
+    const bool mesh = io::is_mesh_format(ext), view = io::is_view_format(ext);
+    std::optional<io::Resolution> res;
+    if (!res_in.is_none()) {
+      if (!mesh && !view)
+        throw ip::error(ip::errc::wrong_type, "res: only a mesh or a viewer page has a resolution, not '" + path.string() + "'");
+      const std::vector<std::size_t> n = ip::python::counts(res_in, "res");
+      res = io::Resolution{n[0], n[1], n.size() == 3 ? n[2] : 0};
+      io::check_counts(io::counts_of(*res), view ? view_res : mesh_res);
+      if (mesh) io::require_mesh_room(*res, path);  // before the lock and any work
+    }
+    if (!mesh && !view) io::check_build_output(path);
     // A viewer page shows the data points.
-    LentPoints lent = ip::io::is_view_format(path.extension().string()) ? lent_data() : LentPoints();
+    LentPoints lent = view ? lent_data() : LentPoints();
+    const ip::progress_callback progress = interruptible();
     py::gil_scoped_release free;
     std::lock_guard<std::mutex> hold(b_->lock);
     const WithData with(b_->c, lent);
-    const bool volume = ip::io::is_volume(b_->c);
-    // res as given, or `fallback`: (nu, nv) for a surface, (nu, nv, nw) for a volume.
-    const auto resolution = [&](const cli::Resolution& fallback) {
-      if (!res) return fallback;
-      if (res->size() != (volume ? 3u : 2u))
-        throw ip::error(ip::errc::size_mismatch, std::string("res: ") + (volume ? "(nu, nv, nw)" : "(nu, nv)") +
-                                                     " vertices, got " + std::to_string(res->size()) + " counts");
-      return cli::Resolution{(*res)[0], (*res)[1], volume ? (*res)[2] : 0};
-    };
-    try {
-      if (ip::io::is_mesh_format(path.extension().string())) {
-        cli::write_mesh(b_->c, path, resolution(volume ? cli::default_volume_resolution : cli::default_surface_resolution));
-        return;
-      }
-      if (ip::io::has_exact_form(b_->c)) (void)ip::io::exact_form(b_->c);  // the page shows it, as the command does
-      if (ip::io::is_view_format(path.extension().string())) {
-        const auto d = ip::io::view_default_resolution(b_->c);
-        const cli::Resolution r = resolution({d[0], d[1], d[2]});
-        ip::io::write_view(path, b_->c, {.resolution = {r.nu, r.nv, r.nw}, .title = path.stem().string()});
-        return;
-      }
-      cli::check_build_output(path);
-      cli::write_build(b_->c, path);
-    } catch (const cli::usage_error& e) {
-      throw ip::error(ip::errc::wrong_type, e.what());
+    const bool volume = io::is_volume(b_->c);
+    if (mesh) {
+      const io::Resolution r = res ? *res : volume ? io::default_volume_resolution : io::default_surface_resolution;
+      io::write_mesh(b_->c, path, r, mesh_res, progress);
+      return;
     }
+    if (io::has_exact_form(b_->c)) (void)io::exact_form(b_->c);  // the page shows it, as the command does
+    if (view) {
+      const auto d = io::view_default_resolution(b_->c);
+      const io::Resolution r = res ? *res : io::Resolution{d[0], d[1], d[2]};
+      io::check_counts_kind(b_->c, view_res, r);
+      io::write_view(path, b_->c, {.resolution = {r.nu, r.nv, r.nw}, .title = path.stem().string()});
+      return;
+    }
+    io::write_build(b_->c, path);
   }
 
   // The data's parameters along an axis, where the construction has data.
@@ -204,7 +198,7 @@ class PyBuilt {
 };
 
 py::array_t<double> knots_array(const ip::KnotVector& k, const py::capsule& alive) {
-  return py::array_t<double>(static_cast<py::ssize_t>(k.size()), k.values().data(), alive);
+  return read_only(py::array_t<double>(static_cast<py::ssize_t>(k.size()), k.values().data(), alive));
 }
 
 class PySurface : public PyBuilt {
@@ -212,19 +206,20 @@ class PySurface : public PyBuilt {
   using PyBuilt::PyBuilt;
 
   py::array_t<double> evaluate(const py::handle& us_in, const py::handle& vs_in) const {
-    auto us = params(us_in), vs = params(vs_in);
+    auto us = params(us_in, "us"), vs = params(vs_in, "vs");
     std::unique_ptr<ip::PointGrid> out;
+    const ip::progress_callback progress = interruptible();
     {
       py::gil_scoped_release free;
       const ip::Surface& s = surface(us.size() * vs.size(), ip::io::Sample::points);
-      out = std::make_unique<ip::PointGrid>(s.evaluate(us, vs));  // its pages first touched by the threads that fill them
+      out = std::make_unique<ip::PointGrid>(s.evaluate(us, vs, progress));  // its pages first touched by the threads that fill them
     }
     double* data = &out->data()->x;
     return owning_array(std::move(out), data, {static_cast<py::ssize_t>(us.size()), static_cast<py::ssize_t>(vs.size()), 3});
   }
 
   py::array_t<double> evaluate_derivatives(const py::handle& us_in, const py::handle& vs_in) const {
-    auto us = params(us_in), vs = params(vs_in);
+    auto us = params(us_in, "us"), vs = params(vs_in, "vs");
     std::unique_ptr<ip::Grid<ip::SurfaceDerivatives, 2>> out;
     {
       py::gil_scoped_release free;
@@ -268,8 +263,8 @@ class PySurface : public PyBuilt {
     d["degree"] = py::make_tuple(e->knots_u().degree(), e->knots_v().degree());
     d["knots_u"] = knots_array(e->knots_u(), keep);
     d["knots_v"] = knots_array(e->knots_v(), keep);
-    d["control_points"] = py::array_t<double>({nu, nv, py::ssize_t{3}}, &e->control_points().data()->x, keep);
-    d["weights"] = e->rational() ? py::object(py::array_t<double>({nu, nv}, e->weights().data(), keep)) : py::none();
+    d["control_points"] = read_only(py::array_t<double>({nu, nv, py::ssize_t{3}}, &e->control_points().data()->x, keep));
+    d["weights"] = e->rational() ? py::object(read_only(py::array_t<double>({nu, nv}, e->weights().data(), keep))) : py::none();
     d["periodic"] = py::make_tuple(e->knots_u().periodic(), e->knots_v().periodic());
     return d;
   }
@@ -286,11 +281,12 @@ class PyVolume : public PyBuilt {
   using PyBuilt::PyBuilt;
 
   py::array_t<double> evaluate(const py::handle& us_in, const py::handle& vs_in, const py::handle& ws_in) const {
-    auto us = params(us_in), vs = params(vs_in), ws = params(ws_in);
+    auto us = params(us_in, "us"), vs = params(vs_in, "vs"), ws = params(ws_in, "ws");
     std::unique_ptr<ip::PointGrid3> out;
+    const ip::progress_callback progress = interruptible();
     {
       py::gil_scoped_release free;
-      out = std::make_unique<ip::PointGrid3>(ip::io::volume_evaluator(b_->c).evaluate(us, vs, ws));
+      out = std::make_unique<ip::PointGrid3>(ip::io::volume_evaluator(b_->c).evaluate(us, vs, ws, progress));
     }
     double* data = &out->data()->x;
     return owning_array(std::move(out), data,
@@ -299,11 +295,12 @@ class PyVolume : public PyBuilt {
   }
 
   py::tuple jacobians(const py::handle& us_in, const py::handle& vs_in, const py::handle& ws_in) const {
-    auto us = params(us_in), vs = params(vs_in), ws = params(ws_in);
+    auto us = params(us_in, "us"), vs = params(vs_in, "vs"), ws = params(ws_in, "ws");
     std::unique_ptr<ip::VolumeJacobians> j;
+    const ip::progress_callback progress = interruptible();
     {
       py::gil_scoped_release free;
-      j = std::make_unique<ip::VolumeJacobians>(ip::io::volume_evaluator(b_->c).evaluate_jacobians(us, vs, ws));
+      j = std::make_unique<ip::VolumeJacobians>(ip::io::volume_evaluator(b_->c).evaluate_jacobians(us, vs, ws, progress));
     }
     const std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(us.size()), static_cast<py::ssize_t>(vs.size()),
                                          static_cast<py::ssize_t>(ws.size())};
@@ -331,8 +328,9 @@ class PyVolume : public PyBuilt {
     d["knots_u"] = knots_array(e->knots_u(), keep);
     d["knots_v"] = knots_array(e->knots_v(), keep);
     d["knots_w"] = knots_array(e->knots_w(), keep);
-    d["control_points"] = py::array_t<double>({n0, n1, n2, py::ssize_t{3}}, &e->control_points().data()->x, keep);
-    d["weights"] = e->rational() ? py::object(py::array_t<double>({n0, n1, n2}, e->weights().data(), keep)) : py::none();
+    d["control_points"] = read_only(py::array_t<double>({n0, n1, n2, py::ssize_t{3}}, &e->control_points().data()->x, keep));
+    d["weights"] =
+        e->rational() ? py::object(read_only(py::array_t<double>({n0, n1, n2}, e->weights().data(), keep))) : py::none();
     d["periodic"] = py::make_tuple(e->knots_u().periodic(), e->knots_v().periodic(), e->knots_w().periodic());
     return d;
   }
@@ -349,26 +347,34 @@ py::object wrap(ip::io::Construction c, std::shared_ptr<const Sources> sources) 
   return py::cast(PySurface(std::move(b), std::move(sources)));
 }
 
-py::object build(const py::object& spec, const std::filesystem::path& base_dir, const py::dict& arrays) {
+py::object build(const py::handle& spec, const py::handle& base_dir_in, const py::handle& arrays) {
+  const std::filesystem::path base_dir =
+      ip::python::path_arg(base_dir_in, "build: base_dir is the directory data files are named from, a str or an os.PathLike");
+  if (!py::isinstance<py::dict>(arrays))
+    throw ip::error(ip::errc::wrong_type, "build: arrays is a dict of NumPy arrays by name, got a " +
+                                              py::str(py::type::handle_of(arrays).attr("__name__")).cast<std::string>());
   ip::io::BuildOptions o;
   o.defer_exact = true;
   // The data points stay in the caller's arrays until info() asks for the check at the
   // data: the object keeps the arrays rather than a copy of the grid.
   o.borrow_arrays = true;
+  o.progress = interruptible();
   auto sources = std::make_shared<Sources>();
-  for (const auto& [k, v] : arrays) {
+  for (const auto& [k, v] : py::reinterpret_borrow<py::dict>(arrays)) {
+    if (!py::isinstance<py::str>(k))
+      throw ip::error(ip::errc::wrong_type, "build: the names of arrays are strings, got " + py::repr(k).cast<std::string>());
     const auto name = k.cast<std::string>();
     o.arrays[name] = point_array(v, name);
     (*sources)[name] = py::reinterpret_borrow<py::object>(v);
   }
   ip::io::Construction c;
   if (py::isinstance<py::dict>(spec)) {
-    const std::string text = py::module_::import("json").attr("dumps")(spec).cast<std::string>();
-    const nlohmann::json j = ip::io::parse_json(text, "spec");
+    const nlohmann::json j = ip::python::spec_json(spec);
     py::gil_scoped_release free;
     c = ip::io::build(j, base_dir, o);
   } else {
-    const auto path = spec.cast<std::filesystem::path>();
+    const std::filesystem::path path =
+        ip::python::path_arg(spec, "build: the spec is a dict or the path of a spec file (a str or an os.PathLike)");
     py::gil_scoped_release free;
     c = ip::io::build_file(path, o);
   }
@@ -446,7 +452,7 @@ PYBIND11_MODULE(_core, m) {
       .def("to_bspline", &PyVolume::to_bspline,
            "The exact B-spline form: degree (p, q, r), knots_u/v/w, control_points (n0, n1, n2, 3), weights or None.");
 
-  m.def("build", &build, py::arg("spec"), py::arg("base_dir") = std::filesystem::path("."), py::arg("arrays") = py::dict(),
+  m.def("build", &build, py::arg("spec"), py::arg("base_dir") = py::str("."), py::arg("arrays") = py::dict(),
         "A spec (docs/spec-format.md) as a dict, or the path of a spec file, built.\n\n"
         "Example: s = interpatch.build({'type': 'bilinear', 'p00': [0, 0, 0], 'p01': [0, 1, 0], "
         "'p10': [1, 0, 0], 'p11': [1, 1, 1]})");

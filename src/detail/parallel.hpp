@@ -12,6 +12,7 @@
 #include <limits>
 #include <mutex>
 
+#include "interpatch/progress.hpp"
 #include "interpatch/vec3.hpp"
 
 #ifdef _OPENMP
@@ -72,6 +73,34 @@ class ParallelFailure {
   std::atomic<std::size_t> first_{none};
   std::mutex mutex_;
   std::exception_ptr error_;
+};
+
+/// Progress reported from inside a parallel region by the calling thread (thread 0).
+/// A callback may throw to stop the work (progress.hpp), but no exception may leave
+/// a parallel region: the first is kept, every thread's remaining iterations see
+/// stopped() and skip their work, and rethrow() after the region throws it.
+class RegionProgress {
+ public:
+  explicit RegionProgress(const progress_callback& progress) noexcept : progress_(progress) {}
+  void report(double fraction) noexcept {
+    if (!progress_ || stopped()) return;
+    try {
+      progress_(fraction);
+    } catch (...) {
+      error_ = std::current_exception();  // thread 0 alone reports
+      stop_.store(true, std::memory_order_relaxed);
+    }
+  }
+  [[nodiscard]] bool stopped() const noexcept { return stop_.load(std::memory_order_relaxed); }
+  /// After the region: what a callback threw, if it did.
+  void rethrow() const {
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  const progress_callback& progress_;
+  std::exception_ptr error_;
+  std::atomic<bool> stop_{false};
 };
 
 /// How the iterations of parallel_for are shared: `blocks`, one contiguous block a

@@ -144,6 +144,23 @@ TEST(Spec, InMemoryArraysTakenWhenNamedOnceAndHeldByNobodyElse) {
   for (const double u : {0.0, 0.3, 1.0}) EXPECT_EQ(s.point(u, 0.0), s.point(u, 1.0)) << "both curves the same, at u " << u;
 }
 
+// A field given one way only: an array beside a file, or an array the spec never
+// names (the field given inline or from a file as well), is refused, not ignored.
+TEST(Spec, AnArrayBesideAFileOrNeverNamedIsRefused) {
+  auto a = std::make_shared<PointArray>();
+  a->shape = {2, 2};
+  a->points = {{0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 1}};
+  BuildOptions o;
+  o.arrays["q"] = a;
+  for (const char* file : {"npy", "csv"})
+    EXPECT_ERRC((void)build({{"type", "interpolate"}, {"points", {{"array", "q"}, {file, "q.npy"}}}}, {}, o), wrong_type,
+                "/points: give either \"array\" or \"" + std::string(file) + "\", not both");
+  const json inline_points = {{"type", "interpolate"}, {"points", {{{0, 0, 0}, {0, 1, 0}}, {{1, 0, 0}, {1, 1, 1}}}}};
+  EXPECT_ERRC((void)build(inline_points, {}, o), wrong_type,
+              "arrays: \"q\" is given but the spec names no {\"array\": \"q\"}");
+  EXPECT_NO_THROW((void)build({{"type", "interpolate"}, {"points", {{"array", "q"}}}}, {}, o));
+}
+
 // borrow_arrays: the data set of an interpolated or approximated in-memory grid names
 // the array instead of copying it; filled by the caller, info reports what the copy
 // gives. Arrays from anywhere else are copied as before.

@@ -215,7 +215,12 @@ PointArray memory_points(const json& obj, std::size_t rank, std::string_view ptr
 }
 
 PointArray points_impl(const json& j, std::size_t rank, std::string_view ptr, Context& ctx, bool missing_allowed) {
-  if (j.is_object() && j.contains("array")) return memory_points(j, rank, ptr, ctx, missing_allowed);
+  if (j.is_object() && j.contains("array")) {
+    // One way to give a field: a file beside the array would be silently ignored.
+    for (const char* file : {"npy", "csv"})
+      if (j.contains(file)) fail(errc::wrong_type, place(ptr), ": give either \"array\" or \"", file, "\", not both");
+    return memory_points(j, rank, ptr, ctx, missing_allowed);
+  }
   if (j.is_object()) {
     const bool npy = j.contains("npy"), csv = j.contains("csv");
     if (npy && csv) fail(errc::wrong_type, place(ptr), ": give either \"npy\" or \"csv\", not both");

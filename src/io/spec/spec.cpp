@@ -59,6 +59,12 @@ void count_array_uses(const json& j, std::map<std::string, std::size_t, std::les
 
 Construction build_impl(const json& spec, Context& ctx) {
   if (ctx.arrays && !ctx.arrays->empty()) count_array_uses(spec, ctx.array_uses);
+  // An array the spec never names is a field given twice (inline, or from a file, as
+  // well) or misnamed: refused rather than ignored.
+  if (ctx.arrays)
+    for (const auto& [name, array] : *ctx.arrays)
+      if (!ctx.array_uses.contains(name))
+        fail(errc::wrong_type, "arrays: \"", name, "\" is given but the spec names no {\"array\": \"", name, "\"}");
   if (!spec.is_object())
     fail(errc::wrong_type, "(top level): the spec must be a JSON object with a \"type\", got ", kind(spec));
   const json& t = member(spec, "type", "", cat("a string, one of ", type_list()));

@@ -1,0 +1,109 @@
+#pragma once
+/// @file io/outputs.hpp
+/// The files of a built construction and the checks made of them before any work:
+/// counts along each direction, output formats, and the memory and disk room a
+/// mesh or an evaluation grid needs. The command line and the Python module both
+/// call these, so neither accepts what the other refuses.
+
+#include <cstddef>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "interpatch/io/spec.hpp"
+#include "interpatch/progress.hpp"
+
+namespace interpatch::io {
+
+/// Points (or vertices) per direction of a mesh, a viewer page or an evaluation
+/// grid; nw is 0 for a surface.
+struct Resolution {
+  std::size_t nu = 64, nv = 64, nw = 0;
+};
+
+/// The default mesh resolutions: 64 × 64 for a surface, 33 × 33 × 33 for a volume.
+inline constexpr Resolution default_surface_resolution{64, 64, 0};
+inline constexpr Resolution default_volume_resolution{33, 33, 33};
+
+/// How messages name counts along each direction: the option or argument that gave
+/// them, what they make and count, and how its user writes them (the command line's
+/// --res '64x64', Python's res (64, 64)).
+struct CountsOption {
+  std::string_view name;                             ///< "--res", "res"
+  std::string_view noun;                             ///< what the counts make: "mesh"
+  std::string_view unit;                             ///< what they count: "vertices"
+  std::string_view surface_form, volume_form;        ///< "NUxNV", "NUxNVxNW"
+  std::string_view surface_example, volume_example;  ///< "64x64", "33x33x33"
+  bool single = false;                               ///< "K" accepted: K along every direction
+  std::string_view open = " '", separator = "x", close = "'";  ///< --res '64x64'
+};
+
+/// The counts as `option` writes them, after its name: "--res '0x5'", "res (0, 5)".
+[[nodiscard]] std::string counts_text(const CountsOption& option, std::span<const std::size_t> counts);
+
+/// The counts of a resolution, 2 for a surface (nw == 0), 3 for a volume.
+[[nodiscard]] std::span<const std::size_t> counts_of(const Resolution& r) noexcept;
+
+/// Refuse counts below 2 along any direction: a mesh, a grid or a page needs both
+/// ends of each direction.
+///
+/// Example:
+/// @code
+///   constexpr interpatch::io::CountsOption res{"--res", "mesh", "vertices", "NUxNV", "NUxNVxNW", "64x64", "33x33x33"};
+///   const std::size_t n[] = {0, 5};
+///   interpatch::io::check_counts(n, res);  // "--res '0x5': a mesh needs at least 2 vertices along each direction"
+/// @endcode
+/// @throws error too_few_points, naming the counts (`given`, or counts_text when empty).
+void check_counts(std::span<const std::size_t> counts, const CountsOption& option, std::string_view given = {});
+
+/// Refuse counts whose number does not fit the construction's kind: three for a
+/// surface, two for a volume. @throws error size_mismatch.
+void check_counts_kind(const Construction& c, const CountsOption& option, const Resolution& counts);
+
+/// Refuse (error wrong_type) an output format the file kind does not have: build
+/// writes .json, .npz, .step/.stp, .igs/.iges; a mesh .obj .stl .ply .vtk .vts .xyz;
+/// eval .npy or .csv; info .json; view .html or .htm. Case-insensitive.
+void check_build_output(const std::filesystem::path& out);
+void check_mesh_output(const std::filesystem::path& out);
+void check_eval_output(const std::filesystem::path& out);
+void check_info_output(const std::filesystem::path& out);
+void check_view_output(const std::filesystem::path& out);
+
+/// Refuse (error wrong_type) a mesh format that holds surfaces only for a volume, then
+/// counts that do not fit the construction's kind (check_counts_kind).
+void check_mesh_kind(const Construction& c, const std::filesystem::path& out, const Resolution& res,
+                     const CountsOption& option);
+
+/// Refuse (error too_large) an evaluation grid whose .npy file cannot fit on the
+/// output's disk (it is written a block at a time, and a block must fit in memory) or
+/// whose .csv text cannot be made in memory. A count of the largest size_t stands for
+/// one too large to represent.
+void require_eval_room(const Resolution& grid, const std::filesystem::path& out);
+
+/// Refuse (error too_large) a mesh whose points and normals cannot be held in memory,
+/// or, for a surface's .vts or .vtk (written a block of columns at a time), whose
+/// file cannot fit on the output's disk.
+void require_mesh_room(const Resolution& res, const std::filesystem::path& out);
+
+/// Writes the exact form: .json, .npz, .step/.stp (named after the file's stem) or
+/// .igs/.iges. @throws error no_exact_form, wrong_type (another format), and what the
+/// writers throw.
+void write_build(Construction& c, const std::filesystem::path& out);
+
+/// Writes a mesh of `res` vertices, sampled through the cheaper exact evaluator
+/// (evaluator()), which may make the exact form of `c`. Every check above comes
+/// first: the format, counts of at least 2 of the construction's kind (messages
+/// naming `option`), the room. `progress` may throw to stop the work.
+///
+/// Example:
+/// @code
+///   constexpr interpatch::io::CountsOption res{"res", "mesh", "vertices", "(nu, nv)", "(nu, nv, nw)", "(64, 64)",
+///                                              "(33, 33, 33)", false, " (", ", ", ")"};
+///   interpatch::io::write_mesh(c, "patch.vts", {200, 100, 0}, res);  // "res (0, 5): ..." for {0, 5, 0}
+/// @endcode
+/// @throws error wrong_type, too_few_points, size_mismatch, too_large, file_unwritable.
+void write_mesh(Construction& c, const std::filesystem::path& out, const Resolution& res, const CountsOption& option,
+                const progress_callback& progress = {});
+
+}  // namespace interpatch::io

@@ -1,0 +1,196 @@
+// The files of a built construction and the checks made of them before any work,
+// shared by the command line and the Python module.
+
+#include "interpatch/io/outputs.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "interpatch/error.hpp"
+#include "interpatch/evaluate.hpp"
+#include "interpatch/io/atomic_file.hpp"
+#include "interpatch/io/iges.hpp"
+#include "interpatch/io/json_out.hpp"
+#include "interpatch/io/mesh.hpp"
+#include "interpatch/io/npy.hpp"
+#include "interpatch/io/npz.hpp"
+#include "interpatch/io/step.hpp"
+#include "interpatch/io/view.hpp"
+#include "interpatch/memory.hpp"
+
+namespace interpatch::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string lower_extension(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+std::string resolution_text(const Resolution& r) {
+  std::string t = std::to_string(r.nu) + "x" + std::to_string(r.nv);
+  return r.nw ? t + "x" + std::to_string(r.nw) : t;
+}
+
+// The number of points of a grid, or nullopt when it overflows a size_t.
+std::optional<std::size_t> point_count(const Resolution& r) {
+  std::size_t n = 1;
+  for (const std::size_t c : {r.nu, r.nv, r.nw ? r.nw : std::size_t{1}}) {
+    if (c != 0 && n > std::numeric_limits<std::size_t>::max() / c) return std::nullopt;
+    n *= c;
+  }
+  return n;
+}
+
+void mesh_volume(const Construction& c, const fs::path& out, const Resolution& res, const progress_callback& progress) {
+  const Volume& v = volume_evaluator(c);
+  // Every construction is over the unit cube.
+  const std::vector<double> us = linspace(0, 1, res.nu), vs = linspace(0, 1, res.nv), ws = linspace(0, 1, res.nw);
+  const VolumeJacobians j = v.evaluate_jacobians(us, vs, ws, progress);
+  write_volume_mesh(out, j.points, j.determinants);
+}
+
+}  // namespace
+
+std::string counts_text(const CountsOption& option, std::span<const std::size_t> counts) {
+  std::string t = std::string(option.name) + std::string(option.open);
+  for (std::size_t k = 0; k < counts.size(); ++k) t += (k ? std::string(option.separator) : "") + std::to_string(counts[k]);
+  return t + std::string(option.close);
+}
+
+std::span<const std::size_t> counts_of(const Resolution& r) noexcept { return {&r.nu, r.nw ? 3u : 2u}; }
+
+void check_counts(std::span<const std::size_t> counts, const CountsOption& o, std::string_view given) {
+  if (std::none_of(counts.begin(), counts.end(), [](std::size_t n) { return n < 2; })) return;
+  throw error(errc::too_few_points, (given.empty() ? counts_text(o, counts) : std::string(given)) + ": a " +
+                                        std::string(o.noun) + " needs at least 2 " + std::string(o.unit) +
+                                        " along each direction");
+}
+
+void check_counts_kind(const Construction& c, const CountsOption& o, const Resolution& counts) {
+  const std::string given = counts_text(o, counts_of(counts)) + ": ";
+  const std::string k_or = o.single ? "K or " : "";
+  if (!is_volume(c) && counts.nw)
+    throw error(errc::size_mismatch, given + "a surface " + std::string(o.noun) + " takes " + k_or + "two counts, " +
+                                         std::string(o.surface_form) + " (" + std::string(o.volume_form) + " is for volumes)");
+  if (is_volume(c) && !counts.nw)
+    throw error(errc::size_mismatch, given + c.type + " is a volume; its " + std::string(o.noun) + " takes " + k_or +
+                                         "three counts, " + std::string(o.volume_form) + " (e.g. " +
+                                         std::string(o.volume_example) + ")");
+}
+
+void check_build_output(const fs::path& out) {
+  const std::string ext = lower_extension(out);
+  if (ext == ".json" || ext == ".npz" || ext == ".step" || ext == ".stp" || ext == ".igs" || ext == ".iges") return;
+  throw error(errc::wrong_type, "cannot tell the output format of '" + out.string() +
+                                    "': build writes .json, .npz (NumPy), .step/.stp (STEP AP214) or .igs/.iges (IGES 5.3)");
+}
+
+void check_mesh_output(const fs::path& out) {
+  if (is_mesh_format(out.extension().string())) return;
+  throw error(errc::wrong_type,
+              "cannot tell the mesh format of '" + out.string() + "': use .obj, .stl, .ply, .vtk, .vts or .xyz");
+}
+
+void check_eval_output(const fs::path& out) {
+  const std::string ext = lower_extension(out);
+  if (ext == ".npy" || ext == ".csv") return;
+  throw error(errc::wrong_type, "cannot tell the output format of '" + out.string() + "': eval writes .npy or .csv");
+}
+
+void check_info_output(const fs::path& out) {
+  if (lower_extension(out) == ".json") return;
+  throw error(errc::wrong_type, "cannot tell the output format of '" + out.string() + "': info writes .json");
+}
+
+void check_view_output(const fs::path& out) {
+  if (is_view_format(out.extension().string())) return;
+  throw error(errc::wrong_type,
+              "cannot tell the output format of '" + out.string() + "': view writes .html (or .htm)");
+}
+
+void check_mesh_kind(const Construction& c, const fs::path& out, const Resolution& res, const CountsOption& option) {
+  const std::string ext = lower_extension(out);
+  if (is_volume(c) && ext != ".vts" && ext != ".vtk" && ext != ".xyz")
+    throw error(errc::wrong_type, "'" + out.string() + "': " + c.type + " is a volume; " + ext +
+                                      " holds surfaces only, a volume mesh is written to .vts, .vtk or .xyz (Plot3D)");
+  check_counts_kind(c, option, res);
+}
+
+void require_eval_room(const Resolution& grid, const fs::path& out) {
+  constexpr std::size_t beyond = std::numeric_limits<std::size_t>::max();  // a count too large to represent
+  const bool uncountable = grid.nu == beyond || grid.nv == beyond || grid.nw == beyond;
+  const std::string what = "evaluation grid " + (uncountable ? std::string("beyond 2^64") : resolution_text(grid));
+  const std::optional<std::size_t> points = point_count(grid);
+  if (uncountable || !points) throw error(errc::too_large, what + ": more points than can be addressed");
+  if (lower_extension(out) == ".npy") {
+    // Evaluated and written a block at a time: the disk space of the whole file (the
+    // header is at most a few hundred bytes), the memory of one block.
+    if (*points > (std::numeric_limits<std::size_t>::max() - 4096) / sizeof(Vec3))
+      throw error(errc::too_large, what + ": more bytes than a file can hold");
+    check_disk_space(out, *points * sizeof(Vec3) + 4096, what);
+    const std::size_t per_row = *points / grid.nu;
+    require_memory(write_npy_rows_held(grid.nu, 3 * per_row), sizeof(double), what + ", two blocks of u values");
+    return;
+  }
+  // The points, plus the text of a row for .csv.
+  require_memory(*points, sizeof(Vec3) + 8, what);
+}
+
+void require_mesh_room(const Resolution& res, const fs::path& out) {
+  const std::string what = "mesh of " + resolution_text(res) + " vertices";
+  if (res.nw) {
+    constexpr std::size_t limit = std::size_t{1} << 21;
+    if (res.nu >= limit || res.nv >= limit || res.nw >= limit)
+      throw error(errc::too_large, what + ": more vertices than can be addressed");
+    // Points and Jacobian determinants, plus the text of a vertex in the ASCII formats.
+    require_memory(res.nu * res.nv * res.nw, sizeof(Vec3) + sizeof(double) + 80, what);
+    return;
+  }
+  if (res.nu >= (std::size_t{1} << 32) || res.nv >= (std::size_t{1} << 32))
+    throw error(errc::too_large, what + ": more vertices than can be addressed");
+  if (const std::string ext = lower_extension(out); ext == ".vts" || ext == ".vtk") {
+    // Written a block of columns at a time: the disk space of the file (points and
+    // normals, 48 bytes a vertex, and at most a few kilobytes of XML or header).
+    const std::size_t n = res.nu * res.nv;
+    if (n > (std::numeric_limits<std::size_t>::max() - 4096) / (2 * sizeof(Vec3)))
+      throw error(errc::too_large, what + ": more bytes than a file can hold");
+    check_disk_space(out, n * 2 * sizeof(Vec3) + 4096, what);
+    return;
+  }
+  // Points and normals, plus room for the writers' faces (two triangles per vertex in STL).
+  require_memory(res.nu * res.nv, 2 * sizeof(Vec3) + 2 * 50, what);
+}
+
+void write_build(Construction& c, const fs::path& out) {
+  check_build_output(out);
+  const ExactForm& exact = exact_form(c);
+  const std::string ext = lower_extension(out);
+  // The product (STEP) or file (IGES) is named after the output file.
+  if (ext == ".step" || ext == ".stp") return write_step(out, exact, {.name = out.stem().string(), .time_stamp = {}});
+  if (ext == ".igs" || ext == ".iges") return write_iges(out, exact, {.name = out.filename().string(), .time_stamp = {}});
+  if (ext == ".npz") return write_exact_npz(out, exact);
+  write_exact_json(out, exact);
+}
+
+void write_mesh(Construction& c, const fs::path& out, const Resolution& res, const CountsOption& option,
+                const progress_callback& progress) {
+  check_mesh_output(out);
+  check_counts(counts_of(res), option);
+  check_mesh_kind(c, out, res, option);
+  require_mesh_room(res, out);
+  if (is_volume(c)) return mesh_volume(c, out, res, progress);
+  const Surface& s = evaluator(c, res.nu * res.nv, Sample::derivatives);
+  // Every construction is over the unit square.
+  const std::vector<double> us = linspace(0, 1, res.nu), vs = linspace(0, 1, res.nv);
+  write_surface_mesh(out, s, us, vs, progress);  // a .vts or .vtk a block at a time
+}
+
+}  // namespace interpatch::io
