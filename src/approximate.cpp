@@ -13,6 +13,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
+#include "detail/approx_check.hpp"
 #include "detail/approx_rows.hpp"
 #include "detail/banded.hpp"
 #include "detail/parallel.hpp"
@@ -593,10 +594,14 @@ KnotVector clamped_knots(const Axis& ax, const std::vector<double>& interior) {
 }
 
 // The interior knots (open) or the period's knots (closed) of `c` control points
-// for least squares over the data parameters: each knot interval holds data (The
-// NURBS Book eq. 9.69 for an open direction; evenly spaced in the data's order for
-// a closed one, shifted by half a step for an even degree). With as many control
-// points as data, interpolation's knots.
+// for least squares over the data parameters. Open: c parameters spread evenly over
+// the data's order (linear between data parameters), and interpolation's knots
+// averaged from them (The NURBS Book eq. 9.8): every basis function has data under
+// the middle of its support, so the normal equations stay as well conditioned as
+// interpolation's whatever c (The NURBS Book eq. 9.69 reaches condition numbers of
+// 1e16 as c nears the point count, and a fit then swings between the data). With as
+// many control points as data, interpolation's knots. Closed: evenly spaced in the
+// data's order, shifted by half a step for an even degree.
 std::vector<double> least_squares_breaks(const Axis& ax, int c) {
   const auto& t = ax.t;
   const auto n = static_cast<double>(ax.n);
@@ -616,19 +621,17 @@ std::vector<double> least_squares_breaks(const Axis& ax, int c) {
     for (int j = 0; j < c; ++j) k.push_back(at(j * n / c + shift));
     return k;
   }
-  if (static_cast<std::size_t>(c) == ax.n) {
-    const KnotVector avg = averaged_knots(t, ax.p);
-    const auto& u = avg.values();
-    return {u.begin() + ax.p + 1, u.end() - ax.p - 1};
-  }
-  const double step = n / (c - ax.p);
-  for (int j = 1; j < c - ax.p; ++j) {
-    const double x = j * step;
-    const auto i = static_cast<std::size_t>(std::floor(x));
+  std::vector<double> s(static_cast<std::size_t>(c));
+  for (int j = 0; j < c; ++j) {
+    // j (n − 1) / (c − 1) is exact at c = n: the data parameters themselves.
+    const double x = static_cast<double>(j) * (n - 1) / static_cast<double>(c - 1);
+    const auto i = std::min(static_cast<std::size_t>(std::floor(x)), ax.n - 1);
     const double alpha = x - static_cast<double>(i);
-    k.push_back((1 - alpha) * t[i - 1] + alpha * t[std::min(i, ax.n - 1)]);
+    s[static_cast<std::size_t>(j)] = alpha > 0 ? (1 - alpha) * t[i] + alpha * t[i + 1] : t[i];
   }
-  return k;
+  const KnotVector avg = averaged_knots(s, ax.p);
+  const auto& u = avg.values();
+  return {u.begin() + ax.p + 1, u.end() - ax.p - 1};
 }
 
 KnotVector knots_from_breaks(const Axis& ax, const std::vector<double>& breaks) {
@@ -985,10 +988,32 @@ double line_residual(const std::array<Axis, R>& axes, const AxisSolver& lu, cons
   return line_fit_residual(axes[a], lu, line, pos);
 }
 
+// Whether the clamped knots of an open axis with interior knots `breaks` (sorted)
+// meet the Schoenberg–Whitney condition on the lines that hold data: basis function
+// j can be given its own line i_j, i_0 < i_1 < …, inside its support. Without it
+// the least-squares system is singular (more control points than data somewhere).
+// The smallest line that fits each function in turn is the best choice: the
+// supports' ends rise with j.
+bool whitney(const Axis& ax, const std::vector<double>& breaks, const std::vector<bool>& has_data) {
+  std::vector<double> u(static_cast<std::size_t>(ax.p) + 1, ax.t.front());
+  u.insert(u.end(), breaks.begin(), breaks.end());
+  u.insert(u.end(), static_cast<std::size_t>(ax.p) + 1, ax.t.back());
+  const std::size_t c = breaks.size() + static_cast<std::size_t>(ax.p) + 1, p1 = static_cast<std::size_t>(ax.p) + 1;
+  std::size_t i = 0;
+  for (std::size_t j = 0; j < c; ++j) {
+    const double lo = u[j], hi = u[j + p1];
+    while (i < ax.n && (!has_data[i] || ax.t[i] < lo || (ax.t[i] == lo && j > 0))) ++i;
+    if (i == ax.n || !(ax.t[i] < hi || (j + 1 == c && ax.t[i] == hi))) return false;
+    ++i;
+  }
+  return true;
+}
+
 // Splits knot interval k of an axis at the middle of the data in it, between two
 // lines across the axis that hold data (a knot between missing lines would leave
 // the fairness term alone to settle a control point there); false when it holds
-// fewer than 2 such lines (or the direction has as many control points as data).
+// fewer than 2 such lines, when the direction has as many control points as data,
+// or when the new knot would break the Schoenberg–Whitney condition (whitney).
 bool split_interval(const Axis& ax, std::vector<double>& breaks, int k, const std::vector<bool>& has_data) {
   if (static_cast<std::size_t>(ax.c) >= ax.n) return false;
   std::vector<std::size_t> in;  // the lines across the axis in the interval that hold data
@@ -1002,6 +1027,12 @@ bool split_interval(const Axis& ax, std::vector<double>& breaks, int k, const st
   if (ax.periodic) std::stable_sort(in.begin(), in.end(), [&](std::size_t x, std::size_t y) { return at(x) < at(y); });
   const std::size_t mid = in.size() / 2;
   const double knot = 0.5 * (at(in[mid - 1]) + at(in[mid]));
+  if (!ax.periodic) {
+    std::vector<double> next = breaks;  // this round's earlier knots at its end
+    next.push_back(knot);
+    std::sort(next.begin(), next.end());
+    if (!whitney(ax, next, has_data)) return false;
+  }
   breaks.push_back(knot);
   return true;
 }
@@ -1056,6 +1087,12 @@ std::vector<double> removal_costs(const Fit<R>& f, std::size_t a, const std::vec
 // The data a fit to a tolerance works on, all in this process (the split run has its
 // own, Block in the section "split between processes"): what the knot logic of
 // grow() and solve_tolerance() asks of the data.
+// A control net's doubles as points.
+std::span<const Vec3> net_points(const std::vector<double>& cp) {
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "a control net is triples of doubles");
+  return {reinterpret_cast<const Vec3*>(cp.data()), cp.size() / 3};
+}
+
 template <std::size_t R>
 struct Whole {
   std::shared_ptr<const Data<R>> own;  // a thinned grid's data; none for the caller's
@@ -1065,6 +1102,12 @@ struct Whole {
   [[nodiscard]] const Shape<R>& shape() const { return d->shape; }
   void fit(Fit<R>& f) const { solve_once<R>(f, *d, std::nullopt); }
   [[nodiscard]] Residuals<R> errors(const Fit<R>& f) const { return residuals<R>(f.axes, *d, f.cp); }
+  // Whether f's control net stays near the data (detail::approx_net_sane).
+  [[nodiscard]] bool sane(const Fit<R>& f) const {
+    if (!box) box = detail::approx_box({{}, std::span<const Vec3>(d->points.data(), d->points.size()), d->weight});
+    return detail::approx_net_sane(net_points(f.cp), R, *box);
+  }
+  mutable std::optional<std::array<Vec3, 2>> box;  // of the data, found once
   // line_residual at each (axis, point) of `at`, lu[axis] the axis's line solver.
   [[nodiscard]] std::vector<double> line_residuals(const Fit<R>& f, const std::array<std::optional<AxisSolver>, R>& lu,
                                                    const std::vector<std::pair<std::size_t, std::size_t>>& at) const {
@@ -1101,7 +1144,9 @@ bool grow(Fit<R>& f, const Source& s, double tol, std::array<std::vector<double>
     s.fit(f);
     if (progress) progress(std::min(0.9, 0.1 + 0.04 * f.fits));
     const Residuals<R> r = s.errors(f);
-    if (r.max <= tol) return true;
+    // Within the tolerance but swinging between the data (knots that leave a basis
+    // function little data): climb() takes the least-squares knots instead.
+    if (r.max <= tol) return s.sane(f);
     // The intervals beyond the tolerance; those of a direction with a line fit are
     // decided by it, all lines of one round at once.
     std::array<std::vector<int>, R> bad;
@@ -1152,6 +1197,35 @@ bool grow(Fit<R>& f, const Source& s, double tol, std::array<std::vector<double>
   }
 }
 
+// Growth stalled (no interval beyond the tolerance can split): the knots of the
+// least-squares rule (least_squares_breaks), half as many more control points again
+// along every direction each time, up to as many as data points (interpolation, which
+// meets any tolerance on a complete grid but for rounding). True when the fit is
+// within the tolerance; false with the fit of the most control points (the caller's
+// check then refuses it, naming the worst point).
+template <std::size_t R, class Source>
+bool climb(Fit<R>& f, const Source& s, double tol, std::array<std::vector<double>, R>& breaks,
+           const progress_callback& progress) {
+  for (;;) {
+    // A direction growth left with as many control points as data takes
+    // interpolation's knots too: growth's may be poorly conditioned there.
+    bool more = false;
+    for (std::size_t a = 0; a < R; ++a) {
+      Axis& ax = f.axes[a];
+      const int n = static_cast<int>(ax.n), c = ax.c < n ? std::max(ax.c + 1, ax.c + ax.c / 2) : n;
+      std::vector<double> next = least_squares_breaks(ax, std::min(n, c));
+      if (next == breaks[a]) continue;
+      more = true;
+      breaks[a] = std::move(next);
+      ax.set_knots(knots_from_breaks(ax, breaks[a]));
+    }
+    if (!more) return false;
+    s.fit(f);
+    if (progress) progress(std::min(0.9, 0.1 + 0.04 * f.fits));
+    if (s.errors(f).max <= tol && s.sane(f)) return true;
+  }
+}
+
 // Every `step[a]`-th line of the data along each axis (the last one too): a grid to
 // grow the knots on before the whole grid refines them.
 template <std::size_t R>
@@ -1184,7 +1258,7 @@ Data<R> thinned(const Data<R>& d, const std::array<std::vector<std::size_t>, R>&
 template <std::size_t R>
 Whole<R> Whole<R>::thinned(const std::array<std::vector<std::size_t>, R>& kept) const {
   auto t = std::make_shared<const Data<R>>(interpatch::thinned<R>(*d, kept));
-  return {t, t.get()};
+  return {t, t.get(), std::nullopt};
 }
 
 // The fit to a tolerance of the data `s` (Whole, or a block of a split run).
@@ -1222,7 +1296,7 @@ void solve_tolerance(Fit<R>& f, const Source& s, double tol, const progress_call
     coarse.fits = 0;
     for (std::size_t a = 0; a < R; ++a) f.axes[a].set_knots(knots_from_breaks(f.axes[a], breaks[a]));
   }
-  if (!grow<R>(f, s, tol, breaks, progress)) return;
+  if (!grow<R>(f, s, tol, breaks, progress) && !climb<R>(f, s, tol, breaks, progress)) return;
   auto max_error = [&] {
     s.fit(f);
     if (progress) progress(std::min(0.9, 0.1 + 0.04 * f.fits));
@@ -1275,7 +1349,7 @@ void solve_tolerance(Fit<R>& f, const Source& s, double tol, const progress_call
       f.fits += coarse.fits;
       coarse.fits = 0;
     }
-    if (within && max_error().max <= tol) continue;
+    if (within && max_error().max <= tol && s.sane(f)) continue;
     const int fits = f.fits;
     f = kept;
     f.fits = fits;
@@ -1348,6 +1422,7 @@ template <std::size_t R>
 struct Result {
   Fit<R> fit;
   ApproximationReport report;
+  Data<R> data;  // the points fitted (a closed direction's closing line left out)
 };
 
 // Weights of the shape of the points, finite and not negative.
@@ -1392,6 +1467,19 @@ Result<R> approximate(Data<R> d, const ApproximationOptions<R>& o, const char* w
     }
   if (d.present == 0)
     fail(errc::too_few_points, "all ", total, " points are missing or have weight 0: there is nothing to approximate");
+  // Data on a single line across a direction leave the fit free along it (nothing
+  // fixes its slope there).
+  if (!d.weight.empty())
+    for (std::size_t a = 0; a < R; ++a) {
+      std::size_t inner = 1;
+      for (std::size_t x = a + 1; x < R; ++x) inner *= d.shape[x];
+      std::vector<bool> has(d.shape[a], false);
+      for (std::size_t i = 0; i < total; ++i)
+        if (d.weight[i] > 0) has[(i / inner) % d.shape[a]] = true;
+      if (std::count(has.begin(), has.end(), true) < 2)
+        fail(errc::too_few_points, "along ", axis_name(a), " only one line of points holds data (the others are missing ",
+             "or have weight 0): an approximation needs two");
+    }
   if (!d.weight.empty() && d.missing == 0 &&
         std::all_of(d.weight.begin(), d.weight.end(), [&](double w) { return w == d.weight.front(); })) {
     d.weight.clear();  // equal weights: the plain least-squares fit
@@ -1408,7 +1496,7 @@ Result<R> approximate(Data<R> d, const ApproximationOptions<R>& o, const char* w
   if (o.progress) o.progress(0.0);
 
   if (o.tolerance) {
-    solve_tolerance<R>(f, Whole<R>{nullptr, &d}, *o.tolerance, o.progress);
+    solve_tolerance<R>(f, Whole<R>{nullptr, &d, std::nullopt}, *o.tolerance, o.progress);
   } else {
     set_fit_knots<R>(f.axes, o);
     if (o.auto_smoothing) solve_gcv<R>(f, d);
@@ -1426,6 +1514,7 @@ Result<R> approximate(Data<R> d, const ApproximationOptions<R>& o, const char* w
   rep.missing = d.missing;
   rep.fits = f.fits;
   if (o.progress) o.progress(1.0);
+  res.data = std::move(d);
   return res;
 }
 
@@ -1500,29 +1589,65 @@ Result<R> run(Grid<Vec3, R> points, const ApproximationOptions<R>& options, cons
 
 }  // namespace
 
+namespace {
+
+// The fitted data as the checks of detail/approx_check.hpp take them.
+template <std::size_t R>
+detail::ApproxData check_data(const Data<R>& d) {
+  return {std::vector<std::size_t>(d.shape.begin(), d.shape.end()), std::span<const Vec3>(d.points.data(), d.points.size()),
+          std::span<const double>(d.weight)};
+}
+
+// The checks every result passes (docs/spec-format.md, "approximate"): a sane
+// control net before the spline is made of it.
+template <std::size_t R>
+void check_net(const Result<R>& r, const Grid<Vec3, R>& net, const char* what) {
+  std::vector<std::size_t> shape;
+  for (std::size_t a = 0; a < R; ++a) shape.push_back(static_cast<std::size_t>(r.fit.axes[a].c));
+  detail::check_approx_net(std::span<const Vec3>(net.data(), net.size()), shape, check_data<R>(r.data), what);
+}
+
+// Then the distances, measured on the finished spline by its own evaluator: the
+// report's largest one, and the tolerance kept or refused.
+template <std::size_t R>
+void check_distance(Result<R>& r, const detail::ApproxDistance& e, const ApproximationOptions<R>& o) {
+  r.report.max_error = e.max;
+  r.report.max_error_at = unflatten<R>(e.worst, r.data.shape);
+  if (o.tolerance) detail::check_approx_tolerance(e, *o.tolerance, check_data<R>(r.data), r.report.control_points);
+}
+
+}  // namespace
+
 CurveApproximation approximate_curve(std::span<const Vec3> points, const CurveApproximationOptions& options) {
   Grid<Vec3, 1> g({points.size()}, std::vector<Vec3>(points.begin(), points.end()));
   Result<1> r = run<1>(std::move(g), options, "curve");
   Grid<Vec3, 1> net = control_net<1>(r.fit);
+  check_net<1>(r, net, "curve approximation");
   std::vector<Vec3> cp(net.values().begin(), net.values().end());
   Axis& u = r.fit.axes[0];
-  return {BSplineCurve(u.knots, std::move(cp)), std::move(u.t), std::move(r.report)};
+  BSplineCurve curve(u.knots, std::move(cp));
+  check_distance<1>(r, detail::approx_distance(curve, u.t, check_data<1>(r.data)), options);
+  return {std::move(curve), std::move(u.t), std::move(r.report)};
 }
 
 SurfaceApproximation approximate_surface(PointGrid points, const SurfaceApproximationOptions& options) {
   Result<2> r = run<2>(std::move(points), options, "surface");
   PointGrid net = control_net<2>(r.fit);
+  check_net<2>(r, net, "surface approximation");
   auto& ax = r.fit.axes;
-  return {BSplineSurface(ax[0].knots, ax[1].knots, std::move(net)), std::move(ax[0].t), std::move(ax[1].t),
-          std::move(r.report)};
+  BSplineSurface surface(ax[0].knots, ax[1].knots, std::move(net));
+  check_distance<2>(r, detail::approx_distance(surface, ax[0].t, ax[1].t, check_data<2>(r.data)), options);
+  return {std::move(surface), std::move(ax[0].t), std::move(ax[1].t), std::move(r.report)};
 }
 
 VolumeApproximation approximate_volume(PointGrid3 points, const VolumeApproximationOptions& options) {
   Result<3> r = run<3>(std::move(points), options, "volume");
   PointGrid3 net = control_net<3>(r.fit);
+  check_net<3>(r, net, "volume approximation");
   auto& ax = r.fit.axes;
-  return {BSplineVolume(ax[0].knots, ax[1].knots, ax[2].knots, std::move(net)), std::move(ax[0].t), std::move(ax[1].t),
-          std::move(ax[2].t), std::move(r.report)};
+  BSplineVolume volume(ax[0].knots, ax[1].knots, ax[2].knots, std::move(net));
+  check_distance<3>(r, detail::approx_distance(volume, ax[0].t, ax[1].t, ax[2].t, check_data<3>(r.data)), options);
+  return {std::move(volume), std::move(ax[0].t), std::move(ax[1].t), std::move(ax[2].t), std::move(r.report)};
 }
 
 
@@ -1916,6 +2041,15 @@ class Block {
     const std::vector<double> span = team.gather(std::vector<double>{static_cast<double>(first_), static_cast<double>(count_)});
     for (std::size_t s = 0; s < span.size(); s += 2) spans_.emplace_back(static_cast<std::size_t>(span[s]), static_cast<std::size_t>(span[s + 1]));
     cols_ = rows_to_columns(pts_, count_, M, team, {}, [&](std::size_t i, const Vec3&) { return weight()(base + i); });
+    std::vector<double> box(6, -std::numeric_limits<double>::infinity());  // −lo, hi
+    for (std::size_t i = 0; i < count_ * M; ++i)
+      if (weight()(base + i) > 0)
+        for (std::size_t k = 0; k < 3; ++k) {
+          box[k] = std::max(box[k], -pts_[i][static_cast<int>(k)]);
+          box[k + 3] = std::max(box[k + 3], pts_[i][static_cast<int>(k)]);
+        }
+    team.max(box);
+    box_ = {Vec3{-box[0], -box[1], -box[2]}, Vec3{box[3], box[4], box[5]}};
   }
 
   [[nodiscard]] std::size_t size() const { return n_[0] * n_[1]; }
@@ -1943,6 +2077,10 @@ class Block {
     // The separable fit refused (uniform): the fill term settles what the data leave open.
     team_->run([&] { sparse_fit<2>(f, sys, all_rhs, std::nullopt, fill_ || uniform_); });
   }
+
+  // Whole::sane: the box of every process's data (found when the block is made), the
+  // control net whole on every process.
+  [[nodiscard]] bool sane(const Fit<2>& f) const { return detail::approx_net_sane(net_points(f.cp), 2, box_); }
 
   // residuals(): each process its rows, the maxima and worst points merged in process
   // order (a later process's only where strictly greater: the first in one process's
@@ -2071,7 +2209,73 @@ class Block {
   std::vector<bool> present_;     // per point of the block, unless uniform
   std::vector<std::pair<std::size_t, std::size_t>> spans_;  // every process's {first, count}
   std::vector<double> cols_;      // the block's columns (rows_to_columns)
+  std::array<Vec3, 2> box_{};     // the whole grid's data's box (Whole::sane)
 };
+
+// This process's rows of the data as the checks of detail/approx_check.hpp take
+// them (`w` holds their weights).
+template <class Weight>
+detail::ApproxData block_data(const detail::GridBlock& b, const Weight& weight, std::vector<double>& w) {
+  const std::size_t M = b.n[1], base = b.first * M;
+  w.resize(b.count * M);
+  for (std::size_t i = 0; i < w.size(); ++i) w[i] = weight(base + i);
+  return {{b.count, M}, std::span<const Vec3>(b.data, b.count * M), w};
+}
+
+// The data's bounding box over every process, as two corners (check_rows_net).
+template <class Weight>
+std::vector<Vec3> block_box(const detail::GridBlock& b, const Weight& weight, const detail::RowTeam& team) {
+  std::vector<double> w;
+  const detail::ApproxData mine = block_data(b, weight, w);
+  std::vector<double> box(6, -std::numeric_limits<double>::infinity());  // −lo, hi
+  for (std::size_t i = 0; i < mine.points.size(); ++i)
+    if (mine.present(i))
+      for (std::size_t k = 0; k < 3; ++k) {
+        const double x = mine.points[i][static_cast<int>(k)];
+        box[k] = std::max(box[k], -x);
+        box[k + 3] = std::max(box[k + 3], x);
+      }
+  team.max(box);
+  return {{-box[0], -box[1], -box[2]}, {box[3], box[4], box[5]}};
+}
+
+// check_approx_net on a split run, `box` from block_box: each process checks its own
+// control rows (the first with a bad one reports it).
+void check_rows_net(const detail::ApproxRows& out, const std::vector<Vec3>& box, const detail::RowTeam& team) {
+  const detail::ApproxData corners{{box.size()}, box, {}};
+  team.run([&] {
+    if (out.rows.empty()) return;
+    detail::check_approx_net(out.rows, {out.rows.size() / out.net[1], out.net[1]}, corners, "surface approximation");
+  });
+}
+
+// The tolerance kept or refused on a split run, measured as approximate_surface
+// measures it (the spline's own evaluator): each process at its rows, the worst
+// over the processes (the first in row order among equals).
+template <class Weight>
+void check_rows_tolerance(const Fit<2>& f, const detail::GridBlock& b, const Weight& weight, double tol,
+                          const detail::RowTeam& team) {
+  PointGrid net({static_cast<std::size_t>(f.axes[0].c), static_cast<std::size_t>(f.axes[1].c)}, for_overwrite);
+  std::copy_n(f.cp.data(), f.cp.size(), &net.data()->x);
+  std::vector<double> w;
+  detail::ApproxData mine = block_data(b, weight, w);
+  detail::ApproxDistance e;
+  team.run([&] {
+    const BSplineSurface s(f.axes[0].knots, f.axes[1].knots, std::move(net));
+    if (b.count > 0) {
+      const std::vector<double> tu(f.axes[0].t.begin() + static_cast<std::ptrdiff_t>(b.first),
+                                   f.axes[0].t.begin() + static_cast<std::ptrdiff_t>(b.first + b.count));
+      e = detail::approx_distance(s, tu, f.axes[1].t, mine);
+    }
+  });
+  const std::vector<double> all = team.gather(std::vector<double>{e.max, static_cast<double>(b.first * b.n[1] + e.worst)});
+  detail::ApproxDistance worst;
+  for (std::size_t k = 0; k < all.size(); k += 2)
+    if (all[k] > worst.max) worst = {all[k], static_cast<std::size_t>(all[k + 1])};
+  mine.shape = {b.n[0], b.n[1]};
+  std::vector<int> cps{f.axes[0].c, f.axes[1].c};
+  team.run([&] { detail::check_approx_tolerance(worst, tol, mine, cps); });
+}
 
 }  // namespace
 
@@ -2210,13 +2414,18 @@ ApproxRows approximate_rows(const GridBlock& given, const SurfaceApproximationOp
   team.run([&] {
     if (v_degree) std::rethrow_exception(v_degree);
   });
+  // The data's box, taken before the points may be released.
+  const std::vector<Vec3> box = block_box(b, weight, team);
   if (o.tolerance) {
     // The knots grow and are pruned on every process alike (solve_tolerance), the
     // fits and measures on the blocks (Block).
     const Block whole(team, shape, nullptr, pts, b.first, b.count, uniform, nullptr,
                       weights.empty() ? nullptr : weights.values().data() + std::min(base, weights.size()));
     solve_tolerance<R>(f, whole, *o.tolerance, {});
-    return net_rows(f, team);
+    check_rows_tolerance(f, b, weight, *o.tolerance, team);
+    detail::ApproxRows out = net_rows(f, team);
+    check_rows_net(out, box, team);
+    return out;
   }
   team.run([&] {
     check_control_points<R>(f.axes, o);
@@ -2240,7 +2449,11 @@ ApproxRows approximate_rows(const GridBlock& given, const SurfaceApproximationOp
   std::array<std::optional<AxisSolver>, R> lu;
   const bool separable = !o.smoothing && !o.auto_smoothing && uniform;
   if (separable) lu = separable_solvers(f.axes, team);
-  if (lu[0]) return net_rows(f, team, separable_rows(lu, rhs, c0, c1, team).data());
+  if (lu[0]) {
+    detail::ApproxRows out = net_rows(f, team, separable_rows(lu, rhs, c0, c1, team).data());
+    check_rows_net(out, box, team);
+    return out;
+  }
   const bool filled = fill || separable;
   {  // the sparse system
     SparseSystem<R> sys = block_system(f.axes, shape, b, uniform, weight, weight_sum[0], team);
@@ -2272,7 +2485,9 @@ ApproxRows approximate_rows(const GridBlock& given, const SurfaceApproximationOp
       team.run([&] { sparse_fit<R>(f, sys, all_rhs, o.smoothing, filled); });
     }
   }
-  return net_rows(f, team);
+  detail::ApproxRows out = net_rows(f, team);
+  check_rows_net(out, box, team);
+  return out;
 }
 
 }  // namespace detail

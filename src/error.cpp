@@ -28,6 +28,8 @@ std::string_view to_string(errc code) noexcept {
     case errc::no_exact_form: return "no_exact_form";
     case errc::malformed_file: return "malformed_file";
     case errc::closing_gap: return "closing_gap";
+    case errc::tolerance_not_met: return "tolerance_not_met";
+    case errc::ill_conditioned: return "ill_conditioned";
     case errc::file_unreadable: return "file_unreadable";
     case errc::file_unwritable: return "file_unwritable";
     case errc::too_large: return "too_large";

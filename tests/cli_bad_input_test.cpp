@@ -59,6 +59,29 @@ json with(json j, const std::function<void(json&)>& change) {
   return j;
 }
 
+// An approximation to a tolerance below any rounding, of heights no fit reproduces
+// exactly.
+json rounding_tolerance_spec() {
+  return with(grid_spec(), [](json& s) {
+    s["type"] = "approximate";
+    s["tolerance"] = 1e-300;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 5; ++j) s["points"][i][j][2] = std::sin(7 * i + 3 * j);
+  });
+}
+
+// A 100 x 5 grid with points in its first 4 rows only: the fill term carries the
+// surface 25 times the data's length on, far past its box.
+json far_hole_spec() {
+  json rows = json::array();
+  for (int i = 0; i < 100; ++i) {
+    json row = json::array();
+    for (int j = 0; j < 5; ++j) row.push_back(i < 4 ? json{i, j, 0.1 * i * j} : json{nullptr, nullptr, nullptr});
+    rows.push_back(row);
+  }
+  return {{"type", "approximate"}, {"points", rows}, {"control_points", {10, 5}}};
+}
+
 using test::square_coons;
 constexpr auto line = test::line_curve;
 
@@ -205,6 +228,12 @@ std::vector<Row> rows() {
        {"info", grid_file}, 3,
        R"(/points: point \[2\]\[6\], the last along v, = \(.*\) nearly repeats the first point .*: gap 1e-09, more than the .* \(1e-12 of the bounding-box diagonal\))",
        errc::closing_gap},
+      {"ToleranceBelowRounding", {{grid_file, rounding_tolerance_spec().dump()}}, {"info", grid_file}, 3,
+       R"(/points: tolerance 1e-300 not met: point \[\d\]\[\d\] is .* from the approximation with 4 x 5 control points, the finest the data allow)",
+       errc::tolerance_not_met},
+      {"ApproximationFarPastItsData", {{grid_file, far_hole_spec().dump()}}, {"info", grid_file}, 3,
+       R"(/points: surface approximation: control point \[\d+\]\[\d+\] = .* lies .* outside the data's bounding box, more than 9 times its diagonal .*: the fit swings far from its data)",
+       errc::ill_conditioned},
       {"ZeroClosingChord",
        {{grid_file, ruled_with({{"interpolate", {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {1, 0, 0}, {1, 0, 0}}}, {"periodic", true}})}},
        {"build", grid_file, "-o", "out.json"}, 3,

@@ -66,7 +66,9 @@ struct ApproximationOptions {
   std::optional<std::array<int, Rank>> control_points;
   /// The fewest control points found with every data point within this distance of
   /// the approximation: knots are inserted in the spans where the error is largest,
-  /// refitting each time.
+  /// refitting each time, up to as many control points as data (interpolation). A
+  /// promise: every point present is within it, checked on the finished spline by
+  /// its own evaluator; when the finest fit misses it, tolerance_not_met is thrown.
   std::optional<double> tolerance;
   /// The fairness weight λ ≥ 0 over one control point per data point along each
   /// direction, at most `smoothing_max_control_points`.
@@ -130,7 +132,13 @@ struct VolumeApproximation {
 ///   tolerance ≤ 0; negative smoothing), too_few_points (all points missing, more
 ///   control points than data, fewer than degree + 1), invalid_degree, not_finite
 ///   (an infinite coordinate, a NaN weight), size_mismatch (weights of another
-///   shape), invalid_weight (a negative weight), zero_chord, singular, too_large.
+///   shape), invalid_weight (a negative weight), zero_chord, singular, too_large,
+///   tolerance_not_met (the finest fit still leaves a point farther than the
+///   tolerance: missing points, or a tolerance below rounding; the message names the
+///   point, its distance, the tolerance and the control points reached),
+///   ill_conditioned (a control point farther than 3^Rank times the data's
+///   bounding-box diagonal from that box, or not finite: a fit that swings between
+///   or beyond the data).
 [[nodiscard]] CurveApproximation approximate_curve(std::span<const Vec3> points, const CurveApproximationOptions& options);
 
 /// A B-spline surface near the grid Q[p][q] ((n+1) × (m+1), first index along u),

@@ -283,8 +283,20 @@ def _nearly_closed_pipe():
     return {"type": "interpolate", "points": p.tolist(), "periodic": [False, True]}
 
 
+def _tolerance_below_rounding():
+    pts = [[[j, i, float(np.sin(7 * i + 3 * j))] for j in range(5)] for i in range(4)]
+    return {"type": "approximate", "points": pts, "tolerance": 1e-300}
+
+
+def _hole_filled_far_past_the_data():
+    pts = [[[i, j, 0.1 * i * j] if i < 4 else [None, None, None] for j in range(5)] for i in range(100)]
+    return {"type": "approximate", "points": pts, "control_points": [10, 5]}
+
+
 ERRORS += [
     ("out_of_domain", network_with_params([0, 0.25, 0.5, 0.75, 1.5])),
+    ("tolerance_not_met", _tolerance_below_rounding()),
+    ("ill_conditioned", _hole_filled_far_past_the_data()),
     ("network_gap", _missing_u_curve()),
     ("network_order", _swapped_v_curves()),
     ("incompatible_twist", _no_twist_correction()),

@@ -5,8 +5,8 @@ FITPACK (LSQBivariateSpline), independently of interpatch's fitting code.
 Each case is a grid of points with uniform parameters (point (p, q) at
 (p / (n - 1), q / (m - 1))), a number of bicubic control points per direction and
 optionally weights. The interior knots follow the least-squares rule interpatch
-documents (The NURBS Book eq. 9.69: knot j at (1 - a) t[i - 1] + a t[i], i + a =
-j n / (c - p)); FITPACK fits each coordinate with exactly those knots and the
+documents (c parameters s spread evenly over the data's order, knot j the mean of
+s[j] .. s[j + p - 1], The NURBS Book eq. 9.8); FITPACK fits each coordinate with exactly those knots and the
 largest distance |S(u_p, v_q) - Q_pq| over the grid, its place and the root mean
 square of the distances are written out with the data.
 
@@ -20,15 +20,16 @@ from scipy.interpolate import LSQBivariateSpline
 
 
 def interior_knots(t, p, c):
+    # c parameters spread evenly over the data's order (linear between data
+    # parameters), interior knots the averages of p consecutive ones.
     n = len(t)
-    step = n / (c - p)
-    knots = []
-    for j in range(1, c - p):
-        x = j * step
-        i = int(np.floor(x))
+    s = []
+    for j in range(c):
+        x = j * (n - 1) / (c - 1)
+        i = min(int(np.floor(x)), n - 1)
         a = x - i
-        knots.append((1 - a) * t[i - 1] + a * t[min(i, n - 1)])
-    return knots
+        s.append((1 - a) * t[i] + a * t[i + 1] if a > 0 else t[i])
+    return [sum(s[j:j + p]) / p for j in range(1, c - p)]
 
 
 def case(name, n, m, c, seed, weighted):
