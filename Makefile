@@ -34,7 +34,7 @@ DEBS := cmake ninja-build g++ pkg-config python3 libcli11-dev nlohmann-json3-dev
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
-.PHONY: all deps viewer-deps build install demo test test-release test-asan test-fuzz fuzz fuzz-build bench clean \
+.PHONY: all deps viewer-deps build install demo test test-release test-asan test-fuzz fuzz fuzz-build promise bench clean \
         pictures bench-viewer
 
 all: build
@@ -96,6 +96,14 @@ test-fuzz: fuzz-build
 
 fuzz: fuzz-build
 	tests/fuzz/run.sh build/fuzz $(FUZZ_SECONDS)
+
+# The promise harness (tests/property/promise_*_test.cpp) with PROMISE_CASES times the
+# 1000 random cases per construction family that make test runs; a failure prints the
+# family's seed and the case index, which INTERPATCH_PROMISE_REPLAY=<index> replays.
+PROMISE_CASES ?= 50
+
+promise: build
+	INTERPATCH_PROMISE_CASES=$(PROMISE_CASES) ./build/release/tests/interpatch_tests --gtest_filter='Promise*'
 
 test: test-release test-asan test-fuzz
 
