@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "blended_terms.hpp"
+#include "detail/data_scale.hpp"
 #include "detail/text.hpp"
 
 namespace interpatch {
@@ -13,16 +14,10 @@ using detail::fail;
 
 namespace {
 
-double control_diagonal(std::initializer_list<const BSplineCurve*> curves) {
-  constexpr double inf = std::numeric_limits<double>::infinity();  // 1e300 would cap data beyond it
-  Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
-  for (const auto* c : curves)
-    for (const Vec3& p : c->control_points())
-      for (int k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], p[k]);
-        hi[k] = std::max(hi[k], p[k]);
-      }
-  return norm(hi - lo);
+detail::DataScale scale_of(std::initializer_list<const BSplineCurve*> curves) {
+  detail::DataScale s;
+  for (const auto* c : curves) s.add(c->control_points());
+  return s;
 }
 
 // The four corners p_ij (index 2i + j), checked to meet within `tol`.
@@ -61,7 +56,7 @@ double derivative_tolerance(const Vec3& a, const Vec3& b, double diag) {
 
 BlendedSurface coons(const CoonsBoundary& boundary, const CoonsOptions& options) {
   const CoonsBoundary b = on_unit(boundary);
-  const double tol = options.tolerance ? *options.tolerance : 1e-7 * control_diagonal({&b.v0, &b.v1, &b.u0, &b.u1});
+  const double tol = options.tolerance ? *options.tolerance : scale_of({&b.v0, &b.v1, &b.u0, &b.u1}).strict();
   const auto p = corners(b, tol);
   auto t = std::make_shared<detail::BlendedTerms>();
   const detail::Scalar f = detail::scalar(options.blend_u), g = detail::scalar(options.blend_v);
@@ -79,8 +74,9 @@ BlendedSurface coons(const CoonsBoundary& boundary, const CoonsCrossDerivatives&
   const CoonsBoundary b = on_unit(boundary);
   const CoonsCrossDerivatives d{detail::unit(cross.v0), detail::unit(cross.v1), detail::unit(cross.u0),
                                 detail::unit(cross.u1)};
-  const double diag = control_diagonal({&b.v0, &b.v1, &b.u0, &b.u1});
-  const double tol = options.tolerance ? *options.tolerance : 1e-7 * diag;
+  const detail::DataScale scale = scale_of({&b.v0, &b.v1, &b.u0, &b.u1});
+  const double diag = scale.diagonal();
+  const double tol = options.tolerance ? *options.tolerance : scale.strict();
   const auto p = corners(b, tol);
   const BSplineCurve* ucurve[2] = {&b.u0, &b.u1};  // S(i, v)
   const BSplineCurve* vcurve[2] = {&b.v0, &b.v1};  // S(u, j)

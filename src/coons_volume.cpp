@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "blended_terms.hpp"
+#include "detail/data_scale.hpp"
 #include "detail/text.hpp"
 #include "volume_terms.hpp"
 
@@ -59,17 +60,11 @@ errc code_for(int total_order) {
   return total_order == 0 ? errc::corner_gap : (total_order == 1 ? errc::tangent_mismatch : errc::incompatible_twist);
 }
 
-double control_diagonal(const Data& d) {
-  constexpr double inf = std::numeric_limits<double>::infinity();  // 1e300 would cap data beyond it
-  Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
+detail::DataScale scale_of(const Data& d) {
+  detail::DataScale s;
   for (int a = 0; a < 3; ++a)
-    for (int e = 0; e < 2; ++e)
-      for (const Vec3& p : d.at[a][e][0]->control_points().values())
-        for (int k = 0; k < 3; ++k) {
-          lo[k] = std::min(lo[k], p[k]);
-          hi[k] = std::max(hi[k], p[k]);
-        }
-  return norm(hi - lo);
+    for (int e = 0; e < 2; ++e) s.add(d.at[a][e][0]->control_points().values());
+  return s;
 }
 
 // Where two lines along an edge are compared: every knot of either, and 7 points
@@ -100,8 +95,9 @@ class Builder {
   Builder(Data data, std::array<std::vector<Kind>, 3> kinds, std::optional<double> tolerance,
           std::shared_ptr<detail::VolumeTerms> terms)
       : d_(std::move(data)), kinds_(std::move(kinds)), t_(std::move(terms)) {
-    diag_ = control_diagonal(d_);
-    tol_ = tolerance ? *tolerance : 1e-7 * diag_;
+    const detail::DataScale scale = scale_of(d_);
+    diag_ = scale.diagonal();
+    tol_ = tolerance ? *tolerance : scale.strict();
     if (!(std::isfinite(tol_) && tol_ >= 0))
       fail(errc::out_of_domain, "tolerance ", tol_, " must be a finite number >= 0");
   }

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "blended_terms.hpp"
+#include "detail/data_scale.hpp"
 #include "detail/parallel.hpp"
 #include "detail/text.hpp"
 #include "interpatch/evaluate.hpp"
@@ -57,29 +58,11 @@ void check_params(const std::vector<double>& p, const char* name, bool closed) {
   }
 }
 
-double control_diagonal(const CurveNetwork& n) {
-  constexpr double inf = std::numeric_limits<double>::infinity();  // 1e300 would cap data beyond it
-  Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
+detail::DataScale scale_of(const CurveNetwork& n) {
+  detail::DataScale s;
   for (const auto* list : {&n.u_curves, &n.v_curves})
-    for (const auto& c : *list)
-      for (const Vec3& p : c.control_points())
-        for (int k = 0; k < 3; ++k) {
-          lo[k] = std::min(lo[k], p[k]);
-          hi[k] = std::max(hi[k], p[k]);
-        }
-  return norm(hi - lo);
-}
-
-// How far apart two evaluations of the same point can round: a few units in the last
-// place of the largest coordinate. A small part far from the origin (0.1 across at
-// 1e8, where doubles are 1.5e-8 apart) cannot be held to 1e-7 of its diagonal: its
-// curves, interpolated and evaluated there, meet only to a few of those steps.
-double rounding_floor(const CurveNetwork& n) {
-  double m = 0;
-  for (const auto* list : {&n.u_curves, &n.v_curves})
-    for (const auto& c : *list)
-      for (const Vec3& p : c.control_points()) m = std::max({m, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-  return 16 * std::numeric_limits<double>::epsilon() * m;
+    for (const auto& c : *list) s.add(c.control_points());
+  return s;
 }
 
 // Cardinal functions φ_i(t_k) = δ_ik over the node parameters t; periodic over
@@ -201,7 +184,7 @@ struct Prepared {
   std::array<std::vector<bool>, 2> reshaped;       // along[a][j] is not input[a][j] (closed with a C0 seam)
   double tol = 0;       // how far curves may miss each other (NetworkOptions::tolerance)
   double diagonal = 0;  // of the control points' bounding box
-  double rounding = 0;  // rounding_floor
+  double rounding = 0;  // DataScale::rounding
   double strict = 0;    // 1e-7 of the diagonal, or the rounding floor where that is larger
   // How near curves must be, how near a fit: the tolerance, never below the rounding.
   [[nodiscard]] double fit() const { return std::max(std::min(tol, strict), rounding); }
@@ -215,9 +198,10 @@ struct Prepared {
 Prepared prepare(const CurveNetwork& n, const NetworkOptions& o) {
   check_counts(n);
   Prepared r;
-  r.diagonal = control_diagonal(n);
-  r.rounding = rounding_floor(n);
-  r.strict = std::max(1e-7 * r.diagonal, r.rounding);
+  const detail::DataScale scale = scale_of(n);
+  r.diagonal = scale.diagonal();
+  r.rounding = scale.rounding();
+  r.strict = scale.strict();
   const double tol = r.tol = o.tolerance ? *o.tolerance : r.strict;
   r.closed = n.periodic;
   r.curve_name = o.curve_name;
@@ -634,6 +618,7 @@ Built build(const CurveNetwork& network, const NetworkOptions& options, bool fit
   NetworkReport rep;
   rep.tolerance = n.tol;
   rep.diagonal = n.diagonal;
+  rep.strict = n.strict;
   rep.u_curves.resize(network.u_curves.size());
   rep.v_curves.resize(network.v_curves.size());
   // Common parameters per curve as given (a closing curve: 1).

@@ -651,8 +651,14 @@ std::optional<std::vector<Refit>> fit_group(const std::vector<FitJob>& jobs, con
     // Whether some curve was too far to go on is the same on any number of threads:
     // the curve that stopped the others stops the check on one thread as well.
     if (stop) return std::nullopt;
-    if (interior.size() > 64 * initial + 4096)
-      fail(errc::internal, "re-expressing ", m, " network curves found no knots that fit them (", interior.size(), " tried)");
+    if (interior.size() > 64 * initial + 4096) {
+      double closest = 0;
+      for (const Checked& c : checked) closest = std::max(closest, c.error);
+      fail(errc::tolerance_not_met, "re-expressing ", m, " network curves at their common crossing parameters: ",
+           interior.size(), " knots still leave them ", closest, " from the curves given, more than ", target,
+           " (half the tolerance); the curves are too rough or too far from the origin for their size to be held "
+           "that close: give a larger \"tolerance\"");
+    }
     bool again = false;
     for (std::size_t j = 0; j < m && !again; ++j) {
       if (fits[j].failed) split_all();
@@ -680,7 +686,8 @@ std::optional<std::vector<Refit>> fit_group(const std::vector<FitJob>& jobs, con
     interior.insert(interior.end(), cuts.begin(), cuts.end());
     std::sort(interior.begin(), interior.end());
   }
-  fail(errc::internal, "re-expressing ", m, " network curves found no knots that fit them after 60 rounds");
+  fail(errc::tolerance_not_met, "re-expressing ", m, " network curves at their common crossing parameters: 60 rounds of "
+       "knots did not bring them within ", target, " (half the tolerance) of the curves given: give a larger \"tolerance\"");
 }
 
 }  // namespace

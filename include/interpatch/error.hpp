@@ -35,7 +35,7 @@ enum class errc {
   no_exact_form,           ///< the construction has no exact B-spline form (e.g. Gregory's rational twists)
   malformed_file,          ///< a data file is readable but not well formed (NPY header, CSV field)
   closing_gap,             ///< a closed shape's last point nearly, but not quite, repeats the first
-  tolerance_not_met,       ///< an approximation cannot bring every data point within the tolerance asked for
+  tolerance_not_met,       ///< an approximation cannot bring every data point within the tolerance asked for; a network cannot re-express its curves within theirs
   ill_conditioned,         ///< a fit's control points swing far outside its data (a near-singular system)
   // --- files; the command line exits with 4 ---
   file_unreadable,         ///< a file cannot be opened or read

@@ -112,6 +112,9 @@ struct NetworkReport {
   std::array<std::size_t, 2> max_gap_at{0, 0};  ///< where: (u-curve, v-curve) as given
   double tolerance = 0;                       ///< NetworkOptions::tolerance in effect
   double diagonal = 0;                        ///< of the control points' bounding box
+  /// The default tolerance: 1e-7 of the diagonal, or 16 units in the last place of the
+  /// largest coordinate where that is larger (a small part far from the origin).
+  double strict = 0;
 };
 
 struct NetworkSurface {

@@ -313,6 +313,27 @@ TEST(Spec, UnknownFieldsAreWarnedAboutNotRefused) {
   EXPECT_NE(c.warnings[0].find("/degre"), std::string::npos);
 }
 
+// Two v-curves 1e-6 apart, one bulging between the u-curves: the network passes
+// through both, and its cardinal functions swing by about 1e4 between them. The
+// surface is what the curves ask for, but never silently so far from them.
+TEST(Spec, ANetworkThatSwingsFarFromItsCurvesIsWarnedAbout) {
+  json v = json::array();
+  for (double x : {0.0, 0.5, 0.500001, 1.0}) {
+    if (x == 0.500001)
+      v.push_back({{"interpolate", {{x, 0, 0}, {x, 0.25, 0.1}, {x, 0.5, 0}, {x, 0.75, 0.1}, {x, 1, 0}}}});
+    else
+      v.push_back(test::line_curve({x, 0, 0}, {x, 1, 0}));
+  }
+  json u = json::array();
+  for (double y : {0.0, 0.5, 1.0}) u.push_back(test::line_curve({0, y, 0}, {1, y, 0}));
+  const Construction swinging = build(json{{"type", "network"}, {"u_curves", u}, {"v_curves", v}});
+  ASSERT_EQ(swinging.warnings.size(), 1u);
+  EXPECT_NE(swinging.warnings[0].find("beyond the box of its curves"), std::string::npos) << swinging.warnings[0];
+  // Spaced apart, the same curves stay near their box: no warning.
+  v[2] = {{"interpolate", {{0.75, 0, 0}, {0.75, 0.25, 0.1}, {0.75, 0.5, 0}, {0.75, 0.75, 0.1}, {0.75, 1, 0}}}};
+  EXPECT_TRUE(build(json{{"type", "network"}, {"u_curves", u}, {"v_curves", v}}).warnings.empty());
+}
+
 // --- the exact form reads back ------------------------------------------------
 
 TEST(Spec, BuildOutputRoundTripsExactly) {

@@ -114,18 +114,17 @@ json network_spec(const Network& net) {
 }
 
 // Cases of the default run that hit known defects of the network construction
-// (src/network_curves.cpp, src/network.cpp; reported, not fixed here), left out of
+// (src/network_curves.cpp, src/network.cpp), left out of
 // PromiseNetworks.GordonAndCoonsNetworks and replayed by the DISABLED_ tests below.
 //
-// 1. build fails with errc::internal, "re-expressing N network curves found no knots
-//    that fit them (4854 tried)": drawn networks (no parameters, curves reversed)
-//    far from the origin (offsets near 1e8, extents 1e-3 to 1), where the
-//    re-expression tolerance (half of 1e-7 of the control points' diagonal) is about
-//    one unit in the last place of the coordinates.
-const std::set<std::size_t> kReexpressionInternal = {
-    5,   23,  37,  39,  58,  87,  135, 156, 188, 192, 193, 196, 201, 207, 213, 234, 263, 268, 303, 311, 323, 343, 346,
-    363, 388, 390, 398, 450, 451, 456, 472, 476, 479, 499, 502, 531, 539, 541, 568, 611, 612, 617, 623, 640, 656, 663,
-    670, 699, 705, 724, 726, 731, 733, 746, 747, 748, 749, 754, 759, 772, 835, 842, 862, 874, 903, 906, 959, 970, 973};
+// 1. drawn networks (no parameters, curves reversed) of parts 1e-3 across near 1e8,
+//    where doubles keep 5 digits of the part: the arrangement turns a curve the wrong
+//    way round and the surface departs from it by up to 2e-3, with a warning (never
+//    silently). 69 cases of this kind failed with errc::internal, "found no knots
+//    that fit them"; with tolerances floored at the rounding of the coordinates (at
+//    most 1e-5 of the diagonal) most now build and pass, 19 are refused with
+//    tolerance_not_met. Working relative to the part's centre is the fix left to do.
+const std::set<std::size_t> kFarTinyPartTurned = {25, 39, 201, 323, 363, 657, 801, 903};
 // 2. the formula (BlendedSurface) and the exact form differ by more than 1e-12 of
 //    the data's size (3.6e-12 in case 67, a drawn network near 1e114).
 const std::set<std::size_t> kFormulaVsExact = {67,  91,  125, 128, 152, 167, 208, 284, 298, 300,
@@ -137,7 +136,7 @@ void network_family(const std::set<std::size_t>& known, const std::set<std::size
   run_family(
       "network", 0x4e7, kCases,
       {errc::missing_field, errc::wrong_type, errc::too_few_points, errc::size_mismatch, errc::non_increasing,
-       errc::out_of_domain, errc::network_gap, errc::network_order},
+       errc::out_of_domain, errc::network_gap, errc::network_order, errc::tolerance_not_met},
       [&](std::mt19937_64& g) {
         net = random_network(g);
         return network_spec(net);
@@ -196,14 +195,14 @@ void network_family(const std::set<std::size_t>& known, const std::set<std::size
 }
 
 std::set<std::size_t> known_network_defects() {
-  std::set<std::size_t> k = kReexpressionInternal;
+  std::set<std::size_t> k = kFarTinyPartTurned;
   k.insert(kFormulaVsExact.begin(), kFormulaVsExact.end());
   return k;
 }
 
 TEST(PromiseNetworks, GordonAndCoonsNetworks) { network_family(known_network_defects(), nullptr); }
 
-TEST(PromiseNetworks, DISABLED_ReexpressionInternalKnownDefect) { network_family({}, &kReexpressionInternal); }
+TEST(PromiseNetworks, DISABLED_FarTinyPartTurnedKnownDefect) { network_family({}, &kFarTinyPartTurned); }
 
 TEST(PromiseNetworks, DISABLED_FormulaVsExactFormKnownDefect) { network_family({}, &kFormulaVsExact); }
 
