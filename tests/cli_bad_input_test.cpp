@@ -152,6 +152,12 @@ const char* const grid_file = "s.json";
 std::vector<Row> rows() {
   const std::string grid = grid_spec().dump();
   const std::string vol = example("trilinear").dump();
+  const std::string misaligned_ruled = R"({"type": "ruled", "curves": [
+      {"degree": 1, "param": "uniform", "periodic": true, "interpolate": [[0.186, 1.019, 0.061],
+        [-0.765, 0.896, -0.020], [-1.031, -0.403, 0.098], [0.369, -1.065, 0.055], [1.008, -0.308, -0.029]]},
+      {"degree": 6, "param": "chord", "periodic": true, "interpolate": [[1.166, 0.555, 1.229], [0.369, 1.100, 1.241],
+        [-0.537, 1.082, 1.128], [-1.225, 0.015, 1.270], [-0.691, -1.012, 1.068], [0.346, -1.129, 1.097],
+        [1.103, -0.470, 1.233]]}]})";
   const std::string overflowing = json{{"type", "coons"},
                                        {"boundary",
                                         {{"v0", line({-1e308, -1e308, 0}, {1e308, -1e308, 0})},
@@ -414,6 +420,10 @@ std::vector<Row> rows() {
        R"(cannot write 'out\.npy': it is a directory)", errc::file_unwritable, false},
       {"OutputCheckedBeforeTheSpec", {{grid_file, "{"}}, {"build", grid_file, "-o", "missing/out.json"}, 4,
        R"(cannot write 'missing/out\.json')", errc::file_unwritable, false},
+      // an exact form that differs from its construction (two closed curves of degrees 1
+      // and 6 whose merged knots misalign): refused by build, never written
+      {"ExactFormOffItsConstruction", {{grid_file, misaligned_ruled}}, {"build", grid_file, "-o", "out.step"}, 3,
+       R"(ruled: its B-spline form differs from it by [0-9.e+-]+ at \(u, v\) = )", errc::no_exact_form, false},
       // a construction whose arithmetic overflows: corners near 1e308, whose differences
       // are infinite; refused at the first sample that is not finite, every output
       {"EvalOverflowsToNpy", {{grid_file, overflowing}}, {"eval", grid_file, "--grid", "5", "-o", "out.npy"}, 3,

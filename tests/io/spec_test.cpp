@@ -334,6 +334,45 @@ TEST(Spec, ANetworkThatSwingsFarFromItsCurvesIsWarnedAbout) {
   EXPECT_TRUE(build(json{{"type", "network"}, {"u_curves", u}, {"v_curves", v}}).warnings.empty());
 }
 
+// A ruled surface between a closed polygon (degree 1, 5 points) and a closed degree-6
+// curve: the formula is right, but the conversion of the two closed curves to one knot
+// vector misaligns them and the exact form left the polygon by up to 0.6. Every
+// conversion is checked against the formula: this one is refused, never written, and
+// the construction keeps its formula for eval, mesh and view.
+TEST(Spec, AnExactFormThatDiffersFromItsConstructionIsRefused) {
+  const json spec = json::parse(R"({"type": "ruled", "curves": [
+      {"degree": 1, "param": "uniform", "periodic": true, "interpolate": [
+        [0.18579079808879073, 1.0192689718833194, 0.06107895494402585],
+        [-0.7646392748472841, 0.8960185727990039, -0.01971524514099423],
+        [-1.0305837589677036, -0.4033289746284871, 0.09766892952981268],
+        [0.3694463060699154, -1.0651652112602599, 0.05531707094264745],
+        [1.0083822812547871, -0.3077715741130244, -0.02855496332384469]]},
+      {"degree": 6, "param": "chord", "periodic": true, "interpolate": [
+        [1.1657316371841162, 0.5551518963674951, 1.2291921652036566],
+        [0.3694093493292091, 1.0998684691189835, 1.2406522219770693],
+        [-0.5365674256780528, 1.0823435600405293, 1.1284360579688897],
+        [-1.2247690787961294, 0.014925743520540288, 1.2695949271028726],
+        [-0.691025262674186, -1.01231854148499, 1.0679432133841225],
+        [0.34634074611219506, -1.1285338448080864, 1.0968572452055614],
+        [1.103086768412193, -0.4700392918661244, 1.232923090569357]]}]})");
+  Construction c = build(spec);
+  ASSERT_TRUE(c.formula);
+  // S(0.75, 0): three quarters along the polygon's segment from point 3 to point 4
+  // (uniform parameters 0.6 and 0.8 of a closed curve of 5 points).
+  const Vec3 p3{0.3694463060699154, -1.0651652112602599, 0.05531707094264745};
+  const Vec3 p4{1.0083822812547871, -0.3077715741130244, -0.02855496332384469};
+  EXPECT_LT(distance(c.formula->point(0.75, 0.0), p3 + 0.75 * (p4 - p3)), 1e-12);
+  if (c.exact) {
+    // The conversion, once mended, must be right: then it passes the check.
+    EXPECT_LT(distance(std::get<BSplineSurface>(*c.exact).point(0.75, 0.0), p3 + 0.75 * (p4 - p3)), 1e-9);
+  } else {
+    EXPECT_FALSE(has_exact_form(c));
+    EXPECT_NE(c.no_exact_form.find("its B-spline form differs from it by"), std::string::npos) << c.no_exact_form;
+    EXPECT_ERRC((void)exact_form(c), no_exact_form, "differs from it by");
+    EXPECT_EQ(&evaluator(c, 100000, Sample::points), c.formula.get());  // the formula evaluates
+  }
+}
+
 // --- the exact form reads back ------------------------------------------------
 
 TEST(Spec, BuildOutputRoundTripsExactly) {

@@ -132,11 +132,19 @@ struct BuildOptions {
 };
 
 /// The construction's exact form, converted on first use when the build deferred it.
-/// @throws error no_exact_form (saying why the construction has none).
+/// Every conversion of a formula is checked against it at a grid of parameters; one
+/// that differs by more than 1e-8 of the construction's size is refused, and the
+/// construction keeps its formula alone.
+/// @throws error no_exact_form (saying why the construction has none, or where and by
+///   how much its conversion was off).
 [[nodiscard]] const ExactForm& exact_form(Construction& c);
 
 /// Whether the construction has an exact form, built or still to be converted.
 [[nodiscard]] bool has_exact_form(const Construction& c) noexcept;
+
+/// Converts a deferred exact form now: true when the construction has one, false when
+/// it has none or its conversion was refused (no_exact_form then says why).
+bool has_exact_form_after_conversion(Construction& c);
 
 /// Whether the construction is a volume (its exact form a BSplineVolume, or its
 /// formula a Volume) rather than a surface.

@@ -75,7 +75,7 @@ Construction build_impl(const json& spec, Context& ctx) {
     fail(errc::unknown_type, "/type: unknown type \"", interpatch::detail::excerpt(name), "\"; known types: ", type_list());
   check_fields(spec, "", type->fields, ctx);
   Construction c = type->build(spec, ctx);
-  if (!ctx.defer_exact && c.convert) (void)exact_form(c);
+  if (!ctx.defer_exact && c.convert) (void)has_exact_form_after_conversion(c);
   const auto done = Clock::now();
   const auto parsed = ctx.parsed_at.value_or(done);
   c.type = name;
@@ -269,14 +269,32 @@ bool is_volume(const Construction& c) noexcept {
 
 const ExactForm& exact_form(Construction& c) {
   if (!c.exact && c.convert) {
-    c.exact = c.convert();
+    const auto convert = std::move(c.convert);
     c.convert = nullptr;
+    try {
+      c.exact = convert();
+    } catch (const error& e) {
+      // A conversion refused (its check found it off): the construction keeps its
+      // formula, and what asks for the exact form is told why.
+      if (e.code() != errc::no_exact_form) throw;
+      c.no_exact_form = e.what();
+    }
   }
   if (!c.exact) fail(errc::no_exact_form, c.type, ": ", c.no_exact_form);
   return *c.exact;
 }
 
 bool has_exact_form(const Construction& c) noexcept { return c.exact || c.convert; }
+
+bool has_exact_form_after_conversion(Construction& c) {
+  try {
+    (void)exact_form(c);
+    return true;
+  } catch (const error& e) {
+    if (e.code() != errc::no_exact_form) throw;
+    return false;
+  }
+}
 
 const Surface& evaluator(const Construction& c) {
   if (is_volume(c)) fail(errc::wrong_type, c.type, ": the construction is a volume, not a surface");
@@ -299,7 +317,7 @@ const Surface& evaluator(Construction& c, std::size_t points, Sample what) {
   const double net = static_cast<double>(knots[0].count()) * static_cast<double>(knots[1].count());
   const double by_formula = n * terms * w;
   const double by_exact = net * terms + n * (knots[0].degree() + knots[1].degree() + 2) * w;
-  if (by_exact < by_formula) (void)exact_form(c);
+  if (by_exact < by_formula) (void)has_exact_form_after_conversion(c);
   return evaluator(c);
 }
 

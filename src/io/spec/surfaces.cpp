@@ -2,12 +2,17 @@
 // hermite_patch. Their data (corners, curves) are checked against the exact form by
 // `info`, as curves sampled at `curve_samples` parameters.
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <exception>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "detail/parallel.hpp"
+#include "interpatch/blended_volume.hpp"
+#include "interpatch/bspline_volume.hpp"
 #include "interpatch/coons.hpp"
 #include "interpatch/evaluate.hpp"
 #include "interpatch/network.hpp"
@@ -41,6 +46,63 @@ DataSet corner_data(const std::array<Vec3, 4>& p, std::string pointer) {
   return d;
 }
 
+// The exact form evaluates to the formula's points (SPEC: a relative difference of at
+// most 1e-12). Checked on every conversion, at a grid of parameters, so that a
+// conversion that goes wrong (a defect, such as two closed curves of different
+// degrees whose merged knots misalign) is refused rather than written: no_exact_form,
+// naming where and by how much. 1e-8 of the size leaves room for the rounding of
+// long sums far from the origin, and is far below any misplaced control point.
+double largest_coordinate(const Vec3& p) { return std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}); }
+
+void check_exact_form(const BlendedSurface& f, const ExactForm& e, std::string_view type) {
+  const auto& b = std::get<BSplineSurface>(e);
+  const std::vector<double> t = linspace(0, 1, 9);
+  internal::Box box;
+  double large = 0, worst = 0, wu = 0, wv = 0;
+  for (double u : t)
+    for (double v : t) {
+      const Vec3 a = f.point(u, v), x = b.point(u, v);
+      if (!is_finite(a)) continue;  // overflowed: the outputs refuse it (not_finite)
+      box.add(a);
+      large = std::max(large, largest_coordinate(a));
+      if (const double d = distance(a, x); !(d <= worst)) {
+        worst = d;
+        wu = u;
+        wv = v;
+      }
+    }
+  const double tol = 1e-8 * std::max(box.diagonal(), 1e-4 * large);
+  if (!(worst <= tol))
+    fail(errc::no_exact_form, type, ": its B-spline form differs from it by ", worst, " at (u, v) = (", wu, ", ", wv,
+         "), more than ", tol, " (1e-8 of its size): a conversion this far off is refused, not written; eval, mesh "
+         "and view use the construction itself");
+}
+
+void check_exact_form(const BlendedVolume& f, const ExactForm& e, std::string_view type) {
+  const auto& b = std::get<BSplineVolume>(e);
+  const std::vector<double> t = linspace(0, 1, 5);
+  internal::Box box;
+  double large = 0, worst = 0;
+  std::array<double, 3> at{0, 0, 0};
+  for (double u : t)
+    for (double v : t)
+      for (double w : t) {
+        const Vec3 a = f.point(u, v, w), x = b.point(u, v, w);
+        if (!is_finite(a)) continue;
+        box.add(a);
+        large = std::max(large, largest_coordinate(a));
+        if (const double d = distance(a, x); !(d <= worst)) {
+          worst = d;
+          at = {u, v, w};
+        }
+      }
+  const double tol = 1e-8 * std::max(box.diagonal(), 1e-4 * large);
+  if (!(worst <= tol))
+    fail(errc::no_exact_form, type, ": its B-spline form differs from it by ", worst, " at (u, v, w) = (", at[0], ", ",
+         at[1], ", ", at[2], "), more than ", tol, " (1e-8 of its size): a conversion this far off is refused, not "
+         "written; eval, mesh and view use the construction itself");
+}
+
 // A blended construction (surface or volume): the formula, stored in `slot`, and
 // its conversion to the exact form when it has one (run by build_impl, or deferred
 // to exact_form()); otherwise the reason it has none.
@@ -51,7 +113,11 @@ Construction blended_with(std::string_view type, Formula f, std::vector<DataSet>
   c.type = type;
   auto formula = std::make_shared<const Formula>(std::move(f));
   if (formula->has_exact_form()) {
-    c.convert = [formula] { return ExactForm(formula->to_bspline()); };
+    c.convert = [formula, type = std::string(type)] {
+      ExactForm e(formula->to_bspline());
+      check_exact_form(*formula, e, type);
+      return e;
+    };
   } else {
     try {
       (void)formula->to_bspline();  // refuses at once, saying why
