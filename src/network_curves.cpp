@@ -651,14 +651,19 @@ std::optional<std::vector<Refit>> fit_group(const std::vector<FitJob>& jobs, con
     // Whether some curve was too far to go on is the same on any number of threads:
     // the curve that stopped the others stops the check on one thread as well.
     if (stop) return std::nullopt;
-    if (interior.size() > 64 * initial + 4096) {
-      double closest = 0;
-      for (const Checked& c : checked) closest = std::max(closest, c.error);
+    // The last round's knots are refused only when its fits are not all within the
+    // target: a round that got there on the limit is kept.
+    double farthest = 0;
+    bool fitted = true;
+    for (std::size_t j = 0; j < m; ++j) {
+      fitted = fitted && fits[j].curve.has_value();
+      for (double e : err[j]) farthest = std::max(farthest, e);
+    }
+    if (interior.size() > 64 * initial + 4096 && !(fitted && farthest <= target))
       fail(errc::tolerance_not_met, "re-expressing ", m, " network curves at their common crossing parameters: ",
-           interior.size(), " knots still leave them ", closest, " from the curves given, more than ", target,
+           interior.size(), " knots still leave them ", farthest, " from the curves given, more than ", target,
            " (half the tolerance); the curves are too rough or too far from the origin for their size to be held "
            "that close: give a larger \"tolerance\"");
-    }
     bool again = false;
     for (std::size_t j = 0; j < m && !again; ++j) {
       if (fits[j].failed) split_all();
