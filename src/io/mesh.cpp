@@ -21,6 +21,7 @@
 #include "interpatch/evaluate.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/memory.hpp"
+#include "io/extension.hpp"
 #include "io/finite.hpp"
 
 namespace interpatch::io {
@@ -167,11 +168,7 @@ std::uint64_t write_records(std::ostream& os, std::size_t count, std::size_t rec
   return written;
 }
 
-std::string lower_extension(const fs::path& path) {
-  std::string ext = path.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
+using internal::lower_extension;
 
 std::string normalized(std::string_view extension) {
   std::string ext(extension);

@@ -21,6 +21,7 @@
 #include "interpatch/io/step.hpp"
 #include "interpatch/io/view.hpp"
 #include "interpatch/memory.hpp"
+#include "io/extension.hpp"
 
 namespace interpatch::io {
 
@@ -28,11 +29,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string lower_extension(const fs::path& p) {
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
+using internal::lower_extension;
 
 std::string resolution_text(const Resolution& r) {
   std::string t = std::to_string(r.nu) + "x" + std::to_string(r.nv);
