@@ -214,7 +214,8 @@ void check_mesh_kind(const io::Construction& c, const fs::path& out, const Resol
 void write_mesh(io::Construction& c, const fs::path& out, const Resolution& res) {
   check_mesh_kind(c, out, res);
   ProgressLine progress("meshing");
-  io::write_mesh(c, out, res, res_option, progress.callback());
+  for (const std::string& w : io::write_mesh(c, out, res, res_option, progress.callback()))
+    std::fprintf(stderr, "interpatch: warning: %s\n", w.c_str());
 }
 
 void write_eval(io::Construction& c, const fs::path& out, const Resolution& grid) {

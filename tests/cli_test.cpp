@@ -421,6 +421,20 @@ TEST_F(CliTest, MeshWritesEveryFormatAtTheRequestedResolution) {
   EXPECT_NE(read_file(at("d.ply")).find("element vertex 4096"), std::string::npos);
 }
 
+// A 1 mm part 1e8 from the origin: binary STL's float32 cannot hold its shape. The
+// file is written and the command says so; .ply keeps doubles and says nothing.
+TEST_F(CliTest, MeshWarnsWhenStlCannotHoldTheShape) {
+  write_file(at("far.json"), R"({"type": "bilinear", "p00": [1e8, 1e8, 1e8], "p01": [1e8, 1.000000000001e8, 1e8],
+                             "p10": [1.000000000001e8, 1e8, 1e8], "p11": [1.000000000001e8, 1.000000000001e8, 1.00000000001e8]})");
+  const Result stl = run({"mesh", "far.json", "-o", "far.stl", "--res", "5x5"});
+  ASSERT_EQ(stl.status, 0) << stl.err;
+  EXPECT_NE(stl.err.find("interpatch: warning: 'far.stl' holds float32 coordinates"), std::string::npos) << stl.err;
+  EXPECT_TRUE(fs::exists(at("far.stl")));
+  const Result ply = run({"mesh", "far.json", "-o", "far.ply", "--res", "5x5"});
+  ASSERT_EQ(ply.status, 0) << ply.err;
+  EXPECT_EQ(ply.err.find("warning"), std::string::npos) << ply.err;
+}
+
 // The viewer page decimates what it cannot hold, never refuses it: counts too large
 // to represent and very elongated requests alike.
 TEST_F(CliTest, ViewDecimatesRatherThanRefuses) {

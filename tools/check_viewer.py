@@ -30,6 +30,19 @@ def large_grid(work):
     return path
 
 
+def far_small(work):
+    """The hyperbolic paraboloid of examples/bilinear.json made 1 mm across and moved
+    1e8 from the origin: in float32 its corners would be one point."""
+    def corner(x, y, z):
+        return [1e8 + 1e-3 * x, -2e8 + 1e-3 * y, 3e8 + 1e-3 * z]
+    spec = {"type": "bilinear", "p00": corner(0, 0, 1), "p01": corner(1, 1, 1),
+            "p10": corner(1, 0, 0), "p11": corner(0, 1, 0)}
+    path = os.path.join(work, "far_small.json")
+    with open(path, "w") as f:
+        json.dump(spec, f)
+    return path
+
+
 def cases(examples, work):
     """name -> (input, extra arguments of `interpatch view`, colourings to try)."""
     return {
@@ -41,6 +54,7 @@ def cases(examples, work):
         # 257 x 257: SwiftShader draws a 512 x 512 mesh in seconds, on a busy machine
         # tens of them, for each of the pictures compared here.)
         "large_grid": (None, [], ["height", "gaussian"]),
+        "far_small": (far_small(work), [], ["height", "gaussian"]),
     }
 
 
@@ -55,7 +69,7 @@ def main():
     interpatch, examples, work, case = sys.argv[1:5]
     os.makedirs(work, exist_ok=True)
     spec, extra, colourings = cases(examples, work)[case]
-    if spec is None:
+    if spec is None and case == "large_grid":
         spec = large_grid(work)
     page = os.path.join(work, case + ".html")
     subprocess.run([interpatch, "view", spec, "-o", page, *extra], check=True)

@@ -115,24 +115,28 @@ class PyBuilt {
     // A viewer page shows the data points.
     LentPoints lent = view ? lent_data() : LentPoints();
     const ip::progress_callback progress = interruptible();
-    py::gil_scoped_release free;
-    std::lock_guard<std::mutex> hold(b_->lock);
-    const WithData with(b_->c, lent);
-    const bool volume = io::is_volume(b_->c);
-    if (mesh) {
-      const io::Resolution r = res ? *res : volume ? io::default_volume_resolution : io::default_surface_resolution;
-      io::write_mesh(b_->c, path, r, mesh_res, progress);
-      return;
+    std::vector<std::string> warned;
+    {
+      py::gil_scoped_release free;
+      std::lock_guard<std::mutex> hold(b_->lock);
+      const WithData with(b_->c, lent);
+      const bool volume = io::is_volume(b_->c);
+      if (mesh) {
+        const io::Resolution r = res ? *res : volume ? io::default_volume_resolution : io::default_surface_resolution;
+        warned = io::write_mesh(b_->c, path, r, mesh_res, progress);
+      } else if (view) {
+        if (io::has_exact_form(b_->c)) (void)io::exact_form(b_->c);  // the page shows it, as the command does
+        const auto d = io::view_default_resolution(b_->c);
+        const io::Resolution r = res ? *res : io::Resolution{d[0], d[1], d[2]};
+        io::check_counts_kind(b_->c, view_res, r);
+        io::write_view(path, b_->c, {.resolution = {r.nu, r.nv, r.nw}, .title = path.stem().string()});
+      } else {
+        io::write_build(b_->c, path);
+      }
     }
-    if (io::has_exact_form(b_->c)) (void)io::exact_form(b_->c);  // the page shows it, as the command does
-    if (view) {
-      const auto d = io::view_default_resolution(b_->c);
-      const io::Resolution r = res ? *res : io::Resolution{d[0], d[1], d[2]};
-      io::check_counts_kind(b_->c, view_res, r);
-      io::write_view(path, b_->c, {.resolution = {r.nu, r.nv, r.nw}, .title = path.stem().string()});
-      return;
-    }
-    io::write_build(b_->c, path);
+    // What the command line prints as "interpatch: warning: ...", as Python warnings.
+    for (const std::string& w : warned)
+      if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw py::error_already_set();
   }
 
   // The data's parameters along an axis, where the construction has data.

@@ -671,7 +671,31 @@ bool is_mesh_format(std::string_view extension) noexcept {
   }
 }
 
-void write_surface_mesh(const fs::path& path, const SurfaceMesh& mesh) {
+namespace {
+
+/// Binary STL stores float32: a part far from the origin for its size loses its
+/// shape there. Says by how much, when that is over 1e-5 of the mesh's diagonal
+/// (1 µm on a 100 mm part).
+std::vector<std::string> float32_warnings(const fs::path& path, const PointGrid& g) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  Vec3 lo{inf, inf, inf}, hi = -lo;
+  double moved = 0;
+  for (const Vec3& p : g.values())
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], p[a]);
+      hi[a] = std::max(hi[a], p[a]);
+      moved = std::max(moved, std::abs(p[a] - static_cast<double>(static_cast<float>(p[a]))));
+    }
+  const double diagonal = norm(hi - lo);
+  if (!(moved > 1e-5 * diagonal)) return {};
+  return {detail::cat(quoted(path), " holds float32 coordinates (binary STL has no others): rounding moves its points by up to ",
+              moved, diagonal > 0 ? detail::cat(", ", moved / diagonal, " of the mesh's diagonal ", diagonal) : std::string(),
+              "; .ply, .obj, .vtk and .vts keep every digit")};
+}
+
+}  // namespace
+
+std::vector<std::string> write_surface_mesh(const fs::path& path, const SurfaceMesh& mesh) {
   const std::string ext = lower_extension(path);
   check_extension(path, ext, surface_formats, "surface");
   const PointGrid& g = mesh.points;
@@ -694,6 +718,7 @@ void write_surface_mesh(const fs::path& path, const SurfaceMesh& mesh) {
   } else if (ext == ".stl") {
     check_stl_triangle_count(mesh, path);
     write_atomically(path, [&](std::ostream& os) { write_stl(os, mesh); });
+    return float32_warnings(path, g);
   } else if (ext == ".ply") {
     write_atomically(path, [&](std::ostream& os) { write_ply(os, mesh); });
   } else {
@@ -705,6 +730,7 @@ void write_surface_mesh(const fs::path& path, const SurfaceMesh& mesh) {
     s.kind = "surface";
     write_structured(path, ext, s);
   }
+  return {};
 }
 
 void write_volume_mesh(const fs::path& path, const PointGrid3& points, const Grid<double, 3>& jacobian) {
@@ -887,14 +913,15 @@ SurfaceMesh sample_mesh(const Surface& surface, std::span<const double> us, std:
   return mesh;
 }
 
-void write_surface_mesh(const fs::path& path, const Surface& surface, std::span<const double> us,
-                        std::span<const double> vs, const progress_callback& progress) {
+std::vector<std::string> write_surface_mesh(const fs::path& path, const Surface& surface, std::span<const double> us,
+                                            std::span<const double> vs, const progress_callback& progress) {
   const std::string ext = lower_extension(path);
   check_extension(path, ext, surface_formats, "surface");
   if (us.empty() || vs.empty() || (ext != ".vts" && ext != ".vtk"))
     return write_surface_mesh(path, sample_mesh(surface, us, vs, progress));
   stream_structured(path, ext == ".vts" ? vts_layout(us.size(), vs.size()) : legacy_vtk_layout(us.size(), vs.size()),
                     surface, us, vs, progress);
+  return {};
 }
 
 }  // namespace interpatch::io

@@ -177,17 +177,20 @@ void write_build(Construction& c, const fs::path& out) {
   write_exact_json(out, exact);
 }
 
-void write_mesh(Construction& c, const fs::path& out, const Resolution& res, const CountsOption& option,
-                const progress_callback& progress) {
+std::vector<std::string> write_mesh(Construction& c, const fs::path& out, const Resolution& res,
+                                    const CountsOption& option, const progress_callback& progress) {
   check_mesh_output(out);
   check_counts(counts_of(res), option);
   check_mesh_kind(c, out, res, option);
   require_mesh_room(res, out);
-  if (is_volume(c)) return mesh_volume(c, out, res, progress);
+  if (is_volume(c)) {
+    mesh_volume(c, out, res, progress);
+    return {};
+  }
   const Surface& s = evaluator(c, res.nu * res.nv, Sample::derivatives);
   // Every construction is over the unit square.
   const std::vector<double> us = linspace(0, 1, res.nu), vs = linspace(0, 1, res.nv);
-  write_surface_mesh(out, s, us, vs, progress);  // a .vts or .vtk a block at a time
+  return write_surface_mesh(out, s, us, vs, progress);  // a .vts or .vtk a block at a time
 }
 
 }  // namespace interpatch::io

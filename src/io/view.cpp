@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <numeric>
 #include <span>
 #include <string_view>
@@ -111,6 +112,48 @@ class Float32Base64 {
   std::vector<unsigned char> bytes_;
 };
 
+// Where the page's float32 coordinates are measured from, and in what unit: the
+// centre of the construction's box and a power of two at least half its largest side.
+// float32 holds about 7 digits, so a 1 mm part 1e8 from the origin would collapse to
+// one point and coordinates past 3.4e38 would become infinite; relative to its own
+// box every construction keeps float32's 7 digits of its size. A power of two scales
+// without rounding.
+struct PageFrame {
+  Vec3 origin{0, 0, 0};
+  double unit = 1;
+
+  // p / unit - origin / unit rounds as (p - origin) / unit would, and cannot overflow
+  // where p - origin would (p and the origin at opposite ends of the doubles).
+  [[nodiscard]] Vec3 local(const Vec3& p) const { return p / unit - origin / unit; }
+  [[nodiscard]] ojson json() const { return {{"origin", {origin.x, origin.y, origin.z}}, {"unit", unit}}; }
+};
+
+// The box of finite points; first > second in every coordinate when there are none.
+struct Box3 {
+  Vec3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+          std::numeric_limits<double>::infinity()};
+  Vec3 hi = -lo;
+  void add(const Vec3& p) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return;
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+};
+
+PageFrame page_frame(const Box3& box) {
+  if (!(box.lo.x <= box.hi.x)) return {};
+  PageFrame f;
+  // Halves first: (lo + hi) / 2 overflows for coordinates near the largest double.
+  f.origin = box.lo / 2 + box.hi / 2;
+  const double half = std::max({box.hi.x / 2 - box.lo.x / 2, box.hi.y / 2 - box.lo.y / 2, box.hi.z / 2 - box.lo.z / 2});
+  if (half > 0 && std::isfinite(half)) {
+    int e = 0;
+    (void)std::frexp(half, &e);  // half = m 2^e with m in [0.5, 1): 2^e >= half
+    f.unit = std::ldexp(1.0, e);
+  }
+  return f;
+}
+
 // Evenly spaced indices into n samples, at most `keep` of them, first and last kept.
 std::vector<std::size_t> decimated(std::size_t n, std::size_t keep) {
   if (n <= keep || keep < 2) {
@@ -142,9 +185,9 @@ ojson shape_json(const std::vector<std::vector<std::size_t>>& idx) {
   return j;
 }
 
-// The points of a C-order grid of `shape` at the kept indices, as float32.
+// The points of a C-order grid of `shape` at the kept indices, as float32 in the page's frame.
 Float32Base64 grid_points(std::span<const Vec3> points, const std::vector<std::size_t>& shape,
-                          const std::vector<std::vector<std::size_t>>& idx) {
+                          const std::vector<std::vector<std::size_t>>& idx, const PageFrame& frame) {
   std::size_t count = 1;
   for (const auto& i : idx) count *= i.size();
   Float32Base64 out(3 * count);
@@ -152,7 +195,7 @@ Float32Base64 grid_points(std::span<const Vec3> points, const std::vector<std::s
   for (std::size_t n = 0; n < count; ++n) {
     std::size_t offset = 0;
     for (std::size_t a = 0; a < idx.size(); ++a) offset = offset * shape[a] + idx[a][at[a]];
-    out.push(points[offset]);
+    out.push(frame.local(points[offset]));
     for (std::size_t a = idx.size(); a-- > 0;) {
       if (++at[a] < idx[a].size()) break;
       at[a] = 0;
@@ -161,7 +204,7 @@ Float32Base64 grid_points(std::span<const Vec3> points, const std::vector<std::s
   return out;
 }
 
-ojson data_json(const Construction& c) {
+ojson data_json(const Construction& c, const PageFrame& frame) {
   ojson sets = ojson::array();
   for (const DataSet& d : c.data) {
     std::vector<std::size_t> shape;
@@ -174,14 +217,14 @@ ojson data_json(const Construction& c) {
                     {"kind", long_axes == 1 ? "curve" : "points"},
                     {"shape", shape_json(idx)},
                     {"full_shape", std::move(full)},
-                    {"points", grid_points(d.points, shape, idx).json()}});
+                    {"points", grid_points(d.points, shape, idx, frame).json()}});
   }
   return sets;
 }
 
 // The control net of the exact form: its points (decimated), the full shape, which
 // directions are closed (the net then joins its last row to its first).
-ojson control_net_json(const Construction& c) {
+ojson control_net_json(const Construction& c, const PageFrame& frame) {
   if (!c.exact) return nullptr;
   return std::visit(
       [&](const auto& form) -> ojson {
@@ -194,12 +237,14 @@ ojson control_net_json(const Construction& c) {
         return {{"shape", shape_json(idx)},
                 {"full_shape", std::move(full)},
                 {"periodic", std::move(closed)},
-                {"points", grid_points(std::span<const Vec3>(cp.data(), cp.size()), shape, idx).json()}};
+                {"points", grid_points(std::span<const Vec3>(cp.data(), cp.size()), shape, idx, frame).json()}};
       },
       *c.exact);
 }
 
-ojson surface_json(const Surface& s, const std::array<std::size_t, 3>& res) {
+// The samples in the page's frame, with their curvatures in its unit (K unit², H
+// unit): a 1e-200 part's curvatures would overflow float32, its own do not.
+ojson surface_json(const Surface& s, const std::array<std::size_t, 3>& res, const PageFrame& frame) {
   const std::vector<double> us = linspace(0, 1, res[0]), vs = linspace(0, 1, res[1]);
   const std::size_t n = res[0] * res[1];
   Float32Base64 points(3 * n), normals(3 * n), gaussian(n), mean(n);
@@ -210,11 +255,13 @@ ojson surface_json(const Surface& s, const std::array<std::size_t, 3>& res) {
     const auto rows = std::span(us).subspan(i0, std::min(block, us.size() - i0));
     const Grid<SurfaceDerivatives, 2> d = s.evaluate_derivatives(rows, vs);
     for (std::size_t k = 0; k < d.size(); ++k) {
-      const SurfaceDerivatives& x = d.data()[k];
+      const SurfaceDerivatives& t = d.data()[k];
+      const std::size_t shape[3] = {res[0], res[1], 3}, first = (i0 * res[1] + k) * 3;
+      internal::require_finite(&t.s.x, 3, first, shape, "the surface's points on the page");
+      const SurfaceDerivatives x{frame.local(t.s), t.su / frame.unit,  t.sv / frame.unit,
+                                 t.suu / frame.unit, t.suv / frame.unit, t.svv / frame.unit};
       const Curvature k2 = curvature(x);
       const Vec3 normal = unit_normal(x);
-      const std::size_t shape[3] = {res[0], res[1], 3}, first = (i0 * res[1] + k) * 3;
-      internal::require_finite(&x.s.x, 3, first, shape, "the surface's points on the page");
       internal::require_finite(&normal.x, 3, first, shape, "the surface's normals on the page");
       points.push(x.s);
       normals.push(normal);
@@ -229,18 +276,43 @@ ojson surface_json(const Surface& s, const std::array<std::size_t, 3>& res) {
           {"mean", mean.json()}};
 }
 
-ojson volume_json(const Volume& v, const std::array<std::size_t, 3>& res) {
+// The samples in the page's frame, det J in its unit (det J / unit³).
+ojson volume_json(const Volume& v, const std::array<std::size_t, 3>& res, const PageFrame& frame) {
   const std::vector<double> us = linspace(0, 1, res[0]), vs = linspace(0, 1, res[1]), ws = linspace(0, 1, res[2]);
   const VolumeJacobians j = v.evaluate_jacobians(us, vs, ws);
   const std::size_t n = j.points.size();
   const std::size_t shape[4] = {res[0], res[1], res[2], 3};
   internal::require_finite(&j.points.data()->x, 3 * n, 0, shape, "the volume's points on the page");
   Float32Base64 points(3 * n), det(n);
+  const double cube = frame.unit * frame.unit * frame.unit;
   for (std::size_t k = 0; k < n; ++k) {
-    points.push(j.points.data()[k]);
-    det.push(j.determinants.data()[k]);
+    points.push(frame.local(j.points.data()[k]));
+    // In two steps where unit³ would overflow or vanish.
+    det.push(std::isfinite(cube) && cube > 0 ? j.determinants.data()[k] / cube
+                                             : j.determinants.data()[k] / frame.unit / frame.unit / frame.unit);
   }
   return {{"shape", {res[0], res[1], res[2]}}, {"positions", points.json()}, {"det_j", det.json()}};
+}
+
+// The frame of what the page shows: the box of the construction sampled 17 × 17
+// (9 × 9 × 9), its control net and its data. It need not hold every sample: it only
+// has to keep them near 1 in size.
+PageFrame construction_frame(const Construction& c) {
+  Box3 box;
+  if (is_volume(c)) {
+    const std::vector<double> t = linspace(0, 1, 9);
+    const PointGrid3 samples = volume_evaluator(c).evaluate(t, t, t);
+    for (const Vec3& p : samples.values()) box.add(p);
+  } else {
+    const std::vector<double> t = linspace(0, 1, 17);
+    const PointGrid samples = evaluator(c).evaluate(t, t);
+    for (const Vec3& p : samples.values()) box.add(p);
+  }
+  if (c.exact)
+    std::visit([&](const auto& form) { for (const Vec3& p : form.control_points().values()) box.add(p); }, *c.exact);
+  for (const DataSet& d : c.data)
+    for (const Vec3& p : d.points) box.add(p);
+  return page_frame(box);
 }
 
 // A Hermite patch's (volume's) given corner derivatives are its own there.
@@ -375,16 +447,18 @@ std::string view_html(const Construction& c, const ViewOptions& options) {
       view_resolution(asked, volume ? view_limits.volume_samples : view_limits.surface_samples);
 
   ojson data;
-  data["format"] = "interpatch-view 1";
+  data["format"] = "interpatch-view 2";
   data["title"] = options.title.empty() ? c.type : options.title;
   data["kind"] = volume ? "volume" : "surface";
   data["resolution"] = {{"asked", asked}, {"shown", res}};
   data["palettes"] = {{"height", palette_json(height_palette)}, {"signed", palette_json(signed_palette)}};
   data["info"] = info_json(c);
-  if (volume) data["volume"] = volume_json(volume_evaluator(c), res);
-  else data["surface"] = surface_json(evaluator(c), res);
-  data["control_net"] = control_net_json(c);
-  data["data"] = data_json(c);
+  const PageFrame frame = construction_frame(c);
+  data["frame"] = frame.json();
+  if (volume) data["volume"] = volume_json(volume_evaluator(c), res, frame);
+  else data["surface"] = surface_json(evaluator(c), res, frame);
+  data["control_net"] = control_net_json(c, frame);
+  data["data"] = data_json(c, frame);
   data["frames"] = frames_json(c);
 
   const detail::ViewerAssets& a = detail::viewer_assets();

@@ -843,6 +843,55 @@ TEST(Mesh, ClosedSurfaceStlIsWatertightAcrossTheSeam) {
 }
 
 // The structured formats keep the doubled row: a structured grid needs it.
+// Binary STL holds float32. A part far from the origin for its size loses its shape
+// there: the writer warns exactly when the file's points, read back, are further than
+// 1e-5 of the mesh's diagonal from the mesh's, and says by how much.
+TEST(Mesh, StlWarnsWhereFloat32MovesThePointsOfAFarPart) {
+  TempDir dir;
+  auto g = test::rng(29);
+  int warned = 0, quiet = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const double size = std::pow(10.0, test::uniform(g, -3, 3));
+    const double offset = trial % 3 == 0 ? 0.0 : size * std::pow(10.0, test::uniform(g, 0, 9));
+    SurfaceMesh m{PointGrid({5, 4}), {}};
+    for (Vec3& p : m.points.values())
+      p = Vec3{offset, 2 * offset, -offset} + Vec3{test::uniform(g, -1, 1), test::uniform(g, -1, 1), test::uniform(g, -1, 1)} * size;
+    const std::vector<std::string> warnings = write_surface_mesh(dir / "part.stl", m);
+    // Measured on the file: each vertex against the nearest of the mesh's points.
+    const MeshRead r = read_stl(read_bytes(dir / "part.stl"));
+    double moved = 0;
+    for (const Vec3& v : r.vertices) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const Vec3& p : m.points.values())
+        nearest = std::min(nearest, std::max({std::abs(v.x - p.x), std::abs(v.y - p.y), std::abs(v.z - p.z)}));
+      moved = std::max(moved, nearest);
+    }
+    Vec3 lo = m.points.values()[0], hi = lo;
+    for (const Vec3& p : m.points.values())
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], p[a]);
+        hi[a] = std::max(hi[a], p[a]);
+      }
+    const double ratio = moved / norm(hi - lo);
+    // Within a factor 2 of the limit the nearest point may not be the vertex's own.
+    if (ratio > 0.5e-5 && ratio < 2e-5) continue;
+    SCOPED_TRACE(testing::Message() << "size " << size << " offset " << offset << " moved " << ratio << " of the diagonal");
+    if (ratio > 1e-5) {
+      ++warned;
+      ASSERT_EQ(warnings.size(), 1u);
+      EXPECT_NE(warnings[0].find("float32"), std::string::npos) << warnings[0];
+      EXPECT_NE(warnings[0].find("part.stl"), std::string::npos) << warnings[0];
+    } else {
+      ++quiet;
+      EXPECT_TRUE(warnings.empty()) << warnings[0];
+    }
+    // Formats of doubles never warn.
+    EXPECT_TRUE(write_surface_mesh(dir / "part.ply", m).empty());
+  }
+  EXPECT_GT(warned, 10);
+  EXPECT_GT(quiet, 10);
+}
+
 TEST(Mesh, ClosedSurfaceStructuredGridKeepsEverySample) {
   TempDir dir;
   const BSplineSurface s = test::closed_surface({true, true}, 4);

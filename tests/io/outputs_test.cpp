@@ -108,17 +108,17 @@ TEST(OutputsRoom, GridsBeyondMemoryOrDiskAreRefusedBeforeAnyWork) {
 TEST(OutputsWriteMesh, ChecksEverythingBeforeWriting) {
   test::TempDir dir;
   Construction surface = example("coons");
-  EXPECT_ERRC(write_mesh(surface, dir.path() / "x.obj", {1, 1, 0}, py_res), too_few_points, "res (1, 1): a mesh needs");
-  EXPECT_ERRC(write_mesh(surface, dir.path() / "x.obj", {0, 5, 0}, cli_res), too_few_points, "--res '0x5'");
-  EXPECT_ERRC(write_mesh(surface, dir.path() / "x.obj", {3, 3, 3}, py_res), size_mismatch, "a surface mesh takes two counts");
-  EXPECT_ERRC(write_mesh(surface, dir.path() / "x.json", {3, 3, 0}, py_res), wrong_type, "cannot tell the mesh format");
-  EXPECT_ERRC(write_mesh(surface, dir.path() / "x.vts", {100000000, 100000000, 0}, py_res), too_large, "mesh of");
+  EXPECT_ERRC((void)write_mesh(surface, dir.path() / "x.obj", {1, 1, 0}, py_res), too_few_points, "res (1, 1): a mesh needs");
+  EXPECT_ERRC((void)write_mesh(surface, dir.path() / "x.obj", {0, 5, 0}, cli_res), too_few_points, "--res '0x5'");
+  EXPECT_ERRC((void)write_mesh(surface, dir.path() / "x.obj", {3, 3, 3}, py_res), size_mismatch, "a surface mesh takes two counts");
+  EXPECT_ERRC((void)write_mesh(surface, dir.path() / "x.json", {3, 3, 0}, py_res), wrong_type, "cannot tell the mesh format");
+  EXPECT_ERRC((void)write_mesh(surface, dir.path() / "x.vts", {100000000, 100000000, 0}, py_res), too_large, "mesh of");
   EXPECT_FALSE(fs::exists(dir.path() / "x.obj"));
   EXPECT_FALSE(fs::exists(dir.path() / "x.vts"));
   Construction volume = example("trilinear");
-  EXPECT_ERRC(write_mesh(volume, dir.path() / "v.stl", {3, 3, 3}, py_res), wrong_type, "holds surfaces only");
+  EXPECT_ERRC((void)write_mesh(volume, dir.path() / "v.stl", {3, 3, 3}, py_res), wrong_type, "holds surfaces only");
 
-  write_mesh(surface, dir.path() / "x.obj", {3, 2, 0}, py_res);
+  (void)write_mesh(surface, dir.path() / "x.obj", {3, 2, 0}, py_res);
   std::ifstream in(dir.path() / "x.obj");
   std::size_t vertices = 0;
   for (std::string line; std::getline(in, line);) vertices += line.rfind("v ", 0) == 0;

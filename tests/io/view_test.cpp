@@ -69,10 +69,43 @@ std::vector<float> floats(const json& array) {
   return v;
 }
 
-void expect_point(const std::vector<float>& v, std::size_t k, const Vec3& p) {
-  EXPECT_EQ(v[3 * k], static_cast<float>(p.x)) << "point " << k;
-  EXPECT_EQ(v[3 * k + 1], static_cast<float>(p.y)) << "point " << k;
-  EXPECT_EQ(v[3 * k + 2], static_cast<float>(p.z)) << "point " << k;
+// The page's frame: float32 positions are (p - origin) / unit.
+struct Frame {
+  Vec3 origin;
+  double unit = 1;
+  [[nodiscard]] Vec3 true_point(const std::vector<float>& v, std::size_t k) const {
+    return origin + Vec3{v[3 * k], v[3 * k + 1], v[3 * k + 2]} * unit;
+  }
+};
+
+Frame frame_of(const json& d) {
+  const json& f = d.at("frame");
+  const Frame frame{{f["origin"][0].get<double>(), f["origin"][1].get<double>(), f["origin"][2].get<double>()},
+                    f["unit"].get<double>()};
+  // A power of two: scaling by it is exact.
+  int e = 0;
+  EXPECT_EQ(std::frexp(frame.unit, &e), 0.5) << frame.unit;
+  return frame;
+}
+
+// The page holds p in the frame, as float32: to float32's rounding of the frame
+// coordinate, plus the double rounding of p itself (the page and the test may
+// evaluate the same point by different routes, one unit of p's last place apart,
+// which the subtraction of the origin can bring up to float32's size).
+void expect_point(const std::vector<float>& v, std::size_t k, const Vec3& p, const Frame& f) {
+  for (int a = 0; a < 3; ++a) {
+    const double local = (p[a] - f.origin[a]) / f.unit;
+    const double slack = std::numeric_limits<float>::epsilon() * std::abs(local) +
+                         4 * std::numeric_limits<double>::epsilon() * (std::abs(p[a]) + std::abs(f.origin[a])) / f.unit;
+    EXPECT_NEAR(v[3 * k + static_cast<std::size_t>(a)], local, slack) << "point " << k << " coordinate " << a;
+  }
+}
+
+// float32 values agree to a few units in their last place: a value computed in
+// the page's frame and the same in the construction's, scaled, differ by double
+// rounding, which float32's rounding can turn into one unit.
+void expect_float_near(float page, double expected) {
+  EXPECT_NEAR(page, expected, 4 * std::numeric_limits<float>::epsilon() * std::abs(expected) + 1e-30);
 }
 
 TEST(ViewResolution, WithinTheLimitAsAskedAndBeyondItScaledEvenly) {
@@ -127,7 +160,8 @@ TEST(ViewHtml, SurfaceSamplesAreTheLibrarysInFloat32) {
   const io::Construction c = example("coons_hermite");
   const std::string page = io::view_html(c, {.resolution = {9, 7, 0}, .title = "a <patch>"});
   const json d = page_data(page);
-  EXPECT_EQ(d["format"], "interpatch-view 1");
+  EXPECT_EQ(d["format"], "interpatch-view 2");
+  const Frame f = frame_of(d);
   EXPECT_EQ(d["kind"], "surface");
   EXPECT_EQ(d["title"], "a <patch>");
   EXPECT_NE(page.find("<title>a &lt;patch&gt; · interpatch</title>"), std::string::npos);
@@ -141,17 +175,18 @@ TEST(ViewHtml, SurfaceSamplesAreTheLibrarysInFloat32) {
     for (std::size_t j = 0; j < 7; ++j) {
       const SurfaceDerivatives x = s.derivatives(us[i], vs[j]);
       const std::size_t at = i * 7 + j;
-      expect_point(p, at, x.s);
-      expect_point(n, at, unit_normal(x));
-      EXPECT_EQ(k[at], static_cast<float>(curvature(x).gaussian));
-      EXPECT_EQ(h[at], static_cast<float>(curvature(x).mean));
+      expect_point(p, at, x.s, f);
+      for (int a = 0; a < 3; ++a) expect_float_near(n[3 * at + static_cast<std::size_t>(a)], unit_normal(x)[a]);
+      // Curvatures in the frame's unit: K unit², H unit.
+      expect_float_near(k[at], curvature(x).gaussian * f.unit * f.unit);
+      expect_float_near(h[at], curvature(x).mean * f.unit);
     }
   // The control net, whole, in C order.
   const auto& cp = std::get<BSplineSurface>(*c.exact).control_points();
   const std::vector<float> net = floats(d["control_net"]["points"]);
   EXPECT_EQ(d["control_net"]["shape"], d["control_net"]["full_shape"]);
   ASSERT_EQ(net.size(), 3 * cp.size());
-  for (std::size_t q = 0; q < cp.size(); ++q) expect_point(net, q, cp.data()[q]);
+  for (std::size_t q = 0; q < cp.size(); ++q) expect_point(net, q, cp.data()[q], f);
 }
 
 TEST(ViewHtml, TheSummaryIsInfoAndEveryDataSetIsShown) {
@@ -170,7 +205,7 @@ TEST(ViewHtml, TheSummaryIsInfoAndEveryDataSetIsShown) {
       const std::vector<float> p = floats(d["data"][k]["points"]);
       // The examples' data sets are within the limit: every point, in order.
       ASSERT_EQ(p.size(), 3 * set.points.size());
-      for (std::size_t q = 0; q < set.points.size(); ++q) expect_point(p, q, set.points[q]);
+      for (std::size_t q = 0; q < set.points.size(); ++q) expect_point(p, q, set.points[q], frame_of(d));
       const long long long_axes =
           std::count_if(set.params.begin(), set.params.end(), [](const auto& t) { return t.size() > 1; });
       EXPECT_EQ(d["data"][k]["kind"], long_axes == 1 ? "curve" : "points");
@@ -207,10 +242,11 @@ TEST(ViewHtml, VolumeSamplesAndDeterminants) {
   const VolumeJacobians j =
       io::volume_evaluator(c).evaluate_jacobians(linspace(0, 1, 3), linspace(0, 1, 4), linspace(0, 1, 5));
   const std::vector<float> p = floats(d["volume"]["positions"]), det = floats(d["volume"]["det_j"]);
+  const Frame f = frame_of(d);
   ASSERT_EQ(det.size(), 60u);
   for (std::size_t k = 0; k < 60; ++k) {
-    expect_point(p, k, j.points.data()[k]);
-    EXPECT_EQ(det[k], static_cast<float>(j.determinants.data()[k]));
+    expect_point(p, k, j.points.data()[k], f);
+    expect_float_near(det[k], j.determinants.data()[k] / (f.unit * f.unit * f.unit));
   }
   EXPECT_EQ(d["info"]["jacobian"]["inverted_cells"], io::info_json(c)["jacobian"]["inverted_cells"]);
 }
@@ -237,13 +273,58 @@ TEST(ViewHtml, LargeGridsAreDecimatedKeepingTheirEnds) {
   EXPECT_LT(kept[0], 300u);
   const std::vector<float> p = floats(data["points"]);
   ASSERT_EQ(p.size(), 3 * kept[0] * kept[1]);
-  expect_point(p, 0, q(0, 0));
-  expect_point(p, kept[1] - 1, q(0, 279));
-  expect_point(p, kept[0] * kept[1] - 1, q(299, 279));
+  const Frame f = frame_of(d);
+  expect_point(p, 0, q(0, 0), f);
+  expect_point(p, kept[1] - 1, q(0, 279), f);
+  expect_point(p, kept[0] * kept[1] - 1, q(299, 279), f);
   // The degree 1 net is the data: decimated the same way, within its own limit.
   const auto net = d["control_net"]["shape"].get<std::vector<std::size_t>>();
   EXPECT_EQ(d["control_net"]["full_shape"], json({300, 280}));
   EXPECT_LE(net[0] * net[1], io::view_limits.control_points);
+}
+
+// float32 holds 7 digits: a page in absolute coordinates collapsed a 1 mm part 1e8
+// from the origin to one point, and made coordinates of 1e40 infinite. In the page's
+// frame every part keeps float32's precision of its own size, at any offset and scale.
+TEST(ViewHtml, PartsFarFromTheOriginAndAtExtremeScalesKeepTheirShape) {
+  auto g = test::rng(41);
+  for (int trial = 0; trial < 40; ++trial) {
+    const double size = std::pow(10.0, test::uniform(g, -200, 40));
+    const double offset = trial % 2 ? size * std::pow(10.0, test::uniform(g, 0, 12)) : 0.0;
+    const Vec3 o{offset, -offset / 3, offset / 7};
+    std::array<Vec3, 4> corner;
+    for (Vec3& c : corner) c = o + Vec3{test::uniform(g, -1, 1), test::uniform(g, -1, 1), test::uniform(g, -1, 1)} * size;
+    const auto point = [](const Vec3& p) { return json::array({p.x, p.y, p.z}); };
+    const io::Construction c = io::build(json{{"type", "bilinear"},
+                                              {"p00", point(corner[0])},
+                                              {"p01", point(corner[1])},
+                                              {"p10", point(corner[2])},
+                                              {"p11", point(corner[3])}});
+    SCOPED_TRACE(testing::Message() << "size " << size << " offset " << offset);
+    const json d = page_data(io::view_html(c, {.resolution = {9, 9, 0}, .title = {}}));
+    const Frame f = frame_of(d);
+    const std::vector<float> p = floats(d["surface"]["positions"]), k = floats(d["surface"]["gaussian"]),
+                             h = floats(d["surface"]["mean"]);
+    const std::vector<double> t = linspace(0, 1, 9);
+    const Surface& s = io::evaluator(c);
+    double diagonal = 0;
+    for (const Vec3& a : corner)
+      for (const Vec3& b : corner) diagonal = std::max(diagonal, norm(a - b));
+    for (std::size_t i = 0; i < 9; ++i)
+      for (std::size_t j = 0; j < 9; ++j) {
+        const std::size_t at = i * 9 + j;
+        // What the page draws, back in the construction's coordinates: within
+        // float32's precision (6e-8) of the part's size, 1e-6 leaving room for the
+        // frame's unit being up to twice half the size; plus the rounding of doubles
+        // at the offset, which bounds any result at that offset (4 units of its last place).
+        EXPECT_LE(norm(f.true_point(p, at) - s.point(t[i], t[j])),
+                  1e-6 * diagonal + 4 * std::numeric_limits<double>::epsilon() * norm(o)) << at;
+        ASSERT_TRUE(std::isfinite(k[at]) && std::isfinite(h[at])) << at;
+      }
+    // The part is drawn at its size: the page's corners are as far apart as its own.
+    EXPECT_NEAR(norm(f.true_point(p, 0) - f.true_point(p, 80)), norm(corner[0] - corner[3]),
+                1e-6 * diagonal + 8 * std::numeric_limits<double>::epsilon() * norm(o));
+  }
 }
 
 TEST(ViewHtml, AsksForNothingOutsideThePage) {

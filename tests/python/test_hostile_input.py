@@ -102,6 +102,21 @@ def test_formats_and_kinds_are_checked(tmp_path):
     assert (tmp_path / "v.vts").stat().st_size > 0
 
 
+def test_an_stl_that_cannot_hold_the_shape_warns_as_the_command_line_does(tmp_path):
+    # A 0.1 mm part 1e8 from the origin: binary STL's float32 rounds its points by
+    # far more than its size. The file is written; .ply keeps doubles and is quiet.
+    o, d = 1e8, 1e-4
+    s = interpatch.build({"type": "bilinear", "p00": [o, o, o], "p01": [o, o + d, o],
+                          "p10": [o + d, o, o], "p11": [o + d, o + d, o + d]})
+    with pytest.warns(UserWarning, match="holds float32 coordinates"):
+        s.write(str(tmp_path / "far.stl"), res=[5, 5])
+    assert (tmp_path / "far.stl").exists()
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        s.write(str(tmp_path / "far.ply"), res=[5, 5])
+
+
 # --- masked arrays ---
 
 def test_masked_points_are_missing_where_missing_points_are_allowed():

@@ -15,6 +15,13 @@ function floats(array) {
   return new Float32Array(bytes.buffer, 0, array.length);
 }
 
+// Positions on the page are float32 in a frame of the construction's own: measured
+// from `origin` in units of `unit` (a power of two near half its size), so that a
+// small part far from the origin keeps its shape. Curvatures and det J come in the
+// same unit; the colourings and their legends show true values.
+const frame = data.frame;
+const trueValues = (values, scale, offset = 0) => Float64Array.from(values, (v) => v * scale + offset);
+
 const colours = {
   background: 0x20232a, data: 0xff8c1a, net: 0xc8c8d0, isolines: 0x15171c, inverted: 0xff1744,
   du: 0xe53935, dv: 0x43a047, dw: 0x1e88e5,
@@ -156,16 +163,16 @@ function addSurface(s) {
   const step = [Math.max(1, Math.round((nu - 1) / 16)), Math.max(1, Math.round((nv - 1) / 16))];
   const at = (i, j) => { const k = 3 * (i * nv + j); return [pos[k], pos[k + 1], pos[k + 2]]; };
   groups.isolines.add(lineSegments(gridLines(nu, nv, at, step), colours.isolines, 0.55));
-  const height = new Float32Array(nu * nv);
-  for (let k = 0; k < height.length; ++k) height[k] = pos[3 * k + 2];
+  const height = new Float64Array(nu * nv);
+  for (let k = 0; k < height.length; ++k) height[k] = pos[3 * k + 2] * frame.unit + frame.origin[2];
   const paint = (values, range, stops) => {
     const span = range[1] - range[0];
     for (let k = 0; k < values.length; ++k) colour.setXYZ(k, ...paletteAt(stops, span > 0 ? (values[k] - range[0]) / span : 0.5));
     colour.needsUpdate = true;
   };
   colourings.height = { label: 'height (z)', values: height, signed: false, paint };
-  colourings.gaussian = { label: 'Gaussian curvature K', values: floats(s.gaussian), signed: true, paint };
-  colourings.mean = { label: 'mean curvature H', values: floats(s.mean), signed: true, paint };
+  colourings.gaussian = { label: 'Gaussian curvature K', values: trueValues(floats(s.gaussian), 1 / frame.unit ** 2), signed: true, paint };
+  colourings.mean = { label: 'mean curvature H', values: trueValues(floats(s.mean), 1 / frame.unit), signed: true, paint };
   shown.push(`surface: ${nu} × ${nv} samples${resolutionNote()}, isoparametric lines every ${step[0]} × ${step[1]}`);
 }
 
@@ -190,7 +197,7 @@ function addVolume(v) {
     g.setIndex(new THREE.BufferAttribute(gridIndex(dims[0], dims[1]), 1));
     g.computeVertexNormals();
     const mesh = new THREE.Mesh(g, shadedMaterial());
-    mesh.userData = { values: d, height: p.filter((_, k) => k % 3 === 2) };
+    mesh.userData = { values: trueValues(d, frame.unit ** 3), height: trueValues(p.filter((_, k) => k % 3 === 2), frame.unit, frame.origin[2]) };
     const step = [Math.max(1, Math.round((dims[0] - 1) / 8)), Math.max(1, Math.round((dims[1] - 1) / 8))];
     const lines = lineSegments(gridLines(dims[0], dims[1], (a, b) => [p[3 * (a * dims[1] + b)], p[3 * (a * dims[1] + b) + 1], p[3 * (a * dims[1] + b) + 2]], step), colours.isolines, 0.5);
     return { mesh, lines };
@@ -255,9 +262,9 @@ function addVolume(v) {
       colour.needsUpdate = true;
     }
   };
-  const heights = new Float32Array(pos.length / 3);
-  for (let k = 0; k < heights.length; ++k) heights[k] = pos[3 * k + 2];
-  colourings.det_j = { label: 'det J', values: det, signed: false, paint: paintSheets('values') };
+  const heights = new Float64Array(pos.length / 3);
+  for (let k = 0; k < heights.length; ++k) heights[k] = pos[3 * k + 2] * frame.unit + frame.origin[2];
+  colourings.det_j = { label: 'det J', values: trueValues(det, frame.unit ** 3), signed: false, paint: paintSheets('values') };
   colourings.height = { label: 'height (z)', values: heights, signed: false, paint: paintSheets('height') };
   shown.push(`volume: ${nu} × ${nv} × ${nw} samples${resolutionNote()}; ${marks.length / 3} cells with a corner where det J ≤ 0 marked in red`);
 }
@@ -307,10 +314,10 @@ function addData(sets) {
 
 function addFrames(frames) {
   for (const f of frames) {
-    const origin = new THREE.Vector3(...f.p);
+    const origin = new THREE.Vector3(...f.p.map((x, a) => x / frame.unit - frame.origin[a] / frame.unit));
     for (const [key, colour] of [['du', colours.du], ['dv', colours.dv], ['dw', colours.dw]]) {
       if (!f[key]) continue;
-      const d = new THREE.Vector3(...f[key]);
+      const d = new THREE.Vector3(...f[key]).divideScalar(frame.unit);
       const length = d.length() / 3;  // a third of the derivative: the Bézier handle of a cubic Hermite patch or volume
       if (length > 0) groups.data.add(new THREE.ArrowHelper(d.normalize(), origin, length, colour, 0.2 * length, 0.1 * length));
     }

@@ -5,6 +5,8 @@
 
 #include <array>
 #include <filesystem>
+#include <string>
+#include <vector>
 #include <span>
 #include <string_view>
 
@@ -71,7 +73,11 @@ struct SurfaceMesh {
 ///   again, to 1e-9 of the bounding-box diagonal; the message names the point),
 ///   too_large (more than 2^32 - 1 STL triangles), not_finite (a point or normal
 ///   with NaN or infinity, named by its index; nothing written), file_unwritable.
-void write_surface_mesh(const std::filesystem::path& path, const SurfaceMesh& mesh);
+/// @returns warnings for the user, empty when there are none: binary STL holds
+///   float32 coordinates (7 digits), and where rounding to them moves a point by more
+///   than 1e-5 of the mesh's diagonal (a part far from the origin for its size) the
+///   warning says by how much and which formats keep doubles. The file is written.
+std::vector<std::string> write_surface_mesh(const std::filesystem::path& path, const SurfaceMesh& mesh);
 
 /// The mesh of a surface on the grid us × vs written as
 /// write_surface_mesh(path, sample_mesh(surface, us, vs, progress)) writes it, the
@@ -87,8 +93,8 @@ void write_surface_mesh(const std::filesystem::path& path, const SurfaceMesh& me
 ///   const auto t1000 = interpatch::linspace(0, 1, 1000);
 ///   interpatch::io::write_surface_mesh("patch.vts", surface, t1000, t1000);  // 10^6 points and normals
 /// @endcode
-/// @throws error as sample_mesh and write_surface_mesh.
-void write_surface_mesh(const std::filesystem::path& path, const Surface& surface, std::span<const double> us,
+/// @throws error as sample_mesh and write_surface_mesh. @returns its warnings.
+std::vector<std::string> write_surface_mesh(const std::filesystem::path& path, const Surface& surface, std::span<const double> us,
                         std::span<const double> vs, const progress_callback& progress = {});
 
 /// Writes a structured NU × NV × NW grid of points (a volume mesh, first index

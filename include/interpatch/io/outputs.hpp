@@ -10,6 +10,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "interpatch/io/spec.hpp"
 #include "interpatch/progress.hpp"
@@ -100,10 +101,14 @@ void write_build(Construction& c, const std::filesystem::path& out);
 /// @code
 ///   constexpr interpatch::io::CountsOption res{"res", "mesh", "vertices", "(nu, nv)", "(nu, nv, nw)", "(64, 64)",
 ///                                              "(33, 33, 33)", false, " (", ", ", ")"};
-///   interpatch::io::write_mesh(c, "patch.vts", {200, 100, 0}, res);  // "res (0, 5): ..." for {0, 5, 0}
+///   for (const std::string& w : interpatch::io::write_mesh(c, "patch.vts", {200, 100, 0}, res))  // "res (0, 5): ..." for {0, 5, 0}
+///     std::fprintf(stderr, "warning: %s\n", w.c_str());
 /// @endcode
 /// @throws error wrong_type, too_few_points, size_mismatch, too_large, file_unwritable.
-void write_mesh(Construction& c, const std::filesystem::path& out, const Resolution& res, const CountsOption& option,
-                const progress_callback& progress = {});
+/// @returns the writer's warnings for the user (write_surface_mesh: an STL far from
+///   the origin for its size), to be shown: the file is written.
+[[nodiscard]] std::vector<std::string> write_mesh(Construction& c, const std::filesystem::path& out,
+                                                  const Resolution& res, const CountsOption& option,
+                                                  const progress_callback& progress = {});
 
 }  // namespace interpatch::io
