@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <variant>
 
@@ -1568,22 +1569,67 @@ Data<R> closed_data(Grid<Vec3, R> points, Grid<double, R>& weights, const std::a
   return d;
 }
 
+// The power of two that brings the data's largest coordinate near 1, where their
+// coordinates are so large or so small that squared distances would overflow or
+// vanish (the fit's sums of squares, its rms, its search for knots); 1 otherwise,
+// leaving ordinary data untouched. Scaling by it is exact both ways.
+template <std::size_t R>
+double data_unit(const Grid<Vec3, R>& points) {
+  double top = 0;
+  for (const Vec3& q : points.values())
+    if (is_finite(q)) top = std::max({top, std::abs(q.x), std::abs(q.y), std::abs(q.z)});
+  constexpr double low = 0x1p-64, high = 0x1p64;  // squares between 2^-128 and 2^128: far from either end of double
+  if (top == 0 || (top >= low && top <= high)) return 1;
+  int e = 0;
+  (void)std::frexp(top, &e);
+  return std::ldexp(1.0, e);
+}
+
+// Finite points scaled by 1 / unit (NaN marks a missing point; infinite ones are kept
+// for approximate() to name as given).
+template <std::size_t R>
+void scale_points(Grid<Vec3, R>& points, double factor) {
+  for (Vec3& q : points.values())
+    if (is_finite(q)) q = q * factor;
+}
+
 template <std::size_t R>
 Result<R> run(Grid<Vec3, R> points, const ApproximationOptions<R>& options, const char* what) {
-  bool closed = std::any_of(options.periodic.begin(), options.periodic.end(), [](bool b) { return b; });
-  if (!closed) {
-    Data<R> d;
+  check_request<R>(options, [&] {
+    Shape<R> shape{};
+    for (std::size_t a = 0; a < R; ++a) shape[a] = points.extent(a);
+    return shape;
+  }(), what);
+  const double unit = data_unit<R>(points);
+  const bool closed = std::any_of(options.periodic.begin(), options.periodic.end(), [](bool b) { return b; });
+  // A copy of the options (and their weights) only where they change.
+  std::optional<ApproximationOptions<R>> changed;
+  if (unit != 1 || closed) changed = options;
+  if (unit != 1) {
+    scale_points<R>(points, 1 / unit);
+    // Below the smallest double in the data's unit it could not be met anyway: the
+    // refinement goes to its finest fit and says so.
+    if (changed->tolerance)
+      changed->tolerance = std::max(*changed->tolerance / unit, std::numeric_limits<double>::denorm_min());
+  }
+  const auto given = points.shape();
+  Data<R> d;
+  if (closed) {
+    d = closed_data<R>(std::move(points), changed->weights, changed->periodic);
+  } else {
     for (std::size_t a = 0; a < R; ++a) d.shape[a] = points.extent(a);
     d.points = std::move(points);
-    return approximate<R>(std::move(d), options, what);
   }
-  ApproximationOptions<R> o = options;
-  const auto given = points.shape();
-  Data<R> d = closed_data<R>(std::move(points), o.weights, o.periodic);
-  Result<R> r = approximate<R>(std::move(d), o, what);
+  Result<R> r = approximate<R>(std::move(d), changed ? *changed : options, what);
   // A closing line left out has the parameter one period after the first line's.
   for (std::size_t a = 0; a < R; ++a)
     if (r.fit.axes[a].n < given[a]) r.fit.axes[a].t.push_back(r.fit.axes[a].t.front() + 1.0);
+  if (unit != 1) {
+    for (double& x : r.fit.cp) x *= unit;
+    scale_points<R>(r.data.points, unit);
+    r.report.max_error *= unit;
+    r.report.rms_error *= unit;
+  }
   return r;
 }
 

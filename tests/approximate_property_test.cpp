@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdio>
+#include <optional>
 #include <map>
 #include <cmath>
 #include <limits>
@@ -188,6 +190,80 @@ TEST(ApproximateProperty, RandomCasesKeepThePromiseOrFailWithADocumentedCode) {
   for (const auto& [name, count] : outcomes) std::printf("  %s: %d\n", name.c_str(), count);
   // Most cases are kept: the property is about results, not refusals.
   EXPECT_GT(outcomes["kept"], static_cast<int>(cases) / 2);
+}
+
+// The case's data (and tolerance) times 2^e.
+Case scaled(Case c, int e) {
+  for (Vec3& q : c.points)
+    for (int k = 0; k < 3; ++k) q[k] = std::ldexp(q[k], e);
+  if (c.tolerance) c.tolerance = std::ldexp(*c.tolerance, e);
+  return c;
+}
+
+// The control net and report of a case's fit, or the code it failed with.
+struct Outcome {
+  std::optional<errc> code;
+  std::vector<Vec3> net;
+  ApproximationReport report;
+};
+
+Outcome outcome(const Case& c) {
+  Outcome o;
+  try {
+    if (c.rank == 1) {
+      const auto r = approximate_curve(c.points, options_of<1>(c));
+      o.net = r.curve.control_points();
+      o.report = r.report;
+    } else if (c.rank == 2) {
+      const auto r = approximate_surface(PointGrid({c.n[0], c.n[1]}, c.points), options_of<2>(c));
+      o.net.assign(r.surface.control_points().values().begin(), r.surface.control_points().values().end());
+      o.report = r.report;
+    } else {
+      const auto r = approximate_volume(PointGrid3({c.n[0], c.n[1], c.n[2]}, c.points), options_of<3>(c));
+      o.net.assign(r.volume.control_points().values().begin(), r.volume.control_points().values().end());
+      o.report = r.report;
+    }
+  } catch (const error& e) {
+    o.code = e.code();
+  }
+  return o;
+}
+
+// Squared distances of data of 1e-200 vanished and those of 1e200 overflowed: a
+// tolerance fit of tiny data stopped at 4 x 4 control points, and the rms of large
+// data was infinite. The fit is the same at any scale: the same outcome, the same
+// control points scaled, the report scaled.
+TEST(ApproximateProperty, TheSameFitAtEveryScale) {
+  auto g = test::rng(37);
+  int compared = 0;
+  for (std::size_t k = 0; k < 300; ++k) {
+    const Case c = random_case(g);
+    const int e = std::array<int, 6>{-900, -640, -330, 330, 640, 900}[k % 6];
+    const Outcome one = outcome(c), big = outcome(scaled(c, e));
+    SCOPED_TRACE(testing::Message() << "case " << k << " scaled by 2^" << e);
+    ASSERT_EQ(one.code.has_value(), big.code.has_value());
+    if (one.code) {
+      EXPECT_EQ(*one.code, *big.code);
+      continue;
+    }
+    ++compared;
+    EXPECT_EQ(one.report.control_points, big.report.control_points);
+    ASSERT_EQ(one.net.size(), big.net.size());
+    Box box;
+    for (const Vec3& q : c.points) box.add(q);
+    // The fit at 1 and at 2^e differ only in rounding: the solves are linear in the
+    // data, and the choices (knots, lambda) depend on ratios of distances. 1e-9 of the
+    // data's size leaves room for the rounding of ill-conditioned systems.
+    const double size = distance(box.lo, box.hi) + 1;
+    for (std::size_t i = 0; i < one.net.size(); ++i)
+      ASSERT_LE(distance(one.net[i], big.net[i] * std::ldexp(1.0, -e)), 1e-9 * size) << "control point " << i;
+    EXPECT_NEAR(std::ldexp(big.report.max_error, -e), one.report.max_error, 1e-9 * size);
+    EXPECT_NEAR(std::ldexp(big.report.rms_error, -e), one.report.rms_error, 1e-9 * size);
+    EXPECT_TRUE(std::isfinite(big.report.rms_error));
+    // lambda by cross-validation: the minimum of a flat function, found to its rounding.
+    EXPECT_NEAR(big.report.lambda, one.report.lambda, 1e-6 * one.report.lambda);
+  }
+  EXPECT_GT(compared, 150);
 }
 
 }  // namespace
