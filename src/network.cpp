@@ -471,7 +471,17 @@ Arrangement arrangement(const Prepared& n, const CurveNetwork& net) {
   r.X.assign(U.size(), std::vector<detail::Crossing>(V.size()));
   for (std::size_t j = 0; j < U.size(); ++j)
     for (std::size_t i = 0; i < V.size(); ++i) {
-      const auto x = detail::closest_points(U[j], V[i], n.closed[0], n.closed[1], n.tol, su[j], sv[i]);
+      auto x = detail::closest_points(U[j], V[i], n.closed[0], n.closed[1], n.tol, su[j], sv[i]);
+      // Every place they meet: a u-curve crosses each v-curve once; and where the
+      // search above settled on a near miss, a crossing it passed by.
+      const auto all = detail::crossings(U[j], V[i], n.closed[0], n.closed[1], n.tol, su[j], sv[i]);
+      if (all.size() > 1) {
+        std::string where;
+        for (std::size_t k = 0; k < all.size() && k < 4; ++k) where += detail::cat(k ? ", " : "", all[k].a);
+        fail(errc::network_order, n.name(0, j), " and ", n.name(1, i), " cross ", all.size(), " times (at ", where,
+             all.size() > 4 ? ", ..." : "", "): each curve of a network crosses each curve of the other family once");
+      }
+      if (!(x.gap <= n.tol) && !all.empty()) x = all.front();
       if (!(x.gap <= n.tol)) {
         const auto own = [](const BSplineCurve& given, double t) {
           const auto [lo, hi] = given.domain();

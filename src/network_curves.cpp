@@ -232,6 +232,90 @@ Crossing closest_points(const BSplineCurve& U, const BSplineCurve& V, bool close
   return fine.gap < coarse.gap ? fine : coarse;
 }
 
+namespace {
+
+// How far p lies from V: from the nearest of V's samples, Newton on |V(t) − p|²
+// (a step that does not bring V nearer ends it).
+double distance_to(const BSplineCurve& V, bool closed, const CurveSamples& sv, const Vec3& p) {
+  const auto& pv = sv.points();
+  std::size_t best = 0;
+  for (std::size_t j = 1; j < pv.size(); ++j)
+    if (distance(pv[j], p) < distance(pv[best], p)) best = j;
+  double t = sv.params()[best], d = distance(pv[best], p);
+  for (int it = 0; it < 30; ++it) {
+    Vec3 dv[3];
+    V.derivatives(t, 2, dv);
+    const Vec3 r = dv[0] - p;
+    const double g = dot(dv[1], r), h = dot(dv[1], dv[1]) + dot(dv[2], r);
+    const double dt = h > 0 ? -g / h : -g / std::max(dot(dv[1], dv[1]), 1e-300);
+    const double next = on_curve(t + dt, closed), e = distance(V.point(next), p);
+    if (!(e < d)) break;
+    t = next;
+    d = e;
+  }
+  return d;
+}
+
+}  // namespace
+
+std::vector<Crossing> crossings(const BSplineCurve& U, const BSplineCurve& V, bool closed_u, bool closed_v, double tol,
+                                const CurveSamples& su, const CurveSamples& sv) {
+  const auto& pu = su.points();
+  const auto& pv = sv.points();
+  const auto& cu = su.chunks();
+  const auto& cv = sv.chunks();
+  // A crossing lies within half a sample step of a sample on each curve.
+  double hu = 0, hv = 0;
+  for (std::size_t i = 0; i + 1 < pu.size(); ++i) hu = std::max(hu, distance(pu[i], pu[i + 1]));
+  for (std::size_t j = 0; j + 1 < pv.size(); ++j) hv = std::max(hv, distance(pv[j], pv[j + 1]));
+  const double reach = hu + hv + tol;
+  const auto near = [&](std::size_t i, std::size_t j) { return distance(pu[i], pv[j]); };
+  // A neighbour's index, around the seam of a closed curve (whose last sample is its first).
+  const auto neighbour = [](std::size_t i, int d, std::size_t n, bool closed) -> std::optional<std::size_t> {
+    const auto k = static_cast<std::ptrdiff_t>(i) + d, last = static_cast<std::ptrdiff_t>(n) - 1;
+    if (k >= 0 && k <= last) return static_cast<std::size_t>(k);
+    if (!closed || last < 1) return std::nullopt;
+    return static_cast<std::size_t>(k < 0 ? k + last : k - last);
+  };
+  std::vector<Crossing> found;
+  // Two crossings are one where the curves stay within tol of each other between them
+  // (at 7 points of U between, the shorter way round a closed U).
+  const auto same = [&](const Crossing& x, const Crossing& y) {
+    if (distance(x.a, y.a) <= tol) return true;
+    double from = x.s, span = y.s - x.s;
+    if (closed_u && std::abs(span) > 0.5) span -= std::copysign(1.0, span);
+    for (int k = 1; k < 8; ++k)
+      if (distance_to(V, closed_v, sv, U.point(on_curve(from + span * k / 8, closed_u))) > tol) return false;
+    return true;
+  };
+  for (const auto& a : cu)
+    for (const auto& b : cv) {
+      if (box_distance(a, b) > reach) continue;
+      for (std::size_t i = a.first; i <= a.last; ++i)
+        for (std::size_t j = b.first; j <= b.last; ++j) {
+          const double x = near(i, j);
+          if (x > reach) continue;
+          bool least = true;
+          for (int di = -1; di <= 1 && least; ++di)
+            for (int dj = -1; dj <= 1 && least; ++dj) {
+              if (di == 0 && dj == 0) continue;
+              const auto ii = neighbour(i, di, pu.size(), closed_u), jj = neighbour(j, dj, pv.size(), closed_v);
+              if (ii && jj && near(*ii, *jj) < x) least = false;
+            }
+          if (!least) continue;
+          double s = su.params()[i], t = sv.params()[j];
+          newton(U, V, s, t, closed_u, closed_v, true);
+          const Crossing c = crossing_at(U, V, s, t);
+          if (!(c.gap <= tol)) continue;
+          const auto known = std::find_if(found.begin(), found.end(), [&](const Crossing& f) { return same(f, c); });
+          if (known == found.end()) found.push_back(c);
+          else if (c.gap < known->gap) *known = c;
+        }
+    }
+  std::sort(found.begin(), found.end(), [](const Crossing& x, const Crossing& y) { return x.gap < y.gap; });
+  return found;
+}
+
 // ------------------------------------------------------------------- the map
 
 Reparametrization monotone_map(std::vector<double> at, std::vector<double> to, bool closed) {

@@ -47,6 +47,13 @@ class CurveSamples {
 Crossing closest_points(const BSplineCurve& U, const BSplineCurve& V, bool closed_u, bool closed_v, double tol,
                         const CurveSamples& su, const CurveSamples& sv);
 
+/// Every place where U and V meet within `tol`: Gauss–Newton from each pair of
+/// samples (8 per knot span) nearer than any pair around it, and within a sample
+/// step of each other; nearest first. Two places are one where the curves stay
+/// within `tol` of each other between them (a shallow or tangential crossing).
+std::vector<Crossing> crossings(const BSplineCurve& U, const BSplineCurve& V, bool closed_u, bool closed_v, double tol,
+                                const CurveSamples& su, const CurveSamples& sv);
+
 /// The monotone map through (at[i], to[i]) (at increasing, to strictly monotone):
 /// slopes of the C2 cubic spline (natural ends, or periodic when `closed`: to[last]
 /// is then to[0] ± 1 at at[last] = 1), or of Fritsch–Butland where that spline is

@@ -921,6 +921,42 @@ TEST(NetworkDrawn, AZigzagThatNoOrderFitsIsAnOrderError) {
   EXPECT_ERRC((void)curve_network(n), network_order, "u_curves[1] crosses the v_curves in the order 3, 1, 2, 0");
 }
 
+// A v-curve that crosses a u-curve k times was accepted silently, the surface taking
+// one of the crossings. Each pair of curves must cross once: random grids of lines with
+// one v-curve zigzagging across one u-curve k times (leaving the plane to come back)
+// are refused, naming both; the same grids without the zigzag build.
+TEST(NetworkDrawn, CurvesCrossingMoreThanOnceAreAnOrderError) {
+  auto g = test::rng(44);
+  for (int trial = 0; trial < 24; ++trial) {
+    const std::size_t nu = 3 + static_cast<std::size_t>(test::uniform(g, 0, 3)),
+                      nv = 3 + static_cast<std::size_t>(test::uniform(g, 0, 3));
+    std::vector<double> ys = random_nodes(g, nu), xs = random_nodes(g, nv);
+    CurveNetwork n;
+    for (double y : ys) n.u_curves.push_back(line({0, y, 0}, {1, y, 0}));
+    for (double x : xs) n.v_curves.push_back(line({x, 0, 0}, {x, 1, 0}));
+    ASSERT_NO_THROW((void)curve_network(n)) << "trial " << trial;
+    const std::size_t j = static_cast<std::size_t>(test::uniform(g, 0, 1) * static_cast<double>(nu));
+    const std::size_t i = 1 + static_cast<std::size_t>(test::uniform(g, 0, 1) * static_cast<double>(nv - 2));
+    const int k = 2 + trial % 3;
+    // Within a band of ±d about the u-curve and 3e to the right of the v-curve: clear
+    // of the other curves (nodes are at least 0.3 / count apart).
+    const double d = 0.2 / static_cast<double>(nu), e = 0.2 / static_cast<double>(nv) / 3, h = 0.1;
+    const double x = xs[i], y = ys[j];
+    std::vector<Vec3> zig{{x, 0, 0}, {x, y - d, 0}};
+    for (int m = 0; m < k; ++m) {
+      zig.push_back({x + m * e, y + d, 0});  // across the u-curve, in its plane
+      if (m + 1 < k) zig.insert(zig.end(), {{x + m * e, y + d, h}, {x + (m + 1) * e, y - d, h}, {x + (m + 1) * e, y - d, 0}});
+    }
+    zig.push_back({x, 1, 0});
+    std::vector<double> knots{0, 0};
+    for (std::size_t q = 1; q + 1 < zig.size(); ++q) knots.push_back(static_cast<double>(q) / static_cast<double>(zig.size() - 1));
+    knots.insert(knots.end(), {1, 1});
+    n.v_curves[i] = BSplineCurve(KnotVector(1, knots), zig);
+    EXPECT_ERRC((void)curve_network(n), network_order,
+                "u_curves[" + std::to_string(j) + "] and v_curves[" + std::to_string(i) + "] cross " + std::to_string(k) + " times");
+  }
+}
+
 // The network as a spec: every curve as its B-spline, the method and the tolerance.
 nlohmann::json spec_of(const CurveNetwork& n, std::optional<double> tolerance) {
   const auto curves = [](const std::vector<BSplineCurve>& cs) {
