@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "interpatch/blended_surface.hpp"
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/error.hpp"
 #include "interpatch/evaluate.hpp"
@@ -72,6 +73,18 @@ struct Built {
 };
 
 py::object to_python(const nlohmann::ordered_json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+
+// "(3, 3)", as Python prints a tuple.
+std::string tuple_text(const std::vector<std::size_t>& v) {
+  std::string s = "(";
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + std::to_string(v[i]);
+  return s + ")";
+}
+
+std::vector<const ip::KnotVector*> knots_of(const ip::BSplineSurface& s) { return {&s.knots_u(), &s.knots_v()}; }
+std::vector<const ip::KnotVector*> knots_of(const ip::BSplineVolume& v) {
+  return {&v.knots_u(), &v.knots_v(), &v.knots_w()};
+}
 
 // What surfaces and volumes share: the built spec, its info, its files.
 class PyBuilt {
@@ -133,6 +146,35 @@ class PyBuilt {
       return;
     }
     io::write_build(b_->c, path);
+  }
+
+  // Surface(type='interpolate', degree=(3, 3), control_points=(30, 25)): the exact
+  // form's degrees and net. A surface whose exact form is deferred gives them from its
+  // knots alone; a volume's is made now; one without an exact form says so.
+  [[nodiscard]] std::string repr(const char* kind) const {
+    std::vector<std::size_t> degree, size;
+    {
+      py::gil_scoped_release free;
+      std::lock_guard<std::mutex> hold(b_->lock);
+      ip::io::Construction& c = b_->c;
+      const auto* blended = dynamic_cast<const ip::BlendedSurface*>(c.formula.get());
+      if (!c.exact && c.convert && blended && blended->has_exact_form()) {
+        for (const ip::KnotVector& k : blended->exact_knots()) {
+          degree.push_back(static_cast<std::size_t>(k.degree()));
+          size.push_back(static_cast<std::size_t>(k.count()));
+        }
+      } else if (ip::io::has_exact_form_after_conversion(c)) {
+        std::visit([&](const auto& e) {
+          for (const ip::KnotVector* k : knots_of(e)) {
+            degree.push_back(static_cast<std::size_t>(k->degree()));
+            size.push_back(static_cast<std::size_t>(k->count()));
+          }
+        }, *c.exact);
+      }
+    }
+    std::string out = std::string(kind) + "(type='" + b_->c.type + "'";
+    if (degree.empty()) return out + ", exact_form=None)";
+    return out + ", degree=" + tuple_text(degree) + ", control_points=" + tuple_text(size) + ")";
   }
 
   // The data's parameters along an axis, where the construction has data.
@@ -336,9 +378,145 @@ class PyVolume : public PyBuilt {
   }
 };
 
-py::object wrap(ip::io::Construction c, std::shared_ptr<const Sources> sources) {
+// f(); an error of the curve's (a parameter outside its domain) names `name`.
+template <class F>
+auto at_t(const std::string& name, F&& f) {
+  try {
+    return f();
+  } catch (const ip::error& e) {
+    throw ip::error(e.code(), name + ": " + e.what());
+  }
+}
+
+// A curve spec, built: immutable once made, so every method runs without a lock.
+class PyCurve {
+ public:
+  explicit PyCurve(std::shared_ptr<const ip::io::CurveConstruction> c) : c_(std::move(c)) {}
+
+  [[nodiscard]] const std::string& type() const { return c_->form; }
+  [[nodiscard]] int degree() const { return c_->curve.degree(); }
+  [[nodiscard]] py::tuple domain() const {
+    const auto [a, b] = c_->curve.domain();
+    return py::make_tuple(a, b);
+  }
+
+  // C(ts[i]) for every i, shape (len(ts), 3).
+  py::array_t<double> evaluate(const py::handle& ts_in) const {
+    return sample(ts_in, [&](double t, double* out) {
+      const ip::Vec3 p = c_->curve.point(t);
+      out[0] = p.x, out[1] = p.y, out[2] = p.z;
+    }, {});
+  }
+
+  // C and its derivatives of orders 1..order at every ts[i], shape (len(ts), order + 1, 3).
+  py::array_t<double> derivatives(const py::handle& ts_in, int order) const {
+    if (order < 0) throw ip::error(ip::errc::wrong_type, "order: a derivative order of 0 or more, got " + std::to_string(order));
+    const auto k = static_cast<std::size_t>(order) + 1;
+    return sample(ts_in, [&](double t, double* out) {
+      c_->curve.derivatives(t, order, reinterpret_cast<ip::Vec3*>(out));
+    }, {static_cast<py::ssize_t>(k)});
+  }
+
+  py::array_t<double> point(double t) const {
+    const ip::Vec3 p = at_t("t", [&] { return c_->curve.point(t); });
+    return py::array_t<double>(3, &p.x);
+  }
+
+  // C'/|C'|; the zero vector where C' vanishes, as Surface.normal at a degenerate point.
+  py::array_t<double> tangent(double t) const {
+    const ip::Vec3 d = at_t("t", [&] { return c_->curve.derivative(t, 1); });
+    const double len = ip::norm(d);
+    const ip::Vec3 u = len > 0 ? d / len : ip::Vec3{0, 0, 0};
+    return py::array_t<double>(3, &u.x);
+  }
+
+  // |C' × C''| / |C'|³; NaN where C' vanishes.
+  double curvature(double t) const {
+    ip::Vec3 d[3];
+    at_t("t", [&] {
+      c_->curve.derivatives(t, 2, d);
+      return 0;
+    });
+    const double len = ip::norm(d[1]);
+    return ip::norm(ip::cross(d[1], d[2])) / (len * len * len);
+  }
+
+  py::dict to_bspline() const {
+    const ip::BSplineCurve& c = c_->curve;
+    const py::capsule keep(new std::shared_ptr<const ip::io::CurveConstruction>(c_),
+                           [](void* p) { delete static_cast<std::shared_ptr<const ip::io::CurveConstruction>*>(p); });
+    const auto n = static_cast<py::ssize_t>(c.control_points().size());
+    py::dict d;
+    d["degree"] = c.degree();
+    d["knots"] = knots_array(c.knots(), keep);
+    d["control_points"] = read_only(py::array_t<double>({n, py::ssize_t{3}}, &c.control_points().data()->x, keep));
+    d["weights"] = c.rational() ? py::object(read_only(py::array_t<double>(n, c.weights().data(), keep))) : py::none();
+    d["periodic"] = c.periodic();
+    return d;
+  }
+
+  [[nodiscard]] py::object params() const {
+    if (c_->data.empty()) return py::none();
+    const auto& t = c_->data.front().params.front();
+    return py::array_t<double>(static_cast<py::ssize_t>(t.size()), t.data());
+  }
+
+  py::object info() const {
+    nlohmann::ordered_json j;
+    {
+      py::gil_scoped_release free;
+      j = ip::io::curve_info_json(*c_);
+    }
+    return to_python(j);
+  }
+
+  // Written as `interpatch build` writes a curve spec: .json .npz .step/.stp .igs/.iges.
+  void write(const py::handle& path_in) const {
+    const std::filesystem::path path = ip::python::path_arg(path_in, "write: the path is a str or an os.PathLike");
+    py::gil_scoped_release free;
+    ip::io::write_build(*c_, path);
+  }
+
+  [[nodiscard]] std::string repr() const {
+    return "Curve(type='" + c_->form + "', degree=" + std::to_string(degree()) +
+           ", control_points=" + std::to_string(c_->curve.control_points().size()) + ")";
+  }
+
+ private:
+  // A block of `row` points per parameter (shape row + (3,)), made by fill(t, block)
+  // without the GIL; Ctrl-C stops it between points.
+  template <class Fill>
+  py::array_t<double> sample(const py::handle& ts_in, const Fill& fill, std::vector<py::ssize_t> row) const {
+    const std::vector<double> ts = ip::python::params(ts_in, "ts");
+    std::size_t per = 3;
+    for (const auto r : row) per *= static_cast<std::size_t>(r);
+    auto out = std::make_unique<std::vector<double>>(ts.size() * per);
+    const ip::progress_callback progress = interruptible();
+    {
+      py::gil_scoped_release free;
+      for (std::size_t i = 0; i < ts.size(); ++i) {
+        at_t("ts[" + std::to_string(i) + "]", [&] {
+          fill(ts[i], out->data() + i * per);
+          return 0;
+        });
+        if ((i & 4095) == 4095) progress(static_cast<double>(i) / static_cast<double>(ts.size()));
+      }
+    }
+    std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(ts.size())};
+    shape.insert(shape.end(), row.begin(), row.end());
+    shape.push_back(3);
+    double* data = out->data();
+    return owning_array(std::move(out), data, std::move(shape));
+  }
+
+  std::shared_ptr<const ip::io::CurveConstruction> c_;
+};
+
+py::object wrap(ip::io::Built built, std::shared_ptr<const Sources> sources) {
+  if (auto* curve = std::get_if<ip::io::CurveConstruction>(&built))
+    return py::cast(PyCurve(std::make_shared<const ip::io::CurveConstruction>(std::move(*curve))));
   auto b = std::make_shared<Built>();
-  b->c = std::move(c);
+  b->c = std::move(std::get<ip::io::Construction>(built));
   if (ip::io::is_volume(b->c)) {
     // A volume's formula evaluates without the lock: make its exact form now if it has one
     // and the formula is not kept (volume_evaluator needs one of them).
@@ -367,18 +545,18 @@ py::object build(const py::handle& spec, const py::handle& base_dir_in, const py
     o.arrays[name] = point_array(v, name);
     (*sources)[name] = py::reinterpret_borrow<py::object>(v);
   }
-  ip::io::Construction c;
+  std::optional<ip::io::Built> c;
   if (py::isinstance<py::dict>(spec)) {
     const nlohmann::json j = ip::python::spec_json(spec);
     py::gil_scoped_release free;
-    c = ip::io::build(j, base_dir, o);
+    c = ip::io::build_any(j, base_dir, o);
   } else {
     const std::filesystem::path path =
         ip::python::path_arg(spec, "build: the spec is a dict or the path of a spec file (a str or an os.PathLike)");
     py::gil_scoped_release free;
-    c = ip::io::build_file(path, o);
+    c = ip::io::build_any_file(path, o);
   }
-  return wrap(std::move(c), std::move(sources));
+  return wrap(std::move(*c), std::move(sources));
 }
 
 }  // namespace
@@ -426,7 +604,13 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("params_w", [](const PyBuilt& s) { return s.data_params(2); },
                              "Parameters of a volume's data along w (None without data).");
 
-  py::class_<PySurface, PyBuilt>(m, "Surface", "A surface over [0, 1]², built from a spec or a constructor.")
+  py::class_<PySurface, PyBuilt>(m, "Surface",
+                                 "A surface S(u, v) over [0, 1]², built from a spec or a constructor.\n\n"
+                                 "Example:\n"
+                                 "    s = interpatch.bilinear([0, 0, 0], [0, 1, 0], [1, 0, 0], [1, 1, 1])\n"
+                                 "    s  # Surface(type='bilinear', degree=(1, 1), control_points=(2, 2))\n"
+                                 "    s.evaluate([0, 0.5, 1], [0, 1]).shape  # (3, 2, 3)")
+      .def("__repr__", [](const PySurface& s) { return s.repr("Surface"); })
       .def("evaluate", &PySurface::evaluate, py::arg("us"), py::arg("vs"),
            "Points at every (us[i], vs[j]): a float64 array of shape (len(us), len(vs), 3) over the "
            "library's own result memory.\n\nExample: s.evaluate(np.linspace(0, 1, 100), np.linspace(0, 1, 50))")
@@ -442,7 +626,13 @@ PYBIND11_MODULE(_core, m) {
            "'weights' (shape (nu, nv), or None), 'periodic': (bool, bool)}; the arrays view the construction's memory.")
       ;
 
-  py::class_<PyVolume, PyBuilt>(m, "Volume", "A volume over [0, 1]³, built from a spec.")
+  py::class_<PyVolume, PyBuilt>(m, "Volume",
+                                "A volume S(u, v, w) over [0, 1]³, built from a spec or a constructor.\n\n"
+                                "Example:\n"
+                                "    v = interpatch.trilinear(np.indices((2, 2, 2)).transpose(1, 2, 3, 0))\n"
+                                "    v  # Volume(type='trilinear', degree=(1, 1, 1), control_points=(2, 2, 2))\n"
+                                "    v.evaluate([0, 1], [0, 1], [0, 0.5, 1]).shape  # (2, 2, 3, 3)")
+      .def("__repr__", [](const PyVolume& v) { return v.repr("Volume"); })
       .def("evaluate", &PyVolume::evaluate, py::arg("us"), py::arg("vs"), py::arg("ws"),
            "Points at every (us[i], vs[j], ws[k]): shape (len(us), len(vs), len(ws), 3), over the library's memory.")
       .def("jacobians", &PyVolume::jacobians, py::arg("us"), py::arg("vs"), py::arg("ws"),
@@ -452,8 +642,53 @@ PYBIND11_MODULE(_core, m) {
       .def("to_bspline", &PyVolume::to_bspline,
            "The exact B-spline form: degree (p, q, r), knots_u/v/w, control_points (n0, n1, n2, 3), weights or None.");
 
+  py::class_<PyCurve>(m, "Curve",
+                      "A curve C(t) over [0, 1] (every curve form is mapped onto it), built from a curve spec "
+                      "(docs/spec-format.md, \"Curves\") by interpolate_curve, approximate_curve, bspline_curve, "
+                      "hermite_curve, line or build; a side of ruled, coons and curve_network surfaces.\n\n"
+                      "Example:\n"
+                      "    c = interpatch.interpolate_curve([[0, 0, 0], [1, 2, 0], [3, 3, 0], [4, 0, 1]])\n"
+                      "    c  # Curve(type='interpolate', degree=3, control_points=4)\n"
+                      "    c.evaluate(np.linspace(0, 1, 50)).shape  # (50, 3)\n"
+                      "    c.point(c.params[2])  # the third point, up to rounding")
+      .def("__repr__", &PyCurve::repr)
+      .def_property_readonly("type", &PyCurve::type,
+                             "The curve's form: 'interpolate', 'approximate', 'bspline', 'hermite' or 'line'.")
+      .def_property_readonly("degree", &PyCurve::degree, "The degree p of its exact B-spline form.")
+      .def_property_readonly("domain", &PyCurve::domain, "(0.0, 1.0): every curve is mapped onto [0, 1].")
+      .def_property_readonly("params", &PyCurve::params,
+                             "The parameters of the points it was made through or near (interpolate, approximate, "
+                             "hermite), shape (n,), in [0, 1]: C(params[i]) is points[i] for an interpolated curve "
+                             "(a closed curve's repeated last point at 1). None for bspline and line.")
+      .def("evaluate", &PyCurve::evaluate, py::arg("ts"),
+           "Points C(ts[i]): a float64 array of shape (len(ts), 3). A closed curve takes any t (it wraps); an "
+           "open one refuses a t outside [0, 1] ('out_of_domain', naming ts[i]).\n\n"
+           "Example: c.evaluate(np.linspace(0, 1, 100))  # (100, 3)")
+      .def("derivatives", &PyCurve::derivatives, py::arg("ts"), py::arg("order") = 1,
+           "C and its derivatives of orders 1..order at every ts[i]: shape (len(ts), order + 1, 3), "
+           "[i, k] being d^k C / dt^k at ts[i] (k = 0: the point).\n\n"
+           "Example: c.derivatives([0, 0.5, 1], 2)[:, 1]  # the first derivatives, (3, 3)")
+      .def("point", &PyCurve::point, py::arg("t"), "C(t), shape (3,).")
+      .def("tangent", &PyCurve::tangent, py::arg("t"),
+           "The unit tangent C'(t) / |C'(t)|, shape (3,); the zero vector where C' vanishes.")
+      .def("curvature", &PyCurve::curvature, py::arg("t"),
+           "The curvature |C' × C''| / |C'|³ at t (1 / radius); NaN where C' vanishes.")
+      .def("to_bspline", &PyCurve::to_bspline,
+           "The exact B-spline form: {'degree': p, 'knots' (n + p + 1,; a closed curve's extended knots, "
+           "n + 2p + 1), 'control_points' (n, 3), 'weights' (n,) or None, 'periodic': bool}; "
+           "C(t) = Σ N_i,p(t) w_i P_i / Σ N_i,p(t) w_i. The arrays are read-only views of the curve's memory "
+           "(copy them to change them).")
+      .def("info", &PyCurve::info,
+           "The dict `interpatch info` prints for the curve spec: degree, knots, continuity, bounding box, "
+           "max_data_error (the curve at params against its points), parameters.")
+      .def("write", &PyCurve::write, py::arg("path"),
+           "Write as `interpatch build` writes a curve spec: .json (a {\"bspline\": ...} curve spec that reads back "
+           "to the same curve), .npz (degree, knots_u, control_points, weights, periodic), .step/.stp or .igs/.iges; "
+           "another format is refused ('wrong_type').");
+
   m.def("build", &build, py::arg("spec"), py::arg("base_dir") = py::str("."), py::arg("arrays") = py::dict(),
-        "A spec (docs/spec-format.md) as a dict, or the path of a spec file, built.\n\n"
+        "A spec (docs/spec-format.md) as a dict, or the path of a spec file, built: a Surface, a Volume, or "
+        "a Curve for a curve spec (a curve at the top level, without \"type\").\n\n"
         "Example: s = interpatch.build({'type': 'bilinear', 'p00': [0, 0, 0], 'p01': [0, 1, 0], "
         "'p10': [1, 0, 0], 'p11': [1, 1, 1]})");
 }
