@@ -110,7 +110,7 @@ class PyBuilt {
   // Written as the commands write: .json .npz .step/.stp .igs/.iges (the exact form),
   // a mesh (.obj .ply .stl .vtk .vts .xyz) of `res` vertices, or a viewer page (.html)
   // of `res` samples; checked as the command line checks them (io/outputs.hpp).
-  void write(const py::handle& path_in, const py::handle& res_in) const {
+  void write(const py::object& path_in, const py::object& res_in) const {
     namespace io = ip::io;
     const std::filesystem::path path = ip::python::path_arg(path_in, "write: the path is a str or an os.PathLike");
     const std::string ext = path.extension().string();
@@ -247,7 +247,7 @@ class PySurface : public PyBuilt {
  public:
   using PyBuilt::PyBuilt;
 
-  py::array_t<double> evaluate(const py::handle& us_in, const py::handle& vs_in) const {
+  py::array_t<double> evaluate(const py::object& us_in, const py::object& vs_in) const {
     auto us = params(us_in, "us"), vs = params(vs_in, "vs");
     std::unique_ptr<ip::PointGrid> out;
     const ip::progress_callback progress = interruptible();
@@ -260,7 +260,7 @@ class PySurface : public PyBuilt {
     return owning_array(std::move(out), data, {static_cast<py::ssize_t>(us.size()), static_cast<py::ssize_t>(vs.size()), 3});
   }
 
-  py::array_t<double> evaluate_derivatives(const py::handle& us_in, const py::handle& vs_in) const {
+  py::array_t<double> evaluate_derivatives(const py::object& us_in, const py::object& vs_in) const {
     auto us = params(us_in, "us"), vs = params(vs_in, "vs");
     std::unique_ptr<ip::Grid<ip::SurfaceDerivatives, 2>> out;
     {
@@ -322,7 +322,7 @@ class PyVolume : public PyBuilt {
  public:
   using PyBuilt::PyBuilt;
 
-  py::array_t<double> evaluate(const py::handle& us_in, const py::handle& vs_in, const py::handle& ws_in) const {
+  py::array_t<double> evaluate(const py::object& us_in, const py::object& vs_in, const py::object& ws_in) const {
     auto us = params(us_in, "us"), vs = params(vs_in, "vs"), ws = params(ws_in, "ws");
     std::unique_ptr<ip::PointGrid3> out;
     const ip::progress_callback progress = interruptible();
@@ -336,7 +336,7 @@ class PyVolume : public PyBuilt {
                          static_cast<py::ssize_t>(ws.size()), 3});
   }
 
-  py::tuple jacobians(const py::handle& us_in, const py::handle& vs_in, const py::handle& ws_in) const {
+  py::tuple jacobians(const py::object& us_in, const py::object& vs_in, const py::object& ws_in) const {
     auto us = params(us_in, "us"), vs = params(vs_in, "vs"), ws = params(ws_in, "ws");
     std::unique_ptr<ip::VolumeJacobians> j;
     const ip::progress_callback progress = interruptible();
@@ -401,7 +401,7 @@ class PyCurve {
   }
 
   // C(ts[i]) for every i, shape (len(ts), 3).
-  py::array_t<double> evaluate(const py::handle& ts_in) const {
+  py::array_t<double> evaluate(const py::object& ts_in) const {
     return sample(ts_in, [&](double t, double* out) {
       const ip::Vec3 p = c_->curve.point(t);
       out[0] = p.x, out[1] = p.y, out[2] = p.z;
@@ -409,7 +409,7 @@ class PyCurve {
   }
 
   // C and its derivatives of orders 1..order at every ts[i], shape (len(ts), order + 1, 3).
-  py::array_t<double> derivatives(const py::handle& ts_in, int order) const {
+  py::array_t<double> derivatives(const py::object& ts_in, int order) const {
     if (order < 0) throw ip::error(ip::errc::wrong_type, "order: a derivative order of 0 or more, got " + std::to_string(order));
     const auto k = static_cast<std::size_t>(order) + 1;
     return sample(ts_in, [&](double t, double* out) {
@@ -471,7 +471,7 @@ class PyCurve {
   }
 
   // Written as `interpatch build` writes a curve spec: .json .npz .step/.stp .igs/.iges.
-  void write(const py::handle& path_in) const {
+  void write(const py::object& path_in) const {
     const std::filesystem::path path = ip::python::path_arg(path_in, "write: the path is a str or an os.PathLike");
     py::gil_scoped_release free;
     ip::io::write_build(*c_, path);
@@ -525,7 +525,7 @@ py::object wrap(ip::io::Built built, std::shared_ptr<const Sources> sources) {
   return py::cast(PySurface(std::move(b), std::move(sources)));
 }
 
-py::object build(const py::handle& spec, const py::handle& base_dir_in, const py::handle& arrays) {
+py::object build(const py::object& spec, const py::object& base_dir_in, const py::object& arrays) {
   const std::filesystem::path base_dir =
       ip::python::path_arg(base_dir_in, "build: base_dir is the directory data files are named from, a str or an os.PathLike");
   if (!py::isinstance<py::dict>(arrays))
