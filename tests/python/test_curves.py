@@ -332,3 +332,18 @@ def test_ctrl_c_stops_a_long_evaluation():
     c = BY_NAME["approximate_periodic"][2]()
     assert_ctrl_c_stops(lambda n: c.derivatives(np.linspace(0, 1, n), 3), 1 << 16, 1 << 24)
     assert c.evaluate([0.5]).shape == (1, 3), "still usable"
+
+
+def test_the_readmes_curve_example_runs(tmp_path, monkeypatch):
+    import re
+    readme = open(os.path.join(os.path.dirname(__file__), "..", "..", "README.md")).read()
+    code = re.search(r"Curves are objects of their own.*?```python\n(.*?)```", readme, re.S).group(1)
+    monkeypatch.chdir(tmp_path)
+    scope = {"np": np, "interpatch": interpatch}
+    exec(compile(code, "README.md", "exec"), scope)
+    # What the README's comments say.
+    assert repr(scope["c"]) == "Curve(type='interpolate', degree=3, control_points=8)"
+    assert scope["pts"].shape == (400, 3) and scope["d"].shape == (2, 3, 3)
+    # "~1e-16": a few ulps of a ring of radius 1.
+    assert np.abs(scope["c"].evaluate(scope["c"].params) - scope["ring"]).max() < 1e-15
+    assert (tmp_path / "ring.igs").stat().st_size > 0 and isinstance(scope["lid"], interpatch.Surface)

@@ -55,3 +55,17 @@ def test_help_is_a_reference():
                 # pybind11 puts the signature first; the doc is what follows it.
                 doc = (member.__doc__ or "").split("\n", 1)
                 assert len(doc) == 2 and doc[1].strip(), f"{cls.__name__}.{name} has no doc"
+
+
+def test_the_stubs_declare_what_the_module_has():
+    import ast
+    stub = ast.parse(open(os.path.join(os.path.dirname(interpatch.__file__), "__init__.pyi")).read())
+    declared = {n.name: n for n in stub.body if isinstance(n, (ast.ClassDef, ast.FunctionDef))}
+    for name in interpatch.__all__:
+        if name not in ("__version__", "ERROR_CODES"):
+            assert name in declared, f"{name} is not in the stubs"
+    for cls in (interpatch.Construction, interpatch.Surface, interpatch.Volume, interpatch.Curve):
+        members = {n.name for n in declared[cls.__name__].body if isinstance(n, ast.FunctionDef)}
+        for name in vars(cls):
+            if not name.startswith("_"):
+                assert name in members, f"{cls.__name__}.{name} is not in the stubs"
