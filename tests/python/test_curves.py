@@ -329,8 +329,11 @@ def test_the_command_line_refuses_what_a_curve_is_not(tmp_path):
 
 
 def test_ctrl_c_stops_a_long_evaluation():
-    c = BY_NAME["approximate_periodic"][2]()
-    assert_ctrl_c_stops(lambda n: c.derivatives(np.linspace(0, 1, n), 3), 1 << 16, 1 << 24)
+    # Degree 20: a point costs ~0.5 us, so a call long enough to interrupt holds
+    # (at most 2^22 points) 100 MB.
+    cp = _walk(np.random.default_rng(RNG_SEED), 60)
+    c = interpatch.interpolate_curve(cp, degree=20, param="uniform")
+    assert_ctrl_c_stops(lambda n: c.evaluate(np.linspace(0, 1, n)), 1 << 16, 1 << 22)
     assert c.evaluate([0.5]).shape == (1, 3), "still usable"
 
 
