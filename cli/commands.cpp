@@ -83,6 +83,26 @@ void eval_volume(const io::Construction& c, const fs::path& out, const Resolutio
   io::write_csv_grid(out, params, std::span<const Vec3>(g.data(), g.size()));
 }
 
+// A curve's points at K uniformly spaced parameters over [0, 1]: (K, 3).
+void eval_curve(const BSplineCurve& c, const fs::path& out, std::size_t k) {
+  const std::vector<double> ts = linspace(0, 1, k);
+  ProgressLine progress("evaluating");
+  if (lower_extension(out) == ".npy") {
+    const std::size_t shape[2] = {k, 3};
+    io::write_npy_rows(out, shape, [&](std::size_t first, std::size_t count, std::span<double> values) {
+      const std::span<Vec3> points = points_of(values);
+      for (std::size_t i = 0; i < count; ++i) points[i] = c.point(ts[first + i]);
+    }, progress.callback());
+    progress.clear();
+    return;
+  }
+  std::vector<Vec3> points(k);
+  for (std::size_t i = 0; i < k; ++i) points[i] = c.point(ts[i]);
+  progress.clear();
+  const std::vector<double> params[1] = {ts};
+  io::write_csv_grid(out, params, points);
+}
+
 // The io library's checks of usage (formats, counts) throw error; on the command
 // line what they refuse is bad usage (exit 2).
 template <class Check>
@@ -251,6 +271,21 @@ io::Construction build_spec(const fs::path& spec, io::BuildOptions options) {
   return io::build_file(spec, options);
 }
 
+io::Built build_any_input(const Input& in, io::BuildOptions options) {
+  if (in.kind != Input::Kind::spec) return build_input(in, std::move(options));
+  ProgressLine progress("building");
+  options.progress = progress.callback();
+  return io::build_any_file(in.path, options);
+}
+
+const io::CurveConstruction* curve_of(const io::Built& b) { return std::get_if<io::CurveConstruction>(&b); }
+
+void refuse_curve(const Input& in, const io::Built& b, std::string_view command) {
+  if (curve_of(b))
+    throw usage_error("'" + in.path.string() + "' is a curve spec: " + std::string(command) +
+                      " takes surfaces and volumes; eval, info and build take curves");
+}
+
 io::Construction build_input(const Input& in, io::BuildOptions options) {
   if (in.kind == Input::Kind::spec) return build_spec(in.path, std::move(options));
   const nlohmann::json spec = data_file_spec(in);
@@ -259,16 +294,20 @@ io::Construction build_input(const Input& in, io::BuildOptions options) {
   return io::build(spec, in.path.parent_path(), options);
 }
 
-void report_warnings(const io::Construction& c) {
-  for (const std::string& w : c.warnings) std::fprintf(stderr, "interpatch: warning: %s\n", w.c_str());
+void report_warnings(const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings) std::fprintf(stderr, "interpatch: warning: %s\n", w.c_str());
+}
+
+const std::vector<std::string>& warnings_of(const io::Built& b) {
+  return std::visit([](const auto& c) -> const std::vector<std::string>& { return c.warnings; }, b);
 }
 
 int build_command(const Input& in, const fs::path& out) {
   check_build_output(out);
   io::check_writable(out);
-  io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = false, .arrays = {}});
-  write_build(c, out);
-  report_warnings(c);
+  io::Built b = build_any_input(in, {.progress = {}, .keep_data = false, .defer_exact = false, .arrays = {}});
+  std::visit([&](auto& c) { write_build(c, out); }, b);
+  report_warnings(warnings_of(b));
   return 0;
 }
 
@@ -278,12 +317,14 @@ int mesh_command(const Input& in, const fs::path& out, std::string_view res_text
   io::check_writable(out);
   if (given) require_mesh_room(*given, out);
   // A mesh samples the construction; its exact form is made only if that costs less.
-  io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}});
+  io::Built b = build_any_input(in, {.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}});
+  refuse_curve(in, b, "mesh");
+  io::Construction& c = std::get<io::Construction>(b);
   const Resolution res = given ? *given : (io::is_volume(c) ? default_volume_resolution : default_surface_resolution);
   check_mesh_kind(c, out, res);
   if (!given) require_mesh_room(res, out);
   write_mesh(c, out, res);
-  report_warnings(c);
+  report_warnings(c.warnings);
   return 0;
 }
 
@@ -291,15 +332,24 @@ int eval_command(const Input& in, const fs::path& out, std::string_view grid_tex
   const std::vector<std::size_t> counts = parse_grid(grid_text);
   check_eval_output(out);
   io::check_writable(out);
-  // Before the build, the grid as given (K: KxK, the least it can be); after it, the
-  // grid of the construction's kind (K of a volume: KxKxK).
-  require_eval_room({counts[0], counts.size() > 1 ? counts[1] : counts[0], counts.size() > 2 ? counts[2] : 0}, out);
+  // Before the build, the grid as given (K: a curve's K points, the least it can be);
+  // after it, the grid of the spec's kind (K of a surface: KxK, of a volume: KxKxK).
+  require_eval_room({counts[0], counts.size() > 1 ? counts[1] : 1, counts.size() > 2 ? counts[2] : 0}, out);
   // Evaluation samples the construction; its exact form is made only if that costs less.
-  io::Construction c = build_input(in, {.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}});
+  io::Built b = build_any_input(in, {.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}});
+  if (const io::CurveConstruction* curve = curve_of(b)) {
+    if (counts.size() != 1)
+      throw usage_error("--grid '" + std::string(grid_text) + "': '" + in.path.string() +
+                        "' is a curve spec, evaluated at K points: give --grid K");
+    eval_curve(curve->curve, out, counts[0]);
+    report_warnings(warnings_of(b));
+    return 0;
+  }
+  io::Construction& c = std::get<io::Construction>(b);
   const Resolution grid = grid_resolution(counts, c);
   require_eval_room(grid, out);
   write_eval(c, out, grid);
-  report_warnings(c);
+  report_warnings(c.warnings);
   return 0;
 }
 
@@ -308,15 +358,16 @@ int info_command(const Input& in, const std::optional<fs::path>& out) {
     check_info_output(*out);
     io::check_writable(*out);
   }
-  const io::Construction c = build_input(in);
-  const std::string text = io::pretty_json(info(c));
+  const io::Built b = build_any_input(in);
+  const io::CurveConstruction* curve = curve_of(b);
+  const std::string text = io::pretty_json(curve ? io::curve_info_json(*curve) : info(std::get<io::Construction>(b)));
   if (out) {
     io::write_atomically(*out, [&](std::ostream& os) { os << text; });
   } else {
     std::cout << text << std::flush;
     if (!std::cout) throw error(errc::file_unwritable, "standard output: write failed");
   }
-  report_warnings(c);
+  report_warnings(warnings_of(b));
   return 0;
 }
 
@@ -329,7 +380,9 @@ int view_command(const Input& in, const fs::path& out, std::string_view res_text
   check_view_output(out);
   io::check_writable(out);
   // The page holds what `info` prints, whose error at the data needs the data.
-  const io::Construction c = build_input(in);
+  const io::Built b = build_any_input(in);
+  refuse_curve(in, b, "view");
+  const io::Construction& c = std::get<io::Construction>(b);
   io::ViewOptions options;
   if (given) {
     cli::check_counts_kind(c, view_res_option, *given);
@@ -337,7 +390,7 @@ int view_command(const Input& in, const fs::path& out, std::string_view res_text
   }
   options.title = in.path.stem().string();
   io::write_view(out, c, options);
-  report_warnings(c);
+  report_warnings(c.warnings);
   return 0;
 }
 

@@ -116,6 +116,10 @@ io::Construction build_spec(const std::filesystem::path& spec, io::BuildOptions 
 /// with data files found in that file's directory.
 io::Construction build_input(const Input& in, io::BuildOptions options = {});
 
+/// build_input, or a curve when SPEC is a curve spec (io::is_curve_spec): what eval,
+/// info and build take. mesh and view refuse a curve (usage_error).
+io::Built build_any_input(const Input& in, io::BuildOptions options = {});
+
 /// The subcommands; each returns the exit status of success (0).
 int build_command(const Input& in, const std::filesystem::path& out);
 /// `res` empty: the default resolution of the construction's kind.
@@ -126,7 +130,9 @@ int info_command(const Input& in, const std::optional<std::filesystem::path>& ou
 int view_command(const Input& in, const std::filesystem::path& out, std::string_view res);
 int demo_command(const std::filesystem::path& dir);
 
-/// Prints the warnings of a construction (ignored fields) on stderr.
-void report_warnings(const io::Construction& c);
+/// Prints the warnings of a spec (ignored fields) on stderr.
+void report_warnings(const std::vector<std::string>& warnings);
+/// The warnings of a construction or a curve.
+const std::vector<std::string>& warnings_of(const io::Built& b);
 
 }  // namespace interpatch::cli

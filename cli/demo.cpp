@@ -738,7 +738,7 @@ int demo_command(const fs::path& requested) {
     const ojson description = info(c);
     write_text(out(".info.json"), io::pretty_json(description));
     io::write_view(out(".view.html"), c, {.resolution = volume ? volume_view_res : view_res, .title = ex.name});
-    report_warnings(c);
+    report_warnings(c.warnings);
 
     const auto& err = description["max_data_error"];
     std::string line = "  " + ex.name + std::string(ex.name.size() < 15 ? 15 - ex.name.size() : 1, ' ') + c.type + ": " +

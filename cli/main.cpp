@@ -121,15 +121,16 @@ int main(int argc, char** argv) {
   mesh->add_option("--res", res,
                    "Vertices along u and v, NUxNV (default 64x64); for a volume NUxNVxNW (default 33x33x33)");
 
-  CLI::App* eval = app.add_subcommand("eval", "Evaluate on a uniform grid over [0,1]^2 or, for volumes, [0,1]^3 (.npy, .csv)");
+  CLI::App* eval = app.add_subcommand("eval", "Evaluate on a uniform grid over [0,1]^2, [0,1]^3 for volumes, [0,1] for a curve spec (.npy, .csv)");
   add_input(eval);
   eval->add_option("--grid", grid,
-                   "Points along each direction: K (KxK, or KxKxK for a volume), NUxNV (a surface)\n"
+                   "Points along each direction: K (KxK, KxKxK for a volume, K for a curve), NUxNV (a surface)\n"
                    "or NUxNVxNW (a volume)")
       ->required();
   eval->add_option("-o,--output", out,
                    "Output file: .npy of shape (NU,NV,3) or (NU,NV,NW,3), u index first, float64;\n"
-                   "or .csv, one row per point in the same order, header u,v,x,y,z or u,v,w,x,y,z")
+                   "or (K,3) for a curve; or .csv, one row per point in the same order, header u,v,x,y,z,\n"
+                   "u,v,w,x,y,z or t,x,y,z")
       ->required();
 
   CLI::App* info = app.add_subcommand("info", "Describe the construction as one JSON object (stdout, or .json)");

@@ -13,8 +13,8 @@ Errors raise interpatch.Error (a ValueError) whose .code names the problem
 ("zero_chord", "network_gap", ...) with the command line's message.
 """
 
-from ._core import ERROR_CODES, Construction, Error, Surface, Volume
-from ._specs import (Curve, approximate_curve, approximate_surface, approximate_volume, bilinear, bspline_curve, build,
+from ._core import ERROR_CODES, Construction, Curve, Error, Surface, Volume
+from ._specs import (approximate_curve, approximate_surface, approximate_volume, bilinear, bspline_curve, build,
                      coons, coons_volume, curve_network, hermite_curve,
                      hermite_patch, hermite_volume, interpolate_curve, interpolate_surface, interpolate_volume, line,
                      ruled, trilinear)

@@ -42,7 +42,7 @@ class Construction:
     def params_w(self) -> Optional[_Array]: ...
 
 class Surface(Construction):
-    """A surface over [0, 1]²."""
+    """A surface over [0, 1]²; repr: Surface(type='interpolate', degree=(3, 3), control_points=(30, 25))."""
     def evaluate(self, us: _Params, vs: _Params) -> _Array:
         """Points at every (us[i], vs[j]): shape (len(us), len(vs), 3)."""
     def evaluate_derivatives(self, us: _Params, vs: _Params) -> _Array:
@@ -58,7 +58,7 @@ class Surface(Construction):
         the arrays are read-only views of the construction's memory (copy them to change them)."""
 
 class Volume(Construction):
-    """A volume over [0, 1]³."""
+    """A volume over [0, 1]³; repr: Volume(type='trilinear', degree=(1, 1, 1), control_points=(2, 2, 2))."""
     def evaluate(self, us: _Params, vs: _Params, ws: _Params) -> _Array:
         """Points: shape (len(us), len(vs), len(ws), 3)."""
     def jacobians(self, us: _Params, vs: _Params, ws: _Params) -> tuple[_Array, _Array]:
@@ -69,14 +69,44 @@ class Volume(Construction):
         read-only views of the construction's memory."""
 
 class Curve:
-    """A curve of a spec: interpolate_curve, bspline_curve, hermite_curve or line."""
+    """A curve C(t) over [0, 1], built from a curve spec: interpolate_curve, approximate_curve,
+    bspline_curve, hermite_curve, line, or build() of a curve spec; repr:
+    Curve(type='interpolate', degree=3, control_points=12)."""
+    @property
+    def type(self) -> str:
+        """'interpolate', 'approximate', 'bspline', 'hermite' or 'line'."""
+    @property
+    def degree(self) -> int: ...
+    @property
+    def domain(self) -> tuple[float, float]:
+        """(0.0, 1.0)."""
+    @property
+    def params(self) -> Optional[_Array]:
+        """The parameters of its points, shape (n,) (interpolate, approximate, hermite); None otherwise."""
+    def evaluate(self, ts: _Params) -> _Array:
+        """C(ts[i]): shape (len(ts), 3). An open curve refuses t outside [0, 1] ('out_of_domain')."""
+    def derivatives(self, ts: _Params, order: int = 1) -> _Array:
+        """C and its derivatives up to `order` at every ts[i]: shape (len(ts), order + 1, 3)."""
+    def point(self, t: float) -> _Array:
+        """C(t): shape (3,)."""
+    def tangent(self, t: float) -> _Array:
+        """The unit tangent: shape (3,); zero where C' vanishes."""
+    def curvature(self, t: float) -> float:
+        """|C' × C''| / |C'|³; NaN where C' vanishes."""
+    def to_bspline(self) -> dict[str, Any]:
+        """{'degree': p, 'knots' (n + p + 1,), 'control_points' (n, 3), 'weights' (n,) or None, 'periodic'};
+        read-only views of the curve's memory."""
+    def info(self) -> dict[str, Any]:
+        """The dict `interpatch info` prints for the curve spec."""
+    def write(self, path: _Path) -> None:
+        """.json .npz .step .igs, as `interpatch build` writes the curve spec ('wrong_type' for another format)."""
 
 _CurveLike = Union[Curve, npt.ArrayLike]
 
 def build(spec: Union[dict[str, Any], _Path], base_dir: _Path = ".",
-          arrays: Optional[dict[str, npt.ArrayLike]] = None) -> Union[Surface, Volume]:
-    """A spec as a dict (arrays named {"array": NAME}) or the path of a spec file, built; anything
-    else is refused ('wrong_type'). Every array in `arrays` must be named by the spec, and a field
+          arrays: Optional[dict[str, npt.ArrayLike]] = None) -> Union[Surface, Volume, Curve]:
+    """A spec as a dict (arrays named {"array": NAME}) or the path of a spec file, built (a Curve for a
+    curve spec: a curve at the top level, without "type"); anything else is refused ('wrong_type'). Every array in `arrays` must be named by the spec, and a field
     names an array or a file, not both. A masked array's masked points are missing (NaN)."""
 def interpolate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int], None] = None,
                         param: Optional[str] = None, periodic: Optional[Sequence[bool]] = None) -> Surface:
@@ -98,7 +128,8 @@ def approximate_volume(points: npt.ArrayLike, degree: Union[int, Sequence[int], 
 def approximate_curve(points: npt.ArrayLike, degree: Optional[int] = None, param: Optional[str] = None,
                       periodic: bool = False, control_points: Optional[int] = None, tolerance: Optional[float] = None,
                       smoothing: Union[float, str, None] = None, weights: Optional[npt.ArrayLike] = None) -> Curve:
-    """A curve near points, shape (n, 3), for the constructions that take curves."""
+    """A curve near points, shape (n, 3), NaN marking missing ones; exactly one of control_points,
+    tolerance, smoothing."""
 def bilinear(p00: npt.ArrayLike, p01: npt.ArrayLike, p10: npt.ArrayLike, p11: npt.ArrayLike) -> Surface: ...
 def ruled(c0: _CurveLike, c1: _CurveLike) -> Surface: ...
 def coons(v0: _CurveLike, v1: _CurveLike, u0: _CurveLike, u1: _CurveLike, blending: Optional[str] = None,
@@ -113,9 +144,12 @@ def coons_volume(faces: dict[str, Any], blending: Optional[str] = None, toleranc
 def hermite_volume(corners: Sequence[dict[str, npt.ArrayLike]]) -> Volume: ...
 def interpolate_curve(points: npt.ArrayLike, degree: Optional[int] = None, param: str = "chord",
                       periodic: bool = False, start_derivative: Optional[npt.ArrayLike] = None,
-                      end_derivative: Optional[npt.ArrayLike] = None) -> Curve: ...
+                      end_derivative: Optional[npt.ArrayLike] = None) -> Curve:
+    """Through points, shape (n, 3): C(params[i]) = points[i]."""
 def bspline_curve(degree: int, knots: Sequence[float], control_points: npt.ArrayLike,
-                  weights: Optional[Sequence[float]] = None, periodic: bool = False) -> Curve: ...
+                  weights: Optional[Sequence[float]] = None, periodic: bool = False) -> Curve:
+    """Knots (n + p + 1; closed: n + 2p + 1), control points (n, 3), weights (n,)."""
 def hermite_curve(points: npt.ArrayLike, tangents: Optional[npt.ArrayLike] = None,
-                  params: Optional[Sequence[float]] = None) -> Curve: ...
+                  params: Optional[Sequence[float]] = None) -> Curve:
+    """Piecewise cubic through points (n, 3) with tangents (n, 3) at params (n,)."""
 def line(a: npt.ArrayLike, b: npt.ArrayLike) -> Curve: ...

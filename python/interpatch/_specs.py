@@ -9,6 +9,7 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
+from ._core import Curve
 from ._core import Error as Error_
 from ._core import build as _build
 
@@ -76,84 +77,106 @@ def _reals(x: Any, name: str) -> Any:
     return _real(x, name).tolist()
 
 
-class Curve:
-    """A curve of a spec (a Coons side, a network curve, a ruled surface's curve):
-    make one with interpolate_curve, bspline_curve, hermite_curve or line."""
-
-    def __init__(self, make) -> None:
-        self._make = make
-
-    def _spec(self, arrays: _Arrays, name: str) -> dict[str, Any]:
-        """The curve's spec; `name` is the argument it was given as (messages name it)."""
-        return self._make(arrays, name)
+def _curve_built(make) -> Curve:
+    """The curve spec make(arrays) gives, built (a Curve): the same reader as a curve
+    spec file's, so the command line's `eval`, `info` and `build` of that spec agree."""
+    a = _Arrays()
+    return _build(make(a), ".", a.table)
 
 
 def interpolate_curve(points: Any, degree: Optional[int] = None, param: str = "chord",
                       periodic: bool = False, start_derivative: Any = None, end_derivative: Any = None) -> Curve:
     """The B-spline curve through `points` (shape (n, 3)), as the spec's
     {"interpolate": ...} curve: degree min(3, n - 1) unless given, chord-length
-    parameters unless `param` says otherwise, closed with periodic=True, with given
-    end derivatives (over the curve's [0, 1]) if any.
+    parameters unless `param` says otherwise ("uniform", "centripetal"), closed with
+    periodic=True (a last point repeating the first is left out), with given end
+    derivatives dC/dt (over the curve's [0, 1]) if any. C(params[i]) = points[i].
 
-    Example: c = interpatch.interpolate_curve(np.array([[0, 0, 0], [1, 2, 0], [3, 3, 0]]))"""
+    Example::
 
-    def make(arrays: _Arrays, name: str) -> dict[str, Any]:
-        s: dict[str, Any] = {"interpolate": arrays.add(points, name), "param": param}
+        c = interpatch.interpolate_curve(np.array([[0, 0, 0], [1, 2, 0], [3, 3, 0]]))
+        c.evaluate(np.linspace(0, 1, 20))   # (20, 3)"""
+
+    def make(arrays: _Arrays) -> dict[str, Any]:
+        s: dict[str, Any] = {"interpolate": arrays.add(points, "points"), "param": param}
         if degree is not None:
             s["degree"] = int(degree)
         if periodic:
             s["periodic"] = True
         if start_derivative is not None:
-            s["start_derivative"] = _point(start_derivative, f"{name}.start_derivative")
+            s["start_derivative"] = _point(start_derivative, "start_derivative")
         if end_derivative is not None:
-            s["end_derivative"] = _point(end_derivative, f"{name}.end_derivative")
+            s["end_derivative"] = _point(end_derivative, "end_derivative")
         return s
 
-    return Curve(make)
+    return _curve_built(make)
 
 
 def bspline_curve(degree: int, knots: Sequence[float], control_points: Any,
                   weights: Optional[Sequence[float]] = None, periodic: bool = False) -> Curve:
-    """A B-spline curve given by its degree, knots and control points (shape (n, 3)),
-    rational with `weights`, closed with periodic=True (knots as the spec's
-    {"bspline": ...} curve takes them)."""
+    """A B-spline curve given by its degree, knots (n + p + 1 of them, clamped) and
+    control points (shape (n, 3)), rational with `weights` (n,), closed with
+    periodic=True (then the n + 2p + 1 extended knots): the spec's {"bspline": ...}
+    curve, mapped onto [0, 1].
 
-    def make(arrays: _Arrays, name: str) -> dict[str, Any]:
-        b: dict[str, Any] = {"degree": int(degree), "knots": _reals(knots, f"{name}.knots"),
-                             "control_points": arrays.add(control_points, f"{name}.control_points")}
+    Example::
+
+        quarter = interpatch.bspline_curve(2, [0, 0, 0, 1, 1, 1], [[1, 0, 0], [1, 1, 0], [0, 1, 0]],
+                                           weights=[1, 2 ** -0.5, 1])
+        quarter.curvature(0.3)              # 1.0, a unit circle's"""
+
+    def make(arrays: _Arrays) -> dict[str, Any]:
+        b: dict[str, Any] = {"degree": int(degree), "knots": _reals(knots, "knots"),
+                             "control_points": arrays.add(control_points, "control_points")}
         if weights is not None:
-            b["weights"] = _reals(weights, f"{name}.weights")
+            b["weights"] = _reals(weights, "weights")
         if periodic:
             b["periodic"] = True
         return {"bspline": b}
 
-    return Curve(make)
+    return _curve_built(make)
 
 
 def hermite_curve(points: Any, tangents: Any = None, params: Optional[Sequence[float]] = None) -> Curve:
     """The piecewise cubic Hermite curve through `points` with `tangents` (both shape
-    (n, 3); Catmull–Rom tangents when not given) at `params` (equally spaced by default)."""
+    (n, 3); Catmull–Rom tangents when not given) at `params` (equally spaced by
+    default), mapped onto [0, 1]: C1, through points[i] at its .params[i].
 
-    def make(arrays: _Arrays, name: str) -> dict[str, Any]:
-        h: dict[str, Any] = {"points": arrays.add(points, f"{name}.points")}
+    Example::
+
+        c = interpatch.hermite_curve([[0, 0, 0], [1, 1, 0], [2, 0, 0]], [[1, 1, 0], [1, 0, 0], [1, -1, 0]])"""
+
+    def make(arrays: _Arrays) -> dict[str, Any]:
+        h: dict[str, Any] = {"points": arrays.add(points, "points")}
         if tangents is not None:
-            h["tangents"] = arrays.add(tangents, f"{name}.tangents")
+            h["tangents"] = arrays.add(tangents, "tangents")
         if params is not None:
-            h["params"] = _reals(params, f"{name}.params")
+            h["params"] = _reals(params, "params")
         return {"hermite": h}
 
-    return Curve(make)
+    return _curve_built(make)
 
 
 def line(a: Any, b: Any) -> Curve:
-    """The straight segment from a to b."""
-    return Curve(lambda arrays, name: {"line": [_point(a, f"{name}.a"), _point(b, f"{name}.b")]})
+    """The straight segment from a to b: C(t) = (1 - t) a + t b.
+
+    Example: interpatch.line([0, 0, 0], [2, 0, 0]).point(0.5)   # [1, 0, 0]"""
+    return _curve_built(lambda arrays: {"line": [_point(a, "a"), _point(b, "b")]})
 
 
 def _curve(c: Any, arrays: _Arrays, name: str) -> dict[str, Any]:
+    """A curve argument as a spec: a Curve by its exact form (what the surfaces take of
+    it: the curve over [0, 1], bit for bit), an array of points as the curve through them."""
     if isinstance(c, Curve):
-        return c._spec(arrays, name)
-    return interpolate_curve(c)._spec(arrays, name)  # an array of points: the curve through them
+        b = c.to_bspline()
+        spec: dict[str, Any] = {"degree": b["degree"], "knots": b["knots"].tolist(),
+                                "control_points": arrays.add(b["control_points"], f"{name}.control_points")}
+        if b["weights"] is not None:
+            spec["weights"] = b["weights"].tolist()
+        if b["periodic"]:
+            spec["periodic"] = True
+        return {"bspline": spec}
+    return {"interpolate": arrays.add(c, name), "param": "chord"}
 
 
 def _options(spec: dict[str, Any], **kw: Any) -> dict[str, Any]:
@@ -237,21 +260,23 @@ def approximate_volume(points: Any, degree: Any = None, param: Optional[str] = N
 def approximate_curve(points: Any, degree: Optional[int] = None, param: Optional[str] = None, periodic: bool = False,
                       control_points: Optional[int] = None, tolerance: Optional[float] = None, smoothing: Any = None,
                       weights: Any = None) -> Curve:
-    """A curve near points, shape (n, 3), NaN marking missing ones: exactly one of
-    `control_points`, `tolerance`, `smoothing` as for approximate_surface.
+    """A curve near points, shape (n, 3), NaN (or a masked entry) marking missing ones:
+    exactly one of `control_points`, `tolerance`, `smoothing` as for
+    approximate_surface. info()["parameters"] reports max_error and rms_error.
 
     Example::
 
         c = interpatch.approximate_curve(noisy_points, tolerance=0.01)
         s = interpatch.ruled(c, other)"""
 
-    def make(arrays: _Arrays, name: str) -> dict[str, Any]:
-        s: dict[str, Any] = _options({"approximate": arrays.add(points, name, missing=True)}, degree=degree, param=param)
+    def make(arrays: _Arrays) -> dict[str, Any]:
+        s: dict[str, Any] = _options({"approximate": arrays.add(points, "points", missing=True)}, degree=degree,
+                                     param=param)
         if periodic:
             s["periodic"] = True
         return _approximation(s, control_points, tolerance, smoothing, weights)
 
-    return Curve(make)
+    return _curve_built(make)
 
 
 def bilinear(p00: Any, p01: Any, p10: Any, p11: Any):

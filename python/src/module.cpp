@@ -1,5 +1,6 @@
 // The Python module interpatch._core: specs built from dicts or files, surfaces and
-// volumes evaluated into NumPy arrays that own the library's result memory.
+// volumes evaluated into NumPy arrays that own the library's result memory; curves
+// (curve specs) in curve.cpp.
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -16,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "interpatch/blended_surface.hpp"
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/error.hpp"
 #include "interpatch/evaluate.hpp"
@@ -24,6 +26,8 @@
 #include "interpatch/io/outputs.hpp"
 #include "interpatch/io/spec.hpp"
 #include "interpatch/io/view.hpp"
+#include "arrays.hpp"
+#include "curve.hpp"
 #include "inputs.hpp"
 
 namespace py = pybind11;
@@ -34,25 +38,13 @@ namespace {
 // interpatch.Error, a ValueError with .code (the errc name); made at import.
 PyObject* error_type = nullptr;
 
-// A NumPy array over memory a C++ object owns: the capsule frees the object when
-// the array (and every view of it) is gone, so nothing is copied.
-template <class Owner>
-py::array_t<double> owning_array(std::unique_ptr<Owner> owner, double* data, std::vector<py::ssize_t> shape) {
-  py::capsule free_it(owner.get(), [](void* p) { delete static_cast<Owner*>(p); });
-  (void)owner.release();
-  return py::array_t<double>(shape, data, free_it);
-}
-
 using ip::python::interruptible;
+using ip::python::knots_array;
+using ip::python::owning_array;
+using ip::python::read_only;
+using ip::python::to_python;
 using ip::python::params;
 using ip::python::point_array;
-
-// A NumPy array over memory the construction owns, which nothing may write: the
-// construction checked its numbers once, when it was built.
-py::array_t<double> read_only(py::array_t<double> a) {
-  a.attr("setflags")(py::arg("write") = false);
-  return a;
-}
 
 // res as Python's write() names it in messages.
 constexpr ip::io::CountsOption mesh_res{"res", "mesh", "vertices", "(nu, nv)", "(nu, nv, nw)", "(64, 64)", "(33, 33, 33)",
@@ -71,7 +63,17 @@ struct Built {
   std::mutex lock;
 };
 
-py::object to_python(const nlohmann::ordered_json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+// "(3, 3)", as Python prints a tuple.
+std::string tuple_text(const std::vector<std::size_t>& v) {
+  std::string s = "(";
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + std::to_string(v[i]);
+  return s + ")";
+}
+
+std::vector<const ip::KnotVector*> knots_of(const ip::BSplineSurface& s) { return {&s.knots_u(), &s.knots_v()}; }
+std::vector<const ip::KnotVector*> knots_of(const ip::BSplineVolume& v) {
+  return {&v.knots_u(), &v.knots_v(), &v.knots_w()};
+}
 
 // What surfaces and volumes share: the built spec, its info, its files.
 class PyBuilt {
@@ -97,7 +99,7 @@ class PyBuilt {
   // Written as the commands write: .json .npz .step/.stp .igs/.iges (the exact form),
   // a mesh (.obj .ply .stl .vtk .vts .xyz) of `res` vertices, or a viewer page (.html)
   // of `res` samples; checked as the command line checks them (io/outputs.hpp).
-  void write(const py::handle& path_in, const py::handle& res_in) const {
+  void write(const py::object& path_in, const py::object& res_in) const {
     namespace io = ip::io;
     const std::filesystem::path path = ip::python::path_arg(path_in, "write: the path is a str or an os.PathLike");
     const std::string ext = path.extension().string();
@@ -137,6 +139,35 @@ class PyBuilt {
     // What the command line prints as "interpatch: warning: ...", as Python warnings.
     for (const std::string& w : warned)
       if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw py::error_already_set();
+  }
+
+  // Surface(type='interpolate', degree=(3, 3), control_points=(30, 25)): the exact
+  // form's degrees and net. A surface whose exact form is deferred gives them from its
+  // knots alone; a volume's is made now; one without an exact form says so.
+  [[nodiscard]] std::string repr(const char* kind) const {
+    std::vector<std::size_t> degree, size;
+    {
+      py::gil_scoped_release free;
+      std::lock_guard<std::mutex> hold(b_->lock);
+      ip::io::Construction& c = b_->c;
+      const auto* blended = dynamic_cast<const ip::BlendedSurface*>(c.formula.get());
+      if (!c.exact && c.convert && blended && blended->has_exact_form()) {
+        for (const ip::KnotVector& k : blended->exact_knots()) {
+          degree.push_back(static_cast<std::size_t>(k.degree()));
+          size.push_back(static_cast<std::size_t>(k.count()));
+        }
+      } else if (ip::io::has_exact_form_after_conversion(c)) {
+        std::visit([&](const auto& e) {
+          for (const ip::KnotVector* k : knots_of(e)) {
+            degree.push_back(static_cast<std::size_t>(k->degree()));
+            size.push_back(static_cast<std::size_t>(k->count()));
+          }
+        }, *c.exact);
+      }
+    }
+    std::string out = std::string(kind) + "(type='" + b_->c.type + "'";
+    if (degree.empty()) return out + ", exact_form=None)";
+    return out + ", degree=" + tuple_text(degree) + ", control_points=" + tuple_text(size) + ")";
   }
 
   // The data's parameters along an axis, where the construction has data.
@@ -201,15 +232,11 @@ class PyBuilt {
   std::shared_ptr<const Sources> sources_;
 };
 
-py::array_t<double> knots_array(const ip::KnotVector& k, const py::capsule& alive) {
-  return read_only(py::array_t<double>(static_cast<py::ssize_t>(k.size()), k.values().data(), alive));
-}
-
 class PySurface : public PyBuilt {
  public:
   using PyBuilt::PyBuilt;
 
-  py::array_t<double> evaluate(const py::handle& us_in, const py::handle& vs_in) const {
+  py::array_t<double> evaluate(const py::object& us_in, const py::object& vs_in) const {
     auto us = params(us_in, "us"), vs = params(vs_in, "vs");
     std::unique_ptr<ip::PointGrid> out;
     const ip::progress_callback progress = interruptible();
@@ -222,7 +249,7 @@ class PySurface : public PyBuilt {
     return owning_array(std::move(out), data, {static_cast<py::ssize_t>(us.size()), static_cast<py::ssize_t>(vs.size()), 3});
   }
 
-  py::array_t<double> evaluate_derivatives(const py::handle& us_in, const py::handle& vs_in) const {
+  py::array_t<double> evaluate_derivatives(const py::object& us_in, const py::object& vs_in) const {
     auto us = params(us_in, "us"), vs = params(vs_in, "vs");
     std::unique_ptr<ip::Grid<ip::SurfaceDerivatives, 2>> out;
     {
@@ -284,7 +311,7 @@ class PyVolume : public PyBuilt {
  public:
   using PyBuilt::PyBuilt;
 
-  py::array_t<double> evaluate(const py::handle& us_in, const py::handle& vs_in, const py::handle& ws_in) const {
+  py::array_t<double> evaluate(const py::object& us_in, const py::object& vs_in, const py::object& ws_in) const {
     auto us = params(us_in, "us"), vs = params(vs_in, "vs"), ws = params(ws_in, "ws");
     std::unique_ptr<ip::PointGrid3> out;
     const ip::progress_callback progress = interruptible();
@@ -298,7 +325,7 @@ class PyVolume : public PyBuilt {
                          static_cast<py::ssize_t>(ws.size()), 3});
   }
 
-  py::tuple jacobians(const py::handle& us_in, const py::handle& vs_in, const py::handle& ws_in) const {
+  py::tuple jacobians(const py::object& us_in, const py::object& vs_in, const py::object& ws_in) const {
     auto us = params(us_in, "us"), vs = params(vs_in, "vs"), ws = params(ws_in, "ws");
     std::unique_ptr<ip::VolumeJacobians> j;
     const ip::progress_callback progress = interruptible();
@@ -340,9 +367,10 @@ class PyVolume : public PyBuilt {
   }
 };
 
-py::object wrap(ip::io::Construction c, std::shared_ptr<const Sources> sources) {
+py::object wrap(ip::io::Built built, std::shared_ptr<const Sources> sources) {
+  if (auto* curve = std::get_if<ip::io::CurveConstruction>(&built)) return ip::python::wrap_curve(std::move(*curve));
   auto b = std::make_shared<Built>();
-  b->c = std::move(c);
+  b->c = std::move(std::get<ip::io::Construction>(built));
   if (ip::io::is_volume(b->c)) {
     // A volume's formula evaluates without the lock: make its exact form now if it has one
     // and the formula is not kept (volume_evaluator needs one of them).
@@ -351,7 +379,7 @@ py::object wrap(ip::io::Construction c, std::shared_ptr<const Sources> sources) 
   return py::cast(PySurface(std::move(b), std::move(sources)));
 }
 
-py::object build(const py::handle& spec, const py::handle& base_dir_in, const py::handle& arrays) {
+py::object build(const py::object& spec, const py::object& base_dir_in, const py::object& arrays) {
   const std::filesystem::path base_dir =
       ip::python::path_arg(base_dir_in, "build: base_dir is the directory data files are named from, a str or an os.PathLike");
   if (!py::isinstance<py::dict>(arrays))
@@ -371,18 +399,18 @@ py::object build(const py::handle& spec, const py::handle& base_dir_in, const py
     o.arrays[name] = point_array(v, name);
     (*sources)[name] = py::reinterpret_borrow<py::object>(v);
   }
-  ip::io::Construction c;
+  std::optional<ip::io::Built> c;
   if (py::isinstance<py::dict>(spec)) {
     const nlohmann::json j = ip::python::spec_json(spec);
     py::gil_scoped_release free;
-    c = ip::io::build(j, base_dir, o);
+    c = ip::io::build_any(j, base_dir, o);
   } else {
     const std::filesystem::path path =
         ip::python::path_arg(spec, "build: the spec is a dict or the path of a spec file (a str or an os.PathLike)");
     py::gil_scoped_release free;
-    c = ip::io::build_file(path, o);
+    c = ip::io::build_any_file(path, o);
   }
-  return wrap(std::move(c), std::move(sources));
+  return wrap(std::move(*c), std::move(sources));
 }
 
 }  // namespace
@@ -430,7 +458,13 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("params_w", [](const PyBuilt& s) { return s.data_params(2); },
                              "Parameters of a volume's data along w (None without data).");
 
-  py::class_<PySurface, PyBuilt>(m, "Surface", "A surface over [0, 1]², built from a spec or a constructor.")
+  py::class_<PySurface, PyBuilt>(m, "Surface",
+                                 "A surface S(u, v) over [0, 1]², built from a spec or a constructor.\n\n"
+                                 "Example:\n"
+                                 "    s = interpatch.bilinear([0, 0, 0], [0, 1, 0], [1, 0, 0], [1, 1, 1])\n"
+                                 "    s  # Surface(type='bilinear', degree=(1, 1), control_points=(2, 2))\n"
+                                 "    s.evaluate([0, 0.5, 1], [0, 1]).shape  # (3, 2, 3)")
+      .def("__repr__", [](const PySurface& s) { return s.repr("Surface"); })
       .def("evaluate", &PySurface::evaluate, py::arg("us"), py::arg("vs"),
            "Points at every (us[i], vs[j]): a float64 array of shape (len(us), len(vs), 3) over the "
            "library's own result memory.\n\nExample: s.evaluate(np.linspace(0, 1, 100), np.linspace(0, 1, 50))")
@@ -446,7 +480,13 @@ PYBIND11_MODULE(_core, m) {
            "'weights' (shape (nu, nv), or None), 'periodic': (bool, bool)}; the arrays view the construction's memory.")
       ;
 
-  py::class_<PyVolume, PyBuilt>(m, "Volume", "A volume over [0, 1]³, built from a spec.")
+  py::class_<PyVolume, PyBuilt>(m, "Volume",
+                                "A volume S(u, v, w) over [0, 1]³, built from a spec or a constructor.\n\n"
+                                "Example:\n"
+                                "    v = interpatch.trilinear(np.indices((2, 2, 2)).transpose(1, 2, 3, 0))\n"
+                                "    v  # Volume(type='trilinear', degree=(1, 1, 1), control_points=(2, 2, 2))\n"
+                                "    v.evaluate([0, 1], [0, 1], [0, 0.5, 1]).shape  # (2, 2, 3, 3)")
+      .def("__repr__", [](const PyVolume& v) { return v.repr("Volume"); })
       .def("evaluate", &PyVolume::evaluate, py::arg("us"), py::arg("vs"), py::arg("ws"),
            "Points at every (us[i], vs[j], ws[k]): shape (len(us), len(vs), len(ws), 3), over the library's memory.")
       .def("jacobians", &PyVolume::jacobians, py::arg("us"), py::arg("vs"), py::arg("ws"),
@@ -456,8 +496,11 @@ PYBIND11_MODULE(_core, m) {
       .def("to_bspline", &PyVolume::to_bspline,
            "The exact B-spline form: degree (p, q, r), knots_u/v/w, control_points (n0, n1, n2, 3), weights or None.");
 
+  ip::python::bind_curve(m);
+
   m.def("build", &build, py::arg("spec"), py::arg("base_dir") = py::str("."), py::arg("arrays") = py::dict(),
-        "A spec (docs/spec-format.md) as a dict, or the path of a spec file, built.\n\n"
+        "A spec (docs/spec-format.md) as a dict, or the path of a spec file, built: a Surface, a Volume, or "
+        "a Curve for a curve spec (a curve at the top level, without \"type\").\n\n"
         "Example: s = interpatch.build({'type': 'bilinear', 'p00': [0, 0, 0], 'p01': [0, 1, 0], "
         "'p10': [1, 0, 0], 'p11': [1, 1, 1]})");
 }

@@ -243,7 +243,8 @@ void write_csv_grid(const fs::path& path, std::span<const std::vector<double>> p
     std::string out;
     constexpr std::size_t flush_at = std::size_t{1} << 20;
     out.reserve(flush_at + 256);
-    for (std::size_t a = 0; a < axes; ++a) (out += names[a]) += ',';
+    // One axis is a curve's, whose parameter is t.
+    for (std::size_t a = 0; a < axes; ++a) (out += axes == 1 ? "t" : names[a]) += ',';
     out += "x,y,z\n";
     std::size_t idx[3] = {0, 0, 0};
     for (const Vec3& p : points) {

@@ -1,7 +1,10 @@
 #include "interpatch/io/iges.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <functional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -139,36 +142,56 @@ void put_surface(Packer& p, const detail::Face& f, double tol) {
   p.put(s.domain_v().second, true);
 }
 
+// Entity 126's parameters (IGES 5.3, section 4.23): upper index, degree, flags, the
+// knots, weights and control points, parameter range, and the plane's normal (none:
+// PROP1 says the curve is not planar). The curve is clamped (IGES lists every knot);
+// one that was periodic is flagged closed (PROP2) and periodic (PROP4).
+void put_curve(Packer& p, const BSplineCurve& c, bool periodic) {
+  const std::vector<Vec3>& cp = c.control_points();
+  p.put_int(126);
+  p.put_int(static_cast<long long>(cp.size()) - 1);
+  p.put_int(c.degree());
+  p.put_int(0);                      // PROP1: not declared planar
+  p.put_int(periodic ? 1 : 0);       // PROP2: closed
+  p.put_int(c.rational() ? 0 : 1);   // PROP3: 1 = polynomial
+  p.put_int(periodic ? 1 : 0);       // PROP4: periodic
+  for (const double k : c.knots().values()) p.put(k);
+  for (std::size_t i = 0; i < cp.size(); ++i) p.put(c.rational() ? c.weights()[i] : 1.0);
+  for (const Vec3& q : cp) {
+    p.put(q.x);
+    p.put(q.y);
+    p.put(q.z);
+  }
+  p.put(c.domain().first);
+  p.put(c.domain().second);
+  for (int k = 0; k < 3; ++k) p.put(0.0, k == 2);  // no plane
+}
+
 std::string timestamp(const IgesOptions& o) {
   return o.time_stamp.empty() ? detail::utc_now("%Y%m%d.%H%M%S") : o.time_stamp;
 }
 
-}  // namespace
-
-void write_iges(std::ostream& os, const ExactForm& exact, const IgesOptions& options) {
-  const std::vector<detail::Face> faces = detail::faces_of(exact);
-  const double tol = detail::coincidence_tolerance(faces);
-
+// A file of `count` entities of type `type`, entity e's parameters put by put(p, e):
+// the start section's two lines say what it holds, max_coord is the largest coordinate.
+void write_file(std::ostream& os, const IgesOptions& options, int type, std::size_t count,
+                const std::function<void(Packer&, std::size_t)>& put, double max_coord,
+                std::string_view start1, std::string_view start2) {
   // The directory needs each entity's parameter line count: count them first.
   std::vector<std::size_t> param_lines;
   {
     Section counter(nullptr, 'P');
-    for (const auto& f : faces) {
+    for (std::size_t e = 0; e < count; ++e) {
       const std::size_t before = counter.count();
       Packer p(counter, param_data);
-      put_surface(p, f, tol);
+      put(p, e);
       param_lines.push_back(counter.count() - before);
     }
   }
 
   Section start(&os, 'S');
-  start.line("interpatch: the exact B-spline form of a construction as rational");
-  start.line("B-spline surfaces (entity 128); lengths in millimetres.");
+  start.line(start1);
+  start.line(start2);
 
-  double max_coord = 0;
-  for (const auto& f : faces)
-    for (const Vec3& q : f.surface.control_points().values())
-      max_coord = std::max({max_coord, std::abs(q.x), std::abs(q.y), std::abs(q.z)});
   const std::string when = timestamp(options);
   Section global(&os, 'G');
   {
@@ -202,18 +225,18 @@ void write_iges(std::ostream& os, const ExactForm& exact, const IgesOptions& opt
 
   Section directory(&os, 'D');
   std::size_t first_param = 1;
-  for (std::size_t e = 0; e < faces.size(); ++e) {
-    directory.line(right(128, 8) + right(first_param, 8) + right(0, 8) + right(0, 8) + right(0, 8) + right(0, 8) +
+  for (std::size_t e = 0; e < count; ++e) {
+    directory.line(right(type, 8) + right(first_param, 8) + right(0, 8) + right(0, 8) + right(0, 8) + right(0, 8) +
                    right(0, 8) + right(0, 8) + "00000000");
-    directory.line(right(128, 8) + right(0, 8) + right(0, 8) + right(param_lines[e], 8) + right(0, 8) +
+    directory.line(right(type, 8) + right(0, 8) + right(0, 8) + right(param_lines[e], 8) + right(0, 8) +
                    std::string(24, ' ') + right(0, 8));
     first_param += param_lines[e];
   }
 
   Section parameters(&os, 'P');
-  for (std::size_t e = 0; e < faces.size(); ++e) {
+  for (std::size_t e = 0; e < count; ++e) {
     Packer p(parameters, param_data, " " + right(2 * e + 1, 7));  // back-pointer to the directory entry
-    put_surface(p, faces[e], tol);
+    put(p, e);
   }
 
   Section terminate(&os, 'T');
@@ -221,6 +244,34 @@ void write_iges(std::ostream& os, const ExactForm& exact, const IgesOptions& opt
                  "P" + right(parameters.count(), 7));
   os.flush();
   if (!os) throw error(errc::file_unwritable, "IGES output: write failed");
+}
+
+double largest_coordinate(std::span<const Vec3> points, double max_coord = 0) {
+  for (const Vec3& q : points) max_coord = std::max({max_coord, std::abs(q.x), std::abs(q.y), std::abs(q.z)});
+  return max_coord;
+}
+
+}  // namespace
+
+void write_iges(std::ostream& os, const ExactForm& exact, const IgesOptions& options) {
+  const std::vector<detail::Face> faces = detail::faces_of(exact);
+  const double tol = detail::coincidence_tolerance(faces);
+  double max_coord = 0;
+  for (const auto& f : faces) max_coord = largest_coordinate(f.surface.control_points().values(), max_coord);
+  write_file(os, options, 128, faces.size(), [&](Packer& p, std::size_t e) { put_surface(p, faces[e], tol); }, max_coord,
+             "interpatch: the exact B-spline form of a construction as rational",
+             "B-spline surfaces (entity 128); lengths in millimetres.");
+}
+
+void write_iges(std::ostream& os, const BSplineCurve& curve, const IgesOptions& options) {
+  const BSplineCurve c = curve.clamped();
+  write_file(os, options, 126, 1, [&](Packer& p, std::size_t) { put_curve(p, c, curve.periodic()); },
+             largest_coordinate(c.control_points()), "interpatch: a curve as a rational B-spline curve (entity 126);",
+             "lengths in millimetres.");
+}
+
+void write_iges(const std::filesystem::path& path, const BSplineCurve& curve, const IgesOptions& options) {
+  write_atomically(path, [&](std::ostream& os) { write_iges(os, curve, options); });
 }
 
 void write_iges(const std::filesystem::path& path, const ExactForm& exact, const IgesOptions& options) {

@@ -205,13 +205,17 @@ void volume_data_error(const Volume& s, const DataSet& d, DataError& e, std::siz
   }
 }
 
+// The names of the directions in info: u, v, w; a curve's one direction is t.
+constexpr const char* uvw[] = {"u", "v", "w"};
+constexpr const char* t_axis[] = {"t"};
+
 // "continuity" per direction (a closed direction's seam counts as one of its knots),
 // and "seam_continuity" of the closed directions alone.
-void continuity_info(ojson& j, std::initializer_list<const KnotVector*> knots) {
+void continuity_info(ojson& j, std::initializer_list<const KnotVector*> knots, const char* const* names = uvw) {
   ojson all = ojson::object(), seams = ojson::object();
   std::size_t a = 0;
   for (const KnotVector* k : knots) {
-    const char* name = a == 0 ? "u" : (a == 1 ? "v" : "w");
+    const char* name = names[a];
     all[name] = continuity_name(*k);
     if (k->periodic()) seams[name] = cat("C", k->degree() - k->multiplicity(k->front()));
     ++a;
@@ -274,6 +278,79 @@ ojson surface_info(const BSplineSurface& s) {
   for (const Vec3& p : s.control_points().values()) box.add(p);
   j["bounding_box"] = {{"min", vec(box.lo)}, {"max", vec(box.hi)}, {"diagonal", box.diagonal()}};
   return j;
+}
+
+ojson curve_info(const BSplineCurve& c) {
+  ojson j;
+  j["kind"] = "curve";
+  j["exact_form"] = "bspline_curve";
+  j["degree"] = {c.degree()};
+  j["control_points"] = {c.control_points().size()};
+  j["rational"] = c.rational();
+  j["periodic"] = {c.periodic()};
+  j["knots"] = {{"t", c.knots().values()}};
+  continuity_info(j, {&c.knots()}, t_axis);
+  const auto [t0, t1] = c.domain();
+  j["domain"] = {{"t", {t0, t1}}};
+  Box box;
+  for (const Vec3& p : c.control_points()) box.add(p);
+  j["bounding_box"] = {{"min", vec(box.lo)}, {"max", vec(box.hi)}, {"diagonal", box.diagonal()}};
+  return j;
+}
+
+// The curve at its data parameters.
+void curve_data_error(const BSplineCurve& c, const DataSet& d, DataError& e) {
+  if (d.params.size() != 1 || d.params[0].size() != d.points.size())
+    fail(errc::internal, d.pointer, ": ", d.points.size(), " data points for ", d.params.size(), " parameter lists");
+  for (std::size_t i = 0; i < d.points.size(); ++i) {
+    const double dist = distance(c.point(d.params[0][i]), d.points[i]);
+    if (std::isnan(dist)) continue;  // a missing point (approximation's data)
+    if (dist > e.absolute || e.pointer.empty()) {
+      e.absolute = dist;
+      e.pointer = cat(d.pointer, "/", i);
+      e.params = {d.params[0][i]};
+    }
+  }
+}
+
+// The error's size relative to the data's bounding box.
+void set_relative(DataError& e, const Box& box, std::size_t total) {
+  e.count = total;
+  e.diagonal = box.diagonal();
+  e.relative = e.diagonal > 0 ? e.absolute / e.diagonal
+                              : (e.absolute == 0 ? 0.0 : std::numeric_limits<double>::infinity());
+}
+
+// The members of info that every kind shares after its form's: the error at the
+// data, then (after a volume's Jacobian) the data sets, the options, the warnings
+// and the times.
+void put_data_error(ojson& j, const std::optional<DataError>& err) {
+  if (err) {
+    j["max_data_error"] = {{"absolute", err->absolute}, {"relative", err->relative}, {"diagonal", err->diagonal},
+                           {"points", err->count},      {"at", err->pointer},       {"params", err->params}};
+  } else {
+    j["max_data_error"] = nullptr;
+  }
+}
+
+void put_data(ojson& j, const std::vector<DataSet>& sets, const char* const* names, const nlohmann::ordered_json& parameters,
+              const std::vector<std::string>& warnings, const Timings& t, double check_ms) {
+  ojson data = ojson::array();
+  for (const DataSet& d : sets) {
+    ojson shape = ojson::array(), params = ojson::object();
+    for (std::size_t a = 0; a < d.params.size(); ++a) {
+      shape.push_back(d.params[a].size());
+      params[names[a]] = d.params[a];
+    }
+    data.push_back({{"pointer", d.pointer}, {"shape", shape}, {"params", params}});
+  }
+  j["data"] = std::move(data);
+  j["parameters"] = parameters;
+  j["warnings"] = warnings;
+  j["timings"] = {{"parse_ms", round_ms(t.parse_ms)},
+                  {"build_ms", round_ms(t.build_ms)},
+                  {"check_ms", round_ms(check_ms)},
+                  {"total_ms", round_ms(t.parse_ms + t.build_ms + check_ms)}};
 }
 
 bool is_flat(const ojson& j) {
@@ -348,10 +425,7 @@ std::optional<DataError> max_data_error(const Construction& c, const progress_ca
     const Surface& s = evaluator(c);
     for (const DataSet& d : c.data) surface_data_error(s, d, e, done, total, progress);
   }
-  e.count = total;
-  e.diagonal = box.diagonal();
-  e.relative = e.diagonal > 0 ? e.absolute / e.diagonal
-                              : (e.absolute == 0 ? 0.0 : std::numeric_limits<double>::infinity());
+  set_relative(e, box, total);
   return e;
 }
 
@@ -378,30 +452,49 @@ nlohmann::ordered_json info_json(const Construction& c, const progress_callback&
     j["exact_form"] = nullptr;
     j["no_exact_form"] = c.no_exact_form;
   }
-  if (err) {
-    j["max_data_error"] = {{"absolute", err->absolute}, {"relative", err->relative}, {"diagonal", err->diagonal},
-                           {"points", err->count},      {"at", err->pointer},       {"params", err->params}};
-  } else {
-    j["max_data_error"] = nullptr;
-  }
+  put_data_error(j, err);
   if (volume) j["jacobian"] = jac;
-  ojson data = ojson::array();
-  for (const DataSet& d : c.data) {
-    ojson shape = ojson::array(), params = ojson::object();
-    for (std::size_t a = 0; a < d.params.size(); ++a) {
-      shape.push_back(d.params[a].size());
-      params[a == 0 ? "u" : (a == 1 ? "v" : "w")] = d.params[a];
-    }
-    data.push_back({{"pointer", d.pointer}, {"shape", shape}, {"params", params}});
-  }
-  j["data"] = std::move(data);
-  j["parameters"] = c.parameters;
-  j["warnings"] = c.warnings;
-  j["timings"] = {{"parse_ms", round_ms(c.timings.parse_ms)},
-                  {"build_ms", round_ms(c.timings.build_ms)},
-                  {"check_ms", round_ms(check_ms)},
-                  {"total_ms", round_ms(c.timings.parse_ms + c.timings.build_ms + check_ms)}};
+  put_data(j, c.data, uvw, c.parameters, c.warnings, c.timings, check_ms);
   return j;
+}
+
+nlohmann::ordered_json curve_info_json(const CurveConstruction& c) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::optional<DataError> err;
+  Box box;
+  std::size_t total = 0;
+  for (const DataSet& d : c.data) {
+    total += d.points.size();
+    for (const Vec3& p : d.points) box.add(p);
+  }
+  if (total > 0) {
+    err.emplace();
+    for (const DataSet& d : c.data) curve_data_error(c.curve, d, *err);
+    set_relative(*err, box, total);
+  }
+  const double check_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  ojson j;
+  j["type"] = c.form;
+  j.update(curve_info(c.curve));
+  put_data_error(j, err);
+  put_data(j, c.data, t_axis, c.parameters, c.warnings, c.timings, check_ms);
+  return j;
+}
+
+void write_exact_json(std::ostream& os, const BSplineCurve& c) {
+  ojson b;
+  b["degree"] = c.degree();
+  if (c.periodic()) b["periodic"] = true;
+  b["knots"] = c.knots().values();
+  ojson cp = ojson::array();
+  for (const Vec3& p : c.control_points()) cp.push_back(vec(p));
+  b["control_points"] = std::move(cp);
+  if (c.rational()) b["weights"] = c.weights();
+  os << pretty_json({{"bspline", std::move(b)}});
+}
+
+void write_exact_json(const std::filesystem::path& path, const BSplineCurve& c) {
+  write_atomically(path, [&](std::ostream& os) { write_exact_json(os, c); });
 }
 
 }  // namespace interpatch::io

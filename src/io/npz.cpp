@@ -112,6 +112,11 @@ FormView view(const BSplineVolume& v) {
           v.rational() ? v.weights().data() : nullptr};
 }
 
+FormView view(const BSplineCurve& c) {
+  return {{c.degree()}, {&c.knots()}, {c.control_points().size()}, c.control_points().data(),
+          c.rational() ? c.weights().data() : nullptr};
+}
+
 // ---------------------------------------------------------------------------
 // Writing.
 
@@ -789,6 +794,8 @@ ExactForm read_exact_npz(const fs::path& path, std::size_t dims) {
 }  // namespace internal
 
 void write_exact_npz(const fs::path& path, const ExactForm& exact) { internal::write_exact_npz(path, exact, false); }
+
+void write_exact_npz(const fs::path& path, const BSplineCurve& curve) { write_archive(path, view(curve), false); }
 
 ExactForm read_exact_npz(const fs::path& path) { return internal::read_exact_npz(path, 0); }
 

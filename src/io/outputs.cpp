@@ -166,15 +166,29 @@ void require_mesh_room(const Resolution& res, const fs::path& out) {
   require_memory(res.nu * res.nv, 2 * sizeof(Vec3) + 2 * 50, what);
 }
 
-void write_build(Construction& c, const fs::path& out) {
-  check_build_output(out);
-  const ExactForm& exact = exact_form(c);
+namespace {
+
+// An exact form or a curve in the format the extension names (checked before).
+template <class Form>
+void write_exact(const Form& form, const fs::path& out) {
   const std::string ext = lower_extension(out);
   // The product (STEP) or file (IGES) is named after the output file.
-  if (ext == ".step" || ext == ".stp") return write_step(out, exact, {.name = out.stem().string(), .time_stamp = {}});
-  if (ext == ".igs" || ext == ".iges") return write_iges(out, exact, {.name = out.filename().string(), .time_stamp = {}});
-  if (ext == ".npz") return write_exact_npz(out, exact);
-  write_exact_json(out, exact);
+  if (ext == ".step" || ext == ".stp") return write_step(out, form, {.name = out.stem().string(), .time_stamp = {}});
+  if (ext == ".igs" || ext == ".iges") return write_iges(out, form, {.name = out.filename().string(), .time_stamp = {}});
+  if (ext == ".npz") return write_exact_npz(out, form);
+  write_exact_json(out, form);
+}
+
+}  // namespace
+
+void write_build(Construction& c, const fs::path& out) {
+  check_build_output(out);
+  write_exact(exact_form(c), out);
+}
+
+void write_build(const CurveConstruction& c, const fs::path& out) {
+  check_build_output(out);
+  write_exact(c.curve, out);
 }
 
 std::vector<std::string> write_mesh(Construction& c, const fs::path& out, const Resolution& res,

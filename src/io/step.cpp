@@ -1,6 +1,7 @@
 #include "interpatch/io/step.hpp"
 
 #include <array>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -312,10 +313,10 @@ std::vector<bool> outward_senses(const BSplineVolume& b) {
 // ---------------------------------------------------------------- entities
 
 // Control points as CARTESIAN_POINTs; returns their ids in the net's C order.
-std::vector<int> write_points(Entities& out, const PointGrid& cp) {
+std::vector<int> write_points(Entities& out, std::span<const Vec3> cp) {
   std::vector<int> ids;
   ids.reserve(cp.size());
-  for (const Vec3& p : cp.values()) {
+  for (const Vec3& p : cp) {
     out.open();
     out.text("CARTESIAN_POINT('',(").real(p.x).text(",").real(p.y).text(",").real(p.z).text("))");
     ids.push_back(out.close());
@@ -367,6 +368,18 @@ int write_surface(Entities& out, const detail::Face& f, const std::vector<int>& 
   return out.close();
 }
 
+// A B-spline curve over clamped `knots` on the control points `pts` (entity ids),
+// rational with weights `w`.
+int write_bspline_curve(Entities& out, const KnotVector& knots, const std::vector<int>& pts, const std::vector<double>& w,
+                        bool closed) {
+  const std::string head = std::to_string(knots.degree()) + "," + refs(pts) + ",.UNSPECIFIED.," + logical(closed) + ",.F.";
+  const std::string with_knots = knot_lists(knots) + ",.UNSPECIFIED.";
+  if (w.empty()) return out.add("B_SPLINE_CURVE_WITH_KNOTS(''," + head + "," + with_knots + ")");
+  return out.add("(BOUNDED_CURVE() B_SPLINE_CURVE(" + head + ")\nB_SPLINE_CURVE_WITH_KNOTS(" + with_knots +
+                 ")\nCURVE() GEOMETRIC_REPRESENTATION_ITEM() RATIONAL_B_SPLINE_CURVE(" + reals(w) +
+                 ")\nREPRESENTATION_ITEM(''))");
+}
+
 int write_curve(Entities& out, const BSplineSurface& s, const Side& side, const std::vector<int>& ids, double tol) {
   std::vector<int> pts;
   std::vector<double> w;
@@ -376,12 +389,7 @@ int write_curve(Entities& out, const BSplineSurface& s, const Side& side, const 
   }
   const bool closed =
       side.periodic || norm(s.control_points().data()[side.index.front()] - s.control_points().data()[side.index.back()]) <= tol;
-  const std::string head = std::to_string(side.knots->degree()) + "," + refs(pts) + ",.UNSPECIFIED.," + logical(closed) + ",.F.";
-  const std::string with_knots = knot_lists(*side.knots) + ",.UNSPECIFIED.";
-  if (w.empty()) return out.add("B_SPLINE_CURVE_WITH_KNOTS(''," + head + "," + with_knots + ")");
-  return out.add("(BOUNDED_CURVE() B_SPLINE_CURVE(" + head + ")\nB_SPLINE_CURVE_WITH_KNOTS(" + with_knots +
-                 ")\nCURVE() GEOMETRIC_REPRESENTATION_ITEM() RATIONAL_B_SPLINE_CURVE(" + reals(w) +
-                 ")\nREPRESENTATION_ITEM(''))");
+  return write_bspline_curve(out, *side.knots, pts, w, closed);
 }
 
 // The side's parameter line on its face as a PCURVE, parametrized by the edge's curve.
@@ -406,28 +414,20 @@ std::string iso_time(const StepOptions& o) {
   return o.time_stamp.empty() ? detail::utc_now("%Y-%m-%dT%H:%M:%S") : o.time_stamp;
 }
 
-}  // namespace
+// What every file refers to: the product (its shape) and the representation contexts.
+struct Frame {
+  int shape = 0, context3d = 0, context2d = 0;
+};
 
-void write_step(std::ostream& os, const ExactForm& exact, const StepOptions& options) {
-  const std::vector<detail::Face> faces = detail::faces_of(exact);
-  const double tol = detail::coincidence_tolerance(faces);
-  std::vector<bool> same_sense(faces.size(), true);
-  if (const auto* volume = std::get_if<BSplineVolume>(&exact)) {
-    const std::vector<bool> outward = outward_senses(*volume);
-    for (std::size_t f = 0; f < faces.size(); ++f) same_sense[f] = outward[static_cast<std::size_t>(faces[f].side)];
-  }
-  const Topology topo = TopologyBuilder(faces, tol).build(same_sense);
+// The header, then the product structure and contexts: what CAD systems need to import a part.
+Frame write_frame(std::ostream& os, Entities& out, const StepOptions& options) {
   const std::string name = step_string(options.name);
   const auto r = [](int id) { return "#" + std::to_string(id); };
-
   os << "ISO-10303-21;\nHEADER;\n"
      << "FILE_DESCRIPTION(('interpatch exact B-spline form'),'2;1');\n"
      << "FILE_NAME(" << name << ",'" << iso_time(options) << "',(''),(''),'interpatch','interpatch','');\n"
      << "FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));\n"
      << "ENDSEC;\nDATA;\n";
-  Entities out(os);
-
-  // Product structure and contexts: what CAD systems need to import a part.
   const int app = out.add("APPLICATION_CONTEXT('core data for automotive mechanical design processes')");
   out.add("APPLICATION_PROTOCOL_DEFINITION('international standard','automotive_design',2000," + r(app) + ")");
   const int pctx = out.add("PRODUCT_CONTEXT(''," + r(app) + ",'mechanical')");
@@ -447,12 +447,50 @@ void write_step(std::ostream& os, const ExactForm& exact, const StepOptions& opt
                            ")) REPRESENTATION_CONTEXT('3D','3D context with units and uncertainty'))");
   const int ctx2 = out.add("(GEOMETRIC_REPRESENTATION_CONTEXT(2) PARAMETRIC_REPRESENTATION_CONTEXT() "
                            "REPRESENTATION_CONTEXT('2D','parameter space'))");
+  return {pdshape, ctx3, ctx2};
+}
+
+// The shape's representation, made of `items` (after a placement at the origin),
+// and the end of the file.
+void finish(std::ostream& os, Entities& out, const Frame& frame, const std::string& representation,
+            const std::string& name, const std::vector<int>& items) {
+  const auto r = [](int id) { return "#" + std::to_string(id); };
+  const int origin = out.add("CARTESIAN_POINT('',(0.,0.,0.))");
+  const int zdir = out.add("DIRECTION('',(0.,0.,1.))");
+  const int xdir = out.add("DIRECTION('',(1.,0.,0.))");
+  const int placement = out.add("AXIS2_PLACEMENT_3D(''," + r(origin) + "," + r(zdir) + "," + r(xdir) + ")");
+  std::vector<int> all{placement};
+  all.insert(all.end(), items.begin(), items.end());
+  const int rep = out.add(representation + "(" + name + "," + refs(all) + "," + r(frame.context3d) + ")");
+  out.add("SHAPE_DEFINITION_REPRESENTATION(" + r(frame.shape) + "," + r(rep) + ")");
+  out.text("ENDSEC;\nEND-ISO-10303-21;\n");
+  out.flush();
+  os.flush();
+  if (!os) throw error(errc::file_unwritable, "STEP output: write failed");
+}
+
+}  // namespace
+
+void write_step(std::ostream& os, const ExactForm& exact, const StepOptions& options) {
+  const std::vector<detail::Face> faces = detail::faces_of(exact);
+  const double tol = detail::coincidence_tolerance(faces);
+  std::vector<bool> same_sense(faces.size(), true);
+  if (const auto* volume = std::get_if<BSplineVolume>(&exact)) {
+    const std::vector<bool> outward = outward_senses(*volume);
+    for (std::size_t f = 0; f < faces.size(); ++f) same_sense[f] = outward[static_cast<std::size_t>(faces[f].side)];
+  }
+  const Topology topo = TopologyBuilder(faces, tol).build(same_sense);
+  const std::string name = step_string(options.name);
+  const auto r = [](int id) { return "#" + std::to_string(id); };
+  Entities out(os);
+  const Frame frame = write_frame(os, out, options);
+  const int ctx2 = frame.context2d;
 
   // Geometry: control nets and surfaces.
   std::vector<std::vector<int>> point_ids;
   std::vector<int> surfaces;
   for (const auto& f : faces) {
-    point_ids.push_back(write_points(out, f.surface.control_points()));
+    point_ids.push_back(write_points(out, f.surface.control_points().values()));
     surfaces.push_back(write_surface(out, f, point_ids.back(), tol));
   }
 
@@ -488,16 +526,10 @@ void write_step(std::ostream& os, const ExactForm& exact, const StepOptions& opt
                                logical(topo.same_sense[f]) + ")"));
   }
 
-  const int origin = out.add("CARTESIAN_POINT('',(0.,0.,0.))");
-  const int zdir = out.add("DIRECTION('',(0.,0.,1.))");
-  const int xdir = out.add("DIRECTION('',(1.,0.,0.))");
-  const int placement = out.add("AXIS2_PLACEMENT_3D(''," + r(origin) + "," + r(zdir) + "," + r(xdir) + ")");
-  int representation = 0;
   if (topo.closed && topo.shells.size() == 1) {
     const int shell = out.add("CLOSED_SHELL(''," + refs(face_ids) + ")");
     const int solid = out.add("MANIFOLD_SOLID_BREP(" + name + "," + r(shell) + ")");
-    representation = out.add("ADVANCED_BREP_SHAPE_REPRESENTATION(" + name + ",(" + r(placement) + "," + r(solid) +
-                             ")," + r(ctx3) + ")");
+    finish(os, out, frame, "ADVANCED_BREP_SHAPE_REPRESENTATION", name, {solid});
   } else {
     // One shell per set of connected faces; closed ones (a volume's inner and outer
     // skin when it is closed in two directions) say so.
@@ -508,14 +540,24 @@ void write_step(std::ostream& os, const ExactForm& exact, const StepOptions& opt
       shells.push_back(out.add(std::string(topo.closed ? "CLOSED_SHELL" : "OPEN_SHELL") + "(''," + refs(ids) + ")"));
     }
     const int model = out.add("SHELL_BASED_SURFACE_MODEL(" + name + "," + refs(shells) + ")");
-    representation = out.add("MANIFOLD_SURFACE_SHAPE_REPRESENTATION(" + name + ",(" + r(placement) + "," +
-                             r(model) + ")," + r(ctx3) + ")");
+    finish(os, out, frame, "MANIFOLD_SURFACE_SHAPE_REPRESENTATION", name, {model});
   }
-  out.add("SHAPE_DEFINITION_REPRESENTATION(" + r(pdshape) + "," + r(representation) + ")");
-  out.text("ENDSEC;\nEND-ISO-10303-21;\n");
-  out.flush();
-  os.flush();
-  if (!os) throw error(errc::file_unwritable, "STEP output: write failed");
+}
+
+void write_step(std::ostream& os, const BSplineCurve& curve, const StepOptions& options) {
+  // STEP's B-spline curves list every knot: a closed curve is written as its clamped
+  // form, flagged closed.
+  const BSplineCurve c = curve.clamped();
+  const std::string name = step_string(options.name);
+  Entities out(os);
+  const Frame frame = write_frame(os, out, options);
+  const int id = write_bspline_curve(out, c.knots(), write_points(out, c.control_points()), c.weights(), curve.periodic());
+  const int set = out.add("GEOMETRIC_CURVE_SET(" + name + ",(#" + std::to_string(id) + "))");
+  finish(os, out, frame, "GEOMETRICALLY_BOUNDED_WIREFRAME_SHAPE_REPRESENTATION", name, {set});
+}
+
+void write_step(const std::filesystem::path& path, const BSplineCurve& curve, const StepOptions& options) {
+  write_atomically(path, [&](std::ostream& os) { write_step(os, curve, options); });
 }
 
 void write_step(const std::filesystem::path& path, const ExactForm& exact, const StepOptions& options) {

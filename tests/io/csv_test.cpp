@@ -232,7 +232,7 @@ TEST(Csv, WriteGridOneAndThreeAxes) {
     const std::vector<std::vector<double>> params = {{0.0, 0.5, 1.0}};
     const std::vector<Vec3> pts = {{1, 2, 3}, {4, 5, 6}, {7, 8, 9}};
     write_csv_grid(dir / "c.csv", params, pts);
-    EXPECT_EQ(read_text(dir / "c.csv"), "u,x,y,z\n0,1,2,3\n0.5,4,5,6\n1,7,8,9\n");
+    EXPECT_EQ(read_text(dir / "c.csv"), "t,x,y,z\n0,1,2,3\n0.5,4,5,6\n1,7,8,9\n");
   }
   {
     const std::vector<std::vector<double>> params = {{0.0, 1.0}, {0.0, 1.0}, {0.0, 0.25, 1.0}};

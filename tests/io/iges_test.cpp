@@ -167,6 +167,37 @@ TEST(Iges, Entity128HoldsTheSurfaceExactlyUFastest) {
   }
 }
 
+TEST(Iges, Entity126HoldsTheCurveExactly) {
+  const BSplineCurve quarter(KnotVector(2, {0, 0, 0, 1, 1, 1}), {{2, 0, 0}, {2, 2, 0}, {0, 2, 0}}, {1, std::sqrt(0.5), 1});
+  const BSplineCurve ring(KnotVector::periodic_from(3, {0, 0.25, 0.5, 0.75}, 1.0),
+                          {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}});
+  for (const BSplineCurve& c : {quarter, ring}) {
+    std::ostringstream os;
+    write_iges(os, c, {.name = "edge.igs", .time_stamp = "20240501.120000"});
+    const Parsed p = parse(os.str());
+    ASSERT_EQ(p.sections.at('D').size(), 2u);
+    EXPECT_EQ(field(p.sections.at('D')[0], 0), 126u);
+    // IGES lists every knot: a closed curve is its clamped form, flagged closed and periodic.
+    const BSplineCurve k = c.clamped();
+    const std::size_t n = k.control_points().size(), nk = k.knots().size();
+    const auto tok = parameters(p, 1);
+    ASSERT_EQ(tok.size(), 7 + nk + 4 * n + 5);
+    EXPECT_EQ(tok[0], "126");
+    EXPECT_EQ(std::stoul(tok[1]), n - 1);
+    EXPECT_EQ(std::stoi(tok[2]), c.degree());
+    EXPECT_EQ(tok[4], c.periodic() ? "1" : "0");  // closed
+    EXPECT_EQ(tok[5], c.rational() ? "0" : "1");  // polynomial
+    EXPECT_EQ(tok[6], c.periodic() ? "1" : "0");  // periodic
+    std::size_t at = 7;
+    for (std::size_t i = 0; i < nk; ++i) EXPECT_EQ(number(tok[at++]), k.knots()[i]);
+    for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(number(tok[at++]), k.rational() ? k.weights()[i] : 1.0);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int d = 0; d < 3; ++d) EXPECT_EQ(number(tok[at++]), k.control_points()[i][d]);
+    EXPECT_EQ(number(tok[at++]), 0.0);
+    EXPECT_EQ(number(tok[at++]), 1.0);
+  }
+}
+
 TEST(Iges, ClosedSurfaceSaysSo) {
   PointGrid cp({2, 5});
   const Vec3 ring[5] = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {1, 0, 0}};

@@ -16,6 +16,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <variant>
 #include <vector>
 
 #include "cli_specs.hpp"
@@ -99,6 +100,44 @@ TEST(Spec, InterpolateReproducesTheDataOverRandomGrids) {
 // Arrays held in memory ({"array": NAME}, BuildOptions::arrays): the same surface as
 // the same points written inline; an array named once and held by nobody else is
 // taken (its entry left empty), one named twice or still held by the caller copied.
+TEST(Spec, ACurveSpecIsBuiltAsACurveThroughItsData) {
+  const json spec = json::parse(R"({"interpolate": [[0, 0, 0], [1, 2, 0], [3, 3, 1], [4, 0, 0]], "degree": 2})");
+  EXPECT_TRUE(is_curve_spec(spec));
+  EXPECT_FALSE(is_curve_spec(json::parse(R"({"type": "ruled", "interpolate": []})")));
+  const CurveConstruction c = build_curve(spec);
+  EXPECT_EQ(c.form, "interpolate");
+  EXPECT_EQ(c.curve.degree(), 2);
+  EXPECT_EQ(c.curve.domain(), std::make_pair(0.0, 1.0));
+  ASSERT_EQ(c.data.size(), 1u);
+  EXPECT_EQ(c.data[0].pointer, "/interpolate");
+  ASSERT_EQ(c.data[0].params.size(), 1u);
+  const std::vector<double>& t = c.data[0].params[0];
+  ASSERT_EQ(t.size(), 4u);
+  EXPECT_EQ(t.front(), 0.0);
+  EXPECT_EQ(t.back(), 1.0);
+  for (std::size_t i = 0; i < t.size(); ++i)  // the banded solve's rounding, a few ulps of coordinates ~4
+    EXPECT_LT(distance(c.curve.point(t[i]), c.data[0].points[i]), 1e-14);
+  EXPECT_EQ(c.parameters["param"], "chord");
+  // Its curve is the one the same curve gives inside a construction.
+  const BSplineCurve inside = curve_from_json(spec);
+  EXPECT_EQ(inside.control_points(), c.curve.control_points());
+  // build() is for constructions; build_any() takes either.
+  EXPECT_ERRC((void)build(spec), missing_field, "(top level): the spec is a curve");
+  EXPECT_TRUE(std::holds_alternative<CurveConstruction>(build_any(spec, {}, {})));
+  EXPECT_TRUE(std::holds_alternative<Construction>(build_any(test::square_coons(), {}, {})));
+  // An array given but never named is refused as for a construction.
+  BuildOptions o;
+  o.arrays["extra"] = std::make_shared<PointArray>();
+  EXPECT_ERRC((void)build_curve(spec, {}, o), wrong_type, "arrays: \"extra\" is given but the spec names no");
+  // The exact form written as JSON reads back to the same curve, bit for bit.
+  std::ostringstream text;
+  write_exact_json(text, c.curve);
+  const CurveConstruction again = build_curve(parse_json(text.str()));
+  EXPECT_EQ(again.form, "bspline");
+  EXPECT_TRUE(again.data.empty());
+  for (const double u : linspace(0, 1, 33)) EXPECT_EQ(again.curve.point(u), c.curve.point(u));
+}
+
 TEST(Spec, InMemoryArraysTakenWhenNamedOnceAndHeldByNobodyElse) {
   auto g = test::rng(21);
   const PointGrid q = test::random_grid(g, 7, 5);

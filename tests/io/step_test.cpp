@@ -134,6 +134,46 @@ BSplineVolume unit_cube() {
   return BSplineVolume(lin, lin, lin, cp);
 }
 
+// A rational quarter circle of radius 2, and a closed cubic through four points.
+BSplineCurve quarter_circle() {
+  return BSplineCurve(KnotVector(2, {0, 0, 0, 1, 1, 1}), {{2, 0, 0}, {2, 2, 0}, {0, 2, 0}}, {1, std::sqrt(0.5), 1});
+}
+
+BSplineCurve closed_curve() {
+  return BSplineCurve(KnotVector::periodic_from(3, {0, 0.25, 0.5, 0.75}, 1.0),
+                      {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}});
+}
+
+TEST(Step, CurveIsOneBSplineCurveInAWireframeRepresentation) {
+  for (const BSplineCurve& c : {quarter_circle(), closed_curve(), line({0, 0, 0}, {1, 2, 3})}) {
+    std::ostringstream os;
+    write_step(os, c, {.name = "part", .time_stamp = "2024-05-01T12:00:00"});
+    const std::string t = os.str();
+    EXPECT_EQ(t.rfind("ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(", 0), 0u);
+    EXPECT_TRUE(t.ends_with("ENDSEC;\nEND-ISO-10303-21;\n"));
+    const auto e = entities(t);
+    int expected = 1;
+    for (const auto& [n, body] : e) {
+      EXPECT_EQ(n, expected++);
+      for (const int target : references(body)) EXPECT_LT(target, n) << "#" << n << "=" << body;
+    }
+    const BSplineCurve clamped = c.clamped();
+    expect_counts(e, {{"CARTESIAN_POINT", clamped.control_points().size() + 1},  // and the placement's origin
+                      {"B_SPLINE_CURVE_WITH_KNOTS", c.rational() ? 0u : 1u},
+                      {"(BOUNDED_CURVE() B_SPLINE_CURVE(", c.rational() ? 1u : 0u},
+                      {"GEOMETRIC_CURVE_SET('part',(", 1},
+                      {"GEOMETRICALLY_BOUNDED_WIREFRAME_SHAPE_REPRESENTATION('part',(", 1},
+                      {"SHAPE_DEFINITION_REPRESENTATION(", 1},
+                      {"ADVANCED_FACE", 0}});
+    // A closed curve is its clamped form, said to be closed.
+    for (const auto& [n, body] : e) {
+      if (body.find("B_SPLINE_CURVE(") == std::string::npos && body.rfind("B_SPLINE_CURVE_WITH_KNOTS(''", 0) != 0) continue;
+      EXPECT_NE(body.find(std::string(",.UNSPECIFIED.,") + (c.periodic() ? ".T." : ".F.") + ",.F."), std::string::npos)
+          << body;
+    }
+  }
+}
+
 TEST(Step, HeaderAndSectionsFollowPart21) {
   const std::string t = step_text(bilinear_patch());
   EXPECT_EQ(t.rfind("ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(", 0), 0u) << t.substr(0, 80);

@@ -5,17 +5,16 @@ Ctrl-C during long calls.
 
 Run by CTest (python_module) with PYTHONPATH=<build>/python and INTERPATCH_CLI set."""
 
-import _thread
 import json
 import os
 import subprocess
-import threading
 import time
 
 import numpy as np
 import pytest
 
 import interpatch
+from ctrl_c import assert_ctrl_c_stops
 
 CLI = os.environ.get("INTERPATCH_CLI", "interpatch")
 EXAMPLES = os.environ.get("INTERPATCH_EXAMPLES", os.path.join(os.path.dirname(__file__), "..", "..", "examples"))
@@ -267,21 +266,5 @@ def test_a_field_given_two_ways_is_refused(tmp_path):
 
 def test_ctrl_c_stops_a_long_call():
     c = interpatch.build(os.path.join(EXAMPLES, "coons.json"))
-    n = 200
-    while True:  # a call long enough to interrupt, whatever the machine's speed
-        ts = np.linspace(0, 1, n)
-        start = time.monotonic()
-        c.evaluate(ts, ts)
-        full = time.monotonic() - start
-        if full > 0.8 or n >= 6400:
-            break
-        n *= 2
-    timer = threading.Timer(full / 6, _thread.interrupt_main)
-    timer.start()
-    start = time.monotonic()
-    with pytest.raises(KeyboardInterrupt):
-        c.evaluate(ts, ts)
-    took = time.monotonic() - start
-    timer.join()
-    assert took < full / 2, f"stopped after {took:.2f} s of a {full:.2f} s call"
+    assert_ctrl_c_stops(lambda n: c.evaluate(np.linspace(0, 1, n), np.linspace(0, 1, n)), 200, 6400)
     assert c.evaluate([0.5], [0.5]).shape == (1, 1, 3), "still usable"

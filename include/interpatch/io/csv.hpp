@@ -44,7 +44,7 @@ namespace interpatch::io {
                                                  std::string_view name = "csv", bool allow_nan = false);
 
 /// Writes an evaluation grid: a header `u,v,x,y,z` (one name per parameter axis,
-/// then x,y,z), then one row per point in C order (first axis outermost). `params`
+/// then x,y,z; a curve's one axis is t: `t,x,y,z`), then one row per point in C order (first axis outermost). `params`
 /// holds one parameter list per axis; points.size() is the product of their sizes.
 /// Numbers are written with 17 significant digits, so they read back exactly.
 /// Written atomically. @throws error file_unwritable, size_mismatch (params.size()

@@ -54,4 +54,18 @@ void write_iges(std::ostream& os, const ExactForm& exact, const IgesOptions& opt
 /// @throws error file_unwritable, no_exact_form.
 void write_iges(const std::filesystem::path& path, const ExactForm& exact, const IgesOptions& options = {});
 
+/// Writes a curve as an IGES 5.3 file: one entity 126 (rational B-spline curve, form
+/// 0) holding the degree, knots, weights (all 1 and PROP3 = 1 when polynomial),
+/// control points and parameter range. A closed (periodic) curve is written as its
+/// clamped form (BSplineCurve::clamped), flagged closed (PROP2) and periodic (PROP4).
+///
+/// Example:
+/// @code
+///   interpatch::io::write_iges("edge.igs", interpatch::line({0, 0, 0}, {10, 0, 0}));
+/// @endcode
+/// @throws error file_unwritable.
+void write_iges(std::ostream& os, const BSplineCurve& curve, const IgesOptions& options = {});
+/// The same, written atomically to a file. @throws error file_unwritable.
+void write_iges(const std::filesystem::path& path, const BSplineCurve& curve, const IgesOptions& options = {});
+
 }  // namespace interpatch::io

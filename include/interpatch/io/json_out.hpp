@@ -43,6 +43,19 @@ void write_exact_json(std::ostream& os, const ExactForm& exact);
 /// The same, written atomically to a file. @throws error file_unwritable.
 void write_exact_json(const std::filesystem::path& path, const ExactForm& exact);
 
+/// Writes a curve as the curve spec that build_curve() reads back to the same curve:
+/// `{"bspline": {"degree": p, "periodic": true (closed curves only), "knots": [...],
+/// "control_points": [[x, y, z], ...], "weights": [...] (rational curves only)}}`, the
+/// knots of a closed curve its extended knots. Numbers as write_exact_json writes them.
+///
+/// Example:
+/// @code
+///   interpatch::io::write_exact_json(std::cout, interpatch::line({0, 0, 0}, {1, 0, 0}));
+/// @endcode
+void write_exact_json(std::ostream& os, const BSplineCurve& curve);
+/// The same, written atomically to a file. @throws error file_unwritable.
+void write_exact_json(const std::filesystem::path& path, const BSplineCurve& curve);
+
 /// How far the exact form is from the data it interpolates.
 struct DataError {
   double absolute = 0;   ///< the largest distance |S(params) − point|
@@ -81,6 +94,15 @@ struct DataError {
 /// from inverted_cells() on a 17 × 17 × 17 grid (its time counts into check_ms).
 /// @throws error too_large.
 [[nodiscard]] nlohmann::ordered_json info_json(const Construction& c, const progress_callback& progress = {});
+
+/// The description `interpatch info` prints for a curve spec: the keys of info_json()
+/// with one direction, t: `{"type": the curve's form ("interpolate", ...), "kind":
+/// "curve", "exact_form": "bspline_curve", "degree": [p], "control_points": [n],
+/// "rational", "periodic": [false], "knots": {"t"}, "continuity": {"t"},
+/// "seam_continuity", "domain": {"t": [0, 1]}, "bounding_box", "max_data_error" (the
+/// curve at its data's parameters, or null), "data": [{"pointer", "shape": [n],
+/// "params": {"t"}}], "parameters", "warnings", "timings"}`.
+[[nodiscard]] nlohmann::ordered_json curve_info_json(const CurveConstruction& c);
 
 /// JSON text for people: two-space indentation, but arrays of plain values (a
 /// point, a knot vector) on one line. Ends with a newline.

@@ -46,6 +46,11 @@ namespace interpatch::io {
 ///   before writing).
 void write_exact_npz(const std::filesystem::path& path, const ExactForm& exact);
 
+/// Writes a curve as an .npz archive of the same members with one direction:
+/// `degree` (1,), `knots_u`, `control_points` (n, 3), `weights` (n,) when rational,
+/// `periodic` (1,). @throws error as write_exact_npz of a form.
+void write_exact_npz(const std::filesystem::path& path, const BSplineCurve& curve);
+
 /// Reads an archive written by write_exact_npz (or by `numpy.savez` with the same
 /// arrays) back to the same exact form, bit for bit: the knots and control points
 /// are not mapped or rounded. Degrees may be any integer dtype; knots, control points

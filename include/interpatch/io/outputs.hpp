@@ -91,6 +91,9 @@ void require_mesh_room(const Resolution& res, const std::filesystem::path& out);
 /// .igs/.iges. @throws error no_exact_form, wrong_type (another format), and what the
 /// writers throw.
 void write_build(Construction& c, const std::filesystem::path& out);
+/// A curve spec's curve, in the same formats (json_out.hpp, npz.hpp, step.hpp, iges.hpp).
+/// @throws error wrong_type (another format), and what the writers throw.
+void write_build(const CurveConstruction& c, const std::filesystem::path& out);
 
 /// Writes a mesh of `res` vertices, sampled through the cheaper exact evaluator
 /// (evaluator()), which may make the exact form of `c`. Every check above comes

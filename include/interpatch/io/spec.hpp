@@ -283,6 +283,52 @@ struct PointArray {
 [[nodiscard]] PointArray points_from_json(const nlohmann::json& j, std::size_t rank,
                                           const std::filesystem::path& base_dir = {}, std::string_view pointer = "");
 
+/// A curve spec, built: a spec whose top level is one curve in any of its forms
+/// (docs/spec-format.md, "Curves") rather than a construction with a "type". What
+/// `interpatch eval`, `info` and `build` make of a curve spec, and what the Python
+/// module's Curve holds.
+struct CurveConstruction {
+  std::string form;    ///< the curve's key: "interpolate", "bspline", "hermite", "line" or "approximate"
+  BSplineCurve curve;  ///< over [0, 1]: its exact form
+  /// The points it was made through or near (interpolate, hermite, approximate): one
+  /// data set whose one parameter list holds their parameters on [0, 1] (a missing
+  /// point of an approximation is NaN); empty for bspline and line.
+  std::vector<DataSet> data;
+  /// The options in effect, defaults filled in (degree, param, periodic; an
+  /// approximation's report), as `info` shows them.
+  nlohmann::ordered_json parameters = nlohmann::ordered_json::object();
+  std::vector<std::string> warnings;  ///< as Construction::warnings
+  Timings timings;                    ///< reading and building are one step: parse_ms holds both
+};
+
+/// Whether a spec is a curve spec: an object without "type" holding one of the keys
+/// of a curve form ("interpolate", "bspline", "hermite", "line", "approximate").
+[[nodiscard]] bool is_curve_spec(const nlohmann::json& spec) noexcept;
+
+/// Builds a curve spec. Of `options` only `arrays` (named by {"array": NAME}) applies:
+/// a curve keeps its data points whatever keep_data says, and its arrays are copied.
+///
+/// Example:
+/// @code
+///   auto spec = interpatch::io::parse_json(R"({"interpolate": [[0,0,0], [1,1,0], [2,0,0]], "degree": 2})");
+///   interpatch::io::CurveConstruction c = interpatch::io::build_curve(spec);
+///   interpatch::Vec3 p = c.curve.point(c.data[0].params[0][1]);  // (1, 1, 0) up to rounding
+/// @endcode
+/// @throws error what curve_from_json throws, and wrong_type for an array given but
+///   never named, as build() does.
+[[nodiscard]] CurveConstruction build_curve(const nlohmann::json& spec, const std::filesystem::path& base_dir = {},
+                                            const BuildOptions& options = {});
+
+/// What a spec builds to: a construction, or a curve for a curve spec.
+using Built = std::variant<Construction, CurveConstruction>;
+
+/// build() or build_curve(), as is_curve_spec() says. @throws error as they do.
+[[nodiscard]] Built build_any(const nlohmann::json& spec, const std::filesystem::path& base_dir,
+                              const BuildOptions& options);
+
+/// build_file() or build_curve() of a spec file, read once. @throws error as they do.
+[[nodiscard]] Built build_any_file(const std::filesystem::path& spec_path, const BuildOptions& options);
+
 /// Reads a curve in any of its forms (docs/spec-format.md) — `{"interpolate": points,
 /// "degree": p, "param": "chord", "periodic": false, "start_derivative": [x, y, z],
 /// "end_derivative": [x, y, z]}`, `{"bspline": {"degree", "knots", "control_points",

@@ -73,4 +73,19 @@ void write_step(std::ostream& os, const ExactForm& exact, const StepOptions& opt
 /// @throws error file_unwritable, no_exact_form.
 void write_step(const std::filesystem::path& path, const ExactForm& exact, const StepOptions& options = {});
 
+/// Writes a curve as a STEP AP214 file: one B_SPLINE_CURVE_WITH_KNOTS (the complex
+/// rational form when it has weights) in a GEOMETRIC_CURVE_SET of a
+/// GEOMETRICALLY_BOUNDED_WIREFRAME_SHAPE_REPRESENTATION, with the product structure,
+/// units and uncertainty of a form's file. A closed (periodic) curve is written as its
+/// clamped form (BSplineCurve::clamped), closed_curve .T..
+///
+/// Example:
+/// @code
+///   interpatch::io::write_step("edge.step", interpatch::line({0, 0, 0}, {10, 0, 0}), {.name = "edge"});
+/// @endcode
+/// @throws error file_unwritable.
+void write_step(std::ostream& os, const BSplineCurve& curve, const StepOptions& options = {});
+/// The same, written atomically to a file. @throws error file_unwritable.
+void write_step(const std::filesystem::path& path, const BSplineCurve& curve, const StepOptions& options = {});
+
 }  // namespace interpatch::io

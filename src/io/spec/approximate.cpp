@@ -121,6 +121,15 @@ nlohmann::ordered_json report_json(const ApproximationReport& r, std::string_vie
   return j;
 }
 
+// How the approximation was asked for, as info shows it.
+template <std::size_t D>
+void put_way(nlohmann::ordered_json& j, const ApproximationOptions<D>& o) {
+  if (o.tolerance) j["tolerance"] = *o.tolerance;
+  if (o.smoothing) j["smoothing"] = *o.smoothing;
+  if (o.auto_smoothing) j["smoothing"] = "auto";
+  if (!o.weights.empty()) j["weights"] = true;
+}
+
 }  // namespace
 
 template <std::size_t D>
@@ -167,10 +176,7 @@ Construction build_approximate(const json& spec, Context& ctx) {
                   {"degree", degree},
                   {"param", param_name(o.param)},
                   {"periodic", std::vector<bool>(o.periodic.begin(), o.periodic.end())}};
-  if (o.tolerance) c.parameters["tolerance"] = *o.tolerance;
-  if (o.smoothing) c.parameters["smoothing"] = *o.smoothing;
-  if (o.auto_smoothing) c.parameters["smoothing"] = "auto";
-  if (!o.weights.empty()) c.parameters["weights"] = true;
+  put_way(c.parameters, o);
   c.parameters.update(report_json(report, "/points"));
   if (ctx.keep_data) c.data.push_back(std::move(data));
   return c;
@@ -187,18 +193,21 @@ template ApproximationOptions<2> approximation_options<2>(const json&, std::stri
                                                           std::string_view);
 template Construction build_approximate<3>(const json& spec, Context& ctx);
 
-BSplineCurve approximated_curve(const json& obj, std::string_view ptr, Context& ctx) {
+SpecCurve approximated_curve(const json& obj, std::string_view ptr, Context& ctx) {
   check_fields(obj, ptr, forms::approximate_curve, ctx);
   const std::string pts_at = child(ptr, "approximate");
   const PointArray a = points_impl(obj.at("approximate"), 1, pts_at, ctx, true);
   if (a.points.size() < 2) fail(errc::too_few_points, place(pts_at), ": a curve needs at least 2 points, got ", a.points.size());
   const ApproximationOptions<1> o = read_options<1>(obj, ptr, a.shape, pts_at);
-  const std::vector<Vec3> pts(a.points.begin(), a.points.end());
-  return at(ptr, [&] {
-    BSplineCurve c = approximate_curve(pts, o).curve;
-    const auto [t0, t1] = c.domain();
-    return t0 == 0.0 && t1 == 1.0 ? c : c.mapped(0.0, 1.0);
-  });
+  std::vector<Vec3> pts(a.points.begin(), a.points.end());
+  CurveApproximation r = at(ptr, [&] { return approximate_curve(pts, o); });
+  const auto [t0, t1] = r.curve.domain();
+  SpecCurve out(t0 == 0.0 && t1 == 1.0 ? r.curve : r.curve.mapped(0.0, 1.0),
+                unit_params(std::move(r.params), r.curve.domain(), o.periodic[0]), std::move(pts));
+  out.parameters = {{"degree", r.curve.degree()}, {"param", param_name(o.param)}, {"periodic", o.periodic[0]}};
+  put_way(out.parameters, o);
+  out.parameters.update(report_json(r.report, pts_at));
+  return out;
 }
 
 }  // namespace interpatch::io::reader

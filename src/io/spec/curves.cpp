@@ -26,7 +26,7 @@ std::vector<Vec3> curve_points(const json& j, std::string_view ptr, Context& ctx
 
 // {"interpolate": points, ...}: open, or closed ("periodic": true) through the
 // distinct points, a last point repeating the first left out.
-BSplineCurve interpolated_curve(const json& obj, std::string_view ptr, Context& ctx) {
+SpecCurve interpolated_curve(const json& obj, std::string_view ptr, Context& ctx) {
   check_fields(obj, ptr, forms::interpolate_curve, ctx);
   const std::string pts_at = child(ptr, "interpolate");
   const std::vector<Vec3> pts = curve_points(obj.at("interpolate"), pts_at, ctx);
@@ -61,10 +61,15 @@ BSplineCurve interpolated_curve(const json& obj, std::string_view ptr, Context& 
            " coincides with point 0 (the closing chord of a closed curve has zero length); ", param_name(options.param),
            " parameters need distinct consecutive points, the last and the first included");
   }
-  return at(ptr, [&] { return on_unit_domain(interpolate_curve(pts, options).curve); });
+  CurveInterpolation r = at(ptr, [&] { return interpolate_curve(pts, options); });
+  SpecCurve out(on_unit_domain(r.curve), to_unit(std::move(r.params), r.curve.domain()), pts);
+  out.parameters = {{"degree", r.curve.degree()}, {"param", param_name(options.param)}, {"periodic", options.periodic}};
+  for (const auto& [name, d] : {std::pair{"start_derivative", options.start_derivative}, {"end_derivative", options.end_derivative}})
+    if (d) out.parameters[name] = {d->x, d->y, d->z};
+  return out;
 }
 
-BSplineCurve bspline_curve(const json& b, std::string_view ptr, Context& ctx) {
+SpecCurve bspline_curve(const json& b, std::string_view ptr, Context& ctx) {
   expect_object(b, ptr, "an object {\"degree\", \"knots\", \"control_points\", \"weights\"}");
   check_fields(b, ptr, forms::bspline_curve, ctx);
   const int p = degree_value(member(b, "degree", ptr, "an integer degree"), child(ptr, "degree"));
@@ -82,10 +87,10 @@ BSplineCurve bspline_curve(const json& b, std::string_view ptr, Context& ctx) {
     fail(errc::size_mismatch, wptr, ": ", cp.size(), " control points need ", cp.size(), " weights, got ", w.size());
   for (std::size_t i = 0; i < w.size(); ++i)
     if (!(w[i] > 0)) fail(errc::invalid_weight, child(wptr, i), ": weight ", w[i], " is not positive");
-  return at(ptr, [&] { return on_unit_domain(BSplineCurve(std::move(k), std::move(cp), std::move(w))); });
+  return SpecCurve(at(ptr, [&] { return on_unit_domain(BSplineCurve(std::move(k), std::move(cp), std::move(w))); }));
 }
 
-BSplineCurve hermite_curve(const json& h, std::string_view ptr, Context& ctx) {
+SpecCurve hermite_curve(const json& h, std::string_view ptr, Context& ctx) {
   expect_object(h, ptr, "an object {\"points\", \"tangents\", \"params\"}");
   check_fields(h, ptr, forms::hermite_curve, ctx);
   const std::string pptr = child(ptr, "points"), tptr = child(ptr, "tangents"), uptr = child(ptr, "params");
@@ -107,21 +112,24 @@ BSplineCurve hermite_curve(const json& h, std::string_view ptr, Context& ctx) {
         fail(errc::non_increasing, child(uptr, i), ": param ", params[i], " is not greater than the one before, ",
              params[i - 1]);
   }
-  return at(ptr, [&] {
-    return on_unit_domain(HermiteCurve(std::move(pts), std::move(tangents), std::move(params)).to_bspline());
-  });
+  const bool given = !tangents.empty();
+  const HermiteCurve c = at(ptr, [&] { return HermiteCurve(std::move(pts), std::move(tangents), std::move(params)); });
+  return SpecCurve(at(ptr, [&] { return on_unit_domain(c.to_bspline()); }), to_unit(c.params(), c.domain()), c.points(),
+                   {{"tangents", given ? "given" : "catmull_rom"}});
 }
 
-BSplineCurve line_curve(const json& l, std::string_view ptr, Context& ctx) {
+SpecCurve line_curve(const json& l, std::string_view ptr, Context& ctx) {
   const PointStorage pts = points_impl(l, 1, ptr, ctx).points;
   if (pts.size() != 2) fail(errc::size_mismatch, place(ptr), ": a line needs exactly 2 points [A, B], got ", pts.size());
   // A == B is allowed: a collapsed boundary (a triangular patch) is a point.
-  return line(pts[0], pts[1]);
+  return SpecCurve(line(pts[0], pts[1]));
 }
 
 }  // namespace
 
-BSplineCurve curve_impl(const json& j, std::string_view ptr, Context& ctx) {
+BSplineCurve curve_impl(const json& j, std::string_view ptr, Context& ctx) { return read_curve(j, ptr, ctx).curve; }
+
+SpecCurve read_curve(const json& j, std::string_view ptr, Context& ctx) {
   static constexpr std::array<std::string_view, 5> forms{"interpolate", "bspline", "hermite", "line", "approximate"};
   constexpr std::string_view expected =
       "a curve: an object with one of \"interpolate\", \"bspline\", \"hermite\", \"line\", \"approximate\"";
@@ -134,14 +142,18 @@ BSplineCurve curve_impl(const json& j, std::string_view ptr, Context& ctx) {
     fail(errc::wrong_type, place(ptr), ": a curve has exactly one of \"interpolate\", \"bspline\", \"hermite\", \"line\", \"approximate\"; got \"",
          present[0], "\" and \"", present[1], "\"");
   const std::string_view form = present[0];
-  if (form == "interpolate") return interpolated_curve(j, ptr, ctx);
-  if (form == "approximate") return approximated_curve(j, ptr, ctx);
-  check_fields(j, ptr, {form}, ctx);
-  const json& body = j.at(std::string(form));
-  const std::string bptr = child(ptr, form);
-  if (form == "bspline") return bspline_curve(body, bptr, ctx);
-  if (form == "hermite") return hermite_curve(body, bptr, ctx);
-  return line_curve(body, bptr, ctx);
+  SpecCurve r = [&] {
+    if (form == "interpolate") return interpolated_curve(j, ptr, ctx);
+    if (form == "approximate") return approximated_curve(j, ptr, ctx);
+    check_fields(j, ptr, {form}, ctx);
+    const json& body = j.at(std::string(form));
+    const std::string bptr = child(ptr, form);
+    if (form == "bspline") return bspline_curve(body, bptr, ctx);
+    if (form == "hermite") return hermite_curve(body, bptr, ctx);
+    return line_curve(body, bptr, ctx);
+  }();
+  r.form = form;
+  return r;
 }
 
 }  // namespace interpatch::io::reader

@@ -159,7 +159,23 @@ DataSet grid_data(const json& points_spec, std::span<const Vec3> points, std::sp
 /// A grid of numbers (weights) given as nested lists, Rank 2 or 3.
 template <std::size_t Rank>
 Grid<double, Rank> inline_number_grid(const json& j, std::string_view ptr);
-/// A curve in any of its forms, mapped onto [0, 1].
+/// A curve as its spec gives it: the curve mapped onto [0, 1]; for the forms made
+/// through or near points (interpolate, approximate, hermite) those points and their
+/// parameters on [0, 1] (a missing point of an approximation is NaN); and the options
+/// in effect, defaults filled in, as info shows them.
+struct SpecCurve {
+  explicit SpecCurve(BSplineCurve c, std::vector<double> t = {}, std::vector<Vec3> data = {},
+                     nlohmann::ordered_json options = nlohmann::ordered_json::object())
+      : curve(std::move(c)), params(std::move(t)), points(std::move(data)), parameters(std::move(options)) {}
+  BSplineCurve curve;
+  std::vector<double> params;
+  std::vector<Vec3> points;
+  nlohmann::ordered_json parameters = nlohmann::ordered_json::object();
+  std::string_view form;  ///< its key: "interpolate", "bspline", ... (read_curve sets it)
+};
+/// A curve in any of its forms (docs/spec-format.md, "Curves").
+SpecCurve read_curve(const json& j, std::string_view ptr, Context& ctx);
+/// read_curve's curve alone, for the constructions made of curves.
 BSplineCurve curve_impl(const json& j, std::string_view ptr, Context& ctx);
 
 // ---------------------------------------------------------------------------
@@ -216,7 +232,7 @@ template <std::size_t D>
 ApproximationOptions<D> approximation_options(const json& obj, std::string_view ptr, const std::vector<std::size_t>& shape,
                                               std::string_view pts_at);
 /// {"approximate": points, ...} as a curve (approximate.cpp), mapped onto [0, 1].
-BSplineCurve approximated_curve(const json& obj, std::string_view ptr, Context& ctx);
+SpecCurve approximated_curve(const json& obj, std::string_view ptr, Context& ctx);
 Construction build_trilinear(const json& spec, Context& ctx);
 Construction build_hermite_volume(const json& spec, Context& ctx);
 Construction build_coons_volume(const json& spec, Context& ctx);

@@ -57,16 +57,33 @@ void count_array_uses(const json& j, std::map<std::string, std::size_t, std::les
   }
 }
 
-Construction build_impl(const json& spec, Context& ctx) {
+constexpr std::string_view curve_keys[] = {"interpolate", "bspline", "hermite", "line", "approximate"};
+
+// Counts the uses of the in-memory arrays the spec names. An array the spec never
+// names is a field given twice (inline, or from a file, as well) or misnamed:
+// refused rather than ignored.
+void count_arrays(const json& spec, Context& ctx) {
   if (ctx.arrays && !ctx.arrays->empty()) count_array_uses(spec, ctx.array_uses);
-  // An array the spec never names is a field given twice (inline, or from a file, as
-  // well) or misnamed: refused rather than ignored.
   if (ctx.arrays)
     for (const auto& [name, array] : *ctx.arrays)
       if (!ctx.array_uses.contains(name))
         fail(errc::wrong_type, "arrays: \"", name, "\" is given but the spec names no {\"array\": \"", name, "\"}");
+}
+
+void finish(Timings& t, const Context& ctx) {
+  const auto done = Clock::now();
+  const auto parsed = ctx.parsed_at.value_or(done);
+  t.parse_ms = ms_between(ctx.start, parsed);
+  t.build_ms = ms_between(parsed, done);
+}
+
+Construction build_impl(const json& spec, Context& ctx) {
+  count_arrays(spec, ctx);
   if (!spec.is_object())
     fail(errc::wrong_type, "(top level): the spec must be a JSON object with a \"type\", got ", kind(spec));
+  if (is_curve_spec(spec))
+    fail(errc::missing_field, "(top level): the spec is a curve, not a construction with a \"type\"; a curve spec is "
+         "built as a curve (build_curve)");
   const json& t = member(spec, "type", "", cat("a string, one of ", type_list()));
   if (!t.is_string()) wrong_type("/type", cat("a string, one of ", type_list()), t);
   const auto& name = t.get_ref<const std::string&>();
@@ -76,13 +93,33 @@ Construction build_impl(const json& spec, Context& ctx) {
   check_fields(spec, "", type->fields, ctx);
   Construction c = type->build(spec, ctx);
   if (!ctx.defer_exact && c.convert) (void)has_exact_form_after_conversion(c);
-  const auto done = Clock::now();
-  const auto parsed = ctx.parsed_at.value_or(done);
   c.type = name;
   c.warnings = std::move(ctx.warnings);
-  c.timings.parse_ms = ms_between(ctx.start, parsed);
-  c.timings.build_ms = ms_between(parsed, done);
+  finish(c.timings, ctx);
   return c;
+}
+
+CurveConstruction build_curve_impl(const json& spec, Context& ctx) {
+  count_arrays(spec, ctx);
+  SpecCurve r = read_curve(spec, "", ctx);
+  CurveConstruction c{std::string(r.form), std::move(r.curve), {}, std::move(r.parameters), std::move(ctx.warnings), {}};
+  if (!r.points.empty()) {
+    DataSet d{{std::move(r.params)}, PointStorage(r.points.begin(), r.points.end()), {}, child("", r.form)};
+    if (r.form == "hermite") d.pointer = "/hermite/points";
+    c.data.push_back(std::move(d));
+  }
+  finish(c.timings, ctx);
+  return c;
+}
+
+// The context of a build: data files relative to `base_dir`, and the options.
+void set_options(Context& ctx, const std::filesystem::path& base_dir, const BuildOptions& options) {
+  ctx.base_dir = base_dir;
+  ctx.progress = options.progress;
+  ctx.keep_data = options.keep_data;
+  ctx.defer_exact = options.defer_exact;
+  ctx.arrays = &options.arrays;
+  ctx.borrow_arrays = options.borrow_arrays;
 }
 
 std::pair<std::size_t, std::size_t> line_column(std::string_view text, std::size_t pos) {
@@ -329,12 +366,7 @@ const Volume& volume_evaluator(const Construction& c) {
 
 Construction build(const json& spec, const std::filesystem::path& base_dir, const BuildOptions& options) {
   Context ctx;
-  ctx.base_dir = base_dir;
-  ctx.progress = options.progress;
-  ctx.keep_data = options.keep_data;
-  ctx.defer_exact = options.defer_exact;
-  ctx.arrays = &options.arrays;
-  ctx.borrow_arrays = options.borrow_arrays;
+  set_options(ctx, base_dir, options);
   return build_impl(spec, ctx);
 }
 
@@ -346,12 +378,7 @@ Construction build(const json& spec, const std::filesystem::path& base_dir, cons
 Construction build_file(const std::filesystem::path& spec_path, const BuildOptions& options) {
   Context ctx;  // starts the clock: reading the file counts as parsing
   const json spec = read_json_file(spec_path);
-  ctx.base_dir = spec_path.parent_path();
-  ctx.progress = options.progress;
-  ctx.keep_data = options.keep_data;
-  ctx.defer_exact = options.defer_exact;
-  ctx.arrays = &options.arrays;
-  ctx.borrow_arrays = options.borrow_arrays;
+  set_options(ctx, spec_path.parent_path(), options);
   return build_impl(spec, ctx);
 }
 
@@ -364,6 +391,32 @@ PointArray points_from_json(const json& j, std::size_t rank, const std::filesyst
   Context ctx;
   ctx.base_dir = base_dir;
   return points_impl(j, rank, pointer, ctx);
+}
+
+bool is_curve_spec(const json& spec) noexcept {
+  if (!spec.is_object() || spec.contains("type")) return false;
+  return std::any_of(std::begin(curve_keys), std::end(curve_keys), [&](std::string_view k) { return spec.contains(k); });
+}
+
+CurveConstruction build_curve(const json& spec, const std::filesystem::path& base_dir, const BuildOptions& options) {
+  Context ctx;
+  set_options(ctx, base_dir, options);
+  return build_curve_impl(spec, ctx);
+}
+
+Built build_any(const json& spec, const std::filesystem::path& base_dir, const BuildOptions& options) {
+  Context ctx;
+  set_options(ctx, base_dir, options);
+  if (is_curve_spec(spec)) return build_curve_impl(spec, ctx);
+  return build_impl(spec, ctx);
+}
+
+Built build_any_file(const std::filesystem::path& spec_path, const BuildOptions& options) {
+  Context ctx;  // starts the clock: reading the file counts as parsing
+  const json spec = read_json_file(spec_path);
+  set_options(ctx, spec_path.parent_path(), options);
+  if (is_curve_spec(spec)) return build_curve_impl(spec, ctx);
+  return build_impl(spec, ctx);
 }
 
 BSplineCurve curve_from_json(const json& j, const std::filesystem::path& base_dir, std::string_view pointer) {
