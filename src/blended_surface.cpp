@@ -565,7 +565,7 @@ std::array<KnotVector, 2> BlendedSurface::exact_knots() const {
   for (const auto& c : T.a) kv.push_back(c.knots());
   same_kind(ku);
   same_kind(kv);
-  return {merged_knots(ku), merged_knots(kv)};
+  return {merged_knots(snapped_together(ku)), merged_knots(snapped_together(kv))};  // as make_compatible
 }
 
 BSplineSurface BlendedSurface::to_bspline() const {

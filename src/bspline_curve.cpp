@@ -341,10 +341,16 @@ std::vector<BSplineCurve> make_compatible(std::span<const BSplineCurve> curves) 
   std::vector<KnotVector> knots;
   knots.reserve(curves.size());
   for (const auto& c : curves) knots.push_back(c.knots());
+  // Knots a rounding apart are one knot of every curve (each curve moves by rounding).
+  knots = snapped_together(knots);
   const auto merged = merged_knots(knots).interior_breaks();
   std::vector<BSplineCurve> out;
   out.reserve(curves.size());
-  for (const auto& c : curves) out.push_back(c.elevated(p - c.degree()));
+  for (std::size_t k = 0; k < curves.size(); ++k) {
+    const BSplineCurve& c = curves[k];
+    if (knots[k].values() == c.knots().values()) out.push_back(c.elevated(p - c.degree()));
+    else out.push_back(BSplineCurve(knots[k], c.control_points(), c.weights()).elevated(p - c.degree()));
+  }
   // Each curve refined on its own, the curves shared between the threads.
   detail::parallel_for(out.size(), out.size() > 1, detail::Share::one_by_one, [&](std::size_t k) {
     auto& c = out[k];

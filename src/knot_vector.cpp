@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "detail/text.hpp"
 
@@ -309,6 +310,48 @@ int KnotVector::continuity() const noexcept {
   int maxm = 0;
   for (const auto& [t, m] : interior_breaks()) maxm = std::max(maxm, m);
   return p_ - maxm;
+}
+
+std::vector<KnotVector> snapped_together(std::span<const KnotVector> knots) {
+  std::vector<KnotVector> out(knots.begin(), knots.end());
+  if (knots.empty()) return out;
+  const double a = knots.front().front(), b = knots.front().back();
+  const double room = 256 * std::numeric_limits<double>::epsilon() * std::max({std::abs(a), std::abs(b), b - a});
+  const bool periodic = knots.front().periodic();
+  // Where a knot goes: the smallest knot of its cluster (knots each within `room` of
+  // the next). Knots keep their order, so control points keep their places.
+  std::vector<double> all;
+  for (const KnotVector& k : knots)
+    for (const auto& [x, m] : k.interior_breaks()) all.push_back(x);
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  std::vector<double> to(all.size());
+  for (std::size_t i = 0; i < all.size(); ++i) to[i] = i > 0 && all[i] - all[i - 1] <= room ? to[i - 1] : all[i];
+  const auto target = [&](double x) {
+    return to[static_cast<std::size_t>(std::lower_bound(all.begin(), all.end(), x) - all.begin())];
+  };
+  for (KnotVector& k : out) {
+    const auto breaks = k.interior_breaks();
+    if (std::all_of(breaks.begin(), breaks.end(), [&](const auto& br) { return target(br.first) == br.first; })) continue;
+    std::vector<double> moved;
+    if (periodic) {
+      for (double x : k.period_knots()) moved.push_back(target(x));
+    } else {
+      moved = k.values();
+      for (std::size_t i = static_cast<std::size_t>(k.degree()) + 1; i + static_cast<std::size_t>(k.degree()) + 1 < moved.size(); ++i)
+        moved[i] = target(moved[i]);
+    }
+    // A knot more often than the degree allows: this vector keeps its own knots.
+    bool fits = true;
+    for (std::size_t i = 0, j = 0; i < moved.size(); i = j) {
+      while (j < moved.size() && moved[j] == moved[i]) ++j;
+      const bool end = !periodic && (moved[i] == a || moved[i] == b);
+      if (!end && static_cast<int>(j - i) > k.degree()) fits = false;
+    }
+    if (!fits) continue;
+    k = periodic ? KnotVector::periodic_from(k.degree(), std::move(moved), b) : KnotVector(k.degree(), std::move(moved));
+  }
+  return out;
 }
 
 KnotVector merged_knots(std::span<const KnotVector> knots) {

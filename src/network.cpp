@@ -602,7 +602,12 @@ std::vector<BSplineCurve> place_curves(const Prepared& n, const Arrangement& r, 
     jobs.push_back({&along[j], n.reshaped[az][j] ? &given : nullptr, &G[k], report[j].map});
   }
   if (!redo.empty()) {
-    auto fits = detail::refit(jobs, r.params[bz], closed, target);
+    std::vector<detail::Refit> fits;
+    try {
+      fits = detail::refit(jobs, r.params[bz], closed, target);
+    } catch (const detail::RefitShortfall& e) {
+      fail(errc::tolerance_not_met, n.name(a, r.order[az][redo[e.job()]]), ": ", e.what());
+    }
     for (std::size_t q = 0; q < redo.size(); ++q) {
       auto& rep = report[r.order[az][redo[q]]];
       rep.fit_error = fits[q].error;

@@ -706,6 +706,7 @@ std::optional<std::vector<Refit>> fit_group(const std::vector<FitJob>& jobs, con
   };
   int p_max = 1;
   for (std::size_t j : members) p_max = std::max(p_max, jobs[j].c->degree());
+  std::size_t worst_job = members.front();  // the curve farthest from its fit in the last round checked
   while (closed && spans_of(interior).size() < static_cast<std::size_t>(p_max) + 2) split_all();
   const std::size_t initial = std::max(interior.size(), all);
   std::vector<Refit> out;
@@ -741,13 +742,17 @@ std::optional<std::vector<Refit>> fit_group(const std::vector<FitJob>& jobs, con
     bool fitted = true;
     for (std::size_t j = 0; j < m; ++j) {
       fitted = fitted && fits[j].curve.has_value();
-      for (double e : err[j]) farthest = std::max(farthest, e);
+      for (double e : err[j])
+        if (e > farthest) {
+          farthest = e;
+          worst_job = members[j];
+        }
     }
     if (interior.size() > 64 * initial + 4096 && !(fitted && farthest <= target))
-      fail(errc::tolerance_not_met, "re-expressing ", m, " network curves at their common crossing parameters: ",
-           interior.size(), " knots still leave them ", farthest, " from the curves given, more than ", target,
-           " (half the tolerance); the curves are too rough or too far from the origin for their size to be held "
-           "that close: give a larger \"tolerance\"");
+      throw RefitShortfall(worst_job, cat("re-expressed at the common crossing parameters on ", interior.size(),
+                                          " knots, it stays ", farthest, " from the curve given, more than ", target,
+                                          " (half the tolerance): the curves are too rough or too far from the origin "
+                                          "for their size to be held that close; give a larger \"tolerance\""));
     bool again = false;
     for (std::size_t j = 0; j < m && !again; ++j) {
       if (fits[j].failed) split_all();
@@ -775,8 +780,9 @@ std::optional<std::vector<Refit>> fit_group(const std::vector<FitJob>& jobs, con
     interior.insert(interior.end(), cuts.begin(), cuts.end());
     std::sort(interior.begin(), interior.end());
   }
-  fail(errc::tolerance_not_met, "re-expressing ", m, " network curves at their common crossing parameters: 60 rounds of "
-       "knots did not bring them within ", target, " (half the tolerance) of the curves given: give a larger \"tolerance\"");
+  throw RefitShortfall(worst_job, cat("re-expressed at the common crossing parameters, 60 rounds of knots (", m,
+                                      " curves together) did not bring it within ", target,
+                                      " (half the tolerance) of the curve given: give a larger \"tolerance\""));
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "interpatch/bspline_curve.hpp"
+#include "interpatch/error.hpp"
 #include "interpatch/network.hpp"
 
 namespace interpatch::detail {
@@ -66,6 +67,17 @@ double inverse(const Reparametrization& map, double y);
 /// One curve to re-express: C (the prepared curve), the curve as given (both over
 /// [0, 1]; null when C is it, up to rounding), the correction G the surface adds along the curve's line (see
 /// network.cpp: S = D + G there), and the map.
+/// Thrown by refit() when a curve cannot be re-expressed within the target: which
+/// job, the message saying how far it stays. The network names the curve.
+class RefitShortfall : public error {
+ public:
+  RefitShortfall(std::size_t job, const std::string& message) : error(errc::tolerance_not_met, message), job_(job) {}
+  [[nodiscard]] std::size_t job() const noexcept { return job_; }
+
+ private:
+  std::size_t job_;
+};
+
 struct FitJob {
   const BSplineCurve* c;
   const BSplineCurve* given;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "interpatch/bspline_curve.hpp"
+#include "interpatch/evaluate.hpp"
 
 #include "test_util.hpp"
 
@@ -161,6 +162,79 @@ TEST(KnotVector, MergedKnotsAreTheKnotsOfCurvesMadeCompatible) {
     }
   }
   EXPECT_ERRC((void)merged_knots({}), too_few_points, "no knot vectors to merge");
+}
+
+// The same knot reached by different computations differs by rounding. Curves made
+// compatible take it as one knot (their exact form's space stays well conditioned):
+// random clamped and periodic vectors whose shared knots are moved by a few ulps
+// merge to the vector of the unmoved ones, and every curve keeps its shape.
+TEST(KnotVector, KnotsARoundingApartAreOne) {
+  auto g = test::rng(32);
+  for (int trial = 0; trial < 60; ++trial) {
+    const bool periodic = trial % 2 == 1;
+    const int p = 2 + static_cast<int>(test::uniform(g, 0, 2));
+    const int n = 2 + static_cast<int>(test::uniform(g, 0, 4));
+    // A common set of interior knots; each vector holds all of them, some moved by up
+    // to 8 units in the last place, and a knot of its own.
+    std::vector<double> common;
+    for (int k = 1; k < 6; ++k) common.push_back(k / 6.0 + test::uniform(g, -0.02, 0.02));
+    std::vector<KnotVector> exact, moved;
+    for (int k = 0; k < n; ++k) {
+      std::vector<double> a = common, b = common;
+      const double own = test::uniform(g, 0.05, 0.95);
+      a.push_back(own);
+      b.push_back(own);
+      for (double& x : b) x += static_cast<double>(static_cast<int>(test::uniform(g, -8, 9))) * std::numeric_limits<double>::epsilon() * 0.5;
+      if (periodic) {
+        // The seam starts the period; on every other vector a second knot there,
+        // which the moved vector has a rounding after it.
+        a.push_back(0.0);
+        b.push_back(0.0);
+        if (k % 2 == 0) {
+          a.push_back(0.0);
+          b.push_back(4 * std::numeric_limits<double>::epsilon());
+        }
+      }
+      std::sort(a.begin(), a.end());
+      std::sort(b.begin(), b.end());
+      if (periodic) {
+        exact.push_back(KnotVector::periodic_from(p, a, 1.0));
+        moved.push_back(KnotVector::periodic_from(p, b, 1.0));
+      } else {
+        std::vector<double> ua(static_cast<std::size_t>(p) + 1, 0.0), ub = ua;
+        ua.insert(ua.end(), a.begin(), a.end());
+        ub.insert(ub.end(), b.begin(), b.end());
+        ua.insert(ua.end(), static_cast<std::size_t>(p) + 1, 1.0);
+        ub.insert(ub.end(), static_cast<std::size_t>(p) + 1, 1.0);
+        exact.emplace_back(p, ua);
+        moved.emplace_back(p, ub);
+      }
+    }
+    SCOPED_TRACE(testing::Message() << "trial " << trial << (periodic ? " periodic" : " clamped"));
+    const KnotVector want = merged_knots(exact), got = merged_knots(snapped_together(moved));
+    EXPECT_EQ(got.count(), want.count());
+    const auto wb = want.interior_breaks(), gb = got.interior_breaks();
+    ASSERT_EQ(gb.size(), wb.size());
+    for (std::size_t q = 0; q < wb.size(); ++q) {
+      EXPECT_NEAR(gb[q].first, wb[q].first, 16 * std::numeric_limits<double>::epsilon());
+      EXPECT_EQ(gb[q].second, wb[q].second);
+    }
+    // The curves made compatible: one knot vector, each curve's shape to rounding.
+    std::vector<BSplineCurve> curves;
+    for (const KnotVector& kv : moved) {
+      std::vector<Vec3> cp(static_cast<std::size_t>(kv.count()));
+      for (Vec3& x : cp) x = test::random_point(g);
+      curves.emplace_back(kv, cp);
+    }
+    const auto compatible = make_compatible(curves);
+    for (std::size_t k = 0; k < curves.size(); ++k) {
+      EXPECT_EQ(compatible[k].knots(), got) << "curve " << k;
+      // Knots moved by 8 ulps move a curve of O(1) control points by about as much
+      // times its basis functions' slope (up to (p / h) with spans h > 1/50); 1e-12.
+      for (double t : linspace(0, periodic ? 0.999 : 1, 37))
+        EXPECT_LT(distance(compatible[k].point(t), curves[k].point(t)), 1e-12) << "curve " << k << " t " << t;
+    }
+  }
 }
 
 }  // namespace

@@ -154,4 +154,12 @@ class KnotVector {
 ///   clamped vectors mixed).
 [[nodiscard]] KnotVector merged_knots(std::span<const KnotVector> knots);
 
+/// The knot vectors with knots that differ by rounding moved onto one value: knots
+/// of different vectors within 256 ε of the domain's size (the same parameter
+/// reached along different computations) take the smallest of them, so knots keep
+/// their order (and curves their control points). Merged as they are, such knots would give a space with basis functions over a
+/// few units of rounding (nearly singular). A vector that would then hold a knot more
+/// than its degree times is left as it is. The knot vectors share their domain.
+[[nodiscard]] std::vector<KnotVector> snapped_together(std::span<const KnotVector> knots);
+
 }  // namespace interpatch
