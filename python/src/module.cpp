@@ -252,10 +252,25 @@ class PySurface : public PyBuilt {
   py::array_t<double> evaluate_derivatives(const py::object& us_in, const py::object& vs_in) const {
     auto us = params(us_in, "us"), vs = params(vs_in, "vs");
     std::unique_ptr<ip::Grid<ip::SurfaceDerivatives, 2>> out;
+    const ip::progress_callback progress = interruptible();
     {
       py::gil_scoped_release free;
       const ip::Surface& s = surface(us.size() * vs.size(), ip::io::Sample::derivatives);
-      out = std::make_unique<ip::Grid<ip::SurfaceDerivatives, 2>>(s.evaluate_derivatives(us, vs));
+      // A block of u rows at a time (about 2^16 points, a few milliseconds), Ctrl-C
+      // looked for between blocks: the surfaces' derivative grids take no callback.
+      const std::size_t rows = std::max<std::size_t>(1, (std::size_t{1} << 16) / std::max<std::size_t>(1, vs.size()));
+      if (us.size() <= rows) {
+        out = std::make_unique<ip::Grid<ip::SurfaceDerivatives, 2>>(s.evaluate_derivatives(us, vs));
+      } else {
+        out = std::make_unique<ip::Grid<ip::SurfaceDerivatives, 2>>(
+            ip::Grid<ip::SurfaceDerivatives, 2>::shape_type{us.size(), vs.size()}, ip::for_overwrite);
+        for (std::size_t i0 = 0; i0 < us.size(); i0 += rows) {
+          const auto block = std::span<const double>(us).subspan(i0, std::min(rows, us.size() - i0));
+          const ip::Grid<ip::SurfaceDerivatives, 2> d = s.evaluate_derivatives(block, vs);
+          std::copy(d.values().begin(), d.values().end(), out->data() + i0 * vs.size());
+          progress(static_cast<double>(i0 + block.size()) / static_cast<double>(us.size()));
+        }
+      }
     }
     static_assert(sizeof(ip::SurfaceDerivatives) == 18 * sizeof(double));
     double* data = &out->data()->s.x;

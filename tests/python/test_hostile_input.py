@@ -268,3 +268,13 @@ def test_ctrl_c_stops_a_long_call():
     c = interpatch.build(os.path.join(EXAMPLES, "coons.json"))
     assert_ctrl_c_stops(lambda n: c.evaluate(np.linspace(0, 1, n), np.linspace(0, 1, n)), 200, 6400)
     assert c.evaluate([0.5], [0.5]).shape == (1, 1, 3), "still usable"
+
+
+def test_ctrl_c_stops_a_long_derivative_evaluation():
+    c = interpatch.build(os.path.join(EXAMPLES, "coons.json"))
+    assert_ctrl_c_stops(lambda n: c.evaluate_derivatives(np.linspace(0, 1, n), np.linspace(0, 1, n)), 200, 6400)
+    # Evaluated a block of rows at a time, the same values as in one piece.
+    t = np.linspace(0, 1, 700)
+    whole = c.evaluate_derivatives(t, t)
+    for k in (0, 350, 699):
+        assert np.array_equal(whole[k], c.evaluate_derivatives(t[k:k + 1], t)[0])
