@@ -118,18 +118,21 @@ json network_spec(const Network& net) {
 // PromiseNetworks.GordonAndCoonsNetworks and replayed by the DISABLED_ tests below.
 //
 // 1. drawn networks (no parameters, curves reversed) of parts 1e-3 across near 1e8,
-//    where doubles keep 5 digits of the part: the arrangement turns a curve the wrong
-//    way round and the surface departs from it by up to 2e-3, with a warning (never
-//    silently). 69 cases of this kind failed with errc::internal, "found no knots
-//    that fit them"; with tolerances floored at the rounding of the coordinates (at
-//    most 1e-5 of the diagonal) most now build and pass, 19 are refused with
-//    tolerance_not_met. Working relative to the part's centre is the fix left to do.
-const std::set<std::size_t> kFarTinyPartTurned = {25, 39, 201, 323, 363, 657, 801, 903};
+//    where doubles keep 5 digits of the part: the arrangement turns a curve the other
+//    way round than the harness drew it. 69 cases of this kind failed with
+//    errc::internal, "found no knots that fit them"; with tolerances floored at the
+//    rounding of the coordinates (at most 1e-5 of the diagonal) and a surface that
+//    departs from a curve by more than 4 times the tolerance refused, all but these
+//    two build and pass or are refused with tolerance_not_met. In these two the
+//    construction measures the surface within the tolerance of the curve; the
+//    harness finds it run the other way.
+//    Working relative to the part's centre is the fix left to do.
+const std::set<std::size_t> kFarTinyPartTurned = {25, 363};
 // 2. the formula (BlendedSurface) and the exact form differ by more than 1e-12 of
-//    the data's size (3.6e-12 in case 67, a drawn network near 1e114).
-const std::set<std::size_t> kFormulaVsExact = {67,  91,  125, 128, 152, 167, 208, 284, 298, 300,
-                                               301, 307, 375, 382, 419, 461, 575, 607, 730, 761,
-                                               807, 844, 889, 897, 898, 905, 915, 917, 951};
+//    the data's size (3.6e-12 in case 67, a drawn network near 1e114), within the
+//    1e-8 the exact-form check of every build allows.
+const std::set<std::size_t> kFormulaVsExact = {67,  91,  125, 128, 152, 167, 208, 298, 300, 301, 307, 375,
+                                               419, 461, 575, 607, 761, 807, 898, 905, 915, 917, 951};
 
 void network_family(const std::set<std::size_t>& known, const std::set<std::size_t>* only) {
   Network net;

@@ -349,6 +349,16 @@ Construction build_network(const json& spec, Context& ctx) {
       else reported[ptr]["range"] = {from, to};
       if (c.closing) reported[ptr]["closing"] = true;
       if (c.degenerate) reported[ptr]["degenerate"] = true;
+      // Curves missing each other by up to the tolerance move the surface by about half
+      // of that, the re-expression by up to half the tolerance more, and the cardinal
+      // functions' overshoot spreads a correction by less than twice: beyond 4 times the
+      // tolerance the network is not what it was given as (a curve arranged the wrong
+      // way round, say), and the promise to pass the curves is not kept.
+      if (c.distance > 4 * r.tolerance)
+        fail(errc::tolerance_not_met, ptr, ": the surface departs from this curve by up to ", c.distance,
+             ", more than 4 times the tolerance ", r.tolerance,
+             " could explain: the curves are not held as given (a part too small for its distance from the origin, "
+             "or curves nearly on top of one another)");
       if (c.distance > r.strict)
         ctx.warn(cat(ptr, ": the surface departs from this curve by up to ", c.distance, ", more than ",
                      r.strict > 1e-7 * r.diagonal ? "the rounding of its coordinates" : "1e-7 of the diagonal", " (",
