@@ -10,10 +10,9 @@ SHELL := /bin/bash
 #   nlohmann-json3-dev               specs and JSON output (the io library only; the core needs none)
 #   libeigen3-dev                    the sparse Cholesky decomposition of approximation's normal equations
 #   pybind11-dev python3-dev         the Python module (import interpatch)
-#   nodejs npm                       npm ci installs three.js for the viewer (viewer/package-lock.json);
-#                                    installed only when npm is not already on PATH
+# and three.js for the viewer from the npm registry (viewer-deps, below): no Debian package.
 BUILD_DEBS := cmake ninja-build g++ python3 libcli11-dev nlohmann-json3-dev libeigen3-dev \
-        pybind11-dev python3-dev $(if $(shell command -v npm),,nodejs npm)
+        pybind11-dev python3-dev
 # The tests: `make test` (and the targets that run tests or open a browser) adds these.
 #   libgtest-dev libgmock-dev        the C++ tests
 #   pkg-config                       the tests build a program against the installed .pc files
@@ -74,10 +73,14 @@ bench-deps:
 	$(call install_missing,$(BUILD_DEBS) $(BENCH_DEBS))
 
 # three.js for the viewer page, as viewer/package-lock.json pins it (the build embeds
-# it and stops without it). Again whenever the lock file changes.
+# it and stops without it). Again whenever the lock file changes. `npm ci` where npm
+# is installed; elsewhere tools/fetch_viewer_deps.py fetches the same tarball and
+# checks the lock file's hash, which spares a demo Debian's nodejs and npm (over 300
+# packages, half the time of a fresh `make demo`).
 viewer-deps: deps viewer/node_modules/.package-lock.json
 viewer/node_modules/.package-lock.json: viewer/package-lock.json viewer/package.json
-	npm ci --prefix viewer --no-audit --no-fund
+	if command -v npm >/dev/null; then npm ci --prefix viewer --no-audit --no-fund; \
+	else python3 tools/fetch_viewer_deps.py viewer; fi
 	touch $@
 
 build: viewer-deps

@@ -7,8 +7,9 @@ installs the package interpatch (the compiled _core, __init__.pyi, py.typed) int
 and the command into V/bin. The CMake tree is build/temp.*/cmake; with
 INTERPATCH_CMAKE_BUILD_DIR naming a configured tree (build/release) the module and
 the command are built there instead, as they are for the tests, without configuring
-it again. A source tree without viewer/node_modules gets three.js by `npm ci`, as
-`make build` does: the library embeds it in the pages `interpatch view` writes.
+it again. A source tree without viewer/node_modules gets three.js as `make build`
+gets it (npm ci, or tools/fetch_viewer_deps.py without npm): the library embeds it
+in the pages `interpatch view` writes.
 """
 
 import os
@@ -36,12 +37,13 @@ def run(*command, **kwargs):
 
 
 def three_js():
+    """viewer/node_modules as `make build` makes it: the library embeds three.js."""
     if (ROOT / "viewer" / "node_modules" / "three" / "package.json").exists():
         return
-    if not shutil.which("npm"):
-        sys.exit("interpatch: the viewer needs three.js in viewer/node_modules, and npm is not on PATH to install "
-                 "it (Debian: apt-get install npm, then pip install again, or run `npm ci --prefix viewer`)")
-    run("npm", "ci", "--prefix", ROOT / "viewer", "--no-audit", "--no-fund")
+    if shutil.which("npm"):
+        run("npm", "ci", "--prefix", ROOT / "viewer", "--no-audit", "--no-fund")
+    else:
+        run(sys.executable, ROOT / "tools" / "fetch_viewer_deps.py", ROOT / "viewer")
 
 
 class CMakeBuild(build_ext):
