@@ -5,7 +5,8 @@ SHELL := /bin/bash
 # Three lists of Debian packages, by purpose (the README's "Dependencies" says the same).
 # The build: `make demo`, `make build`, `make install`.
 #   cmake ninja-build g++            the build (C++20, CMake presets; OpenMP is g++'s libgomp)
-#   python3                          the build checks the public headers with a generated list
+#   python3                          configure (the header and snippet checks), the Python module,
+#                                    tools/fetch_viewer_deps.py
 #   libcli11-dev                     the command line's option parser
 #   nlohmann-json3-dev               specs and JSON output (the io library only; the core needs none)
 #   libeigen3-dev                    the sparse Cholesky decomposition of approximation's normal equations
@@ -76,7 +77,7 @@ bench-deps:
 # it and stops without it). Again whenever the lock file changes. `npm ci` where npm
 # is installed; elsewhere tools/fetch_viewer_deps.py fetches the same tarball and
 # checks the lock file's hash, which spares a demo Debian's nodejs and npm (over 300
-# packages, half the time of a fresh `make demo`).
+# packages, most of a fresh `make demo`'s apt time).
 viewer-deps: deps viewer/node_modules/.package-lock.json
 viewer/node_modules/.package-lock.json: viewer/package-lock.json viewer/package.json
 	if command -v npm >/dev/null; then npm ci --prefix viewer --no-audit --no-fund; \
