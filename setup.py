@@ -31,9 +31,9 @@ def version():
     return re.search(r"project\(interpatch VERSION (\S+)", (ROOT / "CMakeLists.txt").read_text()).group(1)
 
 
-def run(*command, **kwargs):
+def run(*command):
     print("interpatch:", " ".join(str(c) for c in command), flush=True)
-    subprocess.run([str(c) for c in command], check=True, **kwargs)
+    subprocess.run([str(c) for c in command], check=True)
 
 
 def three_js():
