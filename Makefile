@@ -2,58 +2,86 @@
 # Each installs what is missing from Debian's packages first.
 
 SHELL := /bin/bash
-# What each package is for (the README's "Dependencies" says the same):
-#   cmake ninja-build g++            the build (C++20, CMake presets)
-#   pkg-config                       the tests build a program against the installed .pc files
+# Three lists of Debian packages, by purpose (the README's "Dependencies" says the same).
+# The build: `make demo`, `make build`, `make install`.
+#   cmake ninja-build g++            the build (C++20, CMake presets; OpenMP is g++'s libgomp)
+#   python3                          configure (the header and snippet checks), the Python module,
+#                                    tools/fetch_viewer_deps.py
 #   libcli11-dev                     the command line's option parser
 #   nlohmann-json3-dev               specs and JSON output (the io library only; the core needs none)
-#   libgtest-dev libgmock-dev        the tests;  libbenchmark-dev: make bench
-#   python3 python3-numpy            the reference-data script and the read-back checks
-#   python3-scipy                    the closed-spline reference data (tools/reference/make_periodic_reference.py)
-#   python3-vtk9                     VTK's own readers read back the .vts/.vtk/.xyz files interpatch writes
-#   python3-matplotlib               make bench draws docs/bench_interpolation.png
-#   pybind11-dev python3-dev         the Python module (import interpatch)
-#   python3-pytest                   its test suite
-#   python3-hypothesis               its fuzz tests: random arrays into the constructors (tests/python/test_fuzz.py)
-#   libocct-*-dev                    OpenCASCADE reads back the STEP and IGES files (tests) and races us (make bench)
-#   libsisl-dev                      SISL races us in make bench
-#   clang libclang-rt-14-dev libomp-14-dev   libFuzzer (with its OpenMP) runs the fuzz targets of make test
 #   libeigen3-dev                    the sparse Cholesky decomposition of approximation's normal equations
+#   pybind11-dev python3-dev         the Python module (import interpatch)
+# and three.js for the viewer from the npm registry (viewer-deps, below): no Debian package.
+BUILD_DEBS := cmake ninja-build g++ python3 libcli11-dev nlohmann-json3-dev libeigen3-dev \
+        pybind11-dev python3-dev
+# The tests: `make test` (and the targets that run tests or open a browser) adds these.
+#   libgtest-dev libgmock-dev        the C++ tests
+#   pkg-config                       the tests build a program against the installed .pc files
+#   python3-numpy                    the reference-data script and the read-back checks
+#   python3-scipy                    the closed-spline and least-squares reference data (tools/reference/)
+#   python3-vtk9                     VTK's own readers read back the .vts/.vtk/.xyz files interpatch writes
+#   python3-pytest                   the Python module's test suite
+#   python3-hypothesis               its fuzz tests: random arrays into the constructors (tests/python/test_fuzz.py)
+#   python3-matplotlib               the README's Python example, run by that suite
+#   python3-venv python3-pip python3-setuptools python3-wheel
+#                                    `pip install .` into a virtual environment, then the suite against it
+#   libocct-*-dev                    OpenCASCADE reads back the STEP and IGES files
+#   clang libclang-rt-14-dev libomp-14-dev   libFuzzer (with its OpenMP) runs the fuzz targets
 #   chromium chromium-driver python3-selenium   the viewer pages opened in a real browser (make test,
 #                                    make pictures, make bench-viewer)
-#   nodejs npm                       npm ci installs three.js for the viewer (viewer/package-lock.json);
-#                                    installed only when npm is not already on PATH
 #   libopenmpi-dev openmpi-bin       MPI: eval and build split between processes (mpirun; docs/mpi.md) and their tests
-DEBS := cmake ninja-build g++ pkg-config python3 libcli11-dev nlohmann-json3-dev \
-        libgtest-dev libgmock-dev libbenchmark-dev python3-numpy python3-vtk9 python3-matplotlib \
+TEST_DEBS := libgtest-dev libgmock-dev pkg-config python3-numpy python3-scipy python3-vtk9 \
+        python3-pytest python3-hypothesis python3-matplotlib \
+        python3-venv python3-pip python3-setuptools python3-wheel \
         libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
-        libocct-foundation-dev libsisl-dev python3-scipy clang libclang-rt-14-dev libomp-14-dev \
-        pybind11-dev python3-pybind11 python3-dev python3-pytest python3-hypothesis \
-        libeigen3-dev chromium chromium-driver python3-selenium $(if $(shell command -v npm),,nodejs npm) \
-        libopenmpi-dev openmpi-bin
+        libocct-foundation-dev clang libclang-rt-14-dev libomp-14-dev \
+        chromium chromium-driver python3-selenium libopenmpi-dev openmpi-bin
+# The benchmarks: `make bench` adds these.
+#   libbenchmark-dev                 Google Benchmark (bench/interpatch_bench)
+#   libocct-*-dev libsisl-dev        OpenCASCADE and SISL race interpatch (bench/compare)
+#   python3-matplotlib               make bench draws docs/bench_interpolation.png
+#   python3-scipy                    tools/bench_fitpack.py races FITPACK (run by hand)
+BENCH_DEBS := libbenchmark-dev libocct-data-exchange-dev libocct-modeling-algorithms-dev \
+        libocct-modeling-data-dev libocct-foundation-dev libsisl-dev python3-matplotlib python3-scipy
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
-.PHONY: all deps viewer-deps build install demo test test-release test-asan test-fuzz fuzz fuzz-build promise bench clean \
-        pictures bench-viewer
+.PHONY: all deps test-deps bench-deps viewer-deps build install demo test test-release test-asan test-fuzz \
+        fuzz fuzz-build promise bench clean pictures bench-viewer
+# Prerequisites run in the order written, so that a target's packages are installed
+# before its configure looks for them (cmake parallelizes the builds themselves).
+.NOTPARALLEL:
 
 all: build
 
+# apt-get update, then whatever the list holds that is missing, in one apt-get call.
+define install_missing
+@missing=""; for p in $(1); do \
+  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" || missing="$$missing $$p"; \
+done; \
+if [ -n "$$missing" ]; then \
+  echo "interpatch: installing from Debian:$$missing"; \
+  $(SUDO) apt-get update -qq && \
+  $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing; \
+fi
+endef
+
 deps:
-	@missing=""; for p in $(DEBS); do \
-	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" || missing="$$missing $$p"; \
-	done; \
-	if [ -n "$$missing" ]; then \
-	  echo "interpatch: installing from Debian:$$missing"; \
-	  $(SUDO) apt-get update -qq && \
-	  $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing; \
-	fi
+	$(call install_missing,$(BUILD_DEBS))
+test-deps:
+	$(call install_missing,$(BUILD_DEBS) $(TEST_DEBS))
+bench-deps:
+	$(call install_missing,$(BUILD_DEBS) $(BENCH_DEBS))
 
 # three.js for the viewer page, as viewer/package-lock.json pins it (the build embeds
-# it and stops without it). Again whenever the lock file changes.
+# it and stops without it). Again whenever the lock file changes. `npm ci` where npm
+# is installed; elsewhere tools/fetch_viewer_deps.py fetches the same tarball and
+# checks the lock file's hash, which spares a demo Debian's nodejs and npm (over 300
+# packages, most of a fresh `make demo`'s apt time).
 viewer-deps: deps viewer/node_modules/.package-lock.json
 viewer/node_modules/.package-lock.json: viewer/package-lock.json viewer/package.json
-	npm ci --prefix viewer --no-audit --no-fund
+	if command -v npm >/dev/null; then npm ci --prefix viewer --no-audit --no-fund; \
+	else python3 tools/fetch_viewer_deps.py viewer; fi
 	touch $@
 
 build: viewer-deps
@@ -61,22 +89,27 @@ build: viewer-deps
 	cmake --build --preset release -j $(JOBS)
 
 # The library (interpatch::core, interpatch::io), its headers, CMake package and
-# pkg-config files, and the interpatch command, under PREFIX (sudo for /usr/local).
+# pkg-config files, the interpatch command and the Python module, under PREFIX (sudo
+# for /usr/local).
 PREFIX ?= /usr/local
 install: build
 	cmake --install build/release --prefix $(PREFIX)
 
-demo: build
+# The command alone: the demo needs nothing else, and the tests, examples and the
+# Python module are most of the build.
+demo: viewer-deps
+	cmake --preset release
+	cmake --build --preset release --target interpatch_cli -j $(JOBS)
 	./build/release/interpatch demo -o demo-output
 
-test-release: build
+test-release: test-deps build
 	ctest --preset release -j $(JOBS)
 
 # The sanitizer build with line tables alone (-g1, CMakePresets.json): three quarters of
 # the compile time of -g, and the reports still name every function, file and line. It
 # stays at -O2: tests compare networks with fixtures made at -O3, and -O1 rounds a knot
 # differently enough to change a merge.
-test-asan: viewer-deps
+test-asan: test-deps viewer-deps
 	cmake --preset asan
 	cmake --build --preset asan -j $(JOBS)
 	ctest --preset asan -j $(JOBS)
@@ -87,7 +120,7 @@ test-asan: viewer-deps
 FUZZ_TEST_SECONDS ?= 20
 FUZZ_SECONDS ?= 600
 
-fuzz-build: viewer-deps
+fuzz-build: test-deps viewer-deps
 	cmake --preset fuzz
 	cmake --build --preset fuzz -j $(JOBS)
 
@@ -102,7 +135,7 @@ fuzz: fuzz-build
 # family's seed and the case index, which INTERPATCH_PROMISE_REPLAY=<index> replays.
 PROMISE_CASES ?= 50
 
-promise: build
+promise: test-deps build
 	INTERPATCH_PROMISE_CASES=$(PROMISE_CASES) ./build/release/tests/interpatch_tests --gtest_filter='Promise*'
 
 test: test-release test-asan test-fuzz
@@ -120,7 +153,7 @@ BENCH_OUT ?= build/bench/results.json
 # docs/bench_interpolation.png and prints the Markdown tables of docs/BENCHMARKS.md.
 COMPARE_FLAGS ?= --reps 5
 COMPARE_OUT ?= build/bench/compare.json
-bench: viewer-deps
+bench: bench-deps viewer-deps
 	cmake --preset bench
 	cmake --build --preset bench -j $(JOBS)
 	env $(BENCH_ENV) ./build/bench/bench/interpatch_bench $(BENCH_FLAGS) \
@@ -131,13 +164,13 @@ bench: viewer-deps
 	/usr/bin/python3 tools/plot_bench.py $(COMPARE_OUT) -o docs/bench_interpolation.png
 
 # The README's pictures: viewer pages of the examples rendered to docs/images/*.png
-# by headless Chromium (tools/make_pictures.py).
-pictures: build
+# by headless Chromium (tools/make_pictures.py; the test list brings the browser).
+pictures: test-deps build
 	/usr/bin/python3 tools/make_pictures.py ./build/release/interpatch docs/images
 
 # A 1000 x 1000 surface's viewer page: its size, the time `interpatch view` takes to
 # write it and the time Chromium takes to open and draw it (docs/BENCHMARKS.md).
-bench-viewer: build
+bench-viewer: test-deps build
 	/usr/bin/python3 tools/bench_viewer.py ./build/release/interpatch build/bench-viewer
 
 clean:

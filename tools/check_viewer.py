@@ -6,11 +6,14 @@ viewer_browser_*): a surface, a network, a volume and a large grid.
 For the case's page: it loads with no console error and makes no network request;
 the canvas is drawn where the model is; showing the control net and changing the
 colouring (and, for a volume, showing a slice) change the picture; the summary
-panel holds the same numbers as `interpatch info` on the same spec.
+panel holds the same numbers as `interpatch info` on the same spec, shown to 4
+significant digits with every digit in the cell's title (on hover).
 """
 
 import json
+import math
 import os
+import re
 import subprocess
 import sys
 
@@ -63,6 +66,17 @@ def lookup(info, key):
     for part in key.split("."):
         value = value[part]
     return value
+
+
+def readable(text, value):
+    """text is value to 4 significant digits (at most 4 digits, within half a unit of the last)."""
+    try:
+        shown = float(text)
+    except ValueError:
+        return False
+    mantissa = re.sub(r"e.*$", "", text).lstrip("-").replace(".", "").lstrip("0")
+    last = 10.0 ** (math.floor(math.log10(abs(value))) - 3)
+    return len(mantissa) <= 4 and abs(shown - value) <= 0.5 * last * (1 + 1e-9)
 
 
 def main():
@@ -133,6 +147,20 @@ def main():
                 expect(info["max_data_error"] is None, "the summary says there are no data points")
             else:
                 expect(lookup(info, key) == value, f"{key}: the page says {value!r}, interpatch info {lookup(info, key)!r}")
+        # As read: counts whole, other numbers to 4 significant digits, every digit on hover.
+        rounded = 0
+        for key, (text, title) in vb.info_shown(driver).items():
+            value = panel[key]
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                continue
+            if isinstance(value, int) or value.is_integer():
+                expect(text == str(int(value)) and title is None, f"{key}: {value!r} shown as {text!r} (title {title!r})")
+                continue
+            expect(readable(text, value), f"{key}: {value!r} shown as {text!r}, not to 4 significant digits")
+            if readable(text, value) and float(text) != value:
+                rounded += 1
+                expect(title is not None and float(title) == value, f"{key}: the title {title!r} is not {value!r}")
+        expect(rounded > 0, "no number of the summary is rounded: nothing to check the formatting on")
     finally:
         driver.quit()
     for f in failures:

@@ -130,6 +130,14 @@ def info_panel(driver):
     return {k: json.loads(v) for k, v in rows}
 
 
+def info_shown(driver):
+    """The summary panel's rows as a reader sees them: {key: (text, title or None)}."""
+    rows = driver.execute_script(
+        "return [...document.querySelectorAll('#info tr')]"
+        ".map(r => [r.dataset.key, r.cells[1].textContent, r.cells[1].getAttribute('title')])")
+    return {k: (text, title) for k, text, title in rows}
+
+
 def view_element(driver):
     """The element holding the 3D view (the canvas), for screenshots."""
     return driver.find_element(By.ID, "view")

@@ -83,9 +83,14 @@ function rangeOf(values, signed) {
   return [-m, m];
 }
 
+// A number as people read it: 4 significant digits, trailing zeros dropped
+// (2.331e-7, 0.785, 12.5); the summary keeps integers whole and every digit in a title.
 function fmt(x) {
   if (!Number.isFinite(x)) return String(x);
-  return Math.abs(x) >= 1e4 || (Math.abs(x) < 1e-3 && x !== 0) ? x.toExponential(3) : x.toPrecision(4);
+  const s = Math.abs(x) >= 1e4 || (Math.abs(x) < 1e-3 && x !== 0) ? x.toExponential(3) : x.toPrecision(4);
+  const [mantissa, exponent] = s.split('e');
+  const m = mantissa.includes('.') ? mantissa.replace(/\.?0+$/, '') : mantissa;
+  return exponent === undefined ? m : `${m}e${exponent}`;
 }
 
 function drawLegend(stops, range, label) {
@@ -329,8 +334,11 @@ function addFrames(frames) {
 function addInfo(info) {
   const rows = [];
   const add = (key, label, value) => { if (value !== undefined && value !== null) rows.push([key, label, value]); };
-  const text = (v) => (Array.isArray(v) ? v.map(text).join(' × ') : typeof v === 'object' && v !== null
-    ? Object.entries(v).map(([k, x]) => `${k}: ${text(x)}`).join(', ') : String(v));
+  // shown: counts whole, other numbers to 4 digits; full: every digit, for the title.
+  const text = (v, number) => (Array.isArray(v) ? v.map((x) => text(x, number)).join(' × ')
+    : typeof v === 'object' && v !== null ? Object.entries(v).map(([k, x]) => `${k}: ${text(x, number)}`).join(', ')
+      : typeof v === 'number' ? number(v) : String(v));
+  const shown = (x) => (Number.isInteger(x) ? String(x) : fmt(x));
   add('type', 'type', info.type);
   add('kind', 'kind', info.kind);
   add('exact_form', 'exact form', info.exact_form ?? `none: ${info.no_exact_form}`);
@@ -362,7 +370,9 @@ function addInfo(info) {
     tr.dataset.key = key;
     tr.insertCell().textContent = label;
     const td = tr.insertCell();
-    td.textContent = text(value);
+    td.textContent = text(value, shown);
+    const full = text(value, String);
+    if (full !== td.textContent) td.title = full;
     td.dataset.value = JSON.stringify(value);
   }
 }
