@@ -239,6 +239,20 @@ void iges_files(const fs::path& examples) {
   std::printf("terrain as IGES: %zu lines of 80 columns\n", lines.size());
 }
 
+// A curve to STEP (a B-spline curve in a wireframe representation) and to IGES
+// (entity 126).
+void curve_files() {
+  interpatch::io::write_step("edge.step", interpatch::line({0, 0, 0}, {10, 0, 0}), {.name = "edge", .time_stamp = {}});
+  example::expect(read_text("edge.step").find("B_SPLINE_CURVE_WITH_KNOTS") != std::string::npos,
+                  "the edge is a B-spline curve in STEP");
+  interpatch::io::write_iges("edge.igs", interpatch::line({0, 0, 0}, {10, 0, 0}));
+  std::size_t entities = 0;
+  for (const auto& l : lines_of(read_text("edge.igs")))
+    if (l[72] == 'D' && std::stoi(l.substr(73)) % 2 == 1 && l.starts_with("     126")) ++entities;
+  example::expect(entities == 1, "one entity 126 for the curve in IGES");
+  std::printf("a line as STEP and IGES\n");
+}
+
 // The viewer page (io/view.hpp): one HTML file holding everything it shows.
 void view_pages(const fs::path& examples) {
   fs::copy_file(examples / "coons.json", "coons.json");
@@ -322,6 +336,7 @@ int main() {
     meshes();
     step_files(INTERPATCH_EXAMPLES_DIR);
     iges_files(INTERPATCH_EXAMPLES_DIR);
+    curve_files();
     npz_files();
     view_pages(INTERPATCH_EXAMPLES_DIR);
     output_checks();

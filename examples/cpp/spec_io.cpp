@@ -101,6 +101,20 @@ void curves() {
   std::printf("line as a curve: C(0.5) = %s\n", example::str(c.point(0.5)).c_str());
 }
 
+// A curve spec at the top level: the curve, and its data with their parameters.
+void curve_specs() {
+  auto spec = interpatch::io::parse_json(R"({"interpolate": [[0,0,0], [1,1,0], [2,0,0]], "degree": 2})");
+  interpatch::io::CurveConstruction c = interpatch::io::build_curve(spec);
+  interpatch::Vec3 p = c.curve.point(c.data[0].params[0][1]);  // (1, 1, 0) up to rounding
+  example::expect_near(p, {1, 1, 0}, "the curve passes its middle point at its parameter");
+  // Its exact form as a {"bspline": ...} curve spec.
+  std::ostringstream text;
+  interpatch::io::write_exact_json(text, interpatch::line({0, 0, 0}, {1, 0, 0}));
+  example::expect(text.str().find("\"bspline\"") != std::string::npos, "a curve's exact form is a bspline curve spec");
+  interpatch::io::write_exact_json(std::cout, interpatch::line({0, 0, 0}, {1, 0, 0}));
+  std::printf("\n");
+}
+
 }  // namespace
 
 int main() {
@@ -110,5 +124,6 @@ int main() {
     sampling();
     point_arrays();
     curves();
+    curve_specs();
   });
 }

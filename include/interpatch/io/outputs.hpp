@@ -104,8 +104,9 @@ void write_build(const CurveConstruction& c, const std::filesystem::path& out);
 /// @code
 ///   constexpr interpatch::io::CountsOption res{"res", "mesh", "vertices", "(nu, nv)", "(nu, nv, nw)", "(64, 64)",
 ///                                              "(33, 33, 33)", false, " (", ", ", ")"};
-///   for (const std::string& w : interpatch::io::write_mesh(c, "patch.vts", {200, 100, 0}, res))  // "res (0, 5): ..." for {0, 5, 0}
-///     std::fprintf(stderr, "warning: %s\n", w.c_str());
+///   // Warnings are the writer's word to the user (an STL far from the origin for its size).
+///   for (const std::string& w : interpatch::io::write_mesh(c, "patch.vts", {200, 100, 0}, res))
+///     std::printf("warning: %s\n", w.c_str());
 /// @endcode
 /// @throws error wrong_type, too_few_points, size_mismatch, too_large, file_unwritable.
 /// @returns the writer's warnings for the user (write_surface_mesh: an STL far from

@@ -81,7 +81,7 @@ void write_step(const std::filesystem::path& path, const ExactForm& exact, const
 ///
 /// Example:
 /// @code
-///   interpatch::io::write_step("edge.step", interpatch::line({0, 0, 0}, {10, 0, 0}), {.name = "edge"});
+///   interpatch::io::write_step("edge.step", interpatch::line({0, 0, 0}, {10, 0, 0}), {.name = "edge", .time_stamp = {}});
 /// @endcode
 /// @throws error file_unwritable.
 void write_step(std::ostream& os, const BSplineCurve& curve, const StepOptions& options = {});
