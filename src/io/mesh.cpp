@@ -21,6 +21,7 @@
 #include "interpatch/evaluate.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/memory.hpp"
+#include "io/box.hpp"
 #include "io/extension.hpp"
 #include "io/finite.hpp"
 
@@ -677,16 +678,13 @@ namespace {
 /// shape there. Says by how much, when that is over 1e-5 of the mesh's diagonal
 /// (1 µm on a 100 mm part).
 std::vector<std::string> float32_warnings(const fs::path& path, const PointGrid& g) {
-  constexpr double inf = std::numeric_limits<double>::infinity();
-  Vec3 lo{inf, inf, inf}, hi = -lo;
+  internal::Box box;
   double moved = 0;
-  for (const Vec3& p : g.values())
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], p[a]);
-      hi[a] = std::max(hi[a], p[a]);
-      moved = std::max(moved, std::abs(p[a] - static_cast<double>(static_cast<float>(p[a]))));
-    }
-  const double diagonal = norm(hi - lo);
+  for (const Vec3& p : g.values()) {
+    box.add(p);
+    for (int a = 0; a < 3; ++a) moved = std::max(moved, std::abs(p[a] - static_cast<double>(static_cast<float>(p[a]))));
+  }
+  const double diagonal = box.diagonal();
   if (!(moved > 1e-5 * diagonal)) return {};
   return {detail::cat(quoted(path), " holds float32 coordinates (binary STL has no others): rounding moves its points by up to ",
               moved, diagonal > 0 ? detail::cat(", ", moved / diagonal, " of the mesh's diagonal ", diagonal) : std::string(),

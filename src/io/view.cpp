@@ -21,6 +21,7 @@
 #include "interpatch/io/json_out.hpp"
 #include "interpatch/memory.hpp"
 #include "interpatch/volume.hpp"
+#include "io/box.hpp"
 #include "io/finite.hpp"
 #include "io/viewer_assets.hpp"
 
@@ -128,19 +129,8 @@ struct PageFrame {
   [[nodiscard]] ojson json() const { return {{"origin", {origin.x, origin.y, origin.z}}, {"unit", unit}}; }
 };
 
-// The box of finite points; first > second in every coordinate when there are none.
-struct Box3 {
-  Vec3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
-          std::numeric_limits<double>::infinity()};
-  Vec3 hi = -lo;
-  void add(const Vec3& p) {
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return;
-    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-  }
-};
-
-PageFrame page_frame(const Box3& box) {
+// The frame of the box of the finite points shown (none: the identity).
+PageFrame page_frame(const internal::Box& box) {
   if (!(box.lo.x <= box.hi.x)) return {};
   PageFrame f;
   // Halves first: (lo + hi) / 2 overflows for coordinates near the largest double.
@@ -298,20 +288,23 @@ ojson volume_json(const Volume& v, const std::array<std::size_t, 3>& res, const 
 // (9 × 9 × 9), its control net and its data. It need not hold every sample: it only
 // has to keep them near 1 in size.
 PageFrame construction_frame(const Construction& c) {
-  Box3 box;
+  internal::Box box;
+  const auto add = [&](const Vec3& p) {
+    if (is_finite(p)) box.add(p);
+  };
   if (is_volume(c)) {
     const std::vector<double> t = linspace(0, 1, 9);
     const PointGrid3 samples = volume_evaluator(c).evaluate(t, t, t);
-    for (const Vec3& p : samples.values()) box.add(p);
+    for (const Vec3& p : samples.values()) add(p);
   } else {
     const std::vector<double> t = linspace(0, 1, 17);
     const PointGrid samples = evaluator(c).evaluate(t, t);
-    for (const Vec3& p : samples.values()) box.add(p);
+    for (const Vec3& p : samples.values()) add(p);
   }
   if (c.exact)
-    std::visit([&](const auto& form) { for (const Vec3& p : form.control_points().values()) box.add(p); }, *c.exact);
+    std::visit([&](const auto& form) { for (const Vec3& p : form.control_points().values()) add(p); }, *c.exact);
   for (const DataSet& d : c.data)
-    for (const Vec3& p : d.points) box.add(p);
+    for (const Vec3& p : d.points) add(p);
   return page_frame(box);
 }
 
