@@ -77,6 +77,11 @@ class CyclicLU {
   void solve(double* b, std::size_t width, std::size_t stride) const;
 
  private:
+  // The solve with `border` (m × width doubles) as scratch, allocating nothing: g++
+  // compiles a call to a kernel's processor clones as one that cannot throw (a
+  // handler around it is left out), so solve allocates before the call.
+  void solve_with(double* b, std::size_t width, std::size_t stride, double* border) const noexcept;
+
   int n_, h_ = 0, m_ = 0, nb_ = 0;  // shift, border size, size of B
   std::vector<std::vector<Entry>> rows_;
   BandedLU b_{0, 0, 0};
