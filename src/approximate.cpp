@@ -195,7 +195,8 @@ constexpr std::size_t parallel_work = detail::parallel_min_work * 16;
 
 // Runs f(o, c0, c1) over blocks of `outer` slabs × columns [c0, c1) of `width`
 // doubles, in parallel when there is enough work. Every number is computed by the
-// same operations whatever the thread count.
+// same operations whatever the thread count. f must not throw (it only multiplies
+// and adds into memory its caller allocated).
 template <class F>
 void for_blocks(std::size_t outer, std::size_t width, std::size_t work, const F& f) {
   constexpr std::size_t chunk = 2048;
@@ -760,16 +761,23 @@ Residuals<R> residual_blocks(const std::array<Axis, R>& axes, const Shape<R>& sh
   std::vector<Residuals<R>> part(blocks, Residuals<R>(axes));
   const auto nb = static_cast<long long>(blocks);
   const std::vector<std::size_t> off = residual_offsets(axes[R - 1]);
+  detail::ParallelFailure failure;  // allocating a thread's scratch
 #pragma omp parallel if ((q1 - q0) * n * pp * 3 >= parallel_work)
   {
-    std::vector<double> row(3 * n), e2(n);
+    std::vector<double> row, e2;
+    failure.attempt(static_cast<std::size_t>(detail::thread_index()), [&] {
+      row.resize(3 * n);
+      e2.resize(n);
+    });
 #pragma omp for schedule(static)
     for (long long bi = 0; bi < nb; ++bi) {
+      if (failure.failed()) continue;
       const std::size_t b0 = q0 + static_cast<std::size_t>(bi) * residual_block_rows;
       residual_rows<R>(part[static_cast<std::size_t>(bi)], axes, shape, partial, pts, base, b0,
                        std::min(q1, b0 + residual_block_rows), weight, off.data(), row.data(), e2.data());
     }
   }
+  failure.rethrow();
   Residuals<R> all(axes);
   for (const auto& r : part) all.merge(r);
   return all;

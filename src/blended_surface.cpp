@@ -318,14 +318,18 @@ class BlendedRows final : public Surface::Rows {
     const auto rows = static_cast<long long>(nu);
     std::atomic<std::size_t> done{0};
     detail::RegionProgress report(progress);
+    detail::ParallelFailure failure;  // making the terms' vectors of a thread
 #pragma omp parallel if (nu * nv * (KA + L) >= detail::parallel_min_work)
     {
-      std::vector<detail::LineTerm> lines(KA);
+      std::vector<detail::LineTerm> lines;
       std::vector<detail::PointTerm> points;
-      points.reserve(L);
+      failure.attempt(static_cast<std::size_t>(detail::thread_index()), [&] {
+        lines.resize(KA);
+        points.reserve(L);  // then emplace_back below never allocates
+      });
 #pragma omp for schedule(static, 16)
       for (long long ri = 0; ri < rows; ++ri) {
-        if (report.stopped()) continue;  // a progress callback stopped the work
+        if (report.stopped() || failure.failed()) continue;  // stopped by a progress callback or a failure
         const auto i = static_cast<std::size_t>(ri);
         for (std::size_t k = 0; k < KA; ++k) lines[k] = {F[i * K + k], &A_[k * nv].x};
         points.clear();
@@ -335,6 +339,7 @@ class BlendedRows final : public Surface::Rows {
         if (detail::thread_index() == 0 && d % 64 == 0) report.report(static_cast<double>(d) / static_cast<double>(nu));
       }
     }
+    failure.rethrow();
     report.rethrow();
     if (progress) progress(1.0);
   }
@@ -453,12 +458,17 @@ class BlendedNormalGrid final : public Surface::NormalGrid {
     const auto rows = static_cast<long long>(ni);
     std::atomic<std::size_t> done{0};
     detail::RegionProgress report(progress);
+    detail::ParallelFailure failure;  // making the vectors of a thread
 #pragma omp parallel if (ni * nj * (KA + L) * 4 >= detail::parallel_min_work)
     {
-      std::vector<detail::LineTerm> lines(KA);
+      std::vector<detail::LineTerm> lines;
       std::vector<detail::PointTerm> terms;
-      terms.reserve(L);
-      std::array<std::vector<Vec3>, 3> partial{std::vector<Vec3>(nj), std::vector<Vec3>(nj), std::vector<Vec3>(nj)};
+      std::array<std::vector<Vec3>, 3> partial;
+      failure.attempt(static_cast<std::size_t>(detail::thread_index()), [&] {
+        lines.resize(KA);
+        terms.reserve(L);  // then emplace_back below never allocates
+        for (auto& p : partial) p.resize(nj);
+      });
       // The row's sum of derivative order du in u and dv in v into o.
       const auto sum = [&](std::size_t i, std::size_t du, std::size_t dv, Vec3* o) {
         for (std::size_t k = 0; k < KA; ++k) lines[k] = {F_[i * K + k].v[du], &A_[dv][k * nv + j0].x};
@@ -468,7 +478,7 @@ class BlendedNormalGrid final : public Surface::NormalGrid {
       };
 #pragma omp for schedule(static, 16)
       for (long long ri = 0; ri < rows; ++ri) {
-        if (report.stopped()) continue;  // a progress callback stopped the work
+        if (report.stopped() || failure.failed()) continue;  // stopped by a progress callback or a failure
         const auto r = static_cast<std::size_t>(ri), i = i0 + r;
         sum(i, 0, 0, points.data() + r * nj);
         sum(i, 1, 0, partial[0].data());
@@ -479,6 +489,7 @@ class BlendedNormalGrid final : public Surface::NormalGrid {
         if (detail::thread_index() == 0 && n % 64 == 0) report.report(static_cast<double>(n) / static_cast<double>(ni));
       }
     }
+    failure.rethrow();
     report.rethrow();
     if (progress) progress(1.0);
   }
@@ -606,12 +617,18 @@ BSplineSurface BlendedSurface::to_bspline() const {
   // a_k of the nonzero F[x][k] and the g_l that are not zero over each stretch.
   PointGrid P({nu, nv}, for_overwrite);
   const auto rows = static_cast<long long>(nu);
+  detail::ParallelFailure failure;  // making the terms' vectors of a thread
 #pragma omp parallel if (nu * nv * (na + nb) >= detail::parallel_min_work)
   {
     std::vector<detail::LineTerm> lines;
     std::vector<detail::PointTerm> points;
+    failure.attempt(static_cast<std::size_t>(detail::thread_index()), [&] {
+      lines.reserve(na);  // a stretch's terms at most: push_back below never allocates
+      points.reserve(nb);
+    });
 #pragma omp for schedule(static)
     for (long long r = 0; r < rows; ++r) {
+      if (failure.failed()) continue;
       const auto x = static_cast<std::size_t>(r);
       detail::fill_row(&P(x, 0).x, nv, lines, points, [&](std::size_t y0, std::size_t y1, auto& ls, auto& ps) {
         for (std::size_t k = 0; k < na; ++k)
@@ -622,6 +639,7 @@ BSplineSurface BlendedSurface::to_bspline() const {
       });
     }
   }
+  failure.rethrow();
   return BSplineSurface(ku, kv, std::move(P));
 }
 

@@ -332,13 +332,19 @@ BSplineVolume BlendedVolume::to_bspline() const {
   const std::size_t nh = T.blends[2].size();
   PointGrid3 P(n, for_overwrite);
   const auto rows = static_cast<long long>(n[0] * n[1]);
+  detail::ParallelFailure failure;  // making the terms' vectors of a thread
 #pragma omp parallel if (n[0] * n[1] * n[2] * (line_terms.size() + nh) >= detail::parallel_min_work)
   {
     std::vector<detail::LineTerm> lines;
     std::vector<detail::PointTerm> points;
+    failure.attempt(static_cast<std::size_t>(detail::thread_index()), [&] {
+      lines.reserve(line_terms.size());  // a stretch's terms at most: push_back below never allocates
+      points.reserve(nh);
+    });
     std::array<Vec3, detail::max_volume_blends> h;  // the point of each blend of w
 #pragma omp for schedule(static)
     for (long long r = 0; r < rows; ++r) {
+      if (failure.failed()) continue;
       const std::size_t x = static_cast<std::size_t>(r) / n[1], y = static_cast<std::size_t>(r) % n[1];
       auto factor = [x, y](const RowTerm& t) {
         const double a = t.fu ? t.scale * t.fu->c[3 * x] : t.scale;
@@ -355,6 +361,7 @@ BSplineVolume BlendedVolume::to_bspline() const {
       });
     }
   }
+  failure.rethrow();
   return BSplineVolume(target[0], target[1], target[2], std::move(P));
 }
 

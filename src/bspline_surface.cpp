@@ -204,14 +204,17 @@ void evaluate_rows_on(const KnotVector& ku_, const KnotVector& kv_, const RowWin
   // A periodic v: the row's first q points repeated after it, so that spans past
   // the last control point read on (sample_row never wraps).
   const std::size_t wrap_doubles = kv_.periodic() ? 3 * static_cast<std::size_t>(q) : 0;
+  detail::ParallelFailure failure;  // allocating a thread's row
 #pragma omp parallel if (threads)
   {
-    std::vector<double> row(row_doubles + wrap_doubles + 1);  // one double of slack for sample_row
+    std::vector<double> row;
+    failure.attempt(static_cast<std::size_t>(detail::thread_index()),
+                    [&] { row.resize(row_doubles + wrap_doubles + 1); });  // one double of slack for sample_row
     const double* rows[W];
     const bool reporter = detail::thread_index() == 0;
 #pragma omp for schedule(static, 16)
     for (long long ri = 0; ri < nu; ++ri) {
-      if (report.stopped()) continue;  // a progress callback stopped the work
+      if (report.stopped() || failure.failed()) continue;  // stopped by a progress callback or a failure
       const auto i = static_cast<std::size_t>(ri);
       const Basis& b = bu[i];
       for (int a = 0; a <= p; ++a) rows[a] = &net.row(static_cast<std::size_t>(ku_.wrap_index(b.span - p + a)))->x;
@@ -223,6 +226,7 @@ void evaluate_rows_on(const KnotVector& ku_, const KnotVector& kv_, const RowWin
       if (reporter && d % 64 == 0) report.report(static_cast<double>(d) / static_cast<double>(bu.size()));
     }
   }
+  failure.rethrow();
   report.rethrow();
   if (progress) progress(1.0);
 }
@@ -280,15 +284,17 @@ void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const d
   std::atomic<std::size_t> done{0};
   detail::RegionProgress report(progress);
   const auto nu = static_cast<long long>(us.size());
+  detail::ParallelFailure failure;  // allocating a thread's row
 #pragma omp parallel if (threads)
   {
     // One contracted row of homogeneous points per thread, reused for every u.
-    std::vector<std::array<double, 4>> row(ncv);
+    std::vector<std::array<double, 4>> row;
+    failure.attempt(static_cast<std::size_t>(detail::thread_index()), [&] { row.resize(ncv); });
     const KnotVector& kv = kv_;
     const bool reporter = detail::thread_index() == 0;
 #pragma omp for schedule(static, 16)
     for (long long ri = 0; ri < nu; ++ri) {
-      if (report.stopped()) continue;  // a progress callback stopped the work
+      if (report.stopped() || failure.failed()) continue;  // stopped by a progress callback or a failure
       const auto i = static_cast<std::size_t>(ri);
       const Basis& b = bu[i];
       for (std::size_t l = 0; l < ncv; ++l) {
@@ -321,6 +327,7 @@ void BSplineSurface::evaluate_into(std::span<const double> us, std::span<const d
       if (reporter && d % 64 == 0) report.report(static_cast<double>(d) / static_cast<double>(us.size()));
     }
   }
+  failure.rethrow();
   report.rethrow();
   if (progress) progress(1.0);
 }
@@ -336,13 +343,17 @@ Grid<SurfaceDerivatives, 2> BSplineSurface::evaluate_derivatives(std::span<const
   Grid<SurfaceDerivatives, 2> out({us.size(), nv}, for_overwrite);
   const bool rat = rational();
   const auto nu = static_cast<long long>(us.size());
+  detail::ParallelFailure failure;  // allocating a thread's rows
 #pragma omp parallel if (us.size() * (nv + ncv) >= detail::parallel_min_work)
   {
     // rows[k][l]: the net contracted with the k-th u-derivative of the basis.
     std::vector<std::array<double, 4>> rows[3];
-    for (auto& r : rows) r.resize(ncv);
+    failure.attempt(static_cast<std::size_t>(detail::thread_index()), [&] {
+      for (auto& r : rows) r.resize(ncv);
+    });
 #pragma omp for schedule(static)
     for (long long ri = 0; ri < nu; ++ri) {
+      if (failure.failed()) continue;
       const auto i = static_cast<std::size_t>(ri);
       const Basis& b = bu[i];
       for (int k = 0; k <= 2; ++k)
@@ -391,6 +402,7 @@ Grid<SurfaceDerivatives, 2> BSplineSurface::evaluate_derivatives(std::span<const
       }
     }
   }
+  failure.rethrow();
   return out;
 }
 

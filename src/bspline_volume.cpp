@@ -142,18 +142,22 @@ void contract(const Net& b, const std::vector<Basis>& bu, const std::vector<Basi
   constexpr int nv_terms = Partials ? 3 : 1;  // (k, l) = (0,0), (1,0), (0,1)
   constexpr int kk[3] = {0, 1, 0}, ll[3] = {0, 0, 1};
   const auto first = static_cast<long long>(r0), last = static_cast<long long>(r1);
+  detail::ParallelFailure failure;  // allocating a thread's nets
 #pragma omp parallel if (threads)
   {
     // Per-thread nets, reused for every u: no allocation per point.
     std::vector<H> U[nu_terms];
-    for (auto& x : U) x.resize(plane);
     std::vector<H> V[nv_terms];
     // A periodic w: the row's first r points repeated after it, so that spans past
     // the last control point read on (sample_line never wraps).
     const std::size_t wrap = b.kw.periodic() ? static_cast<std::size_t>(r) : 0;
-    for (auto& x : V) x.resize(ncw + wrap);
+    failure.attempt(static_cast<std::size_t>(detail::thread_index()), [&] {
+      for (auto& x : U) x.resize(plane);
+      for (auto& x : V) x.resize(ncw + wrap);
+    });
 #pragma omp for schedule(static)
     for (long long ri = first; ri < last; ++ri) {
+      if (failure.failed()) continue;
       const auto i = static_cast<std::size_t>(ri);
       const Basis& a = bu[i];
       for (int k = 0; k < nu_terms; ++k) {
@@ -236,6 +240,7 @@ void contract(const Net& b, const std::vector<Basis>& bu, const std::vector<Basi
       }
     }
   }
+  failure.rethrow();
 }
 
 // Runs `contract` over all u rows in chunks, reporting progress between chunks from

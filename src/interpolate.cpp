@@ -624,14 +624,20 @@ class GridChords {
     line_length_.assign(R, {});
     for (std::size_t a = 1; a < R; ++a) line_length_[a].assign(b.count * g.lines(a), 0.0);
     const auto nchunks = static_cast<long long>(chunks);
+    detail::ParallelFailure failure;  // the scratch and the chunks' sums are allocated
 #pragma omp parallel if (b.count * M >= detail::parallel_min_work / 4)
     {
-      std::vector<double> scratch(scratch_size());
+      std::vector<double> scratch;
+      failure.attempt(static_cast<std::size_t>(detail::thread_index()), [&] { scratch.resize(scratch_size()); });
 #pragma omp for schedule(static) nowait
       for (long long ci = 0; ci < nchunks; ++ci) {
+        if (failure.failed()) continue;
         const auto c = static_cast<std::size_t>(ci);
-        part[c * R].assign(M, 0.0);
-        for (std::size_t a = 1; a < R; ++a) part[c * R + a].assign(g.n[a], 0.0);
+        failure.attempt(c, [&] {
+          part[c * R].assign(M, 0.0);
+          for (std::size_t a = 1; a < R; ++a) part[c * R + a].assign(g.n[a], 0.0);
+        });
+        if (failure.failed()) continue;
         const std::size_t r1 = std::min(b.count, (c + 1) * rows_per_chunk);
         for (std::size_t r = c * rows_per_chunk; r < r1; ++r) {  // local rows; b.first + r in the grid
           const Vec3* row = q + r * M;
@@ -646,6 +652,7 @@ class GridChords {
         }
       }
     }
+    failure.rethrow();
     // A NaN or an infinity makes the length of its line along v NaN or infinite
     // (every point is on one, with a chord to a neighbour): only then are the points
     // searched for the first of them.
@@ -835,15 +842,19 @@ class GridChords {
 std::vector<double> row_steps(const Vec3* q, const GridShape& g, const GridChords& chords) {
   std::vector<double> steps(g.n[0], 0.0);
   const auto n0 = static_cast<long long>(g.n[0]);
+  detail::ParallelFailure failure;  // each thread's scratch is allocated
 #pragma omp parallel if (g.n[0] * g.row >= detail::parallel_min_work / 4)
   {
-    std::vector<double> scratch(g.row);
+    std::vector<double> scratch;
+    failure.attempt(static_cast<std::size_t>(detail::thread_index()), [&] { scratch.resize(g.row); });
 #pragma omp for schedule(static)
     for (long long r = 1; r < n0; ++r) {
+      if (failure.failed()) continue;
       const auto k = static_cast<std::size_t>(r);
       steps[k] = chords.row_step(q + (k - 1) * g.row, q + k * g.row, scratch.data());
     }
   }
+  failure.rethrow();
   return steps;
 }
 
@@ -1062,29 +1073,40 @@ RowSolution solve_rows(const GridBlock& b, std::span<const int> p, Parametrizati
   for (std::size_t a = 1; a < R; ++a) group_shape[a] = b.n[a];
   group_shape[R] = 3;
   const bool uses_chords = chords.uses_chords();
+  // The threads' copies and the solves (a closed axis's) allocate. A thread that
+  // failed still meets the barrier; the groups after a failed one are skipped.
+  ParallelFailure failure;
 #pragma omp parallel if (b.count * M >= parallel_min_work / 8)
   {
     const std::size_t nt = thread_count(), t = static_cast<std::size_t>(thread_index());
     const std::size_t g0 = groups * t / nt, g1 = groups * (t + 1) / nt;
-    std::vector<Vec3> prev(uses_chords ? M : 0);
-    std::vector<double> scratch(uses_chords ? M : 0);
-    if (uses_chords && g0 < g1) {
+    std::vector<Vec3> prev;
+    std::vector<double> scratch;
+    bool ready = false;
+    failure.attempt(g0, [&] {
+      prev.resize(uses_chords ? M : 0);
+      scratch.resize(uses_chords ? M : 0);
+      ready = true;
+    });
+    if (ready && uses_chords && g0 < g1) {
       if (g0 > 0) std::copy_n(data + (g0 * rows_per_group - 1) * M, M, prev.data());
       else if (b.first > 0) std::copy_n(b.before, M, prev.data());
     }
 #pragma omp barrier
     auto gs = group_shape;
-    for (std::size_t gi = g0; gi < g1; ++gi) {
-      const std::size_t r0 = gi * rows_per_group, r1 = std::min(b.count, r0 + rows_per_group);
-      if (uses_chords) {
-        for (std::size_t k = b.first + r0 == 0 ? 1 : r0; k < r1; ++k)
-          steps[k] = chords.row_step(k == r0 ? prev.data() : data + (k - 1) * M, data + k * M, scratch.data());
-        std::copy_n(data + (r1 - 1) * M, M, prev.data());
-      }
-      gs[0] = r1 - r0;
-      for (std::size_t a = 1; a < R; ++a) solve_axis(lu[a - 1], &data[r0 * M].x, gs.data(), R + 1, a, 1, false);
-    }
+    for (std::size_t gi = g0; gi < g1 && ready; ++gi)
+      failure.attempt(gi, [&] {
+        const std::size_t r0 = gi * rows_per_group, r1 = std::min(b.count, r0 + rows_per_group);
+        if (uses_chords) {
+          for (std::size_t k = b.first + r0 == 0 ? 1 : r0; k < r1; ++k)
+            steps[k] = chords.row_step(k == r0 ? prev.data() : data + (k - 1) * M, data + k * M, scratch.data());
+          std::copy_n(data + (r1 - 1) * M, M, prev.data());
+        }
+        gs[0] = r1 - r0;
+        for (std::size_t a = 1; a < R; ++a) solve_axis(lu[a - 1], &data[r0 * M].x, gs.data(), R + 1, a, 1, false);
+      });
   }
+  failure.rethrow();
 
   // Along u: every row's step, in row order.
   const std::vector<double> all_steps = team.gather(steps);
@@ -1112,16 +1134,30 @@ void drop_last_line(Grid<Vec3, Rank>& points, std::size_t axis) {
   auto values = std::move(points.values());
   Vec3* v = values.data();
   if (axis > 0) {
+    // A thread that cannot hold its first blocks moves nothing but still meets the
+    // barrier; the grid is then left empty, the values lost.
+    detail::ParallelFailure failure;
 #pragma omp parallel if (values.size() >= detail::parallel_min_work)
     {
       const std::size_t nt = detail::thread_count(), t = static_cast<std::size_t>(detail::thread_index());
       const std::size_t a = outer * t / nt, b = outer * (t + 1) / nt;
       // Blocks r with r·K < a·B land where the runs before this one still are.
       const std::size_t late = std::min(b, std::max(a, (a * B + K - 1) / K));
-      std::vector<Vec3> held(v + a * B, v + late * B);
-      for (std::size_t r = std::max<std::size_t>(late, 1); r < b; ++r) std::copy_n(v + r * B, K, v + r * K);
+      std::vector<Vec3> held;
+      bool ready = false;
+      failure.attempt(t, [&] {
+        held.assign(v + a * B, v + late * B);
+        ready = true;
+      });
+      if (ready)
+        for (std::size_t r = std::max<std::size_t>(late, 1); r < b; ++r) std::copy_n(v + r * B, K, v + r * K);
 #pragma omp barrier
-      for (std::size_t r = a; r < late; ++r) std::copy_n(held.data() + (r - a) * B, K, v + r * K);
+      if (ready)
+        for (std::size_t r = a; r < late; ++r) std::copy_n(held.data() + (r - a) * B, K, v + r * K);
+    }
+    if (failure.failed()) {
+      points = Grid<Vec3, Rank>();
+      failure.rethrow();
     }
   }
   values.resize(outer * K);

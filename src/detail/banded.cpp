@@ -250,8 +250,14 @@ bool CyclicLU::factor() {
   return true;
 }
 
-INTERPATCH_KERNEL void CyclicLU::solve(double* b, std::size_t width, std::size_t stride) const {
+void CyclicLU::solve(double* b, std::size_t width, std::size_t stride) const {
   if (n_ == 0) return;
+  std::vector<double> border(static_cast<std::size_t>(m_) * width);
+  solve_with(b, width, stride, border.data());
+}
+
+INTERPATCH_KERNEL void CyclicLU::solve_with(double* b, std::size_t width, std::size_t stride,
+                                            double* border) const noexcept {
   const auto M = static_cast<std::size_t>(m_);
   auto row = [&](int i) { return b + static_cast<std::size_t>(i) * stride; };
   if (nb_ > 0) b_.solve(b, width, stride);
@@ -286,8 +292,7 @@ INTERPATCH_KERNEL void CyclicLU::solve(double* b, std::size_t width, std::size_t
   // x_c = z_c − Σ_j Y[c][j] x_border[j], each moved to its control point: unknown c
   // is control point (c + h) mod n. The border is copied aside first; B's rows then
   // move in the order that reads every row before it is overwritten.
-  std::vector<double> border(M * width);
-  for (std::size_t j = 0; j < M; ++j) std::copy_n(row(nb_ + static_cast<int>(j)), width, border.data() + j * width);
+  for (std::size_t j = 0; j < M; ++j) std::copy_n(row(nb_ + static_cast<int>(j)), width, border + j * width);
   auto update = [&](int c, double* dst) {
     const double* src = row(c);
     const double* yc = y_.data() + static_cast<std::size_t>(c) * M;
@@ -299,7 +304,7 @@ INTERPATCH_KERNEL void CyclicLU::solve(double* b, std::size_t width, std::size_t
     for (std::size_t k = 0; k < width; ++k) dst[k] = src[k];
     for (std::size_t j = 0; j < M; ++j) {
       const double y = yc[j];
-      const double* x = border.data() + j * width;
+      const double* x = border + j * width;
       for (std::size_t k = 0; k < width; ++k) dst[k] -= y * x[k];
     }
   };
@@ -310,7 +315,7 @@ INTERPATCH_KERNEL void CyclicLU::solve(double* b, std::size_t width, std::size_t
     for (int c = 0; c < nb_; ++c) update(c, row(modulo(c + h_, n)));
   }
   for (std::size_t j = 0; j < M; ++j)
-    std::copy_n(border.data() + j * width, width, row(modulo(nb_ + static_cast<int>(j) + h_, n)));
+    std::copy_n(border + j * width, width, row(modulo(nb_ + static_cast<int>(j) + h_, n)));
 }
 
 namespace {
@@ -402,21 +407,30 @@ void solve_along_axis(const Solver& lu, double* data, const std::size_t* shape, 
   const bool check = non_finite != nullptr;
   bool found = false;
   [[maybe_unused]] const bool threads = parallel && block * outer >= parallel_min_work;
+  // A thread's buffer and CyclicLU::solve allocate: a failure skips the work left
+  // and is rethrown after the region.
+  ParallelFailure failure;
   if (inner < 64 && outer > 1) {
     const auto groups = static_cast<long long>((outer + narrow_group - 1) / narrow_group);
 #pragma omp parallel if (threads)
     {
       // Not zeroed: every group writes the part it reads (solve_rows calls this for
       // every few rows, and zeroing the buffer each time cost a tenth of an eval).
-      const std::unique_ptr<double[]> buf(new double[n * narrow_group * inner]);
+      std::unique_ptr<double[]> buf;
+      failure.attempt(static_cast<std::size_t>(thread_index()),
+                      [&] { buf = std::make_unique_for_overwrite<double[]>(n * narrow_group * inner); });
 #pragma omp for schedule(static) reduction(|| : found)
       for (long long g = 0; g < groups; ++g) {
-        const std::size_t o0 = static_cast<std::size_t>(g) * narrow_group;
-        found = solve_narrow_group(lu, data + o0 * block, n, inner, block, std::min(narrow_group, outer - o0),
-                                   buf.get(), check) ||
-                found;
+        if (!buf) continue;
+        failure.attempt(static_cast<std::size_t>(g), [&] {
+          const std::size_t o0 = static_cast<std::size_t>(g) * narrow_group;
+          found = solve_narrow_group(lu, data + o0 * block, n, inner, block, std::min(narrow_group, outer - o0),
+                                     buf.get(), check) ||
+                  found;
+        });
       }
     }
+    failure.rethrow();
     if (check) *non_finite = found;
     return;
   }
@@ -424,16 +438,18 @@ void solve_along_axis(const Solver& lu, double* data, const std::size_t* shape, 
   const std::size_t slices = (inner + slice - 1) / slice;
   const auto tasks = static_cast<long long>(outer * slices);
 #pragma omp parallel for schedule(static) reduction(|| : found) if (tasks > 1 && threads)
-  for (long long t = 0; t < tasks; ++t) {
-    const std::size_t o = static_cast<std::size_t>(t) / slices;
-    const std::size_t s = static_cast<std::size_t>(t) % slices;
-    const std::size_t c0 = s * slice;
-    const std::size_t width = std::min(slice, inner - c0);
-    double* first = data + o * block + c0;
-    lu.solve(first, width, inner);
-    if (check)
-      for (std::size_t k = 0; k < n && !found; ++k) found = has_non_finite(first + k * inner, width);
-  }
+  for (long long t = 0; t < tasks; ++t)
+    failure.attempt(static_cast<std::size_t>(t), [&] {
+      const std::size_t o = static_cast<std::size_t>(t) / slices;
+      const std::size_t s = static_cast<std::size_t>(t) % slices;
+      const std::size_t c0 = s * slice;
+      const std::size_t width = std::min(slice, inner - c0);
+      double* first = data + o * block + c0;
+      lu.solve(first, width, inner);
+      if (check)
+        for (std::size_t k = 0; k < n && !found; ++k) found = has_non_finite(first + k * inner, width);
+    });
+  failure.rethrow();
   if (check) *non_finite = found;
 }
 

@@ -77,6 +77,10 @@ class CyclicLU {
   void solve(double* b, std::size_t width, std::size_t stride) const;
 
  private:
+  // The solve with `border` (m × width doubles) as scratch: the kernel, which must
+  // not allocate (detail/kernel.hpp).
+  void solve_with(double* b, std::size_t width, std::size_t stride, double* border) const noexcept;
+
   int n_, h_ = 0, m_ = 0, nb_ = 0;  // shift, border size, size of B
   std::vector<std::vector<Entry>> rows_;
   BandedLU b_{0, 0, 0};

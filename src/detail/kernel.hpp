@@ -4,6 +4,10 @@
 // runs on. A fused multiply-add rounds once where a multiply and an add round
 // twice, so results can differ between CPUs in the last bits; on one machine they
 // never depend on the number of threads.
+//
+// A kernel must not throw (allocate nothing in one): g++ 12 compiles a call to
+// cloned functions as a call that cannot throw, so an exception from a kernel
+// passes every handler and ends in std::terminate.
 
 // GCC only: clang 14 does not emit the plain symbol of a cloned function that other
 // translation units call.

@@ -41,6 +41,16 @@ inline std::size_t thread_count() noexcept {
 #endif
 }
 
+/// The most threads a parallel region opened here can have (1 without OpenMP):
+/// what memory kept per thread, taken before the region, is sized by.
+inline std::size_t max_threads() noexcept {
+#ifdef _OPENMP
+  return static_cast<std::size_t>(omp_get_max_threads());
+#else
+  return 1;
+#endif
+}
+
 /// What went wrong on the threads of a parallel loop, carried out of it: an exception
 /// that leaves an OpenMP region calls std::terminate (an abort, on one thread too).
 /// Each iteration runs through `attempt`, which catches; the exception of the lowest

@@ -16,7 +16,8 @@ namespace interpatch::detail {
 /// in pieces(b) pieces, make(b, p), shared by every thread as each comes free,
 /// while one thread calls write(b − 1) and then joins them; so two blocks are alive
 /// at once, and a block's memory can be reused two blocks later (buffer b % 2).
-/// make must give the same bits on whichever thread makes a piece; nested parallel
+/// pieces(b) is called by every thread outside the catching below and must not
+/// throw. make must give the same bits on whichever thread makes a piece; nested parallel
 /// regions inside it run on the calling thread (OpenMP's default). With `parallel`
 /// false, or one thread, the same calls run one after another.
 ///

@@ -1,6 +1,7 @@
 #include "io/crc32.hpp"
 
 #include <array>
+#include <new>
 #include <vector>
 
 #include "detail/parallel.hpp"
@@ -98,25 +99,28 @@ std::uint32_t crc32(const void* data, std::size_t n, std::uint32_t crc) noexcept
   constexpr std::size_t parallel_bytes = std::size_t{4} << 20;
   if (n < parallel_bytes) return crc32_serial(data, n, crc);
   const auto* p = static_cast<const unsigned char*>(data);
+  // One piece a thread, its checksum kept in memory taken before the region (an
+  // allocation inside would throw out of it); without that memory, one thread.
   std::vector<std::uint32_t> part;
-  std::vector<std::size_t> end;
+  try {
+    part.resize(detail::max_threads());
+  } catch (const std::bad_alloc&) {
+    return crc32_serial(data, n, crc);
+  }
+  std::size_t parts = 1;
+  const auto end = [&](std::size_t k) { return k + 1 == parts ? n : n / parts * (k + 1); };
 #pragma omp parallel
   {
 #pragma omp single
-    {
-      const std::size_t parts = detail::thread_count();
-      part.assign(parts, 0);
-      end.assign(parts, n);
-      for (std::size_t k = 0; k + 1 < parts; ++k) end[k] = n / parts * (k + 1);
-    }
+    parts = detail::thread_count();
     const auto k = static_cast<std::size_t>(detail::thread_index());
-    if (k < part.size()) {
-      const std::size_t begin = k == 0 ? 0 : end[k - 1];
-      part[k] = crc32_serial(p + begin, end[k] - begin);
+    if (parts <= part.size()) {
+      const std::size_t begin = k == 0 ? 0 : end(k - 1);
+      part[k] = crc32_serial(p + begin, end(k) - begin);
     }
   }
-  for (std::size_t k = 0; k < part.size(); ++k)
-    crc = crc32_combine(crc, part[k], end[k] - (k == 0 ? 0 : end[k - 1]));
+  if (parts > part.size()) return crc32_serial(data, n, crc);
+  for (std::size_t k = 0; k < parts; ++k) crc = crc32_combine(crc, part[k], end(k) - (k == 0 ? 0 : end(k - 1)));
   return crc;
 }
 

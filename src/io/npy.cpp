@@ -423,6 +423,7 @@ void read_pieces(const fs::path& path, const std::string& name, char* dst, std::
   const auto pieces = static_cast<long long>((n + piece - 1) / piece);
   std::vector<std::uint32_t> sums(crc ? static_cast<std::size_t>(pieces) : 0);
   std::atomic<int> failure{0};
+  detail::ParallelFailure visit_failure;  // what `visit` throws, by piece
 #pragma omp parallel for schedule(static) if (n >= 8 * piece)
   for (long long k = 0; k < pieces; ++k) {
     const std::size_t begin = static_cast<std::size_t>(k) * piece;
@@ -438,10 +439,11 @@ void read_pieces(const fs::path& path, const std::string& name, char* dst, std::
       at += static_cast<std::size_t>(got);
     }
     if (crc && at == end) sums[static_cast<std::size_t>(k)] = crc32_serial(dst + begin, end - begin);
-    if (visit && at == end) visit(dst + begin, end - begin);
+    if (visit && at == end) visit_failure.attempt(static_cast<std::size_t>(k), [&] { visit(dst + begin, end - begin); });
   }
   ::close(fd);
   if (const int e = failure.load(); e != 0) fail_read(name, e);
+  visit_failure.rethrow();
   if (!crc) return;
   for (std::size_t k = 0; k < sums.size(); ++k)
     *crc = crc32_combine(*crc, sums[k], std::min(piece, n - k * piece));
