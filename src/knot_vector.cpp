@@ -10,6 +10,20 @@ namespace interpatch {
 
 using detail::fail;
 
+namespace {
+
+// Basis functions divide by knot spans: a span below the smallest normal double
+// (2.2e-308) has a reciprocal beyond the largest, and evaluation gives NaN.
+void require_normal_span(const std::vector<double>& u, std::size_t i) {
+  const double span = u[i] - u[i - 1];
+  if (span > 0 && span < std::numeric_limits<double>::min())
+    fail(errc::invalid_knots, "knot ", i, " = ", u[i], " is only ", span, " above knot ", i - 1, " = ", u[i - 1],
+         ": a knot span below ", std::numeric_limits<double>::min(),
+         " (the smallest normal double) cannot be evaluated; repeat the knot or move it apart");
+}
+
+}  // namespace
+
 KnotVector::KnotVector(int degree, std::vector<double> knots, int count, bool periodic)
     : p_(degree), u_(std::move(knots)), count_(count), end_(periodic ? count + degree : count), periodic_(periodic) {}
 
@@ -23,9 +37,11 @@ KnotVector::KnotVector(int degree, std::vector<double> knots) : p_(degree), u_(s
     fail(errc::invalid_knots, "degree ", p_, " needs at least ", 2 * (p + 1), " knots, got ", u_.size());
   for (std::size_t i = 0; i < u_.size(); ++i)
     if (!std::isfinite(u_[i])) fail(errc::not_finite, "knot ", i, " is ", u_[i]);
-  for (std::size_t i = 1; i < u_.size(); ++i)
+  for (std::size_t i = 1; i < u_.size(); ++i) {
     if (u_[i] < u_[i - 1])
       fail(errc::non_increasing, "knot ", i, " = ", u_[i], " is smaller than knot ", i - 1, " = ", u_[i - 1]);
+    require_normal_span(u_, i);
+  }
   for (std::size_t i = 1; i <= p; ++i) {
     if (u_[i] != u_[0])
       fail(errc::invalid_knots, "knot vector is not clamped at the start: knot ", i, " = ", u_[i],
@@ -63,9 +79,11 @@ KnotVector KnotVector::periodic_from(int degree, std::vector<double> knots, doub
   for (std::size_t i = 0; i < n; ++i)
     if (!std::isfinite(knots[i])) fail(errc::not_finite, "knot ", i, " is ", knots[i]);
   if (!std::isfinite(end)) fail(errc::not_finite, "the end of the period is ", end);
-  for (std::size_t i = 1; i < n; ++i)
+  for (std::size_t i = 1; i < n; ++i) {
     if (knots[i] < knots[i - 1])
       fail(errc::non_increasing, "knot ", i, " = ", knots[i], " is smaller than knot ", i - 1, " = ", knots[i - 1]);
+    require_normal_span(knots, i);
+  }
   const double a = knots.front();
   if (!(end > a)) fail(errc::invalid_knots, "the period [", a, ", ", end, ") is empty");
   if (!(knots.back() < end))

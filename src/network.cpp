@@ -684,6 +684,25 @@ Built build(const CurveNetwork& network, const NetworkOptions& options, bool fit
       c.map.period = n.closed[az] ? hi - lo : 0.0;
     }
   }
+  t->a = std::move(V);
+  t->b = std::move(U);
+  // Each curve against the finished surface: where curves of a family lie close
+  // together their cardinal functions reach about 1/the gap, and spread what the
+  // crossings' mismatch left over that far onto the other curves' lines.
+  const BlendedSurface finished(t);
+  for (int a = 0; a < 2; ++a) {
+    const auto az = static_cast<std::size_t>(a);
+    const auto& given = a == 0 ? network.u_curves : network.v_curves;
+    auto& reports = a == 0 ? rep.u_curves : rep.v_curves;
+    for (std::size_t k = 0; k < r.order[az].size(); ++k) {
+      const std::size_t j = r.order[az][k];
+      const double at = r.params[az][k];
+      double d = 0;
+      for (double x : linspace(0, 1, 129))
+        d = std::max(d, distance(a == 0 ? finished.point(x, at) : finished.point(at, x), given[j].point(reports[j].map(x))));
+      reports[j].distance = std::max(reports[j].distance, d);
+    }
+  }
   const double strict = n.strict;
   std::vector<std::string> far;
   for (int a = 0; a < 2; ++a) {
@@ -691,8 +710,6 @@ Built build(const CurveNetwork& network, const NetworkOptions& options, bool fit
     for (std::size_t j = 0; j < n.along[static_cast<std::size_t>(a)].size(); ++j)
       if (reports[j].distance > strict) far.push_back(detail::cat(n.name(a, j), " by ", reports[j].distance));
   }
-  t->a = std::move(V);
-  t->b = std::move(U);
   // The closing curves: the seam curve's line against each, on the finished surface.
   for (int a = 0; a < 2; ++a) {
     if (!n.closing[static_cast<std::size_t>(1 - a)]) continue;

@@ -144,6 +144,16 @@ double round_ms(double ms) { return std::round(ms * 1000.0) / 1000.0; }
 using internal::Box;
 
 // The surface at the data parameters, a block of rows at a time.
+// A result that is not finite where a data point is: never a data error that skips
+// it (a NaN compares as no distance at all).
+[[noreturn]] void result_not_finite(const Vec3& value, const std::string& at, std::initializer_list<double> params) {
+  std::string where;
+  for (double x : params) where += (where.empty() ? "" : ", ") + cat(x);
+  fail(errc::not_finite, at, ": the result at (", where, ") is (", value.x, ", ", value.y, ", ", value.z,
+       "): the construction's arithmetic left the range of a double there (coordinates near 1e308, "
+       "knot spans or weights so small they vanish)");
+}
+
 void surface_data_error(const Surface& s, const DataSet& d, DataError& e, std::size_t& done, std::size_t total,
                         const progress_callback& progress) {
   if (d.params.size() != 2)
@@ -160,8 +170,10 @@ void surface_data_error(const Surface& s, const DataSet& d, DataError& e, std::s
     const PointGrid p = s.evaluate(std::span<const double>(us).subspan(i0, nb), vs);
     for (std::size_t i = 0; i < nb; ++i)
       for (std::size_t j = 0; j < nv; ++j) {
-        const double dist = distance(p(i, j), d.points[(i0 + i) * nv + j]);
-        if (std::isnan(dist)) continue;  // a missing point (approximation's data)
+        const Vec3& q = d.points[(i0 + i) * nv + j];
+        if (!is_finite(q)) continue;  // a missing point (approximation's data)
+        const double dist = distance(p(i, j), q);
+        if (!std::isfinite(dist)) result_not_finite(p(i, j), cat(d.pointer, "/", i0 + i, "/", j), {us[i0 + i], vs[j]});
         if (dist > e.absolute || e.pointer.empty()) {
           e.absolute = dist;
           e.pointer = cat(d.pointer, "/", i0 + i, "/", j);
@@ -192,8 +204,11 @@ void volume_data_error(const Volume& s, const DataSet& d, DataError& e, std::siz
     for (std::size_t i = 0; i < nb; ++i)
       for (std::size_t j = 0; j < nv; ++j)
         for (std::size_t k = 0; k < nw; ++k) {
-          const double dist = distance(p(i, j, k), d.points[((i0 + i) * nv + j) * nw + k]);
-          if (std::isnan(dist)) continue;  // a missing point (approximation's data)
+          const Vec3& q = d.points[((i0 + i) * nv + j) * nw + k];
+          if (!is_finite(q)) continue;  // a missing point (approximation's data)
+          const double dist = distance(p(i, j, k), q);
+          if (!std::isfinite(dist))
+            result_not_finite(p(i, j, k), cat(d.pointer, "/", i0 + i, "/", j, "/", k), {us[i0 + i], vs[j], ws[k]});
           if (dist > e.absolute || e.pointer.empty()) {
             e.absolute = dist;
             e.pointer = cat(d.pointer, "/", i0 + i, "/", j, "/", k);

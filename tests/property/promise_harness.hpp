@@ -873,11 +873,14 @@ inline std::optional<Tensor> exact_volume(io::Construction& c) {
 
 /// Checks shared by every surface construction: the exact form (when it has one)
 /// is over [0, 1]², finite, and equals the library's evaluator and its formula to
-/// 1e-12 of the size of its control points; sampled on an n × n grid, every value is
-/// finite and inside the data's box grown by its diagonal (unless a warning says
-/// why). Returns the exact form for the family's own checks.
+/// 1e-12 of the size of its control points, or 16 rounding steps of that size times
+/// `amplification` where that is larger (how much the construction's own solve may
+/// amplify rounding, 1 unless the family says why);
+/// sampled on an n × n grid, every value is finite and inside the data's box grown
+/// by its diagonal (unless a warning says why). Returns the exact form for the
+/// family's own checks.
 inline std::optional<Tensor> check_surface_common(io::Construction& c, const Box& data, Findings& f,
-                                                  std::size_t n = 5) {
+                                                  std::size_t n = 5, double amplification = 1) {
   std::optional<Tensor> t = exact_surface(c);
   const Surface* formula = c.formula.get();
   if (!t && !formula) {
@@ -895,7 +898,7 @@ inline std::optional<Tensor> check_surface_common(io::Construction& c, const Box
   // Two evaluations of one B-spline (or of the formula it converts exactly) agree
   // to rounding in coordinates of the control points' size: 1e-12 of it (SPEC).
   const double mag = std::max(t ? t->magnitude() : 0.0, data.magnitude());
-  const double agree = 1e-12 * std::max(mag, data.diagonal());
+  const double agree = std::max(1e-12 * std::max(mag, data.diagonal()), 16 * eps * mag * amplification);
   const double margin = data.diagonal();
   bool outside = false;
   for (std::size_t i = 0; i < n; ++i)
