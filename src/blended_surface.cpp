@@ -579,7 +579,9 @@ std::array<KnotVector, 2> BlendedSurface::exact_knots() const {
   return {merged_knots(snapped_together(ku)), merged_knots(snapped_together(kv))};  // as make_compatible
 }
 
-BSplineSurface BlendedSurface::to_bspline() const {
+BSplineSurface BlendedSurface::to_bspline() const { return to_bspline(progress_callback{}); }
+
+BSplineSurface BlendedSurface::to_bspline(const progress_callback& progress) const {
   const auto& T = *t_;
   require_exact_form(T);
   // Every function of u on one knot vector and degree, every function of v likewise.
@@ -618,6 +620,8 @@ BSplineSurface BlendedSurface::to_bspline() const {
   PointGrid P({nu, nv}, for_overwrite);
   const auto rows = static_cast<long long>(nu);
   detail::ParallelFailure failure;  // making the terms' vectors of a thread
+  detail::RegionProgress report(progress);
+  std::atomic<std::size_t> done{0};
 #pragma omp parallel if (nu * nv * (na + nb) >= detail::parallel_min_work)
   {
     std::vector<detail::LineTerm> lines;
@@ -628,7 +632,7 @@ BSplineSurface BlendedSurface::to_bspline() const {
     });
 #pragma omp for schedule(static)
     for (long long r = 0; r < rows; ++r) {
-      if (failure.failed()) continue;
+      if (failure.failed() || report.stopped()) continue;  // a failure, or stopped by the progress callback
       const auto x = static_cast<std::size_t>(r);
       detail::fill_row(&P(x, 0).x, nv, lines, points, [&](std::size_t y0, std::size_t y1, auto& ls, auto& ps) {
         for (std::size_t k = 0; k < na; ++k)
@@ -637,9 +641,13 @@ BSplineSurface BlendedSurface::to_bspline() const {
           if (const Vec3& b = B[x * nb + l]; b != Vec3{} && G[l].lo < y1 && G[l].hi > y0)
             ps.emplace_back(G[l].c.data() + 3 * y0, b);
       });
+      const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
+      if (detail::thread_index() == 0 && d % 64 == 0) report.report(static_cast<double>(d) / static_cast<double>(nu));
     }
   }
   failure.rethrow();
+  report.rethrow();
+  if (progress) progress(1.0);
   return BSplineSurface(ku, kv, std::move(P));
 }
 

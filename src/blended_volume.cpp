@@ -1,6 +1,7 @@
 #include "interpatch/blended_volume.hpp"
 
 #include <algorithm>
+#include <atomic>
 
 #include "detail/parallel.hpp"
 #include "detail/text.hpp"
@@ -242,7 +243,9 @@ bool BlendedVolume::has_exact_form() const noexcept {
   return true;
 }
 
-BSplineVolume BlendedVolume::to_bspline() const {
+BSplineVolume BlendedVolume::to_bspline() const { return to_bspline(progress_callback{}); }
+
+BSplineVolume BlendedVolume::to_bspline(const progress_callback& progress) const {
   const auto& T = *t_;
   for (std::size_t a = 0; a < 3; ++a)
     for (const auto& b : T.blends[a])
@@ -333,6 +336,8 @@ BSplineVolume BlendedVolume::to_bspline() const {
   PointGrid3 P(n, for_overwrite);
   const auto rows = static_cast<long long>(n[0] * n[1]);
   detail::ParallelFailure failure;  // making the terms' vectors of a thread
+  detail::RegionProgress report(progress);
+  std::atomic<std::size_t> done{0};
 #pragma omp parallel if (n[0] * n[1] * n[2] * (line_terms.size() + nh) >= detail::parallel_min_work)
   {
     std::vector<detail::LineTerm> lines;
@@ -344,7 +349,7 @@ BSplineVolume BlendedVolume::to_bspline() const {
     std::array<Vec3, detail::max_volume_blends> h;  // the point of each blend of w
 #pragma omp for schedule(static)
     for (long long r = 0; r < rows; ++r) {
-      if (failure.failed()) continue;
+      if (failure.failed() || report.stopped()) continue;  // a failure, or stopped by the progress callback
       const std::size_t x = static_cast<std::size_t>(r) / n[1], y = static_cast<std::size_t>(r) % n[1];
       auto factor = [x, y](const RowTerm& t) {
         const double a = t.fu ? t.scale * t.fu->c[3 * x] : t.scale;
@@ -359,9 +364,14 @@ BSplineVolume BlendedVolume::to_bspline() const {
           if (h[b] != Vec3{} && coef[2][b].lo < z1 && coef[2][b].hi > z0)
             ps.emplace_back(coef[2][b].c.data() + 3 * z0, h[b]);
       });
+      const std::size_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
+      if (detail::thread_index() == 0 && d % 256 == 0)
+        report.report(static_cast<double>(d) / static_cast<double>(n[0] * n[1]));
     }
   }
   failure.rethrow();
+  report.rethrow();
+  if (progress) progress(1.0);
   return BSplineVolume(target[0], target[1], target[2], std::move(P));
 }
 

@@ -18,6 +18,7 @@
 #include "interpatch/blend.hpp"
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/bspline_surface.hpp"
+#include "interpatch/progress.hpp"
 #include "interpatch/surface.hpp"
 
 namespace interpatch {
@@ -67,6 +68,9 @@ class BlendedSurface final : public Surface {
   /// count.
   /// @throws error no_exact_form (rational boundary curves, Gregory's twists).
   [[nodiscard]] BSplineSurface to_bspline() const override;
+  /// The same, telling `progress` the fraction of the net made (from the first thread,
+  /// at most every 64 rows); what the callback throws stops the work and is rethrown.
+  [[nodiscard]] BSplineSurface to_bspline(const progress_callback& progress) const;
   /// The knot vectors (u, v) of the exact form, without making its control net:
   /// what to_bspline() gives, count() control points along each. Cheap: the knots
   /// of the curves and blending functions merged. @throws error no_exact_form.

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "interpatch/bspline_volume.hpp"
+#include "interpatch/progress.hpp"
 #include "interpatch/volume.hpp"
 
 namespace interpatch {
@@ -61,6 +62,9 @@ class BlendedVolume final : public Volume {
   /// @throws error no_exact_form (a rational face or cross-derivative surface, or a
   ///   blending function given as a callable).
   [[nodiscard]] BSplineVolume to_bspline() const override;
+  /// The same, telling `progress` the fraction of the net made (from the first thread);
+  /// what the callback throws stops the work and is rethrown.
+  [[nodiscard]] BSplineVolume to_bspline(const progress_callback& progress) const;
   /// Whether to_bspline() succeeds.
   [[nodiscard]] bool has_exact_form() const noexcept;
   /// Notes on how the data were used (e.g. the largest gap found between faces along an edge).

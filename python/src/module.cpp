@@ -84,12 +84,13 @@ class PyBuilt {
   py::object info() const {
     LentPoints lent = lent_data();
     nlohmann::ordered_json j;
+    const ip::progress_callback progress = interruptible();  // Ctrl-C stops the conversion and the check
     {
       py::gil_scoped_release free;
       std::lock_guard<std::mutex> hold(b_->lock);
       const WithData with(b_->c, lent);
-      if (ip::io::has_exact_form(b_->c)) (void)ip::io::exact_form(b_->c);  // info reports it, as the command does
-      j = ip::io::info_json(b_->c);
+      if (ip::io::has_exact_form(b_->c)) (void)ip::io::exact_form(b_->c, progress);  // info reports it, as the command does
+      j = ip::io::info_json(b_->c, progress);
     }
     return to_python(j);
   }
@@ -127,7 +128,7 @@ class PyBuilt {
         const io::Resolution r = res ? *res : volume ? io::default_volume_resolution : io::default_surface_resolution;
         warned = io::write_mesh(b_->c, path, r, mesh_res, progress);
       } else if (view) {
-        if (io::has_exact_form(b_->c)) (void)io::exact_form(b_->c);  // the page shows it, as the command does
+        if (io::has_exact_form(b_->c)) (void)io::exact_form(b_->c, progress);  // the page shows it, as the command does
         const auto d = io::view_default_resolution(b_->c);
         const io::Resolution r = res ? *res : io::Resolution{d[0], d[1], d[2]};
         io::check_counts_kind(b_->c, view_res, r);
@@ -146,6 +147,7 @@ class PyBuilt {
   // knots alone; a volume's is made now; one without an exact form says so.
   [[nodiscard]] std::string repr(const char* kind) const {
     std::vector<std::size_t> degree, size;
+    const ip::progress_callback progress = interruptible();  // a volume's exact form is made now
     {
       py::gil_scoped_release free;
       std::lock_guard<std::mutex> hold(b_->lock);
@@ -156,7 +158,7 @@ class PyBuilt {
           degree.push_back(static_cast<std::size_t>(k.degree()));
           size.push_back(static_cast<std::size_t>(k.count()));
         }
-      } else if (ip::io::has_exact_form_after_conversion(c)) {
+      } else if (ip::io::has_exact_form_after_conversion(c, progress)) {
         std::visit([&](const auto& e) {
           for (const ip::KnotVector* k : knots_of(e)) {
             degree.push_back(static_cast<std::size_t>(k->degree()));
@@ -224,9 +226,10 @@ class PyBuilt {
   }
   template <class Exact>
   const Exact& exact() const {
+    const ip::progress_callback progress = interruptible();  // Ctrl-C stops a long conversion
     py::gil_scoped_release free;
     std::lock_guard<std::mutex> hold(b_->lock);
-    return std::get<Exact>(ip::io::exact_form(b_->c));
+    return std::get<Exact>(ip::io::exact_form(b_->c, progress));
   }
   std::shared_ptr<Built> b_;
   std::shared_ptr<const Sources> sources_;

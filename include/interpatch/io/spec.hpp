@@ -84,7 +84,7 @@ struct Construction {
   std::shared_ptr<const Volume> volume_formula;
   /// Built with BuildOptions::defer_exact: the conversion of the formula to its exact
   /// form, which exact_form() runs on first use (and then empties). Empty otherwise.
-  std::function<ExactForm()> convert;
+  std::function<ExactForm(const progress_callback&)> convert;
 };
 
 struct PointArray;
@@ -137,14 +137,16 @@ struct BuildOptions {
 /// construction keeps its formula alone.
 /// @throws error no_exact_form (saying why the construction has none, or where and by
 ///   how much its conversion was off).
-[[nodiscard]] const ExactForm& exact_form(Construction& c);
+/// `progress` hears how far a conversion has come; what it throws stops the
+/// conversion, which is then made again on the next call.
+[[nodiscard]] const ExactForm& exact_form(Construction& c, const progress_callback& progress = {});
 
 /// Whether the construction has an exact form, built or still to be converted.
 [[nodiscard]] bool has_exact_form(const Construction& c) noexcept;
 
 /// Converts a deferred exact form now: true when the construction has one, false when
 /// it has none or its conversion was refused (no_exact_form then says why).
-bool has_exact_form_after_conversion(Construction& c);
+bool has_exact_form_after_conversion(Construction& c, const progress_callback& progress = {});
 
 /// Whether the construction is a volume (its exact form a BSplineVolume, or its
 /// formula a Volume) rather than a surface.

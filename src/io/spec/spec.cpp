@@ -304,16 +304,17 @@ bool is_volume(const Construction& c) noexcept {
   return c.exact ? std::holds_alternative<BSplineVolume>(*c.exact) : c.volume_formula != nullptr;
 }
 
-const ExactForm& exact_form(Construction& c) {
+const ExactForm& exact_form(Construction& c, const progress_callback& progress) {
   if (!c.exact && c.convert) {
-    const auto convert = std::move(c.convert);
-    c.convert = nullptr;
     try {
-      c.exact = convert();
+      c.exact = c.convert(progress);
+      c.convert = nullptr;
     } catch (const error& e) {
       // A conversion refused (its check found it off): the construction keeps its
-      // formula, and what asks for the exact form is told why.
+      // formula, and what asks for the exact form is told why. Anything else (an
+      // interrupt from the progress callback, memory) leaves it to be made again.
       if (e.code() != errc::no_exact_form) throw;
+      c.convert = nullptr;
       c.no_exact_form = e.what();
     }
   }
@@ -323,9 +324,9 @@ const ExactForm& exact_form(Construction& c) {
 
 bool has_exact_form(const Construction& c) noexcept { return c.exact || c.convert; }
 
-bool has_exact_form_after_conversion(Construction& c) {
+bool has_exact_form_after_conversion(Construction& c, const progress_callback& progress) {
   try {
-    (void)exact_form(c);
+    (void)exact_form(c, progress);
     return true;
   } catch (const error& e) {
     if (e.code() != errc::no_exact_form) throw;

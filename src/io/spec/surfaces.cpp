@@ -113,8 +113,8 @@ Construction blended_with(std::string_view type, Formula f, std::vector<DataSet>
   c.type = type;
   auto formula = std::make_shared<const Formula>(std::move(f));
   if (formula->has_exact_form()) {
-    c.convert = [formula, type = std::string(type)] {
-      ExactForm e(formula->to_bspline());
+    c.convert = [formula, type = std::string(type)](const progress_callback& progress) {
+      ExactForm e(formula->to_bspline(progress));
       check_exact_form(*formula, e, type);
       return e;
     };
