@@ -470,7 +470,20 @@ std::vector<Row> rows() {
        R"(the (points|normals) of 'out\.vts': the value at \[[0-9, ]+\] is -?(nan|inf))", errc::not_finite, false},
       // the page shows the exact form's control net, which overflows first
       {"ViewOverflows", {{grid_file, overflowing}}, {"view", grid_file, "-o", "out.html"}, 3,
-       R"(control point \[0\]\[0\] is \(-?nan)", errc::not_finite, false},
+       R"(coons: its B-spline form's control point \[0\]\[0\] is \(-?nan)", errc::not_finite, false},
+      // a formula (no exact form: a rational curve and a plain one) that overflows at
+      // the data info measures it at: refused, never a data error that skips a NaN
+      {"InfoDataErrorNotFinite",
+       {{grid_file, R"({"type": "ruled", "curves": [
+          {"bspline": {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[-1.5e308, 0, 0], [1.5e308, 0, 0]], "weights": [1, 2]}},
+          {"bspline": {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 1, 0], [1, 1, 0]]}}]})"}},
+       {"info", grid_file}, 3,
+       R"(/curves/[01]/[0-9]+/0: the result at \([0-9.e+-]+, [01]\) is \([^)]*nan[^)]*\): the construction's arithmetic left the range of a double there)",
+       errc::not_finite, false},
+      // info reports the exact form: whose it is and why it cannot be made
+      {"InfoOverflows", {{grid_file, overflowing}}, {"info", grid_file}, 3,
+       R"(coons: its B-spline form's control point \[0\]\[0\] is \(-?nan, -?nan, [^)]*\): the conversion's arithmetic left the range of a double \(coordinates near 1e308\))",
+       errc::not_finite, false},
       // too large: refused before allocating. The bytes needed are an estimate that may
   // change; what stays is the size asked for, the bytes needed and the bytes available.
       {"EvalGridTooLarge", {{grid_file, grid}}, {"eval", grid_file, "--grid", "1000000", "-o", "out.npy"}, 5,

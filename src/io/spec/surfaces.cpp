@@ -114,9 +114,17 @@ Construction blended_with(std::string_view type, Formula f, std::vector<DataSet>
   auto formula = std::make_shared<const Formula>(std::move(f));
   if (formula->has_exact_form()) {
     c.convert = [formula, type = std::string(type)](const progress_callback& progress) {
-      ExactForm e(formula->to_bspline(progress));
-      check_exact_form(*formula, e, type);
-      return e;
+      std::optional<ExactForm> e;
+      try {
+        e.emplace(formula->to_bspline(progress));
+      } catch (const error& x) {
+        // Data near ±1e308 whose sums overflow: say whose form and why.
+        if (x.code() != errc::not_finite) throw;
+        fail(errc::not_finite, type, ": its B-spline form's ", x.what(),
+             ": the conversion's arithmetic left the range of a double (coordinates near 1e308)");
+      }
+      check_exact_form(*formula, *e, type);
+      return std::move(*e);
     };
   } else {
     try {
