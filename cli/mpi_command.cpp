@@ -16,6 +16,7 @@
 #include <cstring>
 #include <exception>
 #include <fstream>
+#include <limits>
 #include <new>
 #include <sstream>
 #include <string>
@@ -708,9 +709,23 @@ int approximate_run(const MpiRequest& r, const Plan& plan, const mpi::Team& team
   b.row0 = rb.halo[1].data();
   b.last = rb.halo[4].data();
   b.ends = {rb.halo[1].data(), rb.halo[2].data(), rb.halo[3].data(), rb.halo[4].data()};
+  // As in one process: data beyond 2^±64 are fitted in a power of two of their own
+  // size (exact both ways), the unit agreed over every process's rows.
+  double top[1] = {detail::largest_coordinate(rb.rows)};
+  team.max(top);
+  const double unit = detail::approximation_unit(top[0]);
+  SurfaceApproximationOptions options = plan.approx;
+  if (unit != 1) {
+    for (Vec3& q : rb.rows) q = q * (1 / unit);
+    for (auto& h : rb.halo)
+      for (Vec3& q : h.values()) q = q * (1 / unit);
+    if (options.tolerance)
+      options.tolerance = std::max(*options.tolerance / unit, std::numeric_limits<double>::denorm_min());
+  }
   detail::ApproxRows fit;
-  io::reader::at("/points", [&] { fit = detail::approximate_rows(b, plan.approx, team, [&] { release(rb.rows); }); });
+  io::reader::at("/points", [&] { fit = detail::approximate_rows(b, options, team, [&] { release(rb.rows); }); });
   release(rb.rows);
+  for (Vec3& q : fit.rows) q = q * unit;
   stages.done("fit");
   const std::size_t N = fit.net[0], width = fit.net[1];
   const OutputRows o = output_rows<2>(r, plan, team, fit.knots[0], N, "approximate");

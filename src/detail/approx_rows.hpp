@@ -5,9 +5,12 @@
 // order: a given number of control points, smoothing (a number or "auto") and a fit
 // to a tolerance, with missing points (NaN), weights, open and closed directions.
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <functional>
+#include <span>
 #include <vector>
 
 #include "detail/grid_rows.hpp"
@@ -16,6 +19,28 @@
 #include "interpatch/vec3.hpp"
 
 namespace interpatch::detail {
+
+/// The power of two a fit works in for data whose largest finite coordinate is
+/// `top`: 1 for ordinary data, whose squared distances lie far from either end of
+/// double (top within 2^±64); otherwise the power of two near top, where the fit's
+/// sums of squares, its rms and its search for knots neither overflow nor vanish.
+/// Scaling by it is exact both ways.
+inline double approximation_unit(double top) noexcept {
+  constexpr double low = 0x1p-64, high = 0x1p64;
+  if (top == 0 || (top >= low && top <= high)) return 1;
+  int e = 0;
+  (void)std::frexp(top, &e);
+  return std::ldexp(1.0, e);
+}
+
+/// The largest absolute finite coordinate of the points (0 when there is none; NaN
+/// marks a missing point).
+inline double largest_coordinate(std::span<const Vec3> points) noexcept {
+  double top = 0;
+  for (const Vec3& q : points)
+    if (is_finite(q)) top = std::max({top, std::abs(q.x), std::abs(q.y), std::abs(q.z)});
+  return top;
+}
 
 /// The fitted surface, its control rows split evenly between the processes.
 struct ApproxRows {

@@ -196,6 +196,13 @@ def tolerance_cases(rng):
         {"tolerance": 2e-3, "degree": [3, 2]}, "40", [4]
     yield "approximate tolerance holes, centripetal, Fortran order", np.asfortranarray(holes(bumps((70, 45), rng), rng)), \
         {"tolerance": 2e-3, "param": "centripetal"}, "33", [2]
+    # Data beyond 2^±64 are fitted in a power of two of their own size, on the split
+    # path as in one process: squared distances would overflow at 1e200 and vanish at 1e-200.
+    for scale in (1e200, 1e-200):
+        yield f"approximate tolerance holes at {scale:g}", holes(bumps((60, 45), rng), rng) * scale, \
+            {"tolerance": 2e-3 * scale}, "30", [3]
+        yield f"approximate control points at {scale:g}", bumps((53, 37), rng) * scale, {"control_points": [20, 15]}, \
+            "30", [2]
 
 
 
