@@ -4,6 +4,9 @@
 // 5 for work too large for this machine, 1 for anything else. The library only
 // names what is wrong; how a process reports it is the command's business.
 
+#include <exception>
+#include <string>
+
 #include "interpatch/error.hpp"
 
 namespace interpatch::cli {
@@ -17,5 +20,18 @@ constexpr int exit_status(errc code) noexcept {
     default: return 3;
   }
 }
+
+/// The exit status of a failure: exit_status(code) for an interpatch::error, 2 for a
+/// usage_error, 5 for std::bad_alloc, 1 for anything else.
+int exit_status(const std::exception_ptr& failure) noexcept;
+
+/// Print `message` as the one error line, "interpatch: <message>" on stderr (line
+/// breaks made spaces, whatever the message holds), and return `status`.
+int fail_with(int status, std::string message);
+
+/// Print the failure's one error line ("out of memory" for std::bad_alloc) and
+/// return its exit status. The single process and the split run (mpi_command.cpp)
+/// both report through here, so they fail alike.
+int report_failure(const std::exception_ptr& failure);
 
 }  // namespace interpatch::cli

@@ -7,7 +7,6 @@
 #include <exception>
 #include <filesystem>
 #include <functional>
-#include <new>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -32,14 +31,6 @@
 #endif
 
 namespace {
-
-// One line, whatever the message holds.
-int fail_with(int status, std::string message) {
-  for (char& c : message)
-    if (c == '\n' || c == '\r') c = ' ';
-  std::fprintf(stderr, "interpatch: %s\n", message.c_str());
-  return status;
-}
 
 #ifdef INTERPATCH_MPI
 // eval or build under an MPI launcher: through the module interpatch-mpi.so, beside
@@ -155,14 +146,14 @@ int main(int argc, char** argv) {
     const std::string first = argv[1];
     if (first != "build" && first != "mesh" && first != "eval" && first != "info" && first != "view" &&
         first != "demo")
-      return fail_with(2, "unknown command '" + first + "'; the commands are build, mesh, eval, info, view, demo (see interpatch --help)");
+      return cli::fail_with(2, "unknown command '" + first + "'; the commands are build, mesh, eval, info, view, demo (see interpatch --help)");
   }
 
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help
-    return fail_with(2, std::string(e.what()) + " (see interpatch --help)");
+    return cli::fail_with(2, std::string(e.what()) + " (see interpatch --help)");
   }
 
   // Threads on CPUs of their own before the first parallel loop (threads.hpp).
@@ -186,15 +177,9 @@ int main(int argc, char** argv) {
       if (info_out) o = *info_out;
       return cli::info_command(input, o);
     }
-    return fail_with(2, "no command given (see interpatch --help)");
-  } catch (const interpatch::error& e) {
-    return fail_with(cli::exit_status(e.code()), e.what());
-  } catch (const cli::usage_error& e) {
-    return fail_with(2, e.what());
-  } catch (const std::bad_alloc&) {
-    return fail_with(5, "out of memory");
-  } catch (const std::exception& e) {
-    return fail_with(1, e.what());
+    return cli::fail_with(2, "no command given (see interpatch --help)");
+  } catch (const std::exception&) {
+    return cli::report_failure(std::current_exception());
   }
   };
 #ifdef INTERPATCH_MPI

@@ -46,38 +46,15 @@ using detail::fail;
 
 namespace {
 
+// A peer's failure carries the status of the process that failed first.
 int status_of(const std::exception_ptr& e) {
   try {
     std::rethrow_exception(e);
-  } catch (const error& x) {
-    return exit_status(x.code());
-  } catch (const usage_error&) {
-    return 2;
-  } catch (const std::bad_alloc&) {
-    return 5;
   } catch (const detail::peer_failure& p) {
     return p.status;
   } catch (...) {
-    return 1;
+    return exit_status(e);
   }
-}
-
-// The one error line, as the single process prints it.
-int report(const std::exception_ptr& e) {
-  std::string message;
-  try {
-    std::rethrow_exception(e);
-  } catch (const std::bad_alloc&) {
-    message = "out of memory";
-  } catch (const std::exception& x) {
-    message = x.what();
-  } catch (...) {
-    message = "unknown failure";
-  }
-  for (char& c : message)
-    if (c == '\n' || c == '\r') c = ' ';
-  std::fprintf(stderr, "interpatch: %s\n", message.c_str());
-  return status_of(e);
 }
 
 // What the split run needs to know before it reads a point; `split` false: the
@@ -759,7 +736,7 @@ int mpi_command(const MpiRequest& request, const std::function<int()>& single) {
   } catch (const detail::peer_failure& p) {
     return p.status;
   } catch (...) {
-    return report(std::current_exception());
+    return report_failure(std::current_exception());
   }
 }
 
