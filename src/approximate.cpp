@@ -16,6 +16,7 @@
 
 #include "detail/approx_check.hpp"
 #include "detail/approx_fit.hpp"
+#include "detail/approx_rows.hpp"
 #include "detail/banded.hpp"
 #include "detail/parallel.hpp"
 #include "detail/text.hpp"
@@ -541,22 +542,6 @@ Data<R> closed_data(Grid<Vec3, R> points, Grid<double, R>& weights, const std::a
   return d;
 }
 
-// The power of two that brings the data's largest coordinate near 1, where their
-// coordinates are so large or so small that squared distances would overflow or
-// vanish (the fit's sums of squares, its rms, its search for knots); 1 otherwise,
-// leaving ordinary data untouched. Scaling by it is exact both ways.
-template <std::size_t R>
-double data_unit(const Grid<Vec3, R>& points) {
-  double top = 0;
-  for (const Vec3& q : points.values())
-    if (is_finite(q)) top = std::max({top, std::abs(q.x), std::abs(q.y), std::abs(q.z)});
-  constexpr double low = 0x1p-64, high = 0x1p64;  // squares between 2^-128 and 2^128: far from either end of double
-  if (top == 0 || (top >= low && top <= high)) return 1;
-  int e = 0;
-  (void)std::frexp(top, &e);
-  return std::ldexp(1.0, e);
-}
-
 // Finite points scaled by 1 / unit (NaN marks a missing point; infinite ones are kept
 // for approximate() to name as given).
 template <std::size_t R>
@@ -572,7 +557,8 @@ Result<R> run(Grid<Vec3, R> points, const ApproximationOptions<R>& options, cons
     for (std::size_t a = 0; a < R; ++a) shape[a] = points.extent(a);
     return shape;
   }(), what);
-  const double unit = data_unit<R>(points);
+  // Data beyond 2^±64 are fitted in a power of two of their own size (exact both ways).
+  const double unit = detail::approximation_unit(detail::largest_coordinate(points.values()));
   const bool closed = std::any_of(options.periodic.begin(), options.periodic.end(), [](bool b) { return b; });
   // A copy of the options (and their weights) only where they change.
   std::optional<ApproximationOptions<R>> changed;
