@@ -24,6 +24,7 @@ every case on its largest count of processes alone, every failure on 3 processes
 import itertools
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -49,10 +50,19 @@ SPLIT_ONLY = [2, 3, 4]
 failures = []
 
 
+# The launcher's own event library may warn while processes that failed together
+# are torn down on a loaded machine ("[warn] Epoll MOD(1) on fd 23 failed ... Bad file
+# descriptor"): a line of mpirun's, not of interpatch's, left out of what is compared.
+LAUNCHER_NOISE = re.compile(r"^\[warn\] Epoll [A-Z]+\(\d+\) on fd \d+ failed\..*$\n?", re.MULTILINE)
+
+
 def run(args, processes=None, cwd=None):
     cmd = [EXE] + args if processes is None else [MPIRUN, "--oversubscribe", "-q", "--mca", "btl", "self,vader", "-np", str(processes), EXE] + args
-    return subprocess.run(cmd, cwd=cwd, env=SINGLE_ENV if processes is None else ENV, capture_output=True, text=True,
-                          timeout=120)
+    r = subprocess.run(cmd, cwd=cwd, env=SINGLE_ENV if processes is None else ENV, capture_output=True, text=True,
+                       timeout=120)
+    if processes is not None:
+        r.stderr = LAUNCHER_NOISE.sub("", r.stderr)
+    return r
 
 
 def check(ok, what):
