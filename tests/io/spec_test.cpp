@@ -1170,6 +1170,31 @@ TEST(SpecExact, DeferredUntilAskedThenTheSameAsBuiltAtOnce) {
   EXPECT_EQ(&evaluator(r, 1000, Sample::points), r.formula.get());
 }
 
+// A progress callback that throws (Python's Ctrl-C, a caller's cancel) stops the
+// conversion, which stays to be made: the next call makes the same exact form as a
+// construction never interrupted.
+TEST(SpecExact, AnInterruptedConversionIsMadeAgainInFull) {
+  const json spec = coons_spec(600);  // ~1200 rows: the progress is heard before the end
+  Construction c = build(spec, {}, deferred);
+  struct Interrupt {};
+  std::size_t heard = 0;
+  const progress_callback stop = [&](double fraction) {
+    ++heard;
+    if (fraction < 1) throw Interrupt{};
+  };
+  EXPECT_THROW((void)exact_form(c, stop), Interrupt);
+  EXPECT_EQ(heard, 1u);  // stopped at the first report
+  EXPECT_FALSE(c.exact.has_value());
+  EXPECT_TRUE(c.convert);
+  std::vector<double> fractions;
+  const auto& made = std::get<BSplineSurface>(exact_form(c, [&](double f) { fractions.push_back(f); }));
+  EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
+  ASSERT_FALSE(fractions.empty());
+  EXPECT_EQ(fractions.back(), 1.0);
+  const Construction at_once = build(spec);
+  EXPECT_EQ(made.control_points().values(), std::get<BSplineSurface>(*at_once.exact).control_points().values());
+}
+
 TEST(SpecExact, TheEvaluatorIsTheCheaperOfFormulaAndExactForm) {
   // A Coons patch of four 600-point curves: 4 terms per point against a ~1200² net.
   Construction coons = build(coons_spec(600), {}, deferred);

@@ -279,30 +279,3 @@ def test_ctrl_c_stops_a_long_derivative_evaluation():
     for k in (0, 350, 699):
         assert np.array_equal(whole[k], c.evaluate_derivatives(t[k:k + 1], t)[0])
 
-
-def big_coons(n):
-    """A Coons patch of four interpolated curves of n points: an exact form of about
-    2n x 2n control points, made on first use."""
-    t = np.linspace(0, 1, n)
-    bump = 0.1 * np.sin(3 * np.pi * t)
-    side = lambda x, y, z: {"interpolate": np.stack([x, y, z], axis=1).tolist()}
-    return interpatch.build({"type": "coons", "boundary": {
-        "v0": side(t, 0 * t, bump), "v1": side(t, 0 * t + 1, -bump),
-        "u0": side(0 * t, t, bump), "u1": side(0 * t + 1, t, -bump)}})
-
-
-def test_ctrl_c_stops_a_long_exact_form_conversion():
-    pending = {}
-
-    def convert(n):
-        c = big_coons(n)
-        pending[n] = c  # kept: an interrupted one is converted again below
-        c.to_bspline()
-        del pending[n]
-    assert_ctrl_c_stops(convert, 64, 4096)
-    # The interrupted construction converts in full when asked again, as a fresh one
-    # does (the building takes a small part of the time: it was the conversion that stopped).
-    assert len(pending) == 1
-    (n, c), = pending.items()
-    again, fresh = c.to_bspline(), big_coons(n).to_bspline()
-    assert np.array_equal(again["control_points"], fresh["control_points"])
