@@ -1,6 +1,6 @@
 // eval and build of a grid interpolation split between MPI processes. Each process
 // reads its block of rows of the .npy points (MPI-IO), the passes along the axes
-// inside the rows run on the blocks (src/detail/grid_rows.hpp, the very functions
+// inside the rows run on the blocks (src/constructions/interpolate/grid_rows.hpp, the very functions
 // the single process runs), one all-to-all turns the rows into columns for the
 // solve along u and another turns the control points back into rows (with the
 // halo each process's output rows need), and every process writes its part of the
@@ -24,9 +24,9 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "detail/approx_rows.hpp"
-#include "detail/grid_rows.hpp"
-#include "detail/row_window.hpp"
+#include "constructions/approximate/approx_rows.hpp"
+#include "constructions/interpolate/grid_rows.hpp"
+#include "splines/row_window.hpp"
 #include "exit_status.hpp"
 #include "interpatch/error.hpp"
 #include "interpatch/evaluate.hpp"
@@ -253,7 +253,7 @@ struct RowBlock {
   std::array<std::size_t, 3> n{};  // the grid's extents
   std::size_t M = 1, first = 0, count = 0;
   // C order. Not a Grid: a Grid's buffer, freed, is kept for reuse
-  // (detail/pages.cpp), which would hold a second share of the data here.
+  // (base/pages.cpp), which would hold a second share of the data here.
   std::vector<Vec3> rows;
   std::array<Grid<Vec3, D>, 5> halo;  // the row before the block; rows 0, 1, n−2, n−1
 };

@@ -1,9 +1,9 @@
-// The approximation of a grid held in blocks of rows (src/detail/approx_rows.hpp):
+// The approximation of a grid held in blocks of rows (src/constructions/approximate/approx_rows.hpp):
 // the control points, bit for bit, of approximate_surface on the whole grid, for
 // every split of the rows. The processes are threads here, sharing a RowTeam that
 // does what the MPI one does (src/mpi/team.cpp): the same sums, in the same order.
 
-#include "detail/approx_rows.hpp"
+#include "constructions/approximate/approx_rows.hpp"
 
 #include <gtest/gtest.h>
 

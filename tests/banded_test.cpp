@@ -1,4 +1,4 @@
-#include "detail/banded.hpp"
+#include "linalg/banded.hpp"
 
 #include <gtest/gtest.h>
 

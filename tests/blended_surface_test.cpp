@@ -2,7 +2,7 @@
 
 #include <numbers>
 
-#include "detail/parallel.hpp"
+#include "base/parallel.hpp"
 #include "interpatch/coons.hpp"
 #include "interpatch/interpolate.hpp"
 #include "interpatch/network.hpp"

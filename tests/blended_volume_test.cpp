@@ -1,6 +1,6 @@
 #include "interpatch/blended_volume.hpp"
 
-#include "detail/parallel.hpp"
+#include "base/parallel.hpp"
 #include "interpatch/coons_volume.hpp"
 #include "interpatch/volume_patches.hpp"
 #include "thread_util.hpp"

@@ -19,7 +19,7 @@
 #endif
 
 #include "cli_runner.hpp"
-#include "detail/parallel.hpp"
+#include "base/parallel.hpp"
 #include "interpatch/evaluate.hpp"
 #include "interpatch/interpolate.hpp"
 #include "interpatch/io/npy.hpp"

@@ -3,7 +3,7 @@
 #include <set>
 #include <string>
 
-#include "detail/collocation.hpp"
+#include "linalg/collocation.hpp"
 #include "test_util.hpp"
 
 namespace interpatch {

@@ -21,7 +21,7 @@
 #include <utility>
 #include <vector>
 
-#include "detail/parallel.hpp"
+#include "base/parallel.hpp"
 #include "interpatch/coons.hpp"
 #include "interpatch/coons_volume.hpp"
 #include "interpatch/evaluate.hpp"

@@ -4,7 +4,7 @@
 #include <limits>
 #include <vector>
 
-#include "detail/normals.hpp"
+#include "splines/normals.hpp"
 #include "test_util.hpp"
 
 namespace interpatch {

@@ -29,7 +29,7 @@
 #include "interpatch/io/npz.hpp"
 #include "interpatch/io/spec.hpp"
 #include "interpatch/network.hpp"
-#include "network_curves.hpp"
+#include "constructions/network/network_curves.hpp"
 #include "surface_util.hpp"
 
 namespace interpatch {

@@ -1,9 +1,9 @@
-// The parallel loops' one way out for an exception (src/detail/parallel.hpp): thrown on
+// The parallel loops' one way out for an exception (src/base/parallel.hpp): thrown on
 // any thread, at any index, it comes out of the loop as the exception of the lowest
 // failing index, on any number of threads; every index below it has run; nothing
 // reaches std::terminate.
 
-#include "detail/parallel.hpp"
+#include "base/parallel.hpp"
 
 #include <gtest/gtest.h>
 
@@ -16,7 +16,7 @@
 #include <omp.h>
 #endif
 
-#include "detail/text.hpp"
+#include "base/text.hpp"
 #include "interpatch/error.hpp"
 
 namespace interpatch {

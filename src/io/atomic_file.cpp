@@ -26,7 +26,7 @@
 #include <system_error>
 #include <vector>
 
-#include "detail/text.hpp"
+#include "base/text.hpp"
 
 namespace interpatch::io {
 namespace fs = std::filesystem;

@@ -4,7 +4,7 @@
 #include <new>
 #include <vector>
 
-#include "detail/parallel.hpp"
+#include "base/parallel.hpp"
 
 namespace interpatch::io::internal {
 

@@ -13,7 +13,7 @@
 #include <string_view>
 #include <system_error>
 
-#include "detail/text.hpp"
+#include "base/text.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "io/finite.hpp"
 #include "io/input_stream.hpp"

@@ -10,8 +10,8 @@
 #include <string>
 #include <string_view>
 
-#include "detail/parallel.hpp"
-#include "detail/text.hpp"
+#include "base/parallel.hpp"
+#include "base/text.hpp"
 
 namespace interpatch::io::internal {
 

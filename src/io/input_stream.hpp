@@ -12,7 +12,7 @@
 #include <streambuf>
 #include <string_view>
 
-#include "detail/text.hpp"
+#include "base/text.hpp"
 
 namespace interpatch::detail {
 

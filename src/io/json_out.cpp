@@ -10,7 +10,7 @@
 #include <type_traits>
 #include <variant>
 
-#include "detail/text.hpp"
+#include "base/text.hpp"
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/bspline_volume.hpp"
 #include "interpatch/io/atomic_file.hpp"

@@ -14,9 +14,9 @@
 #include <sstream>
 #include <string>
 
-#include "detail/parallel.hpp"
-#include "detail/pipeline.hpp"
-#include "detail/text.hpp"
+#include "base/parallel.hpp"
+#include "base/pipeline.hpp"
+#include "base/text.hpp"
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/evaluate.hpp"
 #include "interpatch/io/atomic_file.hpp"

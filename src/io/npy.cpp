@@ -18,8 +18,8 @@
 #include <string>
 #include <string_view>
 
-#include "detail/pipeline.hpp"
-#include "detail/text.hpp"
+#include "base/pipeline.hpp"
+#include "base/text.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/memory.hpp"
 #include "io/crc32.hpp"

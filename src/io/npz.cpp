@@ -27,8 +27,8 @@
 #include <variant>
 #include <vector>
 
-#include "detail/excerpt.hpp"
-#include "detail/text.hpp"
+#include "base/excerpt.hpp"
+#include "base/text.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "io/crc32.hpp"
 #include "io/npy_format.hpp"

@@ -6,7 +6,7 @@
 #include <string_view>
 #include <vector>
 
-#include "exchange.hpp"
+#include "io/exchange.hpp"
 #include "interpatch/error.hpp"
 #include "interpatch/io/atomic_file.hpp"
 

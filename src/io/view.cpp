@@ -13,7 +13,7 @@
 #include <variant>
 #include <vector>
 
-#include "detail/text.hpp"
+#include "base/text.hpp"
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/bspline_volume.hpp"
 #include "interpatch/evaluate.hpp"

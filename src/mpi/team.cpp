@@ -12,7 +12,7 @@
 #include <random>
 #include <thread>
 
-#include "detail/text.hpp"
+#include "base/text.hpp"
 #include "interpatch/error.hpp"
 
 namespace interpatch::mpi {

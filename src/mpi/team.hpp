@@ -1,6 +1,6 @@
 #pragma once
 // The MPI side of a run split between processes (INTERPATCH_MPI): the processes of
-// MPI_COMM_WORLD as a RowTeam (detail/grid_rows.hpp), the transposes between blocks
+// MPI_COMM_WORLD as a RowTeam (constructions/interpolate/grid_rows.hpp), the transposes between blocks
 // of rows and blocks of columns, and the output file written in place by every
 // process. The core library knows nothing of MPI; only this directory does.
 
@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "detail/grid_rows.hpp"
+#include "constructions/interpolate/grid_rows.hpp"
 #include "interpatch/vec3.hpp"
 
 namespace interpatch::mpi {

@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "detail/text.hpp"
-#include "network_curves.hpp"
+#include "base/text.hpp"
+#include "constructions/network/network_curves.hpp"
 #include "interpatch/coons.hpp"
 #include "interpatch/coons_volume.hpp"
 #include "interpatch/evaluate.hpp"

@@ -6,7 +6,7 @@
 #include <array>
 #include <cmath>
 
-#include "detail/excerpt.hpp"
+#include "base/excerpt.hpp"
 #include "interpatch/approximate.hpp"
 #include "interpatch/memory.hpp"
 #include "io/spec/forms.hpp"

@@ -6,7 +6,7 @@
 #include <cstring>
 #include <limits>
 
-#include "detail/parallel.hpp"
+#include "base/parallel.hpp"
 #include "interpatch/io/csv.hpp"
 #include "interpatch/io/npy.hpp"
 #include "interpatch/memory.hpp"

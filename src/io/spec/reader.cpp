@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "detail/excerpt.hpp"
+#include "base/excerpt.hpp"
 
 namespace interpatch::io::reader {
 

@@ -22,7 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "detail/text.hpp"
+#include "base/text.hpp"
 #include "interpatch/grid.hpp"
 #include "interpatch/approximate.hpp"
 #include "interpatch/interpolate.hpp"

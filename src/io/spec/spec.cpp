@@ -12,7 +12,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "detail/excerpt.hpp"
+#include "base/excerpt.hpp"
 #include "interpatch/blended_surface.hpp"
 #include "interpatch/memory.hpp"
 #include "io/spec/forms.hpp"

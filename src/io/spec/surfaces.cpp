@@ -10,7 +10,7 @@
 #include <optional>
 #include <string>
 
-#include "detail/parallel.hpp"
+#include "base/parallel.hpp"
 #include "interpatch/blended_volume.hpp"
 #include "interpatch/bspline_volume.hpp"
 #include "interpatch/coons.hpp"

@@ -7,7 +7,7 @@
 #include "interpatch/coons_volume.hpp"
 #include "interpatch/evaluate.hpp"
 #include "interpatch/volume_patches.hpp"
-#include "detail/excerpt.hpp"
+#include "base/excerpt.hpp"
 #include "io/spec/reader.hpp"
 
 namespace interpatch::io::reader {
