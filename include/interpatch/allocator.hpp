@@ -1,9 +1,8 @@
 #pragma once
 /// @file allocator.hpp
-/// The allocator behind every grid: large buffers come straight from the system in
-/// 2 MiB-aligned mappings marked for transparent huge pages, small ones from
-/// operator new. Touching fresh memory page by page is a large share of the cost
-/// of a pass over a big grid; huge pages cut the number of page faults 512-fold.
+/// The allocator behind every grid (Grid's storage), and the two ways to size a grid
+/// the library's outputs use: zeroed and to be overwritten. Nothing here is needed
+/// to use interpatch; it is public because Grid's storage type names it.
 
 #include <cstddef>
 #include <memory>
@@ -17,10 +16,9 @@ namespace interpatch {
 namespace detail {
 /// Buffers at least this large are mapped directly.
 inline constexpr std::size_t large_buffer_bytes = std::size_t{1} << 20;
-/// A 2 MiB-aligned anonymous mapping of at least `bytes`, marked for transparent
-/// huge pages. With `zero`, a fresh one: zero-filled, its pages untouched. Without,
-/// possibly one given back before with the same rounded size, its pages already
-/// touched and its contents whatever they were.
+/// At least `bytes` of memory from the system (src/base/pages.cpp). With `zero`,
+/// fresh and zero-filled; without, possibly memory given back before, its contents
+/// whatever they were.
 /// @throws std::bad_alloc.
 void* map_pages(std::size_t bytes, bool zero = true);
 /// Gives a mapping back. A few of the most recent ones, up to 256 MiB in all, are
@@ -34,7 +32,8 @@ enum class Start { values, zero_pages, overwrite };
 inline thread_local Start start = Start::values;
 }  // namespace detail
 
-/// A std::allocator drop-in that maps large buffers with huge pages.
+/// A std::allocator drop-in that takes large buffers from the system directly, so
+/// that a large grid's memory is first touched by the threads that write it.
 template <class T>
 struct large_allocator {
   using value_type = T;
@@ -95,9 +94,8 @@ void resize_zeroed(std::vector<T, large_allocator<T>>& v, std::size_t n) {
 }
 
 /// Resizes an empty vector that uses large_allocator to n elements the caller will
-/// all overwrite (trivially copyable T): a large buffer may reuse the pages of one
-/// freed before, already touched, instead of fresh ones, which on a virtual machine
-/// cost as much as writing them twice. Small buffers are value-initialized.
+/// all overwrite (trivially copyable T): a large buffer may reuse the memory of one
+/// freed before instead of fresh memory. Small buffers are value-initialized.
 template <class T>
 void resize_for_overwrite(std::vector<T, large_allocator<T>>& v, std::size_t n) {
   detail::resize_started(v, n, detail::Start::overwrite);

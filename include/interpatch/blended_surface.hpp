@@ -64,7 +64,7 @@ class BlendedSurface final : public Surface {
   /// Every function of u made compatible (common degree and knots, by degree
   /// elevation and knot insertion), likewise v, then the control points of the
   /// tensor-product terms summed: each control point once, in one pass over the
-  /// net, the rows shared by both cores; the result does not depend on the thread
+  /// net, the rows shared between threads; the result does not depend on the thread
   /// count.
   /// @throws error no_exact_form (rational boundary curves, Gregory's twists).
   [[nodiscard]] BSplineSurface to_bspline() const override;

@@ -57,7 +57,7 @@ class BlendedVolume final : public Volume {
   /// Every function of u made compatible (common degree and knots, by degree
   /// elevation and knot insertion), likewise v and w, then the control points of
   /// the tensor-product terms summed: each control point once, in one pass over the
-  /// net, the rows shared by both cores; the result does not depend on the thread
+  /// net, the rows shared between threads; the result does not depend on the thread
   /// count.
   /// @throws error no_exact_form (a rational face or cross-derivative surface, or a
   ///   blending function given as a callable).
