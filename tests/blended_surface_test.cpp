@@ -13,7 +13,7 @@
 namespace interpatch {
 namespace {
 
-// Seed 002 eq. 1: r(u,v) = Σ c_k(u,v) r_k with c_k(u_l, v_l) = δ_kl and Σ c_k ≡ 1. For
+// The blended form r(u,v) = Σ c_k(u,v) r_k with c_k(u_l, v_l) = δ_kl and Σ c_k ≡ 1. For
 // constructions from curves the "data" r_k are whole curves; both properties are
 // checked through linearity in the data.
 

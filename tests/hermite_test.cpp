@@ -23,7 +23,7 @@ TEST(Hermite, BasisInterpolatesEndValuesAndSlopes) {
     const double g = i / 20.0;
     const auto h = hermite_basis(g);
     EXPECT_NEAR(h.a0 + h.a1, 1.0, 1e-15);  // partition of unity of the position functions
-    // Seed 004 eq. 1.24 written out.
+    // The cubic Hermite functions written out.
     EXPECT_NEAR(h.a0, 1 - 3 * g * g + 2 * g * g * g, 1e-15);
     EXPECT_NEAR(h.b0, g - 2 * g * g + g * g * g, 1e-15);
     EXPECT_NEAR(h.b1, -g * g + g * g * g, 1e-15);

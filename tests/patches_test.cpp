@@ -5,8 +5,8 @@
 namespace interpatch {
 namespace {
 
-TEST(Bilinear, SeedExample6_9) {
-  // Seed 000, Example 6-9: P00=(0,0,1), P01=(1,1,1), P10=(1,0,0), P11=(0,1,0).
+TEST(Bilinear, TextbookExample6_9) {
+  // Rogers & Adams, Mathematical Elements for Computer Graphics, Example 6-9: P00=(0,0,1), P01=(1,1,1), P10=(1,0,0), P11=(0,1,0).
   const auto s = bilinear({0, 0, 1}, {1, 1, 1}, {1, 0, 0}, {0, 1, 0});
   EXPECT_EQ(s.point(0.5, 0.5), (Vec3{0.5, 0.5, 0.5}));
   EXPECT_EQ(s.to_bspline().point(0.5, 0.5), (Vec3{0.5, 0.5, 0.5}));

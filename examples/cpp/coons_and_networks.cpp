@@ -75,7 +75,7 @@ void bilinear_patches() {
   // Every isoparametric line is straight: its midpoint is the mean of its ends.
   example::expect_near(s.point(0.3, 0.5), 0.5 * (s.point(0.3, 0) + s.point(0.3, 1)), "the line u = 0.3 is straight");
   example::expect_near(s.point(0.5, 0.7), 0.5 * (s.point(0, 0.7) + s.point(1, 0.7)), "the line v = 0.7 is straight");
-  std::printf("bilinear patch (seed 000, Example 6-9) at (0.5, 0.5): %s\n", example::str(q).c_str());
+  std::printf("bilinear patch (Rogers & Adams, Example 6-9) at (0.5, 0.5): %s\n", example::str(q).c_str());
 }
 
 void coons_patches() {
