@@ -84,9 +84,6 @@ Reparametrization monotone_map(std::vector<double> at, std::vector<double> to, b
 /// u with map(u) = y, for y between map(0) and map(1) (closed: unwrapped).
 double inverse(const Reparametrization& map, double y);
 
-/// One curve to re-express: C (the prepared curve), the curve as given (both over
-/// [0, 1]; null when C is it, up to rounding), the correction G the surface adds along the curve's line (see
-/// network.cpp: S = D + G there), and the map.
 /// Thrown by refit() when a curve cannot be re-expressed within the target: which
 /// job, the message saying how far it stays. The network names the curve.
 class RefitShortfall : public error {
@@ -98,6 +95,9 @@ class RefitShortfall : public error {
   std::size_t job_;
 };
 
+/// One curve to re-express: C (the prepared curve), the curve as given (both over
+/// [0, 1]; null when C is it, up to rounding), the correction G the surface adds along the curve's line (see
+/// place_curves: S = D + G there), and the map.
 struct FitJob {
   const BSplineCurve* c;
   const BSplineCurve* given;

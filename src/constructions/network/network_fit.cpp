@@ -236,7 +236,7 @@ std::vector<double> refinement(const std::vector<double>& sp, const std::vector<
 
 }  // namespace
 
-// As network_curves.hpp says; the knots a round adds are refinement()'s.
+// Declared, and described, in network_curves.hpp.
 std::optional<std::vector<Refit>> fit_group(const std::vector<FitJob>& jobs, const std::vector<std::size_t>& members,
                                             std::vector<double> interior, const std::vector<double>& nodes,
                                             bool closed, double target, std::size_t all,
