@@ -59,6 +59,21 @@ std::vector<Scalar> hermite_scalars();
 /// The curve over [0, 1].
 BSplineCurve unit(const BSplineCurve& c);
 
+/// Value and first two derivatives of a function of one parameter: of a curve (D3),
+/// of a scalar (S3).
+struct D3 {
+  Vec3 v[3];
+};
+struct S3 {
+  double v[3];
+};
+
+inline D3 eval(const BSplineCurve& c, double t) {
+  D3 d;
+  c.derivatives(t, 2, d.v);
+  return d;
+}
+
 // The row kernel of the exact conversions (to_bspline of BlendedSurface and
 // BlendedVolume): every control point of a row is a short sum of terms of two
 // kinds, a line of points times a number and a point times a line of numbers, and

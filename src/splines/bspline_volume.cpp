@@ -129,13 +129,85 @@ struct LineOut {
   detail::PackedBasis w;
 };
 
+// One net of contract's planes of u: U = Σ_e c[e] Pw_e over the p + 1 planes of the
+// span of basis row a, c its derivatives of order k. Each entry summed over the
+// planes in registers, in the order of the planes, and stored once (a pass per plane
+// read each entry back from the store before: stalls on this processor).
+void contract_u(const Net& b, const Basis& a, int k, H* out) {
+  const int p = b.ku.degree();
+  const Grid<double, 3>& wt = b.weights;
+  const bool rat = !wt.empty();
+  const std::size_t plane = b.ncv * b.ncw;
+  const Vec3* planes[max_degree + 1];
+  const double* weights[max_degree + 1];
+  double c[max_degree + 1];
+  for (int e = 0; e <= p; ++e) {
+    c[e] = a.d[k * (p + 1) + e];
+    const auto ii = static_cast<std::size_t>(b.ku.wrap_index(a.span - p + e));
+    planes[e] = b.planes.row(ii);
+    weights[e] = rat ? &wt(ii, 0, 0) : nullptr;
+  }
+  if (rat) {
+    for (std::size_t x = 0; x < plane; ++x) {
+      H h{0, 0, 0, 0};
+      for (int e = 0; e <= p; ++e) {
+        const Vec3& P = planes[e][x];
+        const double cw = c[e] * weights[e][x];
+        h[0] += cw * P.x;
+        h[1] += cw * P.y;
+        h[2] += cw * P.z;
+        h[3] += cw;
+      }
+      out[x] = h;
+    }
+  } else {
+    combine_planes(c, p + 1, planes, plane, out);
+  }
+}
+
+// The point at the w of basis row bm and, with Partials, its three first partials,
+// from contract's rows V of one (u, v): V[0] the row, V[1] and V[2] its derivatives
+// in u and v.
+template <bool Partials>
+VolumeDerivatives contract_w(const Net& b, const Basis& bm, const std::vector<H>* V) {
+  const int r = b.kw.degree();
+  const bool rat = !b.weights.empty();
+  // h[0] = S, h[1] = S_u, h[2] = S_v, h[3] = S_w, homogeneous.
+  H h[4]{};
+  for (int e = 0; e <= r; ++e) {
+    const double c0 = bm.d[e];
+    const auto x = static_cast<std::size_t>(b.kw.wrap_index(bm.span - r + e));
+    for (std::size_t y = 0; y < 4; ++y) h[0][y] += c0 * V[0][x][y];
+    if constexpr (Partials) {
+      const double c1 = bm.d[(r + 1) + e];
+      for (std::size_t y = 0; y < 4; ++y) {
+        h[1][y] += c0 * V[1][x][y];
+        h[2][y] += c0 * V[2][x][y];
+        h[3][y] += c1 * V[0][x][y];
+      }
+    }
+  }
+  auto vec = [](const H& g) { return Vec3{g[0], g[1], g[2]}; };
+  VolumeDerivatives d;
+  if (!rat) {
+    d = {vec(h[0]), vec(h[1]), vec(h[2]), vec(h[3])};
+  } else {
+    const double w = h[0][3];
+    d.s = vec(h[0]) / w;
+    if constexpr (Partials) {
+      d.su = (vec(h[1]) - h[1][3] * d.s) / w;
+      d.sv = (vec(h[2]) - h[2][3] * d.s) / w;
+      d.sw = (vec(h[3]) - h[3][3] * d.s) / w;
+    }
+  }
+  return d;
+}
+
 template <bool Partials, class Sink>
 void contract(const Net& b, const std::vector<Basis>& bu, const std::vector<Basis>& bv,
               const std::vector<Basis>& bw, std::size_t r0, std::size_t r1, [[maybe_unused]] bool threads, const Sink& sink,
               const LineOut& lines) {
-  const int p = b.ku.degree(), q = b.kv.degree(), r = b.kw.degree();
-  const Grid<double, 3>& wt = b.weights;
-  const bool rat = !wt.empty();
+  const int q = b.kv.degree(), r = b.kw.degree();
   const std::size_t ncv = b.ncv, ncw = b.ncw, plane = ncv * ncw;
   const std::size_t nv = bv.size(), nw = bw.size();
   constexpr int nu_terms = Partials ? 2 : 1;  // u-derivative orders 0..1
@@ -159,38 +231,7 @@ void contract(const Net& b, const std::vector<Basis>& bu, const std::vector<Basi
     for (long long ri = first; ri < last; ++ri) {
       if (failure.failed()) continue;
       const auto i = static_cast<std::size_t>(ri);
-      const Basis& a = bu[i];
-      for (int k = 0; k < nu_terms; ++k) {
-        // Each entry summed over the p + 1 planes in registers, in the order of the
-        // planes, and stored once (a pass per plane read each entry back from the
-        // store before: stalls on this processor).
-        const Vec3* planes[max_degree + 1];
-        const double* weights[max_degree + 1];
-        double c[max_degree + 1];
-        for (int e = 0; e <= p; ++e) {
-          c[e] = a.d[k * (p + 1) + e];
-          const auto ii = static_cast<std::size_t>(b.ku.wrap_index(a.span - p + e));
-          planes[e] = b.planes.row(ii);
-          weights[e] = rat ? &wt(ii, 0, 0) : nullptr;
-        }
-        H* out = U[k].data();
-        if (rat) {
-          for (std::size_t x = 0; x < plane; ++x) {
-            H h{0, 0, 0, 0};
-            for (int e = 0; e <= p; ++e) {
-              const Vec3& P = planes[e][x];
-              const double cw = c[e] * weights[e][x];
-              h[0] += cw * P.x;
-              h[1] += cw * P.y;
-              h[2] += cw * P.z;
-              h[3] += cw;
-            }
-            out[x] = h;
-          }
-        } else {
-          combine_planes(c, p + 1, planes, plane, out);
-        }
-      }
+      for (int k = 0; k < nu_terms; ++k) contract_u(b, bu[i], k, U[k].data());
       for (std::size_t j = 0; j < nv; ++j) {
         const Basis& bj = bv[j];
         for (int t = 0; t < nv_terms; ++t) {
@@ -205,38 +246,7 @@ void contract(const Net& b, const std::vector<Basis>& bu, const std::vector<Basi
                       reinterpret_cast<double*>(lines.points + (i * nv + j) * nw));
           continue;
         }
-        for (std::size_t m = 0; m < nw; ++m) {
-          const Basis& bm = bw[m];
-          // h[0] = S, h[1] = S_u, h[2] = S_v, h[3] = S_w, homogeneous.
-          H h[4]{};
-          for (int e = 0; e <= r; ++e) {
-            const double c0 = bm.d[e];
-            const auto x = static_cast<std::size_t>(b.kw.wrap_index(bm.span - r + e));
-            for (std::size_t y = 0; y < 4; ++y) h[0][y] += c0 * V[0][x][y];
-            if constexpr (Partials) {
-              const double c1 = bm.d[(r + 1) + e];
-              for (std::size_t y = 0; y < 4; ++y) {
-                h[1][y] += c0 * V[1][x][y];
-                h[2][y] += c0 * V[2][x][y];
-                h[3][y] += c1 * V[0][x][y];
-              }
-            }
-          }
-          auto vec = [](const H& g) { return Vec3{g[0], g[1], g[2]}; };
-          VolumeDerivatives d;
-          if (!rat) {
-            d = {vec(h[0]), vec(h[1]), vec(h[2]), vec(h[3])};
-          } else {
-            const double w = h[0][3];
-            d.s = vec(h[0]) / w;
-            if constexpr (Partials) {
-              d.su = (vec(h[1]) - h[1][3] * d.s) / w;
-              d.sv = (vec(h[2]) - h[2][3] * d.s) / w;
-              d.sw = (vec(h[3]) - h[3][3] * d.s) / w;
-            }
-          }
-          sink(i, j, m, d);
-        }
+        for (std::size_t m = 0; m < nw; ++m) sink(i, j, m, contract_w<Partials>(b, bw[m], V));
       }
     }
   }

@@ -1,10 +1,16 @@
 #pragma once
-// The curve work of a network as drawn (src/constructions/network/network.cpp): where two curves cross,
-// and a curve re-expressed so that it passes its crossings at given parameters.
+// The curve work of a network as drawn (network_build.hpp): where two curves cross
+// (network_samples.cpp, network_crossings.cpp), the maps from the surface's parameter
+// to a curve's (network_map.cpp), and a curve re-expressed so that it passes its
+// crossings at given parameters (network_refit.cpp, network_fit.cpp).
 // Every curve here is over [0, 1].
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
+#include <span>
 #include <vector>
 
 #include "interpatch/bspline_curve.hpp"
@@ -12,6 +18,20 @@
 #include "interpatch/network.hpp"
 
 namespace interpatch::detail {
+
+/// t moved by whole periods into [0, 1).
+inline double wrap_unit(double t) {
+  const double r = t - std::floor(t);
+  return r < 1.0 ? r : 0.0;  // a tiny negative t rounds to 1
+}
+
+/// A curve's parameter for the surface's: in a closed direction a value just past an
+/// end (rounding in the map, or an open curve whose ends meet) is taken around the
+/// curve, not refused as outside [0, 1]; in an open one it is held at the end.
+inline double on_curve(double x, bool closed) {
+  if (!closed) return std::clamp(x, 0.0, 1.0);
+  return x >= 0.0 && x <= 1.0 ? x : wrap_unit(x);
+}
 
 /// The closest points of two curves: U(s) and V(t), `gap` apart.
 struct Crossing {
@@ -64,9 +84,6 @@ Reparametrization monotone_map(std::vector<double> at, std::vector<double> to, b
 /// u with map(u) = y, for y between map(0) and map(1) (closed: unwrapped).
 double inverse(const Reparametrization& map, double y);
 
-/// One curve to re-express: C (the prepared curve), the curve as given (both over
-/// [0, 1]; null when C is it, up to rounding), the correction G the surface adds along the curve's line (see
-/// network.cpp: S = D + G there), and the map.
 /// Thrown by refit() when a curve cannot be re-expressed within the target: which
 /// job, the message saying how far it stays. The network names the curve.
 class RefitShortfall : public error {
@@ -78,6 +95,9 @@ class RefitShortfall : public error {
   std::size_t job_;
 };
 
+/// One curve to re-express: C (the prepared curve), the curve as given (both over
+/// [0, 1]; null when C is it, up to rounding), the correction G the surface adds along the curve's line (see
+/// place_curves: S = D + G there), and the map.
 struct FitJob {
   const BSplineCurve* c;
   const BSplineCurve* given;
@@ -106,6 +126,27 @@ struct Refit {
   double distance = 0;  ///< the largest |D(u) + G(u) − given(map(u))| at the same points
 };
 std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<double>& nodes, bool closed, double target);
+
+/// The work of checking a fit, per span, in multiply-adds: 4 points, each 3 curve
+/// points of about 30 (a cubic's basis functions and their sum); for parallel_min_work.
+inline constexpr std::size_t span_work = 4 * 3 * 30;
+
+/// Curves of one family (`members` of `jobs`) fitted on one knot vector, starting from
+/// `interior`, until every one is within `target` of its curve (see refit). Shared
+/// knots (`others` null): every span where some curve is farther halved; empty when
+/// `all` (the count of the curves' own knots together) is not 0 and the halvings the
+/// error calls for would make more knots than that, so the caller takes the curves'
+/// own knots instead. One curve on its own knots (`others`: the family's own knots,
+/// all curves'): a span farther than half the target by a factor f is cut into about
+/// f^(1/4) pieces (the distance falls with the fourth power of the span, the curve C2
+/// between its own knots; aiming at half, the cut spans' neighbours, which the new
+/// fit moves a little, rarely need another round), at knots of the other curves or
+/// else at coarse dyadic fractions.
+/// @throws RefitShortfall when the knots grow too many or 60 rounds do not do.
+std::optional<std::vector<Refit>> fit_group(const std::vector<FitJob>& jobs, const std::vector<std::size_t>& members,
+                                            std::vector<double> interior, const std::vector<double>& nodes,
+                                            bool closed, double target, std::size_t all,
+                                            const std::vector<double>* others);
 
 /// Parameters in [0, 1] at which a curve of the network is checked against the
 /// surface: 4 in every span of its knots (closed: of its period), and the ends.
