@@ -47,10 +47,12 @@ int mpi_run(const interpatch::cli::MpiRequest& request, const std::function<int(
       continue;
     }
     void* symbol = ::dlsym(module, "interpatch_mpi_command");
-    int (*entry)(const interpatch::cli::MpiRequest*, const std::function<int()>*) = nullptr;
+    interpatch::cli::MpiEntry entry = nullptr;
     static_assert(sizeof entry == sizeof symbol);
     std::memcpy(&entry, &symbol, sizeof entry);
-    if (entry != nullptr) return entry(&request, &single);
+    if (entry != nullptr)
+      return entry(request.build, request.spec.c_str(), request.shape.c_str(), request.out.c_str(), request.grid.c_str(),
+                   &single);
     why = "interpatch-mpi.so has no entry point interpatch_mpi_command";
   }
   if (interpatch::cli::mpi_launched_rank() != 0) return 0;

@@ -30,14 +30,15 @@ struct MpiRequest {
   std::string spec, shape, out, grid;
 };
 
-/// Runs the request on every process of MPI_COMM_WORLD (MPI initialized and
-/// finalized here) and returns this process's exit status, the same on every
-/// process; exactly one process prints the one error line. What the split run does
-/// not cover (other types, points not in an .npy file, other output formats) runs
-/// as `single` on rank 0 alone, the others waiting for its status.
-int mpi_command(const MpiRequest& request, const std::function<int()>& single);
+/// The module's entry point, looked up by name (interpatch_mpi_command): runs the
+/// request on every process of MPI_COMM_WORLD (MPI initialized and finalized there)
+/// and returns this process's exit status, the same on every process; exactly one
+/// process prints the one error line. What the split run does not cover (other
+/// types, points not in an .npy file, other output formats) runs as `single` on rank
+/// 0 alone, the others waiting for its status. The request goes in plain types, so
+/// that the module (src/mpi/command.cpp, which defines it) and the command share no
+/// header.
+using MpiEntry = int (*)(bool build, const char* spec, const char* shape, const char* out, const char* grid,
+                         const std::function<int()>* single);
 
 }  // namespace interpatch::cli
-
-/// The module's entry point, looked up by name: mpi_command.
-extern "C" int interpatch_mpi_command(const interpatch::cli::MpiRequest* request, const std::function<int()>* single);

@@ -1,7 +1,8 @@
 #pragma once
 // The MPI side of a run split between processes (INTERPATCH_MPI): the processes of
-// MPI_COMM_WORLD as a RowTeam (constructions/interpolate/grid_rows.hpp), the transposes between blocks
-// of rows and blocks of columns, and the output file written in place by every
+// MPI_COMM_WORLD as a RowTeam (constructions/interpolate/grid_rows.hpp), with the
+// all-to-all exchange the transposes between blocks of rows and blocks of columns
+// use, the input file read in blocks, and the output file written in place by every
 // process. The core library knows nothing of MPI; only this directory does.
 
 #include <cstddef>
@@ -44,7 +45,7 @@ class Team final : public detail::RowTeam {
   [[nodiscard]] std::vector<double> gather(std::span<const double> mine) const override;
 
   /// Sizes (any type of 8 bytes or less, as 64-bit) from every process, in order.
-  [[nodiscard]] std::vector<std::uint64_t> all(std::uint64_t mine) const;
+  [[nodiscard]] std::vector<std::uint64_t> all(std::uint64_t mine) const override;
   /// Rank 0's value, on every process; the others wait asleep (not spinning, as a
   /// blocking collective would, on cores rank 0 may need).
   [[nodiscard]] int await(int value) const;

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <span>
@@ -51,6 +52,8 @@ class RowTeam {
   virtual void fold(std::span<double> acc, const std::function<void(std::span<double>)>& add) const { add(acc); }
   /// Every process's values, concatenated in order.
   [[nodiscard]] virtual std::vector<double> gather(std::span<const double> mine) const { return {mine.begin(), mine.end()}; }
+  /// Every process's count, in order.
+  [[nodiscard]] virtual std::vector<std::uint64_t> all(std::uint64_t mine) const { return {mine}; }
   /// How many processes there are, and which one this is (row order).
   [[nodiscard]] virtual std::size_t processes() const { return 1; }
   [[nodiscard]] virtual std::size_t process() const { return 0; }
@@ -98,10 +101,6 @@ struct GridBlock {
 /// The factored collocation system of one axis.
 using AxisSolver = std::variant<BandedLU, CyclicLU>;
 
-/// Degree `degree` or the default min(3, count − 1), checked; `where` (" in u", " around v
-/// (closed)") goes into the messages.
-int grid_degree(const std::optional<int>& degree, std::size_t count, const char* where);
-
 /// The closing line along `axis` of the grid a block belongs to, and whether it is
 /// dropped (find_closing): axis 0 from the whole grid's rows 0, 1, n−2, n−1 (`ends`,
 /// shared by every process), an axis inside the rows from each process's own lines.
@@ -109,37 +108,92 @@ int grid_degree(const std::optional<int>& degree, std::size_t count, const char*
 Closing block_closing(const GridBlock& b, std::size_t axis, std::span<const Vec3* const> ends, bool refuse,
                       const RowTeam& team);
 
-/// The exponent 2^e the grid is solved at (0 unless its scale is extreme).
-int block_shift(const GridBlock& b, const RowTeam& team);
-/// Refuses (not_finite, naming the point in the whole grid) a NaN or infinite
-/// coordinate among the block's points.
-void check_finite(const GridBlock& b);
 /// p[i] * 2^k for i < count, exactly.
 void scale_points(Vec3* p, std::size_t count, int k);
 
-/// Passes 1 and 2 of the grid interpolation on a block: parameters along every axis,
-/// the knots and factored systems of the axes inside the rows, the banded solves
-/// along them done in place; then the parameters and knots along u.
-struct RowSolution {
-  std::vector<std::vector<double>> params;  ///< per axis
-  std::vector<KnotVector> knots;            ///< per axis
+/// The rows of a grid one process holds while it is interpolated — every row when
+/// it is alone — and, split, copies of the few rows of the others it looks at.
+/// Values: the grid's own storage (alone, solved in place) or a plain vector (split:
+/// a Grid's buffer, freed, is kept for reuse, which would hold a second share of the
+/// data there).
+template <std::size_t Rank, class Values>
+struct HeldRows {
+  std::array<std::size_t, 3> n{};    ///< extents of the whole grid
+  std::size_t first = 0, count = 0;  ///< rows [first, first + count); first a multiple of rows_per_chunk
+  Values rows;                       ///< C order
+  /// Split: the row before the block, then the grid's rows 0, 1, n−2 and n−1, as read.
+  /// Alone: empty (the rows are the whole grid).
+  std::array<Values, 5> halo;
+
+  [[nodiscard]] bool whole() const { return halo[1].empty(); }
+  [[nodiscard]] std::size_t row_size() const {
+    std::size_t m = 1;
+    for (std::size_t a = 1; a < Rank; ++a) m *= n[a];
+    return m;
+  }
+  /// The block these rows are, with `ends` set.
+  [[nodiscard]] GridBlock block() {
+    GridBlock b;
+    b.rank = Rank;
+    b.n = n;
+    b.data = rows.data();
+    b.first = first;
+    b.count = count;
+    if (whole()) {
+      const std::size_t M = row_size();
+      auto row = [&](std::size_t r) -> const Vec3* { return rows.data() + std::min(r, n[0] - 1) * M; };
+      b.row0 = row(0);
+      b.last = row(n[0] - 1);
+      b.ends = {row(0), row(1), row(n[0] < 2 ? 0 : n[0] - 2), row(n[0] - 1)};
+      return b;
+    }
+    b.before = halo[0].data();
+    b.row0 = halo[1].data();
+    b.last = halo[4].data();
+    b.ends = {halo[1].data(), halo[2].data(), halo[3].data(), halo[4].data()};
+    return b;
+  }
 };
-RowSolution solve_rows(const GridBlock& b, std::span<const int> degrees, Parametrization param,
-                       std::span<const bool> periodic, const RowTeam& team);
 
-/// The factored system along `axis` (its name in the messages).
-AxisSolver factor_axis(const KnotVector& knots, std::span<const double> params, std::size_t axis);
-/// Solves every column of an n × width array of doubles in place; with
-/// `non_finite`, also tells whether the solution has a NaN or an infinity.
-void solve_columns(const AxisSolver& lu, double* data, std::size_t n, std::size_t width, bool* non_finite = nullptr);
+/// What a grid interpolation is asked for, per axis.
+struct GridOptions {
+  std::array<std::optional<int>, 3> degree{};
+  Parametrization param{};
+  std::array<bool, 3> periodic{};
+};
 
-/// Re-anchors a closed axis of even degree at its first parameter (one more control
-/// point along it).
-template <std::size_t Rank>
-void insert_seam(Grid<Vec3, Rank>& points, std::size_t axis, KnotVector& knots, double first);
-/// Leaves out the last line along `axis` (a closing line equal to the first).
-template <std::size_t Rank>
-void drop_last_line(Grid<Vec3, Rank>& points, std::size_t axis);
+/// The steps of a grid solve, each reported as it ends (for progress and timings)
+/// with the bytes it sent to other processes.
+enum class GridStep { degrees, checks, rows, to_columns, solve_u, to_rows, done };
+using GridSteps = std::function<void(GridStep step, std::uint64_t sent)>;
+
+/// The control rows a process keeps at the end, {lo, window}: rows [lo, lo + window)
+/// of the net, modulo its `rows` around a periodic u, from its knots (seams inserted).
+using ControlWindow =
+    std::function<std::pair<long long, std::size_t>(const std::vector<KnotVector>& knots, std::size_t rows)>;
+
+/// A solved grid: the control net's knots and extents, and the process's window of it.
+template <class Values>
+struct SolvedGrid {
+  std::vector<int> degrees;
+  std::vector<KnotVector> knots;            ///< per axis, seams inserted
+  std::vector<std::vector<double>> params;  ///< per axis; a dropped closing line's parameter appended
+  std::array<std::size_t, 3> net{};         ///< the control net's extents
+  bool finite = false;                      ///< the control points are known to be finite
+  long long lo = 0;                         ///< the window: control rows [lo, lo + window)
+  std::size_t window = 0;
+  Values rows;  ///< the window's control rows, whole rows, C order
+};
+
+/// The grid interpolation of interpolate_surface and interpolate_volume on the rows
+/// a process holds, the same steps for one process and for many: the closing lines
+/// left out, the degrees, the scale, passes 1 and 2 on the rows (solve_rows), the
+/// rows turned into columns for the solve along u, the seams of closed axes of even
+/// degree, and the control rows `window` asks for turned back into rows. The held
+/// rows are used up.
+template <std::size_t Rank, class Values>
+SolvedGrid<Values> solve_grid_rows(HeldRows<Rank, Values>& held, const GridOptions& options, const RowTeam& team,
+                                   const GridSteps& steps, const ControlWindow& window);
 
 /// The parameters along the first `axes` axes of a grid held in blocks of rows, as
 /// grid_parameters gives them for the whole grid (open directions, every point present);
