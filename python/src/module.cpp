@@ -15,6 +15,7 @@
 #include <optional>
 #include <utility>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "interpatch/blended_surface.hpp"
@@ -515,6 +516,23 @@ PYBIND11_MODULE(_core, m) {
            "The exact B-spline form: degree (p, q, r), knots_u/v/w, control_points (n0, n1, n2, 3), weights or None.");
 
   ip::python::bind_curve(m);
+
+  // The reader's own field lists, so that tests/python/test_spec_fields.py holds the
+  // keyword constructors (_specs.py) and their stubs to them.
+  m.def("spec_fields", [] {
+    py::dict forms;
+    for (const ip::io::SpecForm& f : ip::io::spec_forms()) {
+      const py::str kind(f.kind.data(), f.kind.size());
+      if (!forms.contains(kind)) forms[kind] = py::dict();
+      py::list fields;
+      for (std::string_view field : f.fields) fields.append(py::str(field.data(), field.size()));
+      py::dict of_kind = forms[kind];
+      of_kind[py::str(f.name.data(), f.name.size())] = py::tuple(fields);
+    }
+    return forms;
+  }, "Every form a spec may hold, as the reader checks it: {kind: {name: (field, ...)}}, kind 'type' (the "
+     "construction types, their top-level fields, \"type\" included), 'curve' (the curve forms) or 'points' (point "
+     "arrays given as files).");
 
   m.def("build", &build, py::arg("spec"), py::arg("base_dir") = py::str("."), py::arg("arrays") = py::dict(),
         "A spec (docs/spec-format.md) as a dict, or the path of a spec file, built: a Surface, a Volume, or "

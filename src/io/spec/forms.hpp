@@ -1,7 +1,8 @@
 #pragma once
 // The fields each form of a spec object takes: the readers check objects against
-// these lists, and io::spec_forms() publishes them (docs/spec-format.md is tested
-// against it). Adding a field to a form means adding it here.
+// these lists, and io::spec_forms() publishes them (docs/spec-format.md and the
+// Python keyword constructors, tests/python/test_spec_fields.py, are tested against
+// it). Adding a field to a form means adding it here.
 
 #include <array>
 #include <string_view>
