@@ -12,7 +12,6 @@
 #include <optional>
 #include <string>
 #include <system_error>
-#include <utility>
 #include <variant>
 #include <vector>
 
@@ -132,8 +131,7 @@ void check_mesh_kind(const io::Construction& c, const fs::path& out, const Resol
 void write_mesh(io::Construction& c, const fs::path& out, const Resolution& res) {
   check_mesh_kind(c, out, res);
   ProgressLine progress("meshing");
-  for (const std::string& w : io::write_mesh(c, out, res, res_option, progress.callback()))
-    std::fprintf(stderr, "interpatch: warning: %s\n", w.c_str());
+  report_warnings(io::write_mesh(c, out, res, res_option, progress.callback()));
 }
 
 void write_eval(io::Construction& c, const fs::path& out, const Resolution& grid) {
@@ -147,16 +145,24 @@ nlohmann::ordered_json info(const io::Construction& c) {
   return io::info_json(c, progress.callback());
 }
 
-io::Construction build_spec(const fs::path& spec, io::BuildOptions options) {
+namespace {
+
+// What `build` makes of `options`, with the progress line of a terminal.
+template <class Build>
+auto with_progress(io::BuildOptions& options, const Build& build) {
   ProgressLine progress("building");
   options.progress = progress.callback();
-  return io::build_file(spec, options);
+  return build(options);
+}
+
+}  // namespace
+
+io::Construction build_spec(const fs::path& spec, io::BuildOptions options) {
+  return with_progress(options, [&](const io::BuildOptions& o) { return io::build_file(spec, o); });
 }
 
 io::Built build_any_input(const Input& in, io::BuildOptions options) {
-  ProgressLine progress("building");
-  options.progress = progress.callback();
-  return io::build_any_input(in, options);
+  return with_progress(options, [&](const io::BuildOptions& o) { return io::build_any_input(in, o); });
 }
 
 const io::CurveConstruction* curve_of(const io::Built& b) { return std::get_if<io::CurveConstruction>(&b); }
@@ -168,9 +174,7 @@ void refuse_curve(const Input& in, const io::Built& b, std::string_view command)
 }
 
 io::Construction build_input(const Input& in, io::BuildOptions options) {
-  ProgressLine progress("building");
-  options.progress = progress.callback();
-  return io::build_input(in, options);
+  return with_progress(options, [&](const io::BuildOptions& o) { return io::build_input(in, o); });
 }
 
 void report_warnings(const std::vector<std::string>& warnings) {
