@@ -1,3 +1,6 @@
+// The subcommands as the command line runs them: usage checked as bad usage (exit
+// 2), progress shown on a terminal, warnings printed; the work itself is io's.
+
 #include "commands.hpp"
 
 #include <algorithm>
@@ -7,25 +10,15 @@
 #include <iostream>
 #include <limits>
 #include <optional>
-#include <span>
 #include <string>
 #include <system_error>
-#include <utility>
 #include <variant>
 #include <vector>
 
 #include "interpatch/error.hpp"
-#include "interpatch/evaluate.hpp"
 #include "interpatch/io/atomic_file.hpp"
-#include "interpatch/io/csv.hpp"
-#include "interpatch/io/iges.hpp"
 #include "interpatch/io/json_out.hpp"
-#include "interpatch/io/mesh.hpp"
-#include "interpatch/io/npy.hpp"
-#include "interpatch/io/npz.hpp"
-#include "interpatch/io/step.hpp"
 #include "interpatch/io/view.hpp"
-#include "interpatch/memory.hpp"
 #include "progress.hpp"
 
 namespace interpatch::cli {
@@ -33,12 +26,6 @@ namespace interpatch::cli {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string lower_extension(const fs::path& p) {
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
 
 // A count on the command line: digits only. nullopt for anything else; the
 // largest size_t for a count too large to represent.
@@ -50,57 +37,6 @@ std::optional<std::size_t> parse_count(std::string_view s) {
   if (r.ec == std::errc::result_out_of_range) return std::numeric_limits<std::size_t>::max();
   if (r.ec != std::errc() || r.ptr != s.data() + s.size()) return std::nullopt;
   return v;
-}
-
-// A shape as NumPy prints it: (4, 3), (5,).
-std::string shape_text(const std::vector<std::size_t>& shape) {
-  std::string s = "(";
-  for (std::size_t i = 0; i < shape.size(); ++i) s += (i ? ", " : "") + std::to_string(shape[i]);
-  return s + (shape.size() == 1 ? ",)" : ")");
-}
-
-// The float64 triples of a .npy block as the points they hold.
-std::span<Vec3> points_of(std::span<double> values) {
-  static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 grids are written as arrays of doubles");
-  return {reinterpret_cast<Vec3*>(values.data()), values.size() / 3};
-}
-
-void eval_volume(const io::Construction& c, const fs::path& out, const Resolution& grid) {
-  const Volume& v = io::volume_evaluator(c);
-  const std::vector<std::vector<double>> params{linspace(0, 1, grid.nu), linspace(0, 1, grid.nv), linspace(0, 1, grid.nw)};
-  ProgressLine progress("evaluating");
-  if (lower_extension(out) == ".npy") {
-    const std::size_t shape[4] = {grid.nu, grid.nv, grid.nw, 3};
-    // A few u values a call, on both threads, while the block before is written.
-    io::write_npy_rows(out, shape, [&](std::size_t first, std::size_t count, std::span<double> values) {
-      v.evaluate_into(std::span<const double>(params[0]).subspan(first, count), params[1], params[2], points_of(values));
-    }, progress.callback());
-    progress.clear();
-    return;
-  }
-  const PointGrid3 g = v.evaluate(params[0], params[1], params[2], progress.callback());
-  progress.clear();
-  io::write_csv_grid(out, params, std::span<const Vec3>(g.data(), g.size()));
-}
-
-// A curve's points at K uniformly spaced parameters over [0, 1]: (K, 3).
-void eval_curve(const BSplineCurve& c, const fs::path& out, std::size_t k) {
-  const std::vector<double> ts = linspace(0, 1, k);
-  ProgressLine progress("evaluating");
-  if (lower_extension(out) == ".npy") {
-    const std::size_t shape[2] = {k, 3};
-    io::write_npy_rows(out, shape, [&](std::size_t first, std::size_t count, std::span<double> values) {
-      const std::span<Vec3> points = points_of(values);
-      for (std::size_t i = 0; i < count; ++i) points[i] = c.point(ts[first + i]);
-    }, progress.callback());
-    progress.clear();
-    return;
-  }
-  std::vector<Vec3> points(k);
-  for (std::size_t i = 0; i < k; ++i) points[i] = c.point(ts[i]);
-  progress.clear();
-  const std::vector<double> params[1] = {ts};
-  io::write_csv_grid(out, params, points);
 }
 
 // The io library's checks of usage (formats, counts) throw error; on the command
@@ -156,9 +92,8 @@ Resolution parse_resolution(std::string_view text) {
 std::vector<std::size_t> parse_grid(std::string_view text) { return parse_counts(text, grid_option); }
 
 Resolution grid_resolution(const std::vector<std::size_t>& counts, const io::Construction& c) {
-  if (counts.size() == 1) return {counts[0], counts[0], io::is_volume(c) ? counts[0] : 0};
-  const Resolution grid{counts.at(0), counts.at(1), counts.size() == 3 ? counts[2] : 0};
-  cli::check_counts_kind(c, grid_option, grid);
+  Resolution grid;
+  as_usage([&] { grid = io::grid_resolution(counts, c, grid_option); });
   return grid;
 }
 
@@ -167,8 +102,7 @@ void check_counts_kind(const io::Construction& c, const CountsOption& o, const R
 }
 
 Input parse_input(const fs::path& spec, std::string_view shape) {
-  const std::string ext = lower_extension(spec);
-  Input in{spec, ext == ".npy" ? Input::Kind::npy : ext == ".csv" ? Input::Kind::csv : Input::Kind::spec, {}};
+  Input in{spec, io::input_kind(spec), {}};
   const std::string name = "'" + spec.string() + "'";
   if (in.kind == Input::Kind::csv && shape.empty())
     throw usage_error(name + " is a CSV file of points: give the shape of its grid, --shape NxM (a surface) or "
@@ -184,43 +118,6 @@ Input parse_input(const fs::path& spec, std::string_view shape) {
   return in;
 }
 
-namespace {
-
-// The shape of a .npy file, from its header alone; nullopt when the header cannot
-// be read (the build of the spec reports why).
-std::optional<std::vector<std::size_t>> npy_shape(const fs::path& file) {
-  struct header_read {
-    std::vector<std::size_t> shape;
-  };
-  try {
-    // The destination is asked for once the header is read and checked against the
-    // file's size: refusing it there leaves the data unread.
-    (void)io::read_npy_into(file, [](std::span<const std::size_t> shape, std::size_t) -> double* {
-      throw header_read{{shape.begin(), shape.end()}};
-    });
-  } catch (const header_read& h) {
-    return h.shape;
-  } catch (const error&) {
-    return std::nullopt;
-  }
-  return std::nullopt;  // not reached: read_npy_into asks for the memory of every array it reads
-}
-
-}  // namespace
-
-nlohmann::json data_file_spec(const Input& in) {
-  const std::string file = in.path.filename().string();
-  if (in.kind == Input::Kind::csv)
-    return {{"type", in.shape.size() == 3 ? "interpolate_volume" : "interpolate"},
-            {"points", {{"csv", file}, {"shape", in.shape}}}};
-  const std::optional<std::vector<std::size_t>> shape = npy_shape(in.path);
-  if (shape && shape->size() != 3 && shape->size() != 4)
-    throw error(errc::size_mismatch, in.path.string() + " has shape " + shape_text(*shape) +
-                                         ": points to interpolate are an array of shape (n, m, 3) (a surface) "
-                                         "or (n, m, l, 3) (a volume)");
-  return {{"type", shape && shape->size() == 4 ? "interpolate_volume" : "interpolate"}, {"points", {{"npy", file}}}};
-}
-
 void check_build_output(const fs::path& out) { as_usage([&] { io::check_build_output(out); }); }
 void check_mesh_output(const fs::path& out) { as_usage([&] { io::check_mesh_output(out); }); }
 void check_eval_output(const fs::path& out) { as_usage([&] { io::check_eval_output(out); }); }
@@ -234,30 +131,13 @@ void check_mesh_kind(const io::Construction& c, const fs::path& out, const Resol
 void write_mesh(io::Construction& c, const fs::path& out, const Resolution& res) {
   check_mesh_kind(c, out, res);
   ProgressLine progress("meshing");
-  for (const std::string& w : io::write_mesh(c, out, res, res_option, progress.callback()))
-    std::fprintf(stderr, "interpatch: warning: %s\n", w.c_str());
+  report_warnings(io::write_mesh(c, out, res, res_option, progress.callback()));
 }
 
 void write_eval(io::Construction& c, const fs::path& out, const Resolution& grid) {
   cli::check_counts_kind(c, grid_option, grid);
-  if (io::is_volume(c)) return eval_volume(c, out, grid);
-  const Surface& s = io::evaluator(c, grid.nu * grid.nv, io::Sample::points);
-  constexpr double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  // every construction is over the unit square
-  std::vector<std::vector<double>> params{linspace(u0, u1, grid.nu), linspace(v0, v1, grid.nv)};
   ProgressLine progress("evaluating");
-  if (lower_extension(out) == ".npy") {
-    const std::size_t shape[3] = {grid.nu, grid.nv, 3};
-    const auto rows = s.rows(params[1]);  // what depends on v alone, once for every block
-    // A few rows of points a call, on both threads, while the block before is written.
-    io::write_npy_rows(out, shape, [&](std::size_t first, std::size_t count, std::span<double> values) {
-      rows->evaluate_into(std::span<const double>(params[0]).subspan(first, count), points_of(values));
-    }, progress.callback());
-    progress.clear();
-    return;
-  }
-  const PointGrid g = s.evaluate(params[0], params[1], progress.callback());
-  progress.clear();
-  io::write_csv_grid(out, params, std::span<const Vec3>(g.data(), g.size()));
+  io::write_eval(c, out, grid, grid_option, progress.callback(), [&] { progress.clear(); });
 }
 
 nlohmann::ordered_json info(const io::Construction& c) {
@@ -265,17 +145,24 @@ nlohmann::ordered_json info(const io::Construction& c) {
   return io::info_json(c, progress.callback());
 }
 
-io::Construction build_spec(const fs::path& spec, io::BuildOptions options) {
+namespace {
+
+// What `build` makes of `options`, with the progress line of a terminal.
+template <class Build>
+auto with_progress(io::BuildOptions& options, const Build& build) {
   ProgressLine progress("building");
   options.progress = progress.callback();
-  return io::build_file(spec, options);
+  return build(options);
+}
+
+}  // namespace
+
+io::Construction build_spec(const fs::path& spec, io::BuildOptions options) {
+  return with_progress(options, [&](const io::BuildOptions& o) { return io::build_file(spec, o); });
 }
 
 io::Built build_any_input(const Input& in, io::BuildOptions options) {
-  if (in.kind != Input::Kind::spec) return build_input(in, std::move(options));
-  ProgressLine progress("building");
-  options.progress = progress.callback();
-  return io::build_any_file(in.path, options);
+  return with_progress(options, [&](const io::BuildOptions& o) { return io::build_any_input(in, o); });
 }
 
 const io::CurveConstruction* curve_of(const io::Built& b) { return std::get_if<io::CurveConstruction>(&b); }
@@ -287,11 +174,7 @@ void refuse_curve(const Input& in, const io::Built& b, std::string_view command)
 }
 
 io::Construction build_input(const Input& in, io::BuildOptions options) {
-  if (in.kind == Input::Kind::spec) return build_spec(in.path, std::move(options));
-  const nlohmann::json spec = data_file_spec(in);
-  ProgressLine progress("building");
-  options.progress = progress.callback();
-  return io::build(spec, in.path.parent_path(), options);
+  return with_progress(options, [&](const io::BuildOptions& o) { return io::build_input(in, o); });
 }
 
 void report_warnings(const std::vector<std::string>& warnings) {
@@ -305,7 +188,7 @@ const std::vector<std::string>& warnings_of(const io::Built& b) {
 int build_command(const Input& in, const fs::path& out) {
   check_build_output(out);
   io::check_writable(out);
-  io::Built b = build_any_input(in, {.progress = {}, .keep_data = false, .defer_exact = false, .arrays = {}});
+  io::Built b = cli::build_any_input(in, {.progress = {}, .keep_data = false, .defer_exact = false, .arrays = {}});
   std::visit([&](auto& c) { write_build(c, out); }, b);
   report_warnings(warnings_of(b));
   return 0;
@@ -317,7 +200,7 @@ int mesh_command(const Input& in, const fs::path& out, std::string_view res_text
   io::check_writable(out);
   if (given) require_mesh_room(*given, out);
   // A mesh samples the construction; its exact form is made only if that costs less.
-  io::Built b = build_any_input(in, {.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}});
+  io::Built b = cli::build_any_input(in, {.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}});
   refuse_curve(in, b, "mesh");
   io::Construction& c = std::get<io::Construction>(b);
   const Resolution res = given ? *given : (io::is_volume(c) ? default_volume_resolution : default_surface_resolution);
@@ -336,12 +219,15 @@ int eval_command(const Input& in, const fs::path& out, std::string_view grid_tex
   // after it, the grid of the spec's kind (K of a surface: KxK, of a volume: KxKxK).
   require_eval_room({counts[0], counts.size() > 1 ? counts[1] : 1, counts.size() > 2 ? counts[2] : 0}, out);
   // Evaluation samples the construction; its exact form is made only if that costs less.
-  io::Built b = build_any_input(in, {.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}});
+  io::Built b = cli::build_any_input(in, {.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}});
   if (const io::CurveConstruction* curve = curve_of(b)) {
     if (counts.size() != 1)
       throw usage_error("--grid '" + std::string(grid_text) + "': '" + in.path.string() +
                         "' is a curve spec, evaluated at K points: give --grid K");
-    eval_curve(curve->curve, out, counts[0]);
+    {
+      ProgressLine progress("evaluating");
+      io::write_eval(*curve, out, counts[0], grid_option, progress.callback(), [&] { progress.clear(); });
+    }
     report_warnings(warnings_of(b));
     return 0;
   }
@@ -358,7 +244,7 @@ int info_command(const Input& in, const std::optional<fs::path>& out) {
     check_info_output(*out);
     io::check_writable(*out);
   }
-  const io::Built b = build_any_input(in);
+  const io::Built b = cli::build_any_input(in);
   const io::CurveConstruction* curve = curve_of(b);
   const std::string text = io::pretty_json(curve ? io::curve_info_json(*curve) : info(std::get<io::Construction>(b)));
   if (out) {
@@ -380,7 +266,7 @@ int view_command(const Input& in, const fs::path& out, std::string_view res_text
   check_view_output(out);
   io::check_writable(out);
   // The page holds what `info` prints, whose error at the data needs the data.
-  const io::Built b = build_any_input(in);
+  const io::Built b = cli::build_any_input(in);
   refuse_curve(in, b, "view");
   const io::Construction& c = std::get<io::Construction>(b);
   io::ViewOptions options;

@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "interpatch/io/input.hpp"
 #include "interpatch/io/outputs.hpp"
 #include "interpatch/io/spec.hpp"
 
@@ -53,35 +54,23 @@ Resolution parse_resolution(std::string_view text);
 std::vector<std::size_t> parse_grid(std::string_view text);
 
 /// The evaluation grid `counts` of --grid ask of construction `c`: K becomes KxK or
-/// KxKxK. @throws usage_error when the number of counts does not fit its kind.
+/// KxKxK (io::grid_resolution). @throws usage_error when the number of counts does
+/// not fit its kind.
 Resolution grid_resolution(const std::vector<std::size_t>& counts, const io::Construction& c);
 
 /// Refuse (usage_error) counts of `option` whose number does not fit the kind of the
 /// construction: three for a surface, two for a volume (io::check_counts_kind).
 void check_counts_kind(const io::Construction& c, const CountsOption& option, const Resolution& counts);
 
-/// What SPEC names on the command line: a spec (.json, or any other extension), or a
-/// data file of points to interpolate in its place, told apart by the extension:
-/// .npy (its shape in its header) or .csv (its shape from --shape), case-insensitive.
-struct Input {
-  enum class Kind { spec, npy, csv };
-  std::filesystem::path path;
-  Kind kind = Kind::spec;
-  std::vector<std::size_t> shape;  ///< --shape, for a .csv: NxM or NxMxL
-};
+/// What SPEC names on the command line: a spec, or a data file of points to
+/// interpolate in its place (io/input.hpp).
+using io::data_file_spec;
+using io::Input;
 
 /// Reads SPEC and --shape ("" when not given) without opening any file.
 /// @throws usage_error: a .csv without --shape, --shape with a spec or a .npy, a
 /// malformed --shape.
 Input parse_input(const std::filesystem::path& spec, std::string_view shape);
-
-/// The spec a data file stands for: {"type": "interpolate", "points": {"npy": file}},
-/// or {"csv": file, "shape": [N, M]}; "interpolate_volume" for an (n, m, l, 3) array
-/// or an NxMxL shape. The file is named relative to its own directory, as a spec
-/// beside it would name it. Reads the header of a .npy; a header that cannot be read
-/// gives "interpolate", whose build then reports the problem as it would for the
-/// spec. @throws error size_mismatch (a .npy of a rank other than 3 or 4).
-nlohmann::json data_file_spec(const Input& in);
 
 /// Refuse (usage_error) an output format the command does not write, before any work
 /// (io::check_build_output, ...).
@@ -98,9 +87,9 @@ void check_view_output(const std::filesystem::path& out);
 /// the construction: NUxNVxNW for a surface, NUxNV or .obj/.stl/.ply for a volume.
 void check_mesh_kind(const io::Construction& c, const std::filesystem::path& out, const Resolution& res);
 
-/// The outputs, from a built construction: write_build (io/outputs.hpp), and these.
-/// Meshes and evaluations sample through the cheaper exact evaluator
-/// (io::evaluator), which may make the exact form of `c`.
+/// The outputs, from a built construction: write_build (io/outputs.hpp), and these,
+/// which check the kind as bad usage, then write through io::write_mesh and
+/// io::write_eval with a progress line on a terminal.
 void write_mesh(io::Construction& c, const std::filesystem::path& out, const Resolution& res);
 /// `grid`: the points along u and v (and w, for a volume).
 void write_eval(io::Construction& c, const std::filesystem::path& out, const Resolution& grid);
@@ -112,12 +101,9 @@ nlohmann::ordered_json info(const io::Construction& c);
 /// which evaluation does without.
 io::Construction build_spec(const std::filesystem::path& spec, io::BuildOptions options = {});
 
-/// Builds SPEC as given: a spec file, or the spec of a data file (data_file_spec),
-/// with data files found in that file's directory.
+/// io::build_input and io::build_any_input (what eval, info and build take; mesh and
+/// view refuse a curve, usage_error), showing progress on a terminal.
 io::Construction build_input(const Input& in, io::BuildOptions options = {});
-
-/// build_input, or a curve when SPEC is a curve spec (io::is_curve_spec): what eval,
-/// info and build take. mesh and view refuse a curve (usage_error).
 io::Built build_any_input(const Input& in, io::BuildOptions options = {});
 
 /// The subcommands; each returns the exit status of success (0).

@@ -62,6 +62,104 @@ int mpi_run(const interpatch::cli::MpiRequest& request, const std::function<int(
 }
 #endif
 
+// What the command line gives the subcommands.
+struct Options {
+  std::string spec, shape, out, res, grid, demo_dir = "interpatch-demo";
+  std::optional<std::string> info_out;
+};
+
+// The subcommands, of which CLI11 marks the one given.
+struct Commands {
+  CLI::App *build, *mesh, *eval, *info, *view, *demo;
+};
+
+// SPEC and --shape, the same for the four commands that read a construction.
+void add_input(CLI::App* command, Options& o, const std::string& footer) {
+  command->add_option("SPEC", o.spec,
+                      "A spec .json (the format: docs/spec-format.md) or a .npy/.csv data file of points to\n"
+                      "interpolate: .npy of shape (n,m,3) (a surface) or (n,m,l,3) (a volume); .csv with --shape")
+      ->required();
+  command->add_option("--shape", o.shape,
+                      "The grid of a .csv SPEC: NxM (a surface) or NxMxL (a volume), one x,y,z line per point\n"
+                      "in C order (the last index fastest)");
+  command->footer("SPEC as a data file stands for {\"type\": \"interpolate\", \"points\": {\"npy\": FILE}} (or\n"
+                  "{\"csv\": FILE, \"shape\": [N, M]}; \"interpolate_volume\" for 3-D grids) with default options.\n"
+                  "The spec format: docs/spec-format.md\n\n" +
+                  footer);
+}
+
+// build, mesh and eval: what they write.
+void add_writers(CLI::App& app, Commands& c, Options& o, const std::string& footer) {
+  c.build = app.add_subcommand("build", "Write the exact B-spline form (.json, .npz, .step/.stp, .igs/.iges)");
+  add_input(c.build, o, footer);
+  c.build->add_option("-o,--output", o.out,
+                      "Output file: .json (a bspline_surface or bspline_volume spec), .npz (the same arrays for\n"
+                      "NumPy: numpy.load; read back by {\"type\": \"bspline_surface\", \"npz\": FILE}),\n"
+                      ".step or .stp (STEP AP214), .igs or .iges (IGES 5.3)")
+      ->required();
+
+  c.mesh = app.add_subcommand("mesh", "Tessellate the construction (surfaces .obj .stl .ply .vtk .vts .xyz; volumes .vtk .vts .xyz)");
+  add_input(c.mesh, o, footer);
+  c.mesh->add_option("-o,--output", o.out,
+                     "Output file: .obj, .stl, .ply, .vtk, .vts or .xyz (Plot3D); volumes: .vtk, .vts or .xyz\n"
+                     "(with the Jacobian determinant; beside .xyz in a .f file)")
+      ->required();
+  c.mesh->add_option("--res", o.res,
+                     "Vertices along u and v, NUxNV (default 64x64); for a volume NUxNVxNW (default 33x33x33)");
+
+  c.eval = app.add_subcommand("eval", "Evaluate on a uniform grid over [0,1]^2, [0,1]^3 for volumes, [0,1] for a curve spec (.npy, .csv)");
+  add_input(c.eval, o, footer);
+  c.eval->add_option("--grid", o.grid,
+                     "Points along each direction: K (KxK, KxKxK for a volume, K for a curve), NUxNV (a surface)\n"
+                     "or NUxNVxNW (a volume)")
+      ->required();
+  c.eval->add_option("-o,--output", o.out,
+                     "Output file: .npy of shape (NU,NV,3) or (NU,NV,NW,3), u index first, float64;\n"
+                     "or (K,3) for a curve; or .csv, one row per point in the same order, header u,v,x,y,z,\n"
+                     "u,v,w,x,y,z or t,x,y,z")
+      ->required();
+}
+
+// info, view and demo.
+void add_viewers(CLI::App& app, Commands& c, Options& o, const std::string& footer) {
+  c.info = app.add_subcommand("info", "Describe the construction as one JSON object (stdout, or .json)");
+  add_input(c.info, o, footer);
+  c.info->add_option("-o,--output", o.info_out, "Write the object to this .json file instead of stdout");
+
+  c.view = app.add_subcommand("view", "Write a viewer page: one self-contained .html file showing it in 3D in a browser");
+  add_input(c.view, o, footer);
+  c.view->add_option("-o,--output", o.out, "Output file: .html (or .htm), which loads nothing from a network or another file")
+      ->required();
+  c.view->add_option("--res", o.res,
+                     "Samples along u and v, NUxNV (default 257x257); for a volume NUxNVxNW (default 33x33x33);\n"
+                     "more than the page holds (512x512, 65x65x65) are decimated for display");
+
+  c.demo = app.add_subcommand("demo", "Run every construction on built-in examples");
+  c.demo->add_option("-o,--output", o.demo_dir, "Directory for the outputs (created if missing; its parent must exist)")
+      ->capture_default_str();
+}
+
+// The command as one process runs it.
+int run(const Commands& c, const Options& o) {
+  namespace cli = interpatch::cli;
+  try {
+    if (*c.demo) return cli::demo_command(o.demo_dir);
+    const cli::Input input = cli::parse_input(o.spec, o.shape);
+    if (*c.build) return cli::build_command(input, o.out);
+    if (*c.mesh) return cli::mesh_command(input, o.out, o.res);
+    if (*c.eval) return cli::eval_command(input, o.out, o.grid);
+    if (*c.view) return cli::view_command(input, o.out, o.res);
+    if (*c.info) {
+      std::optional<std::filesystem::path> out;
+      if (o.info_out) out = *o.info_out;
+      return cli::info_command(input, out);
+    }
+    return cli::fail_with(2, "no command given (see interpatch --help)");
+  } catch (const std::exception&) {
+    return cli::report_failure(std::current_exception());
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -80,68 +178,10 @@ int main(int argc, char** argv) {
       "Outputs replace files atomically; INTERPATCH_SYNC=1 also waits until they are on the disk.";
   app.footer(footer);
 
-  std::string spec, shape, out, res, grid, demo_dir = "interpatch-demo";
-
-  // SPEC and --shape, the same for the four commands that read a construction.
-  const auto add_input = [&](CLI::App* command) {
-    command->add_option("SPEC", spec,
-                        "A spec .json (the format: docs/spec-format.md) or a .npy/.csv data file of points to\n"
-                        "interpolate: .npy of shape (n,m,3) (a surface) or (n,m,l,3) (a volume); .csv with --shape")
-        ->required();
-    command->add_option("--shape", shape,
-                        "The grid of a .csv SPEC: NxM (a surface) or NxMxL (a volume), one x,y,z line per point\n"
-                        "in C order (the last index fastest)");
-    command->footer("SPEC as a data file stands for {\"type\": \"interpolate\", \"points\": {\"npy\": FILE}} (or\n"
-                    "{\"csv\": FILE, \"shape\": [N, M]}; \"interpolate_volume\" for 3-D grids) with default options.\n"
-                    "The spec format: docs/spec-format.md\n\n" +
-                    footer);
-  };
-
-  CLI::App* build = app.add_subcommand("build", "Write the exact B-spline form (.json, .npz, .step/.stp, .igs/.iges)");
-  add_input(build);
-  build->add_option("-o,--output", out,
-                    "Output file: .json (a bspline_surface or bspline_volume spec), .npz (the same arrays for\n"
-                    "NumPy: numpy.load; read back by {\"type\": \"bspline_surface\", \"npz\": FILE}),\n"
-                    ".step or .stp (STEP AP214), .igs or .iges (IGES 5.3)")
-      ->required();
-
-  CLI::App* mesh = app.add_subcommand("mesh", "Tessellate the construction (surfaces .obj .stl .ply .vtk .vts .xyz; volumes .vtk .vts .xyz)");
-  add_input(mesh);
-  mesh->add_option("-o,--output", out,
-                   "Output file: .obj, .stl, .ply, .vtk, .vts or .xyz (Plot3D); volumes: .vtk, .vts or .xyz\n"
-                   "(with the Jacobian determinant; beside .xyz in a .f file)")
-      ->required();
-  mesh->add_option("--res", res,
-                   "Vertices along u and v, NUxNV (default 64x64); for a volume NUxNVxNW (default 33x33x33)");
-
-  CLI::App* eval = app.add_subcommand("eval", "Evaluate on a uniform grid over [0,1]^2, [0,1]^3 for volumes, [0,1] for a curve spec (.npy, .csv)");
-  add_input(eval);
-  eval->add_option("--grid", grid,
-                   "Points along each direction: K (KxK, KxKxK for a volume, K for a curve), NUxNV (a surface)\n"
-                   "or NUxNVxNW (a volume)")
-      ->required();
-  eval->add_option("-o,--output", out,
-                   "Output file: .npy of shape (NU,NV,3) or (NU,NV,NW,3), u index first, float64;\n"
-                   "or (K,3) for a curve; or .csv, one row per point in the same order, header u,v,x,y,z,\n"
-                   "u,v,w,x,y,z or t,x,y,z")
-      ->required();
-
-  CLI::App* info = app.add_subcommand("info", "Describe the construction as one JSON object (stdout, or .json)");
-  add_input(info);
-  std::optional<std::string> info_out;
-  info->add_option("-o,--output", info_out, "Write the object to this .json file instead of stdout");
-
-  CLI::App* view = app.add_subcommand("view", "Write a viewer page: one self-contained .html file showing it in 3D in a browser");
-  add_input(view);
-  view->add_option("-o,--output", out, "Output file: .html (or .htm), which loads nothing from a network or another file")
-      ->required();
-  view->add_option("--res", res,
-                   "Samples along u and v, NUxNV (default 257x257); for a volume NUxNVxNW (default 33x33x33);\n"
-                   "more than the page holds (512x512, 65x65x65) are decimated for display");
-
-  CLI::App* demo = app.add_subcommand("demo", "Run every construction on built-in examples");
-  demo->add_option("-o,--output", demo_dir, "Directory for the outputs (created if missing; its parent must exist)")
-      ->capture_default_str();
+  Options o;
+  Commands c{};
+  add_writers(app, c, o, footer);
+  add_viewers(app, c, o, footer);
 
   // CLI11 would call an unknown command an extra argument after a missing one.
   if (argc > 1 && argv[1][0] != '-') {
@@ -164,31 +204,14 @@ int main(int argc, char** argv) {
   if (const char* sync = std::getenv("INTERPATCH_SYNC"); sync && std::string_view(sync) == "1")
     interpatch::io::set_durable_writes(true);
 
-  // The command as one process runs it; under an MPI launcher, eval and build are
-  // split between the processes (docs/mpi.md) and the other commands run on rank 0.
-  const auto run = [&]() -> int {
-  try {
-    if (*demo) return cli::demo_command(demo_dir);
-    const cli::Input input = cli::parse_input(spec, shape);
-    if (*build) return cli::build_command(input, out);
-    if (*mesh) return cli::mesh_command(input, out, res);
-    if (*eval) return cli::eval_command(input, out, grid);
-    if (*view) return cli::view_command(input, out, res);
-    if (*info) {
-      std::optional<std::filesystem::path> o;
-      if (info_out) o = *info_out;
-      return cli::info_command(input, o);
-    }
-    return cli::fail_with(2, "no command given (see interpatch --help)");
-  } catch (const std::exception&) {
-    return cli::report_failure(std::current_exception());
-  }
-  };
+  // Under an MPI launcher, eval and build are split between the processes
+  // (docs/mpi.md) and the other commands run on rank 0.
+  const auto single = [&]() -> int { return run(c, o); };
 #ifdef INTERPATCH_MPI
   if (cli::mpi_launched()) {
-    if (*eval || *build) return mpi_run({static_cast<bool>(*build), spec, shape, out, grid}, run);
+    if (*c.eval || *c.build) return mpi_run({static_cast<bool>(*c.build), o.spec, o.shape, o.out, o.grid}, single);
     if (cli::mpi_launched_rank() != 0) return 0;
   }
 #endif
-  return run();
+  return single();
 }

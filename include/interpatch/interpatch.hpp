@@ -7,6 +7,7 @@
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/io/csv.hpp"
 #include "interpatch/io/iges.hpp"
+#include "interpatch/io/input.hpp"
 #include "interpatch/io/json_out.hpp"
 #include "interpatch/io/mesh.hpp"
 #include "interpatch/io/npy.hpp"

@@ -2,11 +2,12 @@
 /// @file io/outputs.hpp
 /// The files of a built construction and the checks made of them before any work:
 /// counts along each direction, output formats, and the memory and disk room a
-/// mesh or an evaluation grid needs. The command line and the Python module both
-/// call these, so neither accepts what the other refuses.
+/// mesh or an evaluation grid needs. Every front end (the command line, its split
+/// MPI run, the Python module) calls these, so none accepts what another refuses.
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -62,6 +63,13 @@ void check_counts(std::span<const std::size_t> counts, const CountsOption& optio
 /// surface, two for a volume. @throws error size_mismatch.
 void check_counts_kind(const Construction& c, const CountsOption& option, const Resolution& counts);
 
+/// The evaluation grid `counts` (K, NU × NV or NU × NV × NW, as `option` takes them)
+/// ask of construction `c`: K becomes K × K, or K × K × K for a volume.
+/// @throws error size_mismatch when two or three counts do not fit its kind
+///   (check_counts_kind).
+[[nodiscard]] Resolution grid_resolution(const std::vector<std::size_t>& counts, const Construction& c,
+                                         const CountsOption& option);
+
 /// Refuse (error wrong_type) an output format the file kind does not have: build
 /// writes .json, .npz, .step/.stp, .igs/.iges; a mesh .obj .stl .ply .vtk .vts .xyz;
 /// eval .npy or .csv; info .json; view .html or .htm. Case-insensitive.
@@ -114,5 +122,23 @@ void write_build(const CurveConstruction& c, const std::filesystem::path& out);
 [[nodiscard]] std::vector<std::string> write_mesh(Construction& c, const std::filesystem::path& out,
                                                   const Resolution& res, const CountsOption& option,
                                                   const progress_callback& progress = {});
+
+/// Writes the points of a uniform grid over [0, 1]^2 ([0, 1]^3 for a volume) of
+/// `grid` points, u index first: a .npy of shape (NU, NV, 3) or (NU, NV, NW, 3),
+/// float64, or a .csv of one row per point in the same order (write_csv_grid). It
+/// samples through the cheaper exact evaluator (evaluator()), which may make the
+/// exact form of `c`. Every check comes first: the format, counts of at least 2 of
+/// the construction's kind (messages naming `option`), the room. `progress` reports
+/// the evaluation and may throw to stop it; `evaluated`, when given, is called once
+/// the points are made (a .csv is written after it).
+/// @throws error wrong_type, too_few_points, size_mismatch, too_large, not_finite (a
+///   point whose arithmetic overflowed, refused unwritten), file_unwritable.
+void write_eval(Construction& c, const std::filesystem::path& out, const Resolution& grid, const CountsOption& option,
+                const progress_callback& progress = {}, const std::function<void()>& evaluated = {});
+/// A curve spec's curve at `points` uniformly spaced parameters over [0, 1]: a .npy of
+/// shape (K, 3) or a .csv with the header t,x,y,z; checked and reported as above.
+void write_eval(const CurveConstruction& c, const std::filesystem::path& out, std::size_t points,
+                const CountsOption& option, const progress_callback& progress = {},
+                const std::function<void()>& evaluated = {});
 
 }  // namespace interpatch::io
