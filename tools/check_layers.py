@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The layering docs/architecture.md states, checked on the tree:
 - a folder of src/ includes only private headers of its own layer or of the layers
-  below it (LAYERS, lowest first);
+  below it (LAYERS, lowest first); src/mpi/ also the command's own headers (cli/);
 - the front ends (cli/, python/src/) and the public headers (include/) include no
   private header: only <interpatch/...>, the standard and external libraries, and a
   front end's own headers;
@@ -61,6 +61,10 @@ for layer in LAYERS:
             if inc.startswith("interpatch/"):
                 continue
             if "/" not in inc:
+                # The split run is the command's run under mpirun: it parses and
+                # reports through the command's own headers, so it takes and fails alike.
+                if layer == "mpi" and (root / "cli" / inc).exists():
+                    continue
                 if not (path.parent / inc).exists():
                     breaches.append(f"{path.relative_to(root)}: includes \"{inc}\", not beside it")
                 continue
