@@ -432,10 +432,8 @@ py::object build(const py::object& spec, const py::object& base_dir_in, const py
   return wrap(std::move(*c), std::move(sources));
 }
 
-}  // namespace
-
-PYBIND11_MODULE(_core, m) {
-  m.doc() = "interpatch: interpolating curves, surfaces and solids, evaluated exactly.";
+// interpatch.Error, with its codes, and the translation of the library's exceptions.
+void bind_errors(py::module_& m) {
   error_type = PyErr_NewExceptionWithDoc("interpatch.Error",
                                          "Bad input: .code is the error's name (e.g. 'zero_chord'), the message "
                                          "names the place and the size of the problem, as the command line does.",
@@ -458,7 +456,10 @@ PYBIND11_MODULE(_core, m) {
       PyErr_SetString(PyExc_MemoryError, "interpatch: out of memory");
     }
   });
+}
 
+// Construction and its Surface and Volume.
+void bind_constructions(py::module_& m) {
   py::class_<PyBuilt>(m, "Construction", "What surfaces and volumes share.")
       .def_property_readonly("type", &PyBuilt::type, "The spec's \"type\".")
       .def("info", &PyBuilt::info,
@@ -514,9 +515,9 @@ PYBIND11_MODULE(_core, m) {
       .def("point", &PyVolume::point, py::arg("u"), py::arg("v"), py::arg("w"), "S(u, v, w), shape (3,).")
       .def("to_bspline", &PyVolume::to_bspline,
            "The exact B-spline form: degree (p, q, r), knots_u/v/w, control_points (n0, n1, n2, 3), weights or None.");
+}
 
-  ip::python::bind_curve(m);
-
+void bind_spec_fields(py::module_& m) {
   // The reader's own field lists, so that tests/python/test_spec_fields.py holds the
   // keyword constructors (_specs.py) and their stubs to them.
   m.def("spec_fields", [] {
@@ -533,7 +534,16 @@ PYBIND11_MODULE(_core, m) {
   }, "Every form a spec may hold, as the reader checks it: {kind: {name: (field, ...)}}, kind 'type' (the "
      "construction types, their top-level fields, \"type\" included), 'curve' (the curve forms) or 'points' (point "
      "arrays given as files).");
+}
 
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "interpatch: interpolating curves, surfaces and solids, evaluated exactly.";
+  bind_errors(m);
+  bind_constructions(m);
+  ip::python::bind_curve(m);
+  bind_spec_fields(m);
   m.def("build", &build, py::arg("spec"), py::arg("base_dir") = py::str("."), py::arg("arrays") = py::dict(),
         "A spec (docs/spec-format.md) as a dict, or the path of a spec file, built: a Surface, a Volume, or "
         "a Curve for a curve spec (a curve at the top level, without \"type\").\n\n"
