@@ -30,7 +30,7 @@ int exit_status(const std::exception_ptr& failure) noexcept;
 int fail_with(int status, std::string message);
 
 /// Print the failure's one error line ("out of memory" for std::bad_alloc) and
-/// return its exit status. The single process and the split run (mpi_command.cpp)
+/// return its exit status. The single process and the split run (src/mpi/command.cpp)
 /// both report through here, so they fail alike.
 int report_failure(const std::exception_ptr& failure);
 
