@@ -29,51 +29,6 @@ using ojson = nlohmann::ordered_json;
 
 namespace {
 
-// The data of the one example not in examples/: z = x² - y² + 0.3 x y³ on 8 x 8 points.
-PointGrid saddle() {
-  PointGrid g({8, 8});
-  for (std::size_t i = 0; i < 8; ++i)
-    for (std::size_t j = 0; j < 8; ++j) {
-      const double x = -1 + 2 * static_cast<double>(i) / 7, y = -1 + 2 * static_cast<double>(j) / 7;
-      g(i, j) = {x, y, x * x - y * y + 0.3 * x * y * y * y};
-    }
-  return g;
-}
-
-ojson grid_json(const PointGrid& g) {
-  ojson rows = ojson::array();
-  for (std::size_t i = 0; i < g.extent(0); ++i) {
-    ojson row = ojson::array();
-    for (std::size_t j = 0; j < g.extent(1); ++j) row.push_back({g(i, j).x, g(i, j).y, g(i, j).z});
-    rows.push_back(std::move(row));
-  }
-  return rows;
-}
-
-bool is_point_grid(const ojson& v) {
-  return v.is_array() && !v.empty() && v[0].is_array() && !v[0].empty() && v[0][0].is_array();
-}
-
-// A spec as people write them: one member per line, one grid row per line (the
-// specs made here hold no lists of curves or corners).
-std::string spec_text(const ojson& spec) {
-  std::string s = "{\n";
-  bool first = true;
-  for (auto it = spec.begin(); it != spec.end(); ++it) {
-    s += first ? "  " : ",\n  ";
-    first = false;
-    s += ojson(it.key()).dump() + ": ";
-    if (is_point_grid(it.value())) {
-      s += "[\n";
-      for (std::size_t i = 0; i < it.value().size(); ++i) s += (i ? ",\n    " : "    ") + it.value()[i].dump();
-      s += "\n  ]";
-    } else {
-      s += it.value().dump();
-    }
-  }
-  return s + "\n}\n";
-}
-
 void write_text(const fs::path& path, const std::string& text) {
   io::write_atomically(path, [&](std::ostream& os) { os << text; });
 }
@@ -91,52 +46,36 @@ std::string_view example_file(std::string_view name) {
 }
 
 struct Example {
-  Example(std::string n, std::string a, std::string s = {}, std::string file = {}, bool every = false)
-      : name(std::move(n)), about(std::move(a)), spec(std::move(s)), spec_file(std::move(file)), every_mesh_format(every) {}
   std::string name;
-  std::string about;
-  std::string spec;       // written as NAME.spec.json; empty: examples/NAME.json
-  std::string spec_file;  // or: an existing file in DIR is the spec
-  bool every_mesh_format;
+  std::string about;  // the spec's "comment", to its first full stop
+  std::string spec;   // the spec's text, written as NAME.spec.json
+  bool every_mesh_format = false;
 };
 
-// The examples shown, in this order: those of examples/ by name, a saddle of degree
-// 5 that is no checked-in example, and terrain's exact form read back from the files
-// the demo wrote of it (so after terrain).
+// The mesh formats every example is written in are .obj and .vtk; this one shows the others.
+constexpr std::string_view every_mesh_format_example = "hemisphere";
+
+std::string about(const ojson& spec) {
+  const auto comment = spec.find("comment");
+  if (comment == spec.end() || !comment->is_string()) return "a " + spec.value("type", std::string("curve")) + " spec";
+  std::string text = comment->get<std::string>();
+  if (const auto stop = text.find(". "); stop != std::string::npos) text.resize(stop + 1);
+  return text;
+}
+
+// The examples shown: every spec of examples/, by name, then terrain's exact form read
+// back from the .npz the demo wrote of it (so after terrain).
 std::vector<Example> examples() {
-  const std::string saddle_spec = spec_text({{"type", "interpolate"},
-                                             {"comment", "A saddle through an 8x8 grid, degree 5 in both directions (C4)."},
-                                             {"degree", {5, 5}},
-                                             {"points", grid_json(saddle())}});
-  const std::string npz_spec = spec_text({{"type", "bspline_surface"}, {"npz", "terrain.bspline.npz"}});
-  return {
-      {"hemisphere", "bicubic, centripetal, through a 9x17 grid with a pole row", "", "", true},
-      {"terrain", "bicubic, chord length, through 7x13 surveyed heights"},
-      {"approximate_terrain", "a noisy 60x45 survey with a void and a lost row, to a tolerance of 0.35 m"},
-      {"wave", "degrees (2, 3), uniform parameters, 6x9 grid"},
-      {"saddle", "degrees (5, 5) through an 8x8 grid", saddle_spec},
-      {"bilinear", "Rogers & Adams Example 6-9: Q(0.5, 0.5) = (0.5, 0.5, 0.5)"},
-      {"ruled", "between a line and a Hermite arc"},
-      {"coons", "linear Coons patch from four boundary curves"},
-      {"coons_hermite", "Coons patch with cubic Hermite blending (zero cross slopes of the blends)"},
-      {"coons_cross", "bicubically blended Coons patch with cross-boundary derivatives"},
-      {"coons_gregory", "incompatible twist at p00 blended by Gregory's correction (no exact form)"},
-      {"network_gordon", "Gordon surface through a 4 x 5 network of curves"},
-      {"network_coons", "C1 network of Coons patches with Hermite blending"},
-      {"network_closed", "closed Gordon surface through 4 closed sections and 4 curves along them"},
-      {"network_drawn", "Gordon surface through 5 x 4 curves drawn freehand, in no order, some reversed"},
-      {"hermite_patch", "bicubic Hermite (Ferguson) patch from corner data"},
-      {"pipe", "closed around v (\"periodic\": [false, true]), C2 across the seam, through 20x33 points"},
-      {"half_cylinder", "11x5 grid read from half_cylinder.npy"},
-      {"twisted_strip", "5x9 grid read from twisted_strip.csv"},
-      {"trilinear", "a leaning, tapered block from 8 corners"},
-      {"coons_volume", "transfinite volume from 6 faces (bilinear, bspline_surface, interpolate)"},
-      {"hermite_volume", "tricubic Hermite volume from a point frame"},
-      {"annular_sector", "tricubic/quadratic volume through a 5x7x3 grid"},
-      {"terrain_exact", "terrain.bspline.json (the build output) read back as a bspline_surface spec", "",
-       "terrain.bspline.json"},
-      {"terrain_npz", "terrain.bspline.npz (the build output for NumPy) read back as a bspline_surface spec", npz_spec},
-  };
+  std::vector<Example> all;
+  for (const embedded::File& f : embedded::files) {
+    if (!f.name.ends_with(".json")) continue;
+    std::string name(f.name.substr(0, f.name.size() - 5));
+    std::string text(f.bytes());
+    all.push_back({name, about(ojson::parse(text)), std::move(text), name == every_mesh_format_example});
+  }
+  all.push_back({"terrain_npz", "terrain.bspline.npz (the build output for NumPy) read back as a bspline_surface spec",
+                 "{\n  \"type\": \"bspline_surface\",\n  \"npz\": \"terrain.bspline.npz\"\n}\n"});
+  return all;
 }
 
 fs::path prepare(fs::path dir) {
@@ -204,10 +143,9 @@ std::string short_number(double v) {
 }
 
 // Writes the example's spec into DIR (with the data files it reads, from examples/)
-// and returns its path; an example read from a file the demo wrote is left as it is.
+// and returns its path.
 fs::path write_spec(const Example& ex, const fs::path& dir, std::vector<std::string>& written) {
-  if (!ex.spec_file.empty()) return dir / ex.spec_file;
-  const std::string text = ex.spec.empty() ? std::string(example_file(ex.name + ".json")) : ex.spec;
+  const std::string& text = ex.spec;
   const ojson spec = ojson::parse(text);
   if (const auto pts = spec.find("points"); pts != spec.end() && pts->is_object())
     for (const char* form : {"npy", "csv"})
@@ -281,10 +219,10 @@ std::string report_lines(const io::Construction& c, const Example& ex, const ojs
   if (const auto& par = description["parameters"]; par.contains("rms_error"))  // an approximation
     line += " at " + par["max_error_at"].get<std::string>() + ", rms " + short_number(par["rms_error"].get<double>()) +
             ", " + par["missing_points"].dump() + " missing points filled";
-  const ojson spec = ex.spec.empty() ? ojson::object() : ojson::parse(ex.spec);
-  if (!ex.spec_file.empty() || spec.contains("npz")) {
+  const ojson spec = ojson::parse(ex.spec);
+  if (const std::string type = spec.value("type", ""); type == "bspline_surface" || type == "bspline_volume") {
     // An exact form read back and built again: the same bytes as the file it came from.
-    const fs::path original = ex.spec_file.empty() ? dir / spec["npz"].get<std::string>() : spec_path;
+    const fs::path original = spec.contains("npz") ? dir / spec["npz"].get<std::string>() : spec_path;
     const bool same = read_text(original) == read_text(dir / (ex.name + ".bspline" + original.extension().string()));
     line += same ? ", rebuilt identically" : ", rebuilt with differences";
   }

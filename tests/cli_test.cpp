@@ -512,20 +512,16 @@ TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
     }
   }
   for (const std::string& name : shown) {
-    // The examples that are not files of examples/: terrain's exact form is read back
-    // from what the demo wrote of terrain, and the saddle is made by the demo.
-    if (name == "saddle" || name == "terrain_exact" || name == "terrain_npz") continue;
+    // The one example that is no file of examples/: terrain's exact form read back from
+    // the .npz the demo wrote of terrain.
+    if (name == "terrain_npz") continue;
     EXPECT_TRUE(std::ranges::find(checked_in, name) != checked_in.end()) << name << " is not in examples/";
     EXPECT_EQ(read_file(at("out") / (name + ".spec.json")), read_file(fs::path(INTERPATCH_EXAMPLES) / (name + ".json")))
         << name;
   }
-  // Every checked-in example is in the demo but coons_curve_forms (every curve form in
-  // one Coons patch), which only CheckedInExamplesBuild builds.
-  for (const std::string& name : checked_in) {
-    if (name != "coons_curve_forms") {
-      EXPECT_TRUE(std::ranges::find(shown, name) != shown.end()) << name << " is not in the demo";
-    }
-  }
+  // Every checked-in example is in the demo.
+  for (const std::string& name : checked_in)
+    EXPECT_TRUE(std::ranges::find(shown, name) != shown.end()) << name << " is not in the demo";
   // The network drawn freehand: sorted, turned and re-expressed, within 1e-7 of the
   // diagonal of the curves given, and without a warning.
   const json drawn = json::parse(read_file(at("out") / "network_drawn.info.json"));

@@ -38,7 +38,7 @@ class BlendedSurface final : public Surface {
   /// Points at every (us[i], vs[j]) into out[i * vs.size() + j]: each blending
   /// function and curve is evaluated once per parameter, then every point is a
   /// short sum of products of those values (Gregory-corrected patches go point by
-  /// point). Both cores share the rows; the result does not depend on the thread
+  /// point). The threads share the rows; the result does not depend on the thread
   /// count. @throws error out_of_domain, size_mismatch.
   void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
                      const progress_callback& progress = {}) const override;

@@ -40,7 +40,7 @@ class BlendedVolume final : public Volume {
   /// edges and corners into at most four planes per axis, each evaluated once on the
   /// grid of its two axes; a point is then at most 12 products. The planes of u (over
   /// vs × ws) are kept for the next call with the same vs and ws (up to 256 MiB), so
-  /// a grid evaluated slab by slab along u makes them once. Both cores share the
+  /// a grid evaluated slab by slab along u makes them once. The threads share the
   /// lines along w; the result depends neither on the thread count nor on how the u
   /// values are split into calls. @throws error out_of_domain, size_mismatch, too_large.
   void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<const double> ws,

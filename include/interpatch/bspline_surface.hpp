@@ -15,10 +15,6 @@
 
 namespace interpatch {
 
-namespace detail {
-struct SolvedNet;
-}  // namespace detail
-
 /// S(u,v) = Σ_i Σ_j N_i(u) N_j(v) w_ij P_ij / Σ_i Σ_j N_i(u) N_j(v) w_ij.
 /// Control points are an (n+1) × (m+1) grid, first index along u. Valid by
 /// construction; evaluation never allocates per point. A direction whose knot vector
@@ -62,7 +58,7 @@ class BSplineSurface final : public Surface {
 
   /// Points at every (us[i], vs[j]) into out[i * vs.size() + j]. Basis functions
   /// are computed once per parameter; each u row first contracts the control net
-  /// to one curve in v. Both cores share the rows; the result does not depend on
+  /// to one curve in v. The threads share the rows; the result does not depend on
   /// the thread count. @throws error out_of_domain, size_mismatch.
   void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<Vec3> out,
                      const progress_callback& progress = {}) const override;
@@ -87,12 +83,6 @@ class BSplineSurface final : public Surface {
   [[nodiscard]] BSplineSurface clamped() const;
 
  private:
-  friend struct detail::SolvedNet;
-  // The public constructor's checks; the scan of the control points for NaN and
-  // infinities only with `scan` (an interpolation looks at its solution as it
-  // solves).
-  BSplineSurface(KnotVector knots_u, KnotVector knots_v, PointGrid control_points, Grid<double, 2> weights, bool scan);
-
   KnotVector ku_, kv_;
   PointGrid cp_;
   Grid<double, 2> w_;

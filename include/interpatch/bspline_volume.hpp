@@ -15,10 +15,6 @@
 
 namespace interpatch {
 
-namespace detail {
-struct SolvedNet;
-}  // namespace detail
-
 /// Highest derivative order in each direction BSplineVolume::derivative() takes.
 inline constexpr int max_volume_derivative = 3;
 
@@ -73,7 +69,7 @@ class BSplineVolume final : public Volume {
   /// Points at every (us[i], vs[j], ws[k]) into out[(i * vs.size() + j) * ws.size() + k].
   /// Basis functions are computed once per parameter; for each u the control net is
   /// contracted with the u-basis to a net in (v, w), then per v to a row in w, then
-  /// per w to the point. Both cores share the u values; the result does not depend
+  /// per w to the point. The threads share the u values; the result does not depend
   /// on the thread count. @throws error out_of_domain, size_mismatch.
   void evaluate_into(std::span<const double> us, std::span<const double> vs, std::span<const double> ws,
                      std::span<Vec3> out, const progress_callback& progress = {}) const override;
@@ -106,11 +102,6 @@ class BSplineVolume final : public Volume {
   [[nodiscard]] BSplineVolume mapped(double u0, double u1, double v0, double v1, double w0, double w1) const;
 
  private:
-  friend struct detail::SolvedNet;
-  // As BSplineSurface's: the scan of the control points only with `scan`.
-  BSplineVolume(KnotVector knots_u, KnotVector knots_v, KnotVector knots_w, PointGrid3 control_points,
-                Grid<double, 3> weights, bool scan);
-
   KnotVector ku_, kv_, kw_;
   PointGrid3 cp_;
   Grid<double, 3> w_;

@@ -169,7 +169,7 @@ inline bool has_non_finite(const double* d, std::size_t n) noexcept {
 }
 
 /// Index of the first point with a NaN or infinite coordinate, `count` if none:
-/// both threads scan a large array, and the first in storage order is the one found
+/// the threads scan a large array, and the first in storage order is the one found
 /// whatever the thread count.
 inline std::size_t first_non_finite(const Vec3* p, std::size_t count) noexcept {
   // Pieces of 1024 points, each scanned by has_non_finite, and only a piece that has

@@ -233,7 +233,7 @@ Folded fold_slab(const detail::VolumeTerms& T, std::span<const double> us, bool 
 // Calls line_at(i, j, fu, fv) for every line along w of the grid (fu, fv: the
 // blending values of u_i and v_j), split over the threads, in chunks of (i, j) pairs
 // in u-major order between progress reports: a slab of a few u values still keeps
-// both cores busy. line_at must not throw (it only sums and stores; progress is
+// every core busy. line_at must not throw (it only sums and stores; progress is
 // called between the regions).
 template <class Line>
 void for_each_line_index(const Folded& F, const progress_callback& progress, const Line& line_at) {

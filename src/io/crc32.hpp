@@ -3,7 +3,7 @@
 // and final value inverted): "123456789" gives 0xCBF43926. The .npz writer computes
 // it over each member as the bytes go to the file, the reader over the bytes as they
 // come from it. Table-driven, eight bytes a step (slicing-by-8), and on large blocks
-// both cores at once: the checksums of pieces combine into the checksum of the whole
+// every core at once: the checksums of pieces combine into the checksum of the whole
 // (crc32_combine), so a block is cut into one piece per thread.
 
 #include <cstddef>

@@ -35,7 +35,7 @@ void eval_volume(const Construction& c, const fs::path& out, const Resolution& g
   const std::vector<std::vector<double>> params{linspace(0, 1, grid.nu), linspace(0, 1, grid.nv), linspace(0, 1, grid.nw)};
   if (lower_extension(out) == ".npy") {
     const std::size_t shape[4] = {grid.nu, grid.nv, grid.nw, 3};
-    // A few u values a call, on both threads, while the block before is written.
+    // A few u values a call, on every thread, while the block before is written.
     write_npy_rows(out, shape, [&](std::size_t first, std::size_t count, std::span<double> values) {
       v.evaluate_into(std::span<const double>(params[0]).subspan(first, count), params[1], params[2], points_of(values));
     }, progress);
@@ -55,7 +55,7 @@ void eval_surface(Construction& c, const fs::path& out, const Resolution& grid, 
   if (lower_extension(out) == ".npy") {
     const std::size_t shape[3] = {grid.nu, grid.nv, 3};
     const auto rows = s.rows(params[1]);  // what depends on v alone, once for every block
-    // A few rows of points a call, on both threads, while the block before is written.
+    // A few rows of points a call, on every thread, while the block before is written.
     write_npy_rows(out, shape, [&](std::size_t first, std::size_t count, std::span<double> values) {
       rows->evaluate_into(std::span<const double>(params[0]).subspan(first, count), points_of(values));
     }, progress);

@@ -20,7 +20,7 @@ namespace interpatch::io::internal {
 /// the values ("'out.npy'", "the normals of 'm.vts'").
 inline void require_finite(const double* v, std::size_t n, std::size_t first, std::span<const std::size_t> shape,
                            std::string_view what) {
-  if (!detail::has_non_finite(v, n)) return;
+  if (!interpatch::detail::has_non_finite(v, n)) return;
   std::size_t k = 0;
   while (std::isfinite(v[k])) ++k;
   std::size_t at = first + k;
@@ -30,7 +30,7 @@ inline void require_finite(const double* v, std::size_t n, std::size_t first, st
     index = std::to_string(at % extent) + (index.empty() ? "" : ", ") + index;
     at /= extent;
   }
-  detail::fail(errc::not_finite, what, ": the value at [", index, "] is ", v[k],
+  interpatch::detail::fail(errc::not_finite, what, ": the value at [", index, "] is ", v[k],
                ": the construction's arithmetic left the range of a double there (coordinates near 1e308, "
                "or weights so small they vanish); nothing was written");
 }

@@ -19,8 +19,8 @@
 
 namespace interpatch::io {
 
-using detail::cat;
-using detail::fail;
+using interpatch::detail::cat;
+using interpatch::detail::fail;
 using ojson = nlohmann::ordered_json;
 
 namespace {

@@ -26,6 +26,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using interpatch::detail::fail;
 using internal::lower_extension;
 using internal::mesh_io::check_stl_triangle_count;
 using internal::mesh_io::float32_warnings;
@@ -61,14 +62,14 @@ void check_extension(const fs::path& path, const std::string& ext, const std::ar
                      const char* kind) {
   if (std::find(formats.begin(), formats.end(), ext) != formats.end()) return;
   if (ext.empty()) {
-    detail::fail(errc::wrong_type, "cannot write ", quoted(path), ": no extension to choose the ", kind,
+    fail(errc::wrong_type, "cannot write ", quoted(path), ": no extension to choose the ", kind,
                  " mesh format by (supported: ", list(formats), ")");
   }
   if (std::find(surface_formats.begin(), surface_formats.end(), ext) != surface_formats.end()) {
-    detail::fail(errc::wrong_type, "cannot write ", quoted(path), ": '", ext, "' holds surfaces, not ", kind,
+    fail(errc::wrong_type, "cannot write ", quoted(path), ": '", ext, "' holds surfaces, not ", kind,
                  " grids (supported for ", kind, "s: ", list(formats), ")");
   }
-  detail::fail(errc::wrong_type, "cannot write ", quoted(path), ": unknown ", kind, " mesh format '", ext,
+  fail(errc::wrong_type, "cannot write ", quoted(path), ": unknown ", kind, " mesh format '", ext,
                "' (supported: ", list(formats), ")");
 }
 
@@ -94,7 +95,7 @@ void check_closed(const fs::path& path, const SurfaceMesh& m) {
     const char* line = a == 0 ? "row" : "column";
     const std::size_t n = g.extent(a), across = g.extent(1 - a);
     if (n < 2) {
-      detail::fail(errc::size_mismatch, "cannot write ", quoted(path), ": a mesh closed in ", dir, " needs 2 ", line,
+      fail(errc::size_mismatch, "cannot write ", quoted(path), ": a mesh closed in ", dir, " needs 2 ", line,
                    "s or more, the last repeating the first; it has ", n);
     }
     for (std::size_t t = 0; t < across; ++t) {
@@ -102,7 +103,7 @@ void check_closed(const fs::path& path, const SurfaceMesh& m) {
       const Vec3& last = a == 0 ? g(n - 1, t) : g(t, n - 1);
       if (const double gap = norm(last - first); gap > tol) {
         const std::size_t i = a == 0 ? n - 1 : t, j = a == 0 ? t : n - 1;
-        detail::fail(errc::closing_gap, "cannot write ", quoted(path), ": the mesh is closed in ", dir,
+        fail(errc::closing_gap, "cannot write ", quoted(path), ": the mesh is closed in ", dir,
                      " but its last ", line, " does not repeat the first: point [", i, "][", j, "] is ", gap,
                      " away from point [", a == 0 ? 0 : i, "][", a == 0 ? j : 0, "] (allowed: ", tol, ")");
       }
@@ -126,11 +127,11 @@ std::vector<std::string> write_surface_mesh(const fs::path& path, const SurfaceM
   check_extension(path, ext, surface_formats, "surface");
   const PointGrid& g = mesh.points;
   if (g.empty()) {
-    detail::fail(errc::size_mismatch, "cannot write ", quoted(path), ": the surface mesh has no points (",
+    fail(errc::size_mismatch, "cannot write ", quoted(path), ": the surface mesh has no points (",
                  g.extent(0), " x ", g.extent(1), ")");
   }
   if (!mesh.normals.empty() && mesh.normals.shape() != g.shape()) {
-    detail::fail(errc::size_mismatch, "cannot write ", quoted(path), ": ", mesh.normals.extent(0), " x ",
+    fail(errc::size_mismatch, "cannot write ", quoted(path), ": ", mesh.normals.extent(0), " x ",
                  mesh.normals.extent(1), " normals for ", g.extent(0), " x ", g.extent(1), " points");
   }
   check_closed(path, mesh);
@@ -163,11 +164,11 @@ void write_volume_mesh(const fs::path& path, const PointGrid3& points, const Gri
   const std::string ext = lower_extension(path);
   check_extension(path, ext, volume_formats, "volume");
   if (points.empty()) {
-    detail::fail(errc::size_mismatch, "cannot write ", quoted(path), ": the volume grid has no points (",
+    fail(errc::size_mismatch, "cannot write ", quoted(path), ": the volume grid has no points (",
                  points.extent(0), " x ", points.extent(1), " x ", points.extent(2), ")");
   }
   if (!jacobian.empty() && jacobian.shape() != points.shape()) {
-    detail::fail(errc::size_mismatch, "cannot write ", quoted(path), ": jacobian of shape ", jacobian.extent(0),
+    fail(errc::size_mismatch, "cannot write ", quoted(path), ": jacobian of shape ", jacobian.extent(0),
                  " x ", jacobian.extent(1), " x ", jacobian.extent(2), " for ", points.extent(0), " x ",
                  points.extent(1), " x ", points.extent(2), " points");
   }

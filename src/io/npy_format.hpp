@@ -66,7 +66,7 @@ std::vector<std::size_t> read_npy_data(std::istream& in, const NpyHeader& h, std
 /// of 8 when the whole read is.
 using PieceVisitor = std::function<void(const char* bytes, std::size_t n)>;
 
-/// Reads n bytes at `offset` of a file into dst, both threads at once in pieces of
+/// Reads n bytes at `offset` of a file into dst, every thread at once in pieces of
 /// 1 MiB (pread). With `crc`, also the CRC-32 of the bytes read, each piece's
 /// computed while it is still in the cache; with `visit`, called on every piece
 /// read whole.

@@ -148,7 +148,7 @@ std::vector<std::size_t> read_npy_data(std::istream& in, const NpyHeader& h, std
   return h.shape;
 }
 
-// The data block of a file, read by both threads at once in pieces with pread:
+// The data block of a file, read by every thread at once in pieces with pread:
 // copying out of the page cache, and the first touch of the destination's pages,
 // are most of the cost of reading, and both go twice as fast on two cores. The
 // checksum of each piece is taken while the piece is still in the cache, and the

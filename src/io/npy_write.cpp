@@ -39,7 +39,7 @@ void write_values(std::ostream& os, const double* data, std::size_t n, std::uint
     os.write(static_cast<const char*>(bytes), static_cast<std::streamsize>(count));
   };
   if constexpr (std::endian::native == std::endian::little) {
-    // With a checksum, in pieces of 8 MiB: each is summed (by both threads) and
+    // With a checksum, in pieces of 8 MiB: each is summed (by every thread) and
     // written while it is still in the cache. Without, all at once.
     const std::size_t step = crc ? std::size_t{1} << 20 : std::max<std::size_t>(n, 1);
     for (std::size_t done = 0; done < n; done += step) put(data + done, std::min(step, n - done) * sizeof(double));

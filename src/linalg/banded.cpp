@@ -385,27 +385,24 @@ INTERPATCH_KERNEL void shuffle_lines(double* data, std::size_t n, std::size_t in
 
 // Returns whether the group's solution has a NaN or an infinity when `check`.
 template <class Solver>
-bool solve_narrow_group(const Solver& lu, double* data, std::size_t n, std::size_t inner, std::size_t block,
-                        std::size_t m, double* buf, bool check) {
+void solve_narrow_group(const Solver& lu, double* data, std::size_t n, std::size_t inner, std::size_t block,
+                        std::size_t m, double* buf) {
   shuffle_lines<true>(data, n, inner, block, m, buf);
   lu.solve(buf, m * inner, m * inner);
   shuffle_lines<false>(data, n, inner, block, m, buf);
-  return check && has_non_finite(buf, n * m * inner);
 }
 
 }  // namespace
 
 template <class Solver>
 void solve_along_axis(const Solver& lu, double* data, const std::size_t* shape, std::size_t rank, std::size_t axis,
-                      std::size_t components, bool parallel, bool* non_finite) {
+                      std::size_t components, bool parallel) {
   std::size_t outer = 1, inner = components;
   for (std::size_t a = 0; a < axis; ++a) outer *= shape[a];
   for (std::size_t a = axis + 1; a < rank; ++a) inner *= shape[a];
   const std::size_t n = shape[axis];
   if (outer == 0 || inner == 0) return;  // nothing to solve (a process of a split run holding no columns)
   const std::size_t block = n * inner;
-  const bool check = non_finite != nullptr;
-  bool found = false;
   [[maybe_unused]] const bool threads = parallel && block * outer >= parallel_min_work;
   // A thread's buffer and CyclicLU::solve allocate: a failure skips the work left
   // and is rethrown after the region.
@@ -419,25 +416,22 @@ void solve_along_axis(const Solver& lu, double* data, const std::size_t* shape, 
       std::unique_ptr<double[]> buf;
       failure.attempt(static_cast<std::size_t>(thread_index()),
                       [&] { buf = std::make_unique_for_overwrite<double[]>(n * narrow_group * inner); });
-#pragma omp for schedule(static) reduction(|| : found)
+#pragma omp for schedule(static)
       for (long long g = 0; g < groups; ++g) {
         if (!buf) continue;
         failure.attempt(static_cast<std::size_t>(g), [&] {
           const std::size_t o0 = static_cast<std::size_t>(g) * narrow_group;
-          found = solve_narrow_group(lu, data + o0 * block, n, inner, block, std::min(narrow_group, outer - o0),
-                                     buf.get(), check) ||
-                  found;
+          solve_narrow_group(lu, data + o0 * block, n, inner, block, std::min(narrow_group, outer - o0), buf.get());
         });
       }
     }
     failure.rethrow();
-    if (check) *non_finite = found;
     return;
   }
   const std::size_t slice = slice_width(inner, n);
   const std::size_t slices = (inner + slice - 1) / slice;
   const auto tasks = static_cast<long long>(outer * slices);
-#pragma omp parallel for schedule(static) reduction(|| : found) if (tasks > 1 && threads)
+#pragma omp parallel for schedule(static) if (tasks > 1 && threads)
   for (long long t = 0; t < tasks; ++t)
     failure.attempt(static_cast<std::size_t>(t), [&] {
       const std::size_t o = static_cast<std::size_t>(t) / slices;
@@ -446,16 +440,13 @@ void solve_along_axis(const Solver& lu, double* data, const std::size_t* shape, 
       const std::size_t width = std::min(slice, inner - c0);
       double* first = data + o * block + c0;
       lu.solve(first, width, inner);
-      if (check)
-        for (std::size_t k = 0; k < n && !found; ++k) found = has_non_finite(first + k * inner, width);
     });
   failure.rethrow();
-  if (check) *non_finite = found;
 }
 
 template void solve_along_axis<BandedLU>(const BandedLU&, double*, const std::size_t*, std::size_t, std::size_t,
-                                        std::size_t, bool, bool*);
+                                        std::size_t, bool);
 template void solve_along_axis<CyclicLU>(const CyclicLU&, double*, const std::size_t*, std::size_t, std::size_t,
-                                        std::size_t, bool, bool*);
+                                        std::size_t, bool);
 
 }  // namespace interpatch::detail

@@ -96,10 +96,9 @@ class CyclicLU {
 /// side of `lu`. With `parallel`, threads split independent lines and column
 /// slices; without, the calling thread does all (for callers already inside a
 /// parallel region). Every number is computed by the same operations whatever the
-/// thread count. With `non_finite`, also sets *non_finite to whether the solution
-/// has a NaN or an infinity, each piece looked at while it is still in the cache.
+/// thread count.
 template <class Solver>
 void solve_along_axis(const Solver& lu, double* data, const std::size_t* shape, std::size_t rank, std::size_t axis,
-                      std::size_t components, bool parallel = true, bool* non_finite = nullptr);
+                      std::size_t components, bool parallel = true);
 
 }  // namespace interpatch::detail

@@ -95,10 +95,6 @@ BSplineSurface along(const BSplineSurface& s, int axis, Op op) {
 
 BSplineSurface::BSplineSurface(KnotVector knots_u, KnotVector knots_v, PointGrid control_points,
                                Grid<double, 2> weights)
-    : BSplineSurface(std::move(knots_u), std::move(knots_v), std::move(control_points), std::move(weights), true) {}
-
-BSplineSurface::BSplineSurface(KnotVector knots_u, KnotVector knots_v, PointGrid control_points,
-                               Grid<double, 2> weights, bool scan)
     : ku_(std::move(knots_u)), kv_(std::move(knots_v)), cp_(std::move(control_points)), w_(std::move(weights)) {
   const auto nu = static_cast<std::size_t>(ku_.count()), nv = static_cast<std::size_t>(kv_.count());
   if (cp_.extent(0) != nu || cp_.extent(1) != nv)
@@ -107,7 +103,7 @@ BSplineSurface::BSplineSurface(KnotVector knots_u, KnotVector knots_v, PointGrid
   if (!w_.empty() && (w_.extent(0) != nu || w_.extent(1) != nv))
     fail(errc::size_mismatch, nu, " x ", nv, " control points need as many weights, got ", w_.extent(0), " x ",
          w_.extent(1));
-  if (const std::size_t k = scan ? detail::first_non_finite(cp_.data(), cp_.size()) : cp_.size(); k < cp_.size())
+  if (const std::size_t k = detail::first_non_finite(cp_.data(), cp_.size()); k < cp_.size())
     fail(errc::not_finite, "control point [", k / nv, "][", k % nv, "] is ", cp_.data()[k]);
   if (!w_.empty())
     for (std::size_t i = 0; i < nu; ++i)

@@ -327,11 +327,6 @@ BSplineVolume along(const BSplineVolume& b, int axis, Op op) {
 
 BSplineVolume::BSplineVolume(KnotVector knots_u, KnotVector knots_v, KnotVector knots_w, PointGrid3 control_points,
                              Grid<double, 3> weights)
-    : BSplineVolume(std::move(knots_u), std::move(knots_v), std::move(knots_w), std::move(control_points),
-                    std::move(weights), true) {}
-
-BSplineVolume::BSplineVolume(KnotVector knots_u, KnotVector knots_v, KnotVector knots_w, PointGrid3 control_points,
-                             Grid<double, 3> weights, bool scan)
     : ku_(std::move(knots_u)),
       kv_(std::move(knots_v)),
       kw_(std::move(knots_w)),
@@ -345,7 +340,7 @@ BSplineVolume::BSplineVolume(KnotVector knots_u, KnotVector knots_v, KnotVector 
   if (!w_.empty() && w_.shape() != cp_.shape())
     fail(errc::size_mismatch, nu, " x ", nv, " x ", nw, " control points need as many weights, got ", w_.extent(0),
          " x ", w_.extent(1), " x ", w_.extent(2));
-  if (const std::size_t m = scan ? detail::first_non_finite(cp_.data(), cp_.size()) : cp_.size(); m < cp_.size())
+  if (const std::size_t m = detail::first_non_finite(cp_.data(), cp_.size()); m < cp_.size())
     fail(errc::not_finite, "control point [", m / (nv * nw), "][", m / nw % nv, "][", m % nw, "] is ", cp_.data()[m]);
   if (!w_.empty())
     for (std::size_t i = 0; i < nu; ++i)

@@ -927,6 +927,29 @@ TEST(SpecVolume, HermiteVolumeReproducesATricubicPolynomial) {
   EXPECT_ERRC((void)build(json{{"type", "hermite_volume"}, {"corners", corners}}), missing_field, "/corners/7/dw");
 }
 
+// A face is read as the volume is: from an array given with the spec as from the
+// same points written inline, to the same control net bit for bit.
+TEST(SpecVolume, CoonsVolumeFaceFromAnInMemoryArray) {
+  const json inline_spec = cube_coons();
+  const json& lid = inline_spec["faces"]["w1"]["points"];
+  auto a = std::make_shared<PointArray>();
+  a->shape = {lid.size(), lid[0].size()};
+  for (const auto& row : lid)
+    for (const auto& p : row) a->points.push_back({p[0].get<double>(), p[1].get<double>(), p[2].get<double>()});
+  json spec = inline_spec;
+  spec["faces"]["w1"]["points"] = {{"array", "lid"}};
+  BuildOptions o;
+  o.arrays["lid"] = a;
+  const Construction built_from_array = build(spec, {}, o), built_inline = build(inline_spec);
+  const auto& from_array = std::get<BSplineVolume>(*built_from_array.exact);
+  const auto& from_inline = std::get<BSplineVolume>(*built_inline.exact);
+  ASSERT_EQ(from_array.control_points().size(), from_inline.control_points().size());
+  for (std::size_t i = 0; i < from_array.control_points().size(); ++i)
+    EXPECT_EQ(from_array.control_points().data()[i], from_inline.control_points().data()[i]) << "control point " << i;
+  // An array the face names but nobody gave is named at the face's place.
+  EXPECT_ERRC((void)build(spec), missing_field, "/faces/w1/points/array: no array named \"lid\"");
+}
+
 TEST(SpecVolume, CoonsVolumeFromSurfaceSpecsTakesItsFaces) {
   const Construction c = build(cube_coons());
   EXPECT_EQ(c.type, "coons_volume");

@@ -29,7 +29,7 @@ struct SurfaceMesh {
 
 /// The mesh of a surface on the grid us × vs: points and unit normals
 /// (unit_normal()). Derivatives are taken a block of rows at a time (the whole grid
-/// of them would be six times the mesh); both cores share every block. Where the
+/// of them would be six times the mesh); the threads share every block. Where the
 /// surface is a B-spline surface periodic in a direction and the parameters span
 /// exactly one period there (first and last a period apart, to 1e-12 of it), the
 /// mesh is closed in that direction: its last row (column) of points and normals is

@@ -8,21 +8,6 @@
 
 namespace interpatch {
 
-namespace detail {
-
-// The B-splines of solved control nets: the scan for NaN and infinities is left out
-// when the solve has made it.
-struct SolvedNet {
-  static BSplineSurface surface(KnotVector ku, KnotVector kv, PointGrid cp, bool finite) {
-    return {std::move(ku), std::move(kv), std::move(cp), {}, !finite};
-  }
-  static BSplineVolume volume(KnotVector ku, KnotVector kv, KnotVector kw, PointGrid3 cp, bool finite) {
-    return {std::move(ku), std::move(kv), std::move(kw), std::move(cp), {}, !finite};
-  }
-};
-
-}  // namespace detail
-
 namespace {
 
 using GridValues = Grid<Vec3, 2>::storage_type;
@@ -63,15 +48,14 @@ detail::SolvedGrid<GridValues> solve_grid(Grid<Vec3, Rank>& points, const std::a
 
 SurfaceInterpolation interpolate_surface(PointGrid points, const SurfaceInterpolationOptions& options) {
   auto s = solve_grid<2>(points, {options.degree_u, options.degree_v}, options.param, options.progress, options.periodic);
-  return {detail::SolvedNet::surface(std::move(s.knots[0]), std::move(s.knots[1]), std::move(points), s.finite),
+  return {BSplineSurface(std::move(s.knots[0]), std::move(s.knots[1]), std::move(points)),
           std::move(s.params[0]), std::move(s.params[1])};
 }
 
 VolumeInterpolation interpolate_volume(PointGrid3 points, const VolumeInterpolationOptions& options) {
   auto s = solve_grid<3>(points, {options.degree_u, options.degree_v, options.degree_w}, options.param, options.progress,
                          options.periodic);
-  return {detail::SolvedNet::volume(std::move(s.knots[0]), std::move(s.knots[1]), std::move(s.knots[2]),
-                                    std::move(points), s.finite),
+  return {BSplineVolume(std::move(s.knots[0]), std::move(s.knots[1]), std::move(s.knots[2]), std::move(points)),
           std::move(s.params[0]), std::move(s.params[1]), std::move(s.params[2])};
 }
 

@@ -179,7 +179,6 @@ struct SolvedGrid {
   std::vector<KnotVector> knots;            ///< per axis, seams inserted
   std::vector<std::vector<double>> params;  ///< per axis; a dropped closing line's parameter appended
   std::array<std::size_t, 3> net{};         ///< the control net's extents
-  bool finite = false;                      ///< the control points are known to be finite
   long long lo = 0;                         ///< the window: control rows [lo, lo + window)
   std::size_t window = 0;
   Values rows;  ///< the window's control rows, whole rows, C order

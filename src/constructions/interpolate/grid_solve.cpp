@@ -196,24 +196,19 @@ Values to_rows(Columns<Values>& c, std::size_t N, std::size_t M, long long lo, s
 // The solve along u on whole columns, scaled back by 2^shift, and the seam of a
 // closed u of even degree. Returns whether the solution is known to be finite.
 template <class Values>
-bool solve_along_u(Columns<Values>& c, std::size_t n0, RowSolution& rs, int degree, bool closed, int shift,
+void solve_along_u(Columns<Values>& c, std::size_t n0, RowSolution& rs, int degree, bool closed, int shift,
                    const RowTeam& team, const GridSteps& steps) {
   AxisSolver lu0 = BandedLU(0, 0, 0);
   team.run([&] { lu0 = factor_axis(rs.knots[0], rs.params[0], 0); });
-  // The solution is looked at for NaN and infinities as it is made (a solve can
-  // overflow), so that the B-spline need not read it again; a solution scaled back,
-  // or re-anchored at a seam, is read again there.
-  bool non_finite = true;
-  solve_columns(lu0, &c.values.data()->x, n0, 3 * c.width, &non_finite);
+  solve_columns(lu0, &c.values.data()->x, n0, 3 * c.width);
   if (shift != 0) scale_points(c.values.data(), c.values.size(), shift);
   steps(GridStep::solve_u, 0);
-  if (!closed || degree % 2 != 0) return !non_finite && shift == 0;
+  if (!closed || degree % 2 != 0) return;
   team.run([&] {
     Grid<Vec3, 2> g = as_grid(c.values, std::array<std::size_t, 2>{n0, c.width});
     insert_seam(g, 0, rs.knots[0], rs.params[0].front());
     take_grid(g, c.values);
   });
-  return false;
 }
 
 // The knots and extents of the control net once the axes inside the rows have their
@@ -281,7 +276,7 @@ SolvedGrid<Values> solve_grid_rows(HeldRows<Rank, Values>& held, const GridOptio
   const std::array<std::size_t, 3> n = held.n;
   const std::size_t M = held.row_size();
   Columns<Values> columns = to_columns(held, team, steps);
-  s.finite = solve_along_u(columns, n[0], rs, s.degrees[0], o.periodic[0], shift, team, steps);
+  solve_along_u(columns, n[0], rs, s.degrees[0], o.periodic[0], shift, team, steps);
   std::array<bool, 3> seam{};
   for (std::size_t a = 1; a < Rank; ++a) seam[a] = o.periodic[a] && s.degrees[a] % 2 == 0;
   s.net = n;
@@ -293,7 +288,6 @@ SolvedGrid<Values> solve_grid_rows(HeldRows<Rank, Values>& held, const GridOptio
   s.rows = to_rows(columns, s.net[0], M, s.lo, s.window, team, steps);
   seam_rows<Rank>(s, rs, n, seam, team);
   for (std::size_t a = 0; a < Rank; ++a) {
-    if (seam[a]) s.finite = false;
     if (dropped[a]) rs.params[a].push_back(rs.params[a].front() + 1.0);
   }
   s.params = std::move(rs.params);

@@ -68,7 +68,7 @@ RowSolution solve_rows(const GridBlock& b, std::span<const int> degrees, Paramet
 AxisSolver factor_axis(const KnotVector& knots, std::span<const double> params, std::size_t axis);
 /// Solves every column of an n × width array of doubles in place; with
 /// `non_finite`, also tells whether the solution has a NaN or an infinity.
-void solve_columns(const AxisSolver& lu, double* data, std::size_t n, std::size_t width, bool* non_finite = nullptr);
+void solve_columns(const AxisSolver& lu, double* data, std::size_t n, std::size_t width);
 
 /// Re-anchors a closed axis of even degree at its first parameter (one more control
 /// point along it).

@@ -18,10 +18,8 @@ namespace {
 constexpr std::size_t rows_per_group = 8;
 
 void solve_axis(const AxisSolver& lu, double* data, const std::size_t* shape, std::size_t rank, std::size_t axis,
-                std::size_t components, bool parallel = true, bool* non_finite = nullptr) {
-  std::visit(
-      [&](const auto& s) { solve_along_axis(s, data, shape, rank, axis, components, parallel, non_finite); },
-      lu);
+                std::size_t components, bool parallel = true) {
+  std::visit([&](const auto& s) { solve_along_axis(s, data, shape, rank, axis, components, parallel); }, lu);
 }
 
 }  // namespace
@@ -39,9 +37,9 @@ AxisSolver factor_axis(const KnotVector& knots, std::span<const double> params, 
   }
 }
 
-void solve_columns(const AxisSolver& lu, double* data, std::size_t n, std::size_t width, bool* non_finite) {
+void solve_columns(const AxisSolver& lu, double* data, std::size_t n, std::size_t width) {
   const std::size_t shape[2] = {n, width};
-  solve_axis(lu, data, shape, 2, 0, 1, true, non_finite);
+  solve_axis(lu, data, shape, 2, 0, 1, true);
 }
 
 RowSolution solve_rows(const GridBlock& b, std::span<const int> p, Parametrization param, std::span<const bool> periodic,

@@ -130,10 +130,8 @@ void put_way(nlohmann::ordered_json& j, const ApproximationOptions<D>& o) {
   if (!o.weights.empty()) j["weights"] = true;
 }
 
-}  // namespace
-
 template <std::size_t D>
-Construction build_approximate(const json& spec, Context& ctx) {
+Construction approximate_grid(const json& spec, Context& ctx) {
   constexpr const char* grid_form = D == 2 ? "(n+1) x (m+1) x 3" : "(n+1) x (m+1) x (l+1) x 3";
   PointArray pts = points_impl(member(spec, "points", "", cat("a grid of points, ", grid_form)), D, "/points", ctx, true);
   const std::vector<std::size_t> shape = pts.shape;
@@ -182,7 +180,10 @@ Construction build_approximate(const json& spec, Context& ctx) {
   return c;
 }
 
-template Construction build_approximate<2>(const json& spec, Context& ctx);
+}  // namespace
+
+Construction build_approximate(const json& spec, Context& ctx) { return approximate_grid<2>(spec, ctx); }
+Construction build_approximate_volume(const json& spec, Context& ctx) { return approximate_grid<3>(spec, ctx); }
 
 template <std::size_t D>
 ApproximationOptions<D> approximation_options(const json& obj, std::string_view ptr, const std::vector<std::size_t>& shape,
@@ -191,7 +192,6 @@ ApproximationOptions<D> approximation_options(const json& obj, std::string_view 
 }
 template ApproximationOptions<2> approximation_options<2>(const json&, std::string_view, const std::vector<std::size_t>&,
                                                           std::string_view);
-template Construction build_approximate<3>(const json& spec, Context& ctx);
 
 SpecCurve approximated_curve(const json& obj, std::string_view ptr, Context& ctx) {
   check_fields(obj, ptr, forms::approximate_curve, ctx);

@@ -1,8 +1,9 @@
 #pragma once
-// The fields each form of a spec object takes: the readers check objects against
-// these lists, and io::spec_forms() publishes them (docs/spec-format.md and the
-// Python keyword constructors, tests/python/test_spec_fields.py, are tested against
-// it). Adding a field to a form means adding it here.
+// The fields each form of a curve or point array takes: the readers check objects
+// against these lists, and io::spec_forms() publishes them with the construction
+// types' (types.def); docs/spec-format.md and the Python keyword constructors
+// (tests/python/test_spec_fields.py) are tested against it. Adding a field to a
+// form means adding it here.
 
 #include <array>
 #include <string_view>
@@ -27,27 +28,5 @@ inline constexpr auto line_curve = std::to_array({"line"sv});
 inline constexpr auto approximate_curve =
     std::to_array({"approximate"sv, "degree"sv, "param"sv, "periodic"sv, "weights"sv, "control_points"sv, "tolerance"sv,
                    "smoothing"sv});
-
-// Construction types: the top-level fields, "type" included.
-inline constexpr auto bilinear = std::to_array({"type"sv, "p00"sv, "p01"sv, "p10"sv, "p11"sv});
-inline constexpr auto ruled = std::to_array({"type"sv, "curves"sv});
-inline constexpr auto coons = std::to_array(
-    {"type"sv, "boundary"sv, "blending"sv, "cross_derivatives"sv, "twists"sv, "twist_correction"sv, "tolerance"sv});
-inline constexpr auto network =
-    std::to_array({"type"sv, "u_curves"sv, "v_curves"sv, "u_params"sv, "v_params"sv, "method"sv, "tolerance"sv,
-                   "periodic"sv});
-inline constexpr auto interpolate = std::to_array({"type"sv, "points"sv, "degree"sv, "param"sv, "periodic"sv});
-inline constexpr auto hermite_patch = std::to_array({"type"sv, "corners"sv});
-// approximate and approximate_volume.
-inline constexpr auto approximate = std::to_array({"type"sv, "points"sv, "degree"sv, "param"sv, "periodic"sv, "weights"sv,
-                                                   "control_points"sv, "tolerance"sv, "smoothing"sv});
-// bspline_surface and bspline_volume: the form by its fields, or "npz", an archive
-// that holds them all (and excludes the others).
-inline constexpr auto bspline =
-    std::to_array({"type"sv, "degree"sv, "knots"sv, "control_points"sv, "weights"sv, "periodic"sv, "npz"sv});
-inline constexpr auto trilinear = std::to_array(
-    {"type"sv, "p000"sv, "p001"sv, "p010"sv, "p011"sv, "p100"sv, "p101"sv, "p110"sv, "p111"sv});
-inline constexpr auto coons_volume = std::to_array({"type"sv, "faces"sv, "blending"sv, "cross_derivatives"sv, "tolerance"sv});
-inline constexpr auto hermite_volume = std::to_array({"type"sv, "corners"sv});
 
 }  // namespace interpatch::io::reader::forms

@@ -189,8 +189,10 @@ nlohmann::ordered_json check_grid_axes(const json& spec, const std::vector<std::
   return notes;
 }
 
+namespace {
+
 template <std::size_t D>
-Construction build_interpolate(const json& spec, Context& ctx) {
+Construction interpolate_grid(const json& spec, Context& ctx) {
   using T = Tensor<D>;
   PointArray pts = interpolation_points(member(spec, "points", "", cat("a grid of points, ", T::grid_form)), D, "/points", ctx);
   const auto degree = degrees(spec, "", D);
@@ -219,7 +221,7 @@ Construction build_interpolate(const json& spec, Context& ctx) {
 }
 
 template <std::size_t D>
-Construction build_bspline(const json& spec, Context& ctx) {
+Construction exact_form(const json& spec, Context& ctx) {
   using T = Tensor<D>;
   if (find_member(spec, "npz")) return bspline_from_npz<D>(spec, ctx);
   member(spec, "degree", "", T::degree_form);
@@ -266,9 +268,11 @@ Construction build_bspline(const json& spec, Context& ctx) {
   return exact_construction<D>(std::move(s));
 }
 
-template Construction build_interpolate<2>(const json& spec, Context& ctx);
-template Construction build_interpolate<3>(const json& spec, Context& ctx);
-template Construction build_bspline<2>(const json& spec, Context& ctx);
-template Construction build_bspline<3>(const json& spec, Context& ctx);
+}  // namespace
+
+Construction build_interpolate(const json& spec, Context& ctx) { return interpolate_grid<2>(spec, ctx); }
+Construction build_interpolate_volume(const json& spec, Context& ctx) { return interpolate_grid<3>(spec, ctx); }
+Construction build_bspline_surface(const json& spec, Context& ctx) { return exact_form<2>(spec, ctx); }
+Construction build_bspline_volume(const json& spec, Context& ctx) { return exact_form<3>(spec, ctx); }
 
 }  // namespace interpatch::io::reader

@@ -315,7 +315,7 @@ PointArray copy_point_array(const double* xyz, std::vector<std::size_t> shape) {
   out.shape = std::move(shape);
   resize_for_overwrite(out.points, count);
   // Pieces of 2^14 points (384 KiB) are copied and then scanned while they are still
-  // in the core's cache; both cores take pieces.
+  // in the core's cache; every core takes pieces.
   constexpr std::size_t piece = std::size_t{1} << 14;
   const auto pieces = static_cast<long long>((count + piece - 1) / piece);
   Vec3* dst = out.points.data();

@@ -179,7 +179,7 @@ SpecCurve read_curve(const json& j, std::string_view ptr, Context& ctx);
 BSplineCurve curve_impl(const json& j, std::string_view ptr, Context& ctx);
 
 // ---------------------------------------------------------------------------
-// Construction types (spec.cpp holds the table).
+// Construction types (types.def lists them, spec.cpp holds their table).
 
 struct ConstructionType {
   std::string_view name;
@@ -193,13 +193,12 @@ const ConstructionType* find_type(std::string_view name);
 /// The names of the types, comma-separated; only those of `dims` dimensions when it is not 0.
 std::string type_list(int dims = 0);
 
-/// The builders, one per type (surfaces.cpp, grids.cpp, volumes.cpp). The caller has
-/// checked the top-level fields against the type's list.
-Construction build_bilinear(const json& spec, Context& ctx);
-Construction build_ruled(const json& spec, Context& ctx);
-Construction build_coons(const json& spec, Context& ctx);
-Construction build_network(const json& spec, Context& ctx);
-Construction build_hermite_patch(const json& spec, Context& ctx);
+/// The builders, build_<name> for each line of types.def (surfaces.cpp, grids.cpp,
+/// approximate.cpp, volumes.cpp). The caller has checked the top-level fields against
+/// the type's list.
+#define INTERPATCH_SPEC_TYPE(name, dims, ...) Construction build_##name(const json& spec, Context& ctx);
+#include "io/spec/types.def"
+#undef INTERPATCH_SPEC_TYPE
 /// Refuses the first point with a NaN or Inf coordinate among `points`, which are
 /// the points from index `first` on of a grid of `shape` read from `file`, naming
 /// it as a JSON Pointer below `ptr` (`/points/3/7/2`) and the file.
@@ -220,12 +219,6 @@ nlohmann::ordered_json check_grid_axes(const json& spec, const std::vector<std::
                                        const std::array<bool, 3>& periodic, std::span<const std::size_t> shape,
                                        const char* kind, const std::function<Closing(std::size_t)>& closing,
                                        Context& ctx);
-template <std::size_t Dims>
-Construction build_interpolate(const json& spec, Context& ctx);
-template <std::size_t Dims>
-Construction build_bspline(const json& spec, Context& ctx);
-template <std::size_t Dims>
-Construction build_approximate(const json& spec, Context& ctx);
 /// The options of an approximation (`ptr` the object holding its fields), checked
 /// against the points' shape; `pts_at` names the points in messages.
 template <std::size_t D>
@@ -233,9 +226,6 @@ ApproximationOptions<D> approximation_options(const json& obj, std::string_view 
                                               std::string_view pts_at);
 /// {"approximate": points, ...} as a curve (approximate.cpp), mapped onto [0, 1].
 SpecCurve approximated_curve(const json& obj, std::string_view ptr, Context& ctx);
-Construction build_trilinear(const json& spec, Context& ctx);
-Construction build_hermite_volume(const json& spec, Context& ctx);
-Construction build_coons_volume(const json& spec, Context& ctx);
 
 /// Construction helpers shared by the builders.
 /// A blended surface or volume construction: the formula, and its exact form if it has one.

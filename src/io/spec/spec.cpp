@@ -1,7 +1,5 @@
-// The spec reader's front: the table of construction types, and the public
-// functions of io/spec.hpp. Adding a construction type: its builder (surfaces.cpp,
-// volumes.cpp or grids.cpp), its field list (forms.hpp), one line in
-// `construction_types` below, and its section in docs/spec-format.md.
+// The spec reader's front: the table of construction types (made from types.def),
+// and the public functions of io/spec.hpp.
 
 #include "interpatch/io/spec.hpp"
 
@@ -28,21 +26,14 @@ double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
 }
 
+#define INTERPATCH_SPEC_TYPE(name, dims, ...) constexpr std::string_view name##_fields[] = {__VA_ARGS__};
+#include "io/spec/types.def"
+#undef INTERPATCH_SPEC_TYPE
+
 constexpr ConstructionType construction_types[] = {
-    {"bilinear", build_bilinear, 2, forms::bilinear},
-    {"ruled", build_ruled, 2, forms::ruled},
-    {"coons", build_coons, 2, forms::coons},
-    {"network", build_network, 2, forms::network},
-    {"interpolate", build_interpolate<2>, 2, forms::interpolate},
-    {"hermite_patch", build_hermite_patch, 2, forms::hermite_patch},
-    {"bspline_surface", build_bspline<2>, 2, forms::bspline},
-    {"approximate", build_approximate<2>, 2, forms::approximate},
-    {"trilinear", build_trilinear, 3, forms::trilinear},
-    {"coons_volume", build_coons_volume, 3, forms::coons_volume},
-    {"hermite_volume", build_hermite_volume, 3, forms::hermite_volume},
-    {"interpolate_volume", build_interpolate<3>, 3, forms::interpolate},
-    {"bspline_volume", build_bspline<3>, 3, forms::bspline},
-    {"approximate_volume", build_approximate<3>, 3, forms::approximate},
+#define INTERPATCH_SPEC_TYPE(name, dims, ...) {#name, build_##name, dims, name##_fields},
+#include "io/spec/types.def"
+#undef INTERPATCH_SPEC_TYPE
 };
 
 // How many times the spec names each in-memory array ({"array": NAME}): an array

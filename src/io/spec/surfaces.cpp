@@ -185,7 +185,7 @@ struct CurveRead {
 };
 
 // The curves at items[i] (null: none there), each as curve_impl reads it at ptrs[i].
-// Read on both threads when the spec names no in-memory arrays (their use counts are
+// Read on every thread when the spec names no in-memory arrays (their use counts are
 // the reader's shared state), else one after another up to the first error.
 std::vector<CurveRead> read_curves(const std::vector<const json*>& items, const std::vector<std::string>& ptrs,
                                    const Context& ctx) {

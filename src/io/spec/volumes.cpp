@@ -60,8 +60,13 @@ BSplineSurface face_surface(const json& j, const std::string& ptr, Context& ctx)
   if (!type || type->dims != 2)
     fail(errc::unknown_type, child(ptr, "type"), ": \"", interpatch::detail::excerpt(name),
          "\" is not a surface type; a face takes one of ", surfaces);
+  // The face reads files beside the spec and the arrays given with it, as the
+  // volume does; its warnings and errors are placed below `ptr`.
   Context sub;
   sub.base_dir = ctx.base_dir;
+  sub.arrays = ctx.arrays;
+  sub.array_uses = ctx.array_uses;
+  sub.borrow_arrays = ctx.borrow_arrays;
   check_fields(j, "", type->fields, sub);
   Construction c;
   try {
