@@ -3,7 +3,7 @@
     /usr/bin/python3 -m venv --system-site-packages V
     V/bin/pip install --no-build-isolation .
 
-installs the package interpatch (the compiled _core, __init__.pyi, py.typed) into V
+installs the package interpatch (the compiled _core, the .pyi stubs, py.typed) into V
 and the command into V/bin. The CMake tree is build/temp.*/cmake; with
 INTERPATCH_CMAKE_BUILD_DIR naming a configured tree (build/release) the module and
 the command are built there instead, as they are for the tests, without configuring

@@ -13,15 +13,10 @@ Errors raise interpatch.Error (a ValueError) whose .code names the problem
 ("zero_chord", "network_gap", ...) with the command line's message.
 """
 
+from . import _specs
 from ._core import ERROR_CODES, Construction, Curve, Error, Surface, Volume
-from ._specs import (approximate_curve, approximate_surface, approximate_volume, bilinear, bspline_curve, build,
-                     coons, coons_volume, curve_network, hermite_curve,
-                     hermite_patch, hermite_volume, interpolate_curve, interpolate_surface, interpolate_volume, line,
-                     ruled, trilinear)
+from ._specs import *  # the keyword constructors and build, as _specs.__all__ names them
 
 __version__ = "@PROJECT_VERSION@"
-__all__ = ["Error", "ERROR_CODES", "Construction", "Surface", "Volume", "Curve", "build", "interpolate_surface", "bilinear", "ruled", "coons",
-           "curve_network", "hermite_patch", "interpolate_volume", "trilinear", "coons_volume", "hermite_volume",
-           "interpolate_curve", "bspline_curve", "hermite_curve", "line",
-           "approximate_surface", "approximate_volume", "approximate_curve",
-           "__version__"]
+# A constructor named in _specs.__all__ is exported without editing this file.
+__all__ = ["Error", "ERROR_CODES", "Construction", "Surface", "Volume", "Curve"] + _specs.__all__ + ["__version__"]

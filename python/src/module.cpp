@@ -519,7 +519,7 @@ void bind_constructions(py::module_& m) {
 
 void bind_spec_fields(py::module_& m) {
   // The reader's own field lists, so that tests/python/test_spec_fields.py holds the
-  // keyword constructors (_specs.py) and their stubs to them.
+  // keyword constructors (_specs.py) to them.
   m.def("spec_fields", [] {
     py::dict forms;
     for (const ip::io::SpecForm& f : ip::io::spec_forms()) {

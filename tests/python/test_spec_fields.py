@@ -1,17 +1,32 @@
-"""The keyword constructors (interpatch/_specs.py) and their stubs (__init__.pyi)
-held to the spec reader's own field lists (_core.spec_fields(), the table in
-src/io/spec/forms.hpp). The constructors are written by hand, not generated from
-that table: their arguments are not the fields one for one (coons takes four curves
-for "boundary", trilinear one (2, 2, 2, 3) array for eight corner fields, ruled c0
-and c1 for "curves"), each field is converted its own way (arrays passed in memory,
-points as lists, knots as floats), and the table holds names only. So this test
-makes the drift fail instead: a reader type or field no constructor writes, a
-constructor writing a field the reader does not know (the reader would only warn),
-or a stub whose signature is not the function's."""
+"""The keyword constructors (interpatch/_specs.py) held to the spec reader's own
+field lists (_core.spec_fields(), the table in src/io/spec/forms.hpp), and the
+package's type stubs to what it has. The constructors are written by hand, not
+generated from that table: their arguments are not the fields one for one (coons
+takes four curves for "boundary", trilinear one (2, 2, 2, 3) array for eight corner
+fields, ruled c0 and c1 for "curves"), each field is converted its own way (arrays
+passed in memory, points as lists, knots as floats), and the table holds names only.
+So this test makes the drift fail instead.
+
+What a constructor writes is learnt from the examples in its docstring, run as
+doctests with `np` and `interpatch` in their namespace: every spec a call hands the
+reader is caught on its way (the last one of a call is its own; the ones before are
+curves built for its arguments), with the keywords the call gave. It fails on an
+example whose output differs, a constructor without examples or with a keyword its
+examples never give, a reader type or field no constructor writes, and a constructor
+writing a field the reader does not know (the reader would only warn).
+
+The constructors carry their annotations (__init__.pyi star-imports _specs); the
+compiled module's stub _core.pyi must declare what _core has and nothing else, and
+__init__.pyi re-export every name of interpatch.__all__."""
 
 import ast
+import doctest
+import functools
 import inspect
 import os
+import typing
+from dataclasses import dataclass, field
+from typing import Any, Optional
 
 import numpy as np
 import pytest
@@ -40,38 +55,11 @@ NOT_OFFERED = {
 # as files (the constructors pass NumPy arrays in memory, {"array": NAME}).
 NOT_CONSTRUCTED_KINDS = {"points"}
 
-GRID = np.zeros((4, 4, 3))
-GRID3 = np.zeros((3, 3, 3, 3))
-PTS = np.zeros((4, 3))
-P = [0.0, 0.0, 0.0]
 
-# One call per public constructor, every keyword given, so that every keyword shows
-# which field it writes.
-CALLS = {
-    "bilinear": dict(p00=P, p01=P, p10=P, p11=P),
-    "ruled": dict(c0=PTS, c1=PTS),
-    "coons": dict(v0=PTS, v1=PTS, u0=PTS, u1=PTS, blending="linear", tolerance=0.1),
-    "curve_network": dict(u_curves=[PTS], v_curves=[PTS], method="gordon", u_params=[0.0], v_params=[0.0],
-                          tolerance=0.1, periodic=(False, False)),
-    "hermite_patch": dict(corners={"p00": {"p": P}}),
-    "interpolate_surface": dict(points=GRID, degree=3, param="chord", periodic=(False, False)),
-    "approximate_surface": dict(points=GRID, degree=3, param="chord", periodic=(False, False), control_points=(4, 4),
-                                tolerance=0.1, smoothing=1.0, weights=np.ones((4, 4))),
-    "interpolate_volume": dict(points=GRID3, degree=2, param="chord", periodic=(False, False, False)),
-    "approximate_volume": dict(points=GRID3, degree=2, param="chord", periodic=(False, False, False),
-                               control_points=(3, 3, 3), tolerance=0.1, smoothing=1.0, weights=np.ones((3, 3, 3))),
-    "trilinear": dict(corners=np.zeros((2, 2, 2, 3))),
-    "coons_volume": dict(faces={"u0": GRID}, blending="linear", tolerance=0.1),
-    "hermite_volume": dict(corners=[{"p": P}]),
-    "interpolate_curve": dict(points=PTS, degree=3, param="chord", periodic=True, start_derivative=P,
-                              end_derivative=P),
-    "approximate_curve": dict(points=PTS, degree=3, param="chord", periodic=True, control_points=4, tolerance=0.1,
-                              smoothing=1.0, weights=np.ones(4)),
-    "bspline_curve": dict(degree=1, knots=[0, 0, 1, 1], control_points=np.zeros((2, 3)), weights=[1, 1],
-                          periodic=True),
-    "hermite_curve": dict(points=PTS, tangents=PTS, params=[0, 1, 2, 3]),
-    "line": dict(a=P, b=P),
-}
+def public_functions():
+    """The public functions _specs defines: the keyword constructors and build()."""
+    return sorted(name for name, f in vars(_specs).items()
+                  if inspect.isfunction(f) and f.__module__ == _specs.__name__ and not name.startswith("_"))
 
 
 def constructors():
@@ -81,13 +69,69 @@ def constructors():
                   and getattr(interpatch, name).__module__ == _specs.__name__)
 
 
-def written(name, monkeypatch):
-    """(form, fields) the constructor `name` writes given every keyword: the spec it
-    hands the reader, caught before it is built."""
-    seen = []
-    monkeypatch.setattr(_specs, "_build", lambda spec, base_dir, arrays: seen.append(spec))
-    getattr(interpatch, name)(**CALLS[name])
-    (spec,) = seen
+@dataclass
+class Call:
+    """One call of a public function of _specs during the examples."""
+    name: str
+    example_of: str  # the function whose docstring's examples made the call
+    keywords: set  # the parameters it was given, by name or by position
+    spec: Optional[dict]  # the last spec handed to the reader during the call: its own
+
+
+@dataclass
+class Examples:
+    calls: list = field(default_factory=list)
+    tests: dict = field(default_factory=dict)  # name: (number of examples, failed, the runner's report)
+
+
+def recorded(name: str, f: Any, seen: Examples, built: list, running: list) -> Any:
+    signature = inspect.signature(f)
+
+    @functools.wraps(f)
+    def call(*args, **kwargs):
+        given = set(signature.bind(*args, **kwargs).arguments)
+        start = len(built)
+        try:
+            return f(*args, **kwargs)
+        finally:
+            seen.calls.append(Call(name, running[0], given, built[-1] if len(built) > start else None))
+
+    return call
+
+
+@pytest.fixture(scope="module")
+def examples():
+    """Every public function's docstring examples, run with interpatch's functions
+    recording their calls and _specs._build the specs it is handed (then built)."""
+    seen, built, running = Examples(), [], [None]
+    real_build = _specs._build
+
+    def recording_build(spec, base_dir, arrays):
+        built.append(spec)
+        return real_build(spec, base_dir, arrays)
+
+    finder = doctest.DocTestFinder(recurse=False)
+    runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(_specs, "_build", recording_build)
+        for name in _specs.__all__:
+            mp.setattr(interpatch, name, recorded(name, getattr(_specs, name), seen, built, running))
+        for name in _specs.__all__:
+            running[0] = name
+            tests = finder.find(getattr(_specs, name), name, module=_specs, globs={"np": np, "interpatch": interpatch})
+            report = []
+            results = [runner.run(test, out=report.append) for test in tests]
+            seen.tests[name] = (sum(r.attempted for r in results), sum(r.failed for r in results), "".join(report))
+    return seen
+
+
+def own_calls(examples, name):
+    """The calls of `name` its own examples made."""
+    return [c for c in examples.calls if c.name == name and c.example_of == name]
+
+
+def written(spec):
+    """(form, fields) of a spec a constructor handed the reader."""
     if "type" in spec:
         return ("type", spec["type"]), set(spec)
     (key,) = [k for k in spec if k in _core.spec_fields()["curve"]]
@@ -113,26 +157,49 @@ def test_the_reader_publishes_its_table():
     assert forms["curve"]["bspline"][0] == "degree"
 
 
-def test_every_constructor_is_exercised_with_every_keyword():
-    assert set(CALLS) == set(constructors())
-    for name, kw in CALLS.items():
-        params = inspect.signature(getattr(interpatch, name)).parameters
-        assert set(kw) == set(params), name
+def test_interpatch_exports_every_public_function_of_specs():
+    unnamed = set(public_functions()) - set(_specs.__all__)
+    assert not unnamed, f"_specs.__all__ does not name {sorted(unnamed)}, so interpatch does not export them"
+    stray = set(_specs.__all__) - set(public_functions())
+    assert not stray, f"_specs.__all__ names {sorted(stray)}, which are no public functions of _specs"
+    assert constructors() == sorted(set(_specs.__all__) - {"build"})
+    for name in _specs.__all__:
+        assert name in interpatch.__all__ and getattr(interpatch, name) is getattr(_specs, name), name
 
 
-def test_constructors_write_only_reader_fields(reader, monkeypatch):
+def test_every_example_gives_its_output(examples):
+    for name in public_functions():
+        attempted, failed, report = examples.tests.get(name, (0, 0, ""))
+        assert attempted, f"{name} has no examples (>>> lines) in its docstring"
+        assert not failed, f"the examples of {name}:\n{report}"
+
+
+def test_every_constructor_is_exercised_with_every_keyword(examples):
+    for name in public_functions():
+        params = set(inspect.signature(getattr(_specs, name)).parameters)
+        given = set().union(*(c.keywords for c in own_calls(examples, name)))
+        assert given == params, f"the examples of {name} never give {sorted(params - given)}"
+
+
+def test_constructors_write_only_reader_fields(reader, examples):
     for name in constructors():
-        form, fields = written(name, monkeypatch)
-        assert form in reader, f"{name} writes a {form[0]} {form[1]!r}, which the reader does not know"
+        assert any(c.spec is not None for c in own_calls(examples, name)), f"the examples of {name} build nothing"
+    for c in examples.calls:
+        if c.name == "build" or c.spec is None:
+            continue
+        form, fields = written(c.spec)
+        assert form in reader, f"{c.name} writes a {form[0]} {form[1]!r}, which the reader does not know"
         unknown = fields - reader[form]
-        assert not unknown, f"{name} writes fields the reader of {form[1]!r} does not know: {sorted(unknown)}"
+        assert not unknown, f"{c.name} writes fields the reader of {form[1]!r} does not know: {sorted(unknown)}"
 
 
-def test_every_reader_form_and_field_has_a_keyword(reader, monkeypatch):
+def test_every_reader_form_and_field_has_a_keyword(reader, examples):
     made = {}
     for name in constructors():
-        form, fields = written(name, monkeypatch)
-        made.setdefault(form, set()).update(fields)
+        for c in own_calls(examples, name):
+            if c.spec is not None:
+                form, fields = written(c.spec)
+                made.setdefault(form, set()).update(fields)
     for form, fields in sorted(reader.items()):
         if form[0] in NOT_CONSTRUCTED_KINDS:
             continue
@@ -150,32 +217,68 @@ def test_every_reader_form_and_field_has_a_keyword(reader, monkeypatch):
         assert exempt <= reader[form], f"{form}: {sorted(exempt - reader[form])} are no longer reader fields"
 
 
-def stub_functions():
-    path = os.path.join(os.path.dirname(interpatch.__file__), "__init__.pyi")
-    with open(path, encoding="utf-8") as f:
-        tree = ast.parse(f.read())
-    return {node.name: node for node in tree.body if isinstance(node, ast.FunctionDef)}
+def stub(name):
+    with open(os.path.join(os.path.dirname(interpatch.__file__), name), encoding="utf-8") as f:
+        return ast.parse(f.read())
 
 
-REQUIRED = object()
+def core_stub_names():
+    """The names _core.pyi declares: classes, functions and annotated constants, and
+    its own type aliases (_Array, ...: assignments to a private name)."""
+    declared, aliases = set(), set()
+    for node in stub("_core.pyi").body:
+        if isinstance(node, (ast.ClassDef, ast.FunctionDef)):
+            declared.add(node.name)
+        elif isinstance(node, ast.AnnAssign):
+            declared.add(node.target.id)
+        elif isinstance(node, ast.Assign):
+            for target in node.targets:
+                (aliases if target.id.startswith("_") else declared).add(target.id)
+    return declared, aliases
 
 
-def stub_signature(node):
-    """(name, default) of each argument; REQUIRED where there is no default."""
-    args = node.args.args
-    defaults = [REQUIRED] * (len(args) - len(node.args.defaults)) + [ast.literal_eval(d) for d in node.args.defaults]
-    return [(a.arg, d) for a, d in zip(args, defaults)]
+def test_the_package_stub_star_imports_the_constructors():
+    star = [node for node in stub("__init__.pyi").body if isinstance(node, ast.ImportFrom) and node.level == 1
+            and node.module == "_specs" and [a.name for a in node.names] == ["*"]]
+    assert star, "__init__.pyi has no `from ._specs import *`"
 
 
-def runtime_signature(f):
-    return [(p.name, REQUIRED if p.default is inspect.Parameter.empty else p.default)
-            for p in inspect.signature(f).parameters.values()]
+def test_every_public_function_is_annotated():
+    for name in public_functions():
+        f = getattr(_specs, name)
+        signature = inspect.signature(f)
+        bare = [p.name for p in signature.parameters.values() if p.annotation is inspect.Parameter.empty]
+        assert not bare, f"{name}: no annotation on {bare}"
+        assert signature.return_annotation is not inspect.Signature.empty, f"{name}: no return annotation"
+        # The annotations name types _specs has (they are strings until evaluated).
+        hints = typing.get_type_hints(f)
+        assert set(hints) == set(signature.parameters) | {"return"}, name
 
 
-def test_stubs_are_the_constructors_signatures():
-    stubs = stub_functions()
-    for name in constructors() + ["build"]:
-        assert name in stubs, f"__init__.pyi has no stub of {name}"
-        assert stub_signature(stubs[name]) == runtime_signature(getattr(interpatch, name)), name
-    stray = {name for name in stubs if name not in interpatch.__all__}
-    assert not stray, f"__init__.pyi has stubs of functions interpatch does not have: {sorted(stray)}"
+def test_the_core_stub_declares_what_core_has():
+    has = {name for name in dir(_core) if not (name.startswith("__") and name.endswith("__"))}
+    declared, aliases = core_stub_names()
+    assert not has - declared, f"_core.pyi does not declare {sorted(has - declared)}"
+    assert not declared - has, f"_core.pyi declares what _core does not have: {sorted(declared - has)}"
+    assert not aliases & has, f"_core.pyi declares {sorted(aliases & has)} as type aliases"
+
+
+def test_the_package_stub_reexports_every_exported_name():
+    core_declared, _ = core_stub_names()
+    exported = set()
+    for node in stub("__init__.pyi").body:
+        if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module == "_specs":
+            if [a.name for a in node.names] == ["*"]:
+                exported.update(_specs.__all__)
+        elif isinstance(node, ast.ImportFrom) and node.level == 1 and node.module == "_core":
+            for a in node.names:
+                assert a.name in core_declared, f"__init__.pyi imports {a.name}, which _core.pyi does not declare"
+                # Only `import X as X` re-exports X from a stub.
+                assert a.asname == a.name, f"__init__.pyi imports {a.name} from _core without re-exporting it"
+                exported.add(a.name)
+        elif isinstance(node, ast.AnnAssign):
+            exported.add(node.target.id)
+    assert not set(interpatch.__all__) - exported, \
+        f"__init__.pyi does not re-export {sorted(set(interpatch.__all__) - exported)}"
+    assert not exported - set(interpatch.__all__), \
+        f"__init__.pyi exports what interpatch.__all__ does not name: {sorted(exported - set(interpatch.__all__))}"
