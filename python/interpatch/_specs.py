@@ -12,11 +12,10 @@ from __future__ import annotations
 from os import PathLike
 from typing import Any, Callable, Optional, Sequence, Union, cast
 
-import numpy as np
 import numpy.typing as npt
 
+from ._args import _approximation, _Arrays, _curve, _error, _options, _point, _real, _reals, _surface_spec
 from ._core import Curve, Surface, Volume
-from ._core import Error as Error_
 from ._core import build as _build
 
 __all__ = ["build", "interpolate_surface", "bilinear", "ruled", "coons", "curve_network", "hermite_patch",
@@ -25,69 +24,6 @@ __all__ = ["build", "interpolate_surface", "bilinear", "ruled", "coons", "curve_
 
 _Path = Union[str, PathLike[str]]
 _CurveLike = Union[Curve, npt.ArrayLike]
-
-
-def _error(code: str, message: str) -> Error_:
-    e = Error_(message)
-    e.code = code
-    return e
-
-
-def _first_masked(a: Any) -> Optional[tuple[int, ...]]:
-    """The index of the first masked point of a masked array (any coordinate masked), None when none is."""
-    if not np.ma.isMaskedArray(a):
-        return None
-    mask = np.ma.getmaskarray(a)
-    if mask.ndim >= 2:
-        mask = mask.any(axis=-1)
-    where = np.argwhere(mask)
-    return tuple(int(i) for i in where[0]) if len(where) else None
-
-
-def _real(x: Any, name: str) -> np.ndarray:
-    """x as an array of real numbers: NumPy would drop a complex number's imaginary part
-    and read True as 1, so complex, bool, object and text are refused, as are masked
-    entries where nothing may be missing."""
-    at = _first_masked(x)
-    if at is not None:
-        raise _error("wrong_type", f"{name}: masked at index {at}; this argument cannot have missing values")
-    try:
-        a = np.asarray(np.ma.getdata(x) if np.ma.isMaskedArray(x) else x)
-    except (ValueError, TypeError) as e:
-        raise _error("wrong_type", f"{name}: expected real numbers ({e})") from None
-    if a.dtype.kind not in "fiu":
-        raise _error("wrong_type", f"{name}: expected real numbers, got an array of dtype {a.dtype}")
-    return a.astype(np.float64)
-
-
-class _Arrays:
-    """The arrays of one spec, each named after the argument that gave it."""
-
-    def __init__(self) -> None:
-        self.table: dict[str, Any] = {}
-
-    def add(self, points: Any, name: str, missing: bool = False) -> dict[str, str]:
-        """{"array": name} for `points`, kept as given (the module converts it and
-        refuses what is not an array of real numbers). A masked point means a missing
-        one: allowed where `missing` (approximations), refused elsewhere."""
-        if not missing:
-            at = _first_masked(points)
-            if at is not None:
-                raise _error("wrong_type", f"{name}: masked at index {at}; every point is needed here "
-                                           "(the approximations take missing points)")
-        unique, k = name, 2
-        while unique in self.table:
-            unique, k = f"{name}#{k}", k + 1
-        self.table[unique] = points
-        return {"array": unique}
-
-
-def _point(p: Any, name: str) -> list[float]:
-    return [float(x) for x in _real(p, name).reshape(-1)]
-
-
-def _reals(x: Any, name: str) -> Any:
-    return _real(x, name).tolist()
 
 
 def _curve_built(make: Callable[[_Arrays], dict[str, Any]]) -> Curve:
@@ -200,31 +136,6 @@ def line(a: npt.ArrayLike, b: npt.ArrayLike) -> Curve:
     return _curve_built(lambda arrays: {"line": [_point(a, "a"), _point(b, "b")]})
 
 
-def _curve(c: Any, arrays: _Arrays, name: str) -> dict[str, Any]:
-    """A curve argument as a spec: a Curve by its exact form (what the surfaces take of
-    it: the curve over [0, 1], bit for bit), an array of points as the curve through them."""
-    if isinstance(c, Curve):
-        b = c.to_bspline()
-        spec: dict[str, Any] = {"degree": b["degree"], "knots": b["knots"].tolist(),
-                                "control_points": arrays.add(b["control_points"], f"{name}.control_points")}
-        if b["weights"] is not None:
-            spec["weights"] = b["weights"].tolist()
-        if b["periodic"]:
-            spec["periodic"] = True
-        return {"bspline": spec}
-    return {"interpolate": arrays.add(c, name), "param": "chord"}
-
-
-def _options(spec: dict[str, Any], **kw: Any) -> dict[str, Any]:
-    for k, v in kw.items():
-        if v is None:
-            continue
-        if isinstance(v, tuple):
-            v = list(v)
-        spec[k] = v
-    return spec
-
-
 def interpolate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int], None] = None,
                         param: Optional[str] = None, periodic: Optional[Sequence[bool]] = None) -> Surface:
     """The B-spline surface through a grid of points, shape (n, m, 3), any float
@@ -251,14 +162,6 @@ def interpolate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int],
     spec = _options({"type": "interpolate", "points": a.add(points, "points")}, degree=degree, param=param,
                     periodic=periodic)
     return cast(Surface, _build(spec, ".", a.table))
-
-
-def _approximation(spec: dict[str, Any], control_points: Any, tolerance: Optional[float], smoothing: Any,
-                   weights: Any) -> dict[str, Any]:
-    spec = _options(spec, control_points=control_points, tolerance=tolerance, smoothing=smoothing)
-    if weights is not None:
-        spec["weights"] = _reals(weights, "weights")
-    return spec
 
 
 def approximate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int], None] = None,
@@ -523,12 +426,6 @@ def trilinear(corners: npt.ArrayLike) -> Volume:
     return cast(Volume, _build(spec, ".", {}))
 
 
-def _surface_spec(face: Any, arrays: _Arrays, name: str) -> dict[str, Any]:
-    if isinstance(face, dict):
-        return face
-    return {"type": "interpolate", "points": arrays.add(face, name)}
-
-
 def coons_volume(faces: dict[str, Any], blending: Optional[str] = None, tolerance: Optional[float] = None) -> Volume:
     """The Coons volume of six faces keyed u0, u1, v0, v1, w0, w1 (S(0, v, w), S(1, v, w),
     S(u, 0, w), ...): each a grid of points (n, m, 3) to interpolate, or a surface spec dict.
@@ -537,8 +434,8 @@ def coons_volume(faces: dict[str, Any], blending: Optional[str] = None, toleranc
     --------
     >>> def quad(p00, p01, p10, p11):
     ...     return {"type": "bilinear", "p00": p00, "p01": p01, "p10": p10, "p11": p11}
-    >>> bulge = {"type": "interpolate", "points": [[[0, 1, 0], [0, 1, 0.5], [0, 1, 1]],  # face v1, by (u, w)
-    ...          [[1, 1, 0], [1, 1.5, 0.5], [1, 1, 1]], [[2, 1, 0], [2, 1, 0.5], [2, 1, 1]]]}
+    >>> bulge = np.array([[[0, 1, 0], [0, 1, 0.5], [0, 1, 1]],  # face v1 by (u, w), interpolated
+    ...                   [[1, 1, 0], [1, 1.5, 0.5], [1, 1, 1]], [[2, 1, 0], [2, 1, 0.5], [2, 1, 1]]])
     >>> box = interpatch.coons_volume({"u0": quad([0, 0, 0], [0, 0, 1], [0, 1, 0], [0, 1, 1]),
     ...                                "u1": quad([2, 0, 0], [2, 0, 1], [2, 1, 0], [2, 1, 1]),
     ...                                "v0": quad([0, 0, 0], [0, 0, 1], [2, 0, 0], [2, 0, 1]), "v1": bulge,

@@ -29,7 +29,7 @@ import os, sys
 import interpatch
 where = os.path.dirname(interpatch.__file__)
 assert where.startswith(sys.prefix + os.sep), f"interpatch imported from {where}, not the environment {sys.prefix}"
-for name in ("__init__.pyi", "_core.pyi", "py.typed"):
+for name in ("_specs.py", "_args.py", "__init__.pyi", "_core.pyi", "py.typed"):
     assert os.path.isfile(os.path.join(where, name)), f"{name} is not installed"
 assert os.access(os.path.join(sys.prefix, "bin", "interpatch"), os.X_OK), "the interpatch command is not installed"
 ]=])
