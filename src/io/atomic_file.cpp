@@ -27,13 +27,14 @@
 #include <vector>
 
 #include "base/text.hpp"
+#include "io/extension.hpp"
 
 namespace interpatch::io {
 namespace fs = std::filesystem;
 
 namespace {
 
-std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
+using internal::quoted;
 
 fs::path directory_of(const fs::path& path) {
   fs::path dir = path.parent_path();

@@ -1,6 +1,7 @@
 #pragma once
-// A file name's extension in lower case ("OUT.VTS" → ".vts"): how every writer of the
-// io library tells the format it is asked for.
+// File names as the io library takes them: the extension in lower case ("OUT.VTS"
+// → ".vts"), how every writer tells the format it is asked for; a path quoted in a
+// message.
 
 #include <cctype>
 #include <filesystem>
@@ -13,5 +14,7 @@ inline std::string lower_extension(const std::filesystem::path& path) {
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return ext;
 }
+
+inline std::string quoted(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
 
 }  // namespace interpatch::io::internal

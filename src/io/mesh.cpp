@@ -30,7 +30,7 @@ using interpatch::detail::fail;
 using internal::lower_extension;
 using internal::mesh_io::check_stl_triangle_count;
 using internal::mesh_io::float32_warnings;
-using internal::mesh_io::quoted;
+using internal::quoted;
 using internal::mesh_io::Structured;
 using internal::mesh_io::write_obj;
 using internal::mesh_io::write_ply;

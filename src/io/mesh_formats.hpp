@@ -18,10 +18,9 @@
 #include "interpatch/progress.hpp"
 #include "interpatch/surface.hpp"
 #include "interpatch/vec3.hpp"
+#include "io/extension.hpp"
 
 namespace interpatch::io::internal::mesh_io {
-
-inline std::string quoted(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
 
 // ---------------------------------------------------------------------------
 // Polygon meshes (mesh_polygons.cpp). Each list of records (vertices, faces, ...)

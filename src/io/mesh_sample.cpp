@@ -29,7 +29,7 @@ namespace {
 
 using internal::mesh_io::legacy_vtk_head;
 using internal::mesh_io::legacy_vtk_point_data;
-using internal::mesh_io::quoted;
+using internal::quoted;
 using internal::mesh_io::to_byte_order;
 using internal::mesh_io::vts_count;
 using internal::mesh_io::vts_head;

@@ -12,8 +12,15 @@ if(MODE STREQUAL "install")
 else()
   set(args "-DINTERPATCH_SOURCE_DIR=${SOURCE_DIR}")
 endif()
+# The source-tree consumer compiles the library again: unoptimised (no build type),
+# as what it checks is that the tree builds and links as a subdirectory, not its speed.
+if(MODE STREQUAL "install")
+  set(build_type Release)
+else()
+  set(build_type "")
+endif()
 execute_process(COMMAND ${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/consumer" -B "${work}/build" -G Ninja
-                        -DCMAKE_BUILD_TYPE=Release ${args} RESULT_VARIABLE rc)
+                        "-DCMAKE_BUILD_TYPE=${build_type}" ${args} RESULT_VARIABLE rc)
 if(rc)
   message(FATAL_ERROR "configuring the consumer failed: ${rc}")
 endif()
