@@ -108,10 +108,10 @@ test-release: test-deps build
 # The sanitizer build with line tables alone (-g1, CMakePresets.json): three quarters of
 # the compile time of -g, and the reports still name every function, file and line. It
 # stays at -O2: tests compare networks with fixtures made at -O3, and -O1 rounds a knot
-# differently enough to change a merge. It is a unity build (files compiled in batches,
-# as the fuzz build is), which roughly halves its compile time, and its promise tests
-# run a fifth of the random cases (INTERPATCH_PROMISE_CASES=0.2): it looks for memory and
-# undefined-behaviour errors; the Release run tries every case.
+# differently enough to change a merge. Its promise tests run a fifth of the random
+# cases (INTERPATCH_PROMISE_CASES=0.2): it looks for memory and undefined-behaviour
+# errors, and the Release run tries every case. The C++ examples and the browser
+# checks of the viewer pages run in the Release build only.
 test-asan: test-deps viewer-deps
 	cmake --preset asan
 	cmake --build --preset asan -j $(JOBS)
