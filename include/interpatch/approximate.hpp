@@ -176,4 +176,98 @@ struct VolumeApproximation {
 /// @throws error as approximate_curve.
 [[nodiscard]] VolumeApproximation approximate_volume(PointGrid3 points, const VolumeApproximationOptions& options);
 
+/// Where each point of a scattered approximation sits in the parameter plane.
+enum class ScatteredParam {
+  /// The projection onto the least-squares plane of the points: u along its principal
+  /// axis of larger extent, v along the other, both in the points' unit of length.
+  plane,
+  /// A height field: u = x, v = y. Only z is fitted; the control points' x and y are
+  /// the Greville abscissae, so x(u, v) = u and y(u, v) = v to rounding.
+  xy,
+  /// The sites given in ScatteredApproximationOptions::sites, the general scheme.
+  sites,
+};
+
+/// How a scattered approximation is set up. Exactly one of `control_points`,
+/// `tolerance` and `smoothing` is given.
+struct ScatteredApproximationOptions {
+  /// Degrees in u and v; unset means 3.
+  std::array<std::optional<int>, 2> degree{};
+  ScatteredParam param = ScatteredParam::plane;
+  /// With ScatteredParam::sites: (u_k, v_k) of each point, as many as the points.
+  std::vector<std::array<double, 2>> sites;
+  /// The domain [[u0, u1], [v0, v1]]; unset: the bounding rectangle of the sites of
+  /// the points present. It must hold every such site.
+  std::optional<std::array<std::array<double, 2>, 2>> domain;
+  /// Least squares (with the small fairness term that fills voids) on uniform knots
+  /// with this many control points in u and v.
+  std::optional<std::array<int, 2>> control_points;
+  /// Every point present within this distance of S(u_k, v_k): uniform knots, their
+  /// spans doubled in both directions until it holds. A promise, checked on the
+  /// finished spline by its own evaluator; tolerance_not_met when the net would pass
+  /// `max_control_points`.
+  std::optional<double> tolerance;
+  /// The fairness weight λ ≥ 0, on a net of about one control point per point present
+  /// (at most smoothing_max_control_points a direction).
+  std::optional<double> smoothing;
+  /// The largest net a tolerance may reach, per direction; unset: 4096 a direction and
+  /// at most 4 control points per point present (and never fewer than 64 × 64).
+  std::optional<std::array<int, 2>> max_control_points;
+  /// Non-negative weights, one per point; empty means 1.
+  std::vector<double> weights;
+  progress_callback progress;
+};
+
+/// A scattered approximation, its sites and its report (max_error_at holds one index).
+struct ScatteredApproximation {
+  /// Over `domain`: with ScatteredParam::xy, x(u, v) = u and y(u, v) = v.
+  BSplineSurface surface;
+  /// (u_k, v_k) of every point; NaN for a missing one.
+  std::vector<std::array<double, 2>> sites;
+  std::array<std::array<double, 2>, 2> domain{};
+  /// ScatteredParam::plane: u = (p − origin) · axis_u, v = (p − origin) · axis_v.
+  Vec3 origin{}, axis_u{}, axis_v{};
+  ApproximationReport report;
+};
+
+/// A B-spline surface near points without a grid (survey points, scans, boreholes).
+/// It minimizes
+///
+///   E(S) = (1 / Σw) Σ w_k |S(u_k, v_k) − Q_k|²  +  λ J(S),
+///
+/// J the thin-plate energy ∫∫ S_uu² + 2 S_uv² + S_vv² over the domain scaled to a
+/// longer side of 1 (both directions alike), on the control net (second divided differences over the Greville
+/// abscissae). J vanishes on the planes a + b u + c v: λ → ∞ gives the least-squares
+/// plane. With `control_points` or `tolerance`, λ is 1e-5 of the data term's mean
+/// diagonal over J's: too small to pull the fit from its data, large enough to fill
+/// voids and the region outside the points smoothly, bounded by the data around them.
+///
+/// The normal equations are assembled in one pass over the points, each touching
+/// (p+1)(q+1) basis functions, into a banded matrix of the control net (no dense
+/// matrix, memory O(N + control points)), and solved by conjugate gradients started
+/// from the previous, coarser net. The result has the same bits on any number of threads.
+///
+/// Example:
+/// @code
+///   using namespace interpatch;
+///   std::vector<Vec3> q;
+///   for (int k = 0; k < 2000; ++k) {
+///     const double x = (k * 0.618034) - std::floor(k * 0.618034), y = (k * 0.414214) - std::floor(k * 0.414214);
+///     q.push_back({100 * x, 80 * y, 5 * std::sin(x * 6) * std::cos(y * 4)});
+///   }
+///   ScatteredApproximationOptions o;
+///   o.param = ScatteredParam::xy;
+///   o.tolerance = 0.05;
+///   auto r = approximate_scattered(q, o);  // z = f(x, y); every point within 0.05
+/// @endcode
+/// @throws error wrong_type (not exactly one of control_points, tolerance, smoothing;
+///   tolerance ≤ 0; negative smoothing), too_few_points (fewer points present than
+///   (p+1)(q+1), fewer control points than p + 1), invalid_degree, not_finite (an
+///   infinite coordinate or site, a NaN weight), size_mismatch (sites or weights of
+///   another count), invalid_weight, singular (every point on one line, or every site
+///   on one line: no plane), out_of_domain (a site outside `domain`), too_large,
+///   tolerance_not_met, ill_conditioned.
+[[nodiscard]] ScatteredApproximation approximate_scattered(std::span<const Vec3> points,
+                                                           const ScatteredApproximationOptions& options);
+
 }  // namespace interpatch

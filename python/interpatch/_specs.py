@@ -12,6 +12,7 @@ from __future__ import annotations
 from os import PathLike
 from typing import Any, Callable, Optional, Sequence, Union, cast
 
+import numpy as np
 import numpy.typing as npt
 
 from ._args import _approximation, _Arrays, _curve, _error, _options, _point, _real, _reals, _surface_spec
@@ -167,16 +168,23 @@ def interpolate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int],
 def approximate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int], None] = None,
                         param: Optional[str] = None, periodic: Optional[Sequence[bool]] = None,
                         control_points: Union[int, Sequence[int], None] = None, tolerance: Optional[float] = None,
-                        smoothing: Union[float, str, None] = None, weights: Optional[npt.ArrayLike] = None) -> Surface:
-    """A B-spline surface near a grid of points, shape (n, m, 3), any float dtype and
-    memory order; NaN in a point, or a masked entry of a masked array, marks it missing
-    (the fairness term fills the hole).
+                        smoothing: Union[float, str, None] = None, weights: Optional[npt.ArrayLike] = None,
+                        params: Optional[npt.ArrayLike] = None, domain: Optional[Sequence[Sequence[float]]] = None,
+                        max_control_points: Union[int, Sequence[int], None] = None) -> Surface:
+    """A B-spline surface near a grid of points, shape (n, m, 3), or near scattered
+    points, shape (N, 3); any float dtype and memory order. NaN in a point, or a masked
+    entry of a masked array, marks it missing (the fairness term fills the hole).
     Exactly one of `control_points` ((nu, nv): least squares with that net),
     `tolerance` (the fewest control points keeping every point within that distance)
-    and `smoothing` (the fairness weight, or "auto" for generalized cross-validation);
-    optional `weights`, shape (n, m), non-negative. `degree`, `param` and `periodic` as
-    for interpolate_surface. info()["parameters"] reports max_error (and max_error_at),
-    rms_error, control_points, lambda and missing_points.
+    and `smoothing` (the fairness weight, or "auto" for generalized cross-validation
+    on a grid); optional `weights`, one per point, non-negative. For a grid, `degree`,
+    `param` and `periodic` as for interpolate_surface. For scattered points, `param`
+    is "plane" (the default: the points' least-squares plane) or "xy" (a height field,
+    u = x and v = y), or `params` gives the sites, shape (N, 2); `domain`
+    ((u0, u1), (v0, v1)) the rectangle covered (default: the sites' bounding box) and
+    `max_control_points` the largest net a tolerance may reach. The surface is over
+    [0, 1]²: with "xy", x = u0 + u (u1 − u0). info()["parameters"] reports max_error
+    (and max_error_at), rms_error, control_points, lambda and missing_points.
 
     Examples
     --------
@@ -195,10 +203,31 @@ def approximate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int],
     >>> tube = np.stack([np.cos(t), np.sin(t), z], axis=-1)          # closed around v
     >>> s = interpatch.approximate_surface(tube, periodic=(False, True), smoothing=1e-6)
     >>> s.info()["periodic"], s.info()["parameters"]["max_error"] < 0.01
-    ([False, True], True)"""
+    ([False, True], True)
+
+    Scattered survey points, a height field over a given rectangle:
+
+    >>> rng = np.random.default_rng(2)
+    >>> xy = rng.uniform((0, 0), (300, 200), (5000, 2))
+    >>> survey = np.column_stack([xy, 10 * np.sin(xy[:, 0] / 50) + rng.normal(0, 0.05, 5000)])
+    >>> s = interpatch.approximate_surface(survey, param="xy", tolerance=0.3, domain=((0, 300), (0, 200)),
+    ...                                    max_control_points=(200, 200))
+    >>> p = s.info()["parameters"]
+    >>> p["max_error"] <= 0.3, p["param"], p["points"], np.round(s.point(0.5, 0.5)[:2], 9).tolist()
+    (True, 'xy', 5000, [150.0, 100.0])
+    >>> s = interpatch.approximate_surface(survey, params=xy / 100, control_points=(12, 10))
+    >>> s.info()["parameters"]["param"], s.info()["control_points"]
+    ('sites', [12, 10])"""
     a = _Arrays()
     spec = _options({"type": "approximate", "points": a.add(points, "points", missing=True)}, degree=degree, param=param,
-                    periodic=periodic)
+                    periodic=periodic, domain=domain, max_control_points=max_control_points)
+    if params is not None:
+        if param is not None:
+            raise _error("wrong_type", "params: give either param (a name) or params (the sites), not both")
+        sites = np.asarray(params, dtype=float)
+        if sites.ndim != 2 or sites.shape[1] != 2:
+            raise _error("size_mismatch", f"params: shape {sites.shape}; the sites of scattered points are (N, 2)")
+        spec["param"] = a.add(np.column_stack([sites, np.zeros(len(sites))]), "params")
     return cast(Surface, _build(_approximation(spec, control_points, tolerance, smoothing, weights), ".", a.table))
 
 

@@ -194,8 +194,7 @@ class PyBuilt {
       if (!sources_ || it == sources_->end())
         throw ip::error(ip::errc::internal, "the array \"" + data[i].array + "\" is not kept");
       auto a = point_array(it->second, data[i].array);
-      std::size_t expected = 1;
-      for (const auto& p : data[i].params) expected *= p.size();
+      const std::size_t expected = data[i].count();
       if (a->points.size() != expected)
         throw ip::error(ip::errc::size_mismatch, data[i].array + ": the array holds " + std::to_string(a->points.size()) +
                                                      " points now; the construction was built from " + std::to_string(expected));

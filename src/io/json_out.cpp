@@ -154,12 +154,38 @@ using internal::Box;
        "knot spans or weights so small they vanish)");
 }
 
+// Points without a grid: the surface at each point's own site.
+void scattered_data_error(const Surface& s, const DataSet& d, DataError& e, std::size_t& done, std::size_t total,
+                          const progress_callback& progress) {
+  const auto& us = d.params[0];
+  const auto& vs = d.params[1];
+  if (d.points.size() != us.size() || vs.size() != us.size())
+    fail(errc::internal, d.pointer, ": ", d.points.size(), " scattered points for ", us.size(), " sites");
+  for (std::size_t k = 0; k < us.size(); ++k) {
+    const Vec3& q = d.points[k];
+    if (progress && ++done % 65536 == 0) progress(static_cast<double>(done) / static_cast<double>(total));
+    if (!is_finite(q)) continue;  // a missing point
+    const Vec3 p = s.point(us[k], vs[k]);
+    const double dist = distance(p, q);
+    if (!std::isfinite(dist)) result_not_finite(p, cat(d.pointer, "/", k), {us[k], vs[k]});
+    if (dist > e.absolute || e.pointer.empty()) {
+      e.absolute = dist;
+      e.pointer = cat(d.pointer, "/", k);
+      e.params = {us[k], vs[k]};
+    }
+  }
+}
+
 void surface_data_error(const Surface& s, const DataSet& d, DataError& e, std::size_t& done, std::size_t total,
                         const progress_callback& progress) {
   if (d.params.size() != 2)
     fail(errc::internal, d.pointer, ": data for a surface needs 2 parameter lists, got ", d.params.size());
   const auto& us = d.params[0];
   const auto& vs = d.params[1];
+  if (d.scattered) {
+    scattered_data_error(s, d, e, done, total, progress);
+    return;
+  }
   const std::size_t nu = us.size(), nv = vs.size();
   if (d.points.size() != nu * nv)
     fail(errc::internal, d.pointer, ": ", d.points.size(), " data points for ", nu, " x ", nv, " parameters");
@@ -353,6 +379,11 @@ void put_data(ojson& j, const std::vector<DataSet>& sets, const char* const* nam
   ojson data = ojson::array();
   for (const DataSet& d : sets) {
     ojson shape = ojson::array(), params = ojson::object();
+    if (d.scattered) {
+      // Each point's site is its own: as many as the points, too many to list.
+      data.push_back({{"pointer", d.pointer}, {"shape", {d.params[0].size()}}, {"scattered", true}});
+      continue;
+    }
     for (std::size_t a = 0; a < d.params.size(); ++a) {
       shape.push_back(d.params[a].size());
       params[names[a]] = d.params[a];

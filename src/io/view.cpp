@@ -198,13 +198,15 @@ ojson data_json(const Construction& c, const PageFrame& frame) {
   ojson sets = ojson::array();
   for (const DataSet& d : c.data) {
     std::vector<std::size_t> shape;
-    for (const auto& p : d.params) shape.push_back(p.size());
+    if (d.scattered) shape.push_back(d.params[0].size());
+    else
+      for (const auto& p : d.params) shape.push_back(p.size());
     const auto long_axes = std::count_if(shape.begin(), shape.end(), [](std::size_t n) { return n > 1; });
     const auto idx = decimated_grid(shape, view_limits.data_points);
     ojson full = ojson::array();
     for (const std::size_t n : shape) full.push_back(n);
     sets.push_back({{"pointer", d.pointer},
-                    {"kind", long_axes == 1 ? "curve" : "points"},
+                    {"kind", long_axes == 1 && !d.scattered ? "curve" : "points"},
                     {"shape", shape_json(idx)},
                     {"full_shape", std::move(full)},
                     {"points", grid_points(d.points, shape, idx, frame).json()}});

@@ -51,6 +51,15 @@ struct DataSet {
   /// JSON Pointer of the spec field the points came from, e.g. "/points"; the
   /// pointer of one point appends its indices ("/points/3/7").
   std::string pointer;
+  /// Points without a grid: point k sits at (params[0][k], params[1][k]).
+  bool scattered = false;
+  /// How many points the parameters stand for: the grid's, or the scattered points'.
+  [[nodiscard]] std::size_t count() const {
+    if (scattered) return params.empty() ? 0 : params[0].size();
+    std::size_t n = 1;
+    for (const auto& p : params) n *= p.size();
+    return n;
+  }
 };
 
 /// The exact B-spline form of a construction: a surface over [0,1]² or a volume

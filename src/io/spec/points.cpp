@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <limits>
 
 #include "base/parallel.hpp"
@@ -229,6 +230,35 @@ PointArray points_impl(const json& j, std::size_t rank, std::string_view ptr, Co
     fail(errc::missing_field, place(ptr), ": a point array given as an object needs \"npy\": file or \"csv\": file with \"shape\"");
   }
   return inline_points(j, rank, ptr, missing_allowed);
+}
+
+std::size_t point_array_rank(const json& j, Context& ctx) {
+  if (j.is_array()) {
+    std::size_t depth = 0;
+    for (const json* node = &j; node->is_array() && !node->empty(); node = &(*node)[0]) ++depth;
+    return depth > 0 ? depth - 1 : 0;
+  }
+  if (!j.is_object()) return 0;
+  if (const json* a = find_member(j, "array"); a && a->is_string() && ctx.arrays) {
+    const auto it = ctx.arrays->find(a->get<std::string>());
+    return it != ctx.arrays->end() && it->second ? it->second->shape.size() : 0;
+  }
+  if (const json* sh = find_member(j, "shape"); sh && sh->is_array() && find_member(j, "csv")) {
+    const std::size_t n = sh->size();
+    return n > 1 && sh->back() == 3 ? n - 1 : n;
+  }
+  const json* npy = find_member(j, "npy");
+  if (!npy || !npy->is_string()) return 0;
+  try {
+    std::ifstream in(ctx.resolve(npy->get<std::string>()), std::ios::binary);
+    in.seekg(0, std::ios::end);
+    const auto size = static_cast<std::uint64_t>(in.tellg());
+    in.seekg(0);
+    const internal::NpyHeader h = internal::read_npy_header(in, size, npy->get<std::string>());
+    return h.shape.size() > 1 && h.shape.back() == 3 ? h.shape.size() - 1 : 0;
+  } catch (const std::exception&) {
+    return 0;  // unreadable: the reader of the points names the problem
+  }
 }
 
 DataSet grid_data(const json& points_spec, std::span<const Vec3> points, std::span<const std::size_t> shape,

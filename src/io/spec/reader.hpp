@@ -147,6 +147,10 @@ std::string choice(const json& obj, std::string_view key, std::string_view ptr,
 /// With `missing_allowed` (approximation only), a missing point is NaN: null for a
 /// coordinate of an inline list, NaN in a file; infinities are refused still.
 PointArray points_impl(const json& j, std::size_t rank, std::string_view ptr, Context& ctx, bool missing_allowed = false);
+/// The rank of a point array as given (1: a list, 2: a grid, ...), from its nesting, its
+/// "shape", its in-memory array or its .npy header, without reading the points; 0 when
+/// it cannot tell (points_impl then says what is wrong).
+std::size_t point_array_rank(const json& j, Context& ctx);
 /// points_impl for interpolation's data: a missing point (NaN in a file, null in a
 /// list) is refused, and the message says that approximation takes missing points.
 PointArray interpolation_points(const json& j, std::size_t rank, std::string_view ptr, Context& ctx);

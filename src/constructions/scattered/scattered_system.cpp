@@ -1,0 +1,327 @@
+#include "constructions/scattered/scattered_system.hpp"
+
+#include <Eigen/Sparse>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <Eigen/SparseCholesky>
+
+#include "base/parallel.hpp"
+
+namespace interpatch::detail::scattered {
+
+Net::Net(int p_, int q_, int nu_, int nv_, std::array<double, 2> range)
+    : p(p_), q(q_), nu(nu_), nv(nv_), ku(KnotVector::uniform(p_, nu_, 0, range[0])), kv(KnotVector::uniform(q_, nv_, 0, range[1])) {}
+
+NetMatrix::NetMatrix(int nu, int nv, int hu, int hv)
+    : nu_(nu), nv_(nv), hu_(hu), hv_(hv), width_(hv + 1 + hu * (2 * hv + 1)), a_(rows() * static_cast<std::size_t>(width_), 0.0) {}
+
+void NetMatrix::add_outer(std::span<const std::array<int, 2>> at, std::span<const double> coef, double s) {
+  for (std::size_t x = 0; x < at.size(); ++x)
+    for (std::size_t y = 0; y < at.size(); ++y) {
+      const auto [i0, j0] = at[x];
+      const auto [i1, j1] = at[y];
+      const int di = i1 - i0, dj = j1 - j0;
+      if (di < 0 || (di == 0 && dj < 0)) continue;  // the lower half is the upper's mirror
+      this->at(static_cast<std::size_t>(i0) * static_cast<std::size_t>(nv_) + static_cast<std::size_t>(j0), offset(di, dj)) +=
+          s * coef[x] * coef[y];
+    }
+}
+
+void NetMatrix::multiply(std::span<const double> x, std::span<double> y, int cols) const {
+  const std::size_t c = static_cast<std::size_t>(cols), nv = static_cast<std::size_t>(nv_);
+  const bool parallel = rows() * static_cast<std::size_t>(2 * width_) * c >= parallel_min_work;
+#pragma omp parallel for schedule(static) if (parallel)
+  for (int i = 0; i < nu_; ++i)
+    for (int j = 0; j < nv_; ++j) {
+      const std::size_t r = static_cast<std::size_t>(i) * nv + static_cast<std::size_t>(j);
+      double acc[3] = {0, 0, 0};
+      for (int di = 0; di <= hu_; ++di) {
+        // The upper half of row r, and row r's entries kept by the rows above it.
+        const int jlo = std::max(di == 0 ? 0 : -hv_, -j), jhi = std::min(hv_, nv_ - 1 - j);
+        if (i + di < nu_)
+          for (int dj = jlo; dj <= jhi; ++dj) {
+            const double a = at(r, offset(di, dj));
+            const std::size_t s = (r + static_cast<std::size_t>(di) * nv + static_cast<std::size_t>(dj)) * c;
+            for (std::size_t k = 0; k < c; ++k) acc[k] += a * x[s + k];
+          }
+        if (i - di < 0) continue;
+        const int klo = std::max(di == 0 ? 1 : -hv_, j - (nv_ - 1)), khi = std::min(hv_, j);
+        for (int dj = klo; dj <= khi; ++dj) {
+          const std::size_t o = r - static_cast<std::size_t>(di) * nv - static_cast<std::size_t>(dj);
+          const double a = at(o, offset(di, dj));
+          for (std::size_t k = 0; k < c; ++k) acc[k] += a * x[o * c + k];
+        }
+      }
+      for (std::size_t k = 0; k < c; ++k) y[r * c + k] = acc[k];
+    }
+}
+
+void NetMatrix::scale(double s) {
+  for (double& v : a_) v *= s;
+}
+
+double mean_diagonal(const NetMatrix& m) {
+  double sum = 0;
+  for (std::size_t r = 0; r < m.rows(); ++r) sum += m.at(r, 0);
+  return sum / static_cast<double>(m.rows());
+}
+
+namespace {
+
+// The cell (knot span) of each point present, in u-major order, and the points of each
+// cell in the order given (a counting sort).
+struct Cells {
+  std::vector<std::size_t> start;  // cells + 1 offsets into `order`
+  std::vector<std::uint32_t> order;
+};
+
+Cells sort_by_cell(const Net& net, const Samples& s) {
+  const std::size_t su = static_cast<std::size_t>(net.nu - net.p), sv = static_cast<std::size_t>(net.nv - net.q);
+  const std::size_t n = s.site.size();
+  std::vector<std::uint32_t> cell(n);
+  const auto count = static_cast<long long>(n);
+#pragma omp parallel for schedule(static) if (n >= parallel_min_work / 8)
+  for (long long k = 0; k < count; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    if (!(s.weight[kk] > 0)) {
+      cell[kk] = ~std::uint32_t{0};
+      continue;
+    }
+    const auto a = static_cast<std::size_t>(net.ku.find_span(s.site[kk][0]) - net.p);
+    const auto b = static_cast<std::size_t>(net.kv.find_span(s.site[kk][1]) - net.q);
+    cell[kk] = static_cast<std::uint32_t>(a * sv + b);
+  }
+  Cells c;
+  c.start.assign(su * sv + 1, 0);
+  for (std::uint32_t x : cell)
+    if (x != ~std::uint32_t{0}) ++c.start[x + 1];
+  std::partial_sum(c.start.begin(), c.start.end(), c.start.begin());
+  c.order.resize(c.start.back());
+  std::vector<std::size_t> next(c.start.begin(), c.start.end() - 1);
+  for (std::size_t k = 0; k < n; ++k)
+    if (cell[k] != ~std::uint32_t{0}) c.order[next[cell[k]]++] = static_cast<std::uint32_t>(k);
+  return c;
+}
+
+// One cell's points added to the system: the (p+1)(q+1) basis functions of each point,
+// their products summed over the cell's points first, then added to the matrix once.
+void add_cell(const Net& net, const Samples& s, const Cells& cells, std::size_t a, std::size_t b, System& sys,
+              std::vector<double>& local) {
+  const int p = net.p, q = net.q, m = (p + 1) * (q + 1), cols = s.cols;
+  const std::size_t sv = static_cast<std::size_t>(net.nv - net.q), cell = a * sv + b;
+  const std::size_t first = cells.start[cell], last = cells.start[cell + 1];
+  if (first == last) return;
+  const std::size_t pairs = static_cast<std::size_t>(m * (m + 1) / 2);
+  local.assign(pairs + static_cast<std::size_t>(m * cols), 0.0);
+  double nu_b[max_degree + 1], nv_b[max_degree + 1], basis[(max_degree + 1) * (max_degree + 1)];
+  const int span_u = static_cast<int>(a) + p, span_v = static_cast<int>(b) + q;
+  for (std::size_t x = first; x < last; ++x) {
+    const std::size_t k = cells.order[x];
+    net.ku.basis(span_u, s.site[k][0], nu_b);
+    net.kv.basis(span_v, s.site[k][1], nv_b);
+    const double w = s.weight[k];
+    for (int al = 0; al <= p; ++al)
+      for (int be = 0; be <= q; ++be) basis[al * (q + 1) + be] = nu_b[al] * nv_b[be];
+    std::size_t e = 0;
+    for (int l = 0; l < m; ++l) {
+      const double wb = w * basis[l];
+      for (int l2 = l; l2 < m; ++l2) local[e++] += wb * basis[l2];
+      for (int c = 0; c < cols; ++c) local[pairs + static_cast<std::size_t>(l * cols + c)] += wb * s.value[k * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)];
+    }
+  }
+  const std::size_t nv = static_cast<std::size_t>(net.nv), base = a * nv + b;
+  std::size_t e = 0;
+  for (int l = 0; l < m; ++l) {
+    const int al = l / (q + 1), be = l % (q + 1);
+    const std::size_t row = base + static_cast<std::size_t>(al) * nv + static_cast<std::size_t>(be);
+    for (int l2 = l; l2 < m; ++l2) sys.a.at(row, sys.a.offset(l2 / (q + 1) - al, l2 % (q + 1) - be)) += local[e++];
+    for (int c = 0; c < cols; ++c)
+      sys.rhs[row * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)] += local[pairs + static_cast<std::size_t>(l * cols + c)];
+  }
+}
+
+}  // namespace
+
+void add_data_term(const Net& net, const Samples& s, System& sys) {
+  const Cells cells = sort_by_cell(net, s);
+  const std::size_t su = static_cast<std::size_t>(net.nu - net.p), sv = static_cast<std::size_t>(net.nv - net.q);
+  const std::size_t pu = static_cast<std::size_t>(net.p + 1), pv = static_cast<std::size_t>(net.q + 1);
+  const bool parallel = cells.order.size() * pu * pv * pu * pv >= parallel_min_work;
+  const std::size_t threads = parallel ? max_threads() : 1;
+  std::vector<std::vector<double>> local(threads);
+  // Cells of one colour (a mod (p+1), b mod (q+1)) touch disjoint blocks of control points.
+  for (std::size_t ca = 0; ca < pu; ++ca)
+    for (std::size_t cb = 0; cb < pv; ++cb) {
+      const std::size_t na = su > ca ? (su - ca + pu - 1) / pu : 0, nb = sv > cb ? (sv - cb + pv - 1) / pv : 0;
+      const auto count = static_cast<long long>(na * nb);
+#pragma omp parallel for schedule(dynamic, 16) if (parallel)
+      for (long long x = 0; x < count; ++x) {
+        const std::size_t xa = static_cast<std::size_t>(x) / nb, xb = static_cast<std::size_t>(x) % nb;
+        add_cell(net, s, cells, ca + xa * pu, cb + xb * pv, sys, local[static_cast<std::size_t>(thread_index())]);
+      }
+    }
+}
+
+namespace {
+
+// Δ of the Greville abscissae around each control point: half the distance between its
+// neighbours (one neighbour at an end), the length of line each control point stands for.
+std::vector<double> greville_widths(const std::vector<double>& g) {
+  std::vector<double> w(g.size(), 0.0);
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const double lo = i == 0 ? g[0] : (g[i - 1] + g[i]) / 2, hi = i + 1 == g.size() ? g[i] : (g[i] + g[i + 1]) / 2;
+    w[i] = hi - lo;
+  }
+  return w;
+}
+
+}  // namespace
+
+void add_fairness(const Net& net, NetMatrix* a, double s, std::vector<double>* diagonal) {
+  const std::vector<double> gu = net.ku.greville(), gv = net.kv.greville();
+  const std::vector<double> wu = greville_widths(gu), wv = greville_widths(gv);
+  const std::size_t nv = static_cast<std::size_t>(net.nv);
+  auto add = [&](std::span<const std::array<int, 2>> at, std::span<const double> coef, double weight) {
+    if (a) a->add_outer(at, coef, s * weight);
+    if (diagonal)
+      for (std::size_t x = 0; x < at.size(); ++x)
+        (*diagonal)[static_cast<std::size_t>(at[x][0]) * nv + static_cast<std::size_t>(at[x][1])] += weight * coef[x] * coef[x];
+  };
+  // Second divided difference over three abscissae, weighted by the length it stands for.
+  auto second = [](const std::vector<double>& g, int i, double out[3]) {
+    const double h0 = g[static_cast<std::size_t>(i)] - g[static_cast<std::size_t>(i - 1)];
+    const double h1 = g[static_cast<std::size_t>(i + 1)] - g[static_cast<std::size_t>(i)];
+    const double f = 2 / (h0 + h1);
+    out[0] = f / h0, out[1] = -f / h0 - f / h1, out[2] = f / h1;
+  };
+  for (int i = 1; i + 1 < net.nu; ++i) {
+    double c[3];
+    second(gu, i, c);
+    const double len = (gu[static_cast<std::size_t>(i + 1)] - gu[static_cast<std::size_t>(i - 1)]) / 2;
+    for (int j = 0; j < net.nv; ++j) {
+      const std::array<int, 2> at[3] = {{i - 1, j}, {i, j}, {i + 1, j}};
+      add(at, c, len * wv[static_cast<std::size_t>(j)]);
+    }
+  }
+  for (int j = 1; j + 1 < net.nv; ++j) {
+    double c[3];
+    second(gv, j, c);
+    const double len = (gv[static_cast<std::size_t>(j + 1)] - gv[static_cast<std::size_t>(j - 1)]) / 2;
+    for (int i = 0; i < net.nu; ++i) {
+      const std::array<int, 2> at[3] = {{i, j - 1}, {i, j}, {i, j + 1}};
+      add(at, c, len * wu[static_cast<std::size_t>(i)]);
+    }
+  }
+  for (int i = 0; i + 1 < net.nu; ++i)
+    for (int j = 0; j + 1 < net.nv; ++j) {
+      const double hu = gu[static_cast<std::size_t>(i + 1)] - gu[static_cast<std::size_t>(i)];
+      const double hv = gv[static_cast<std::size_t>(j + 1)] - gv[static_cast<std::size_t>(j)];
+      const double f = 1 / (hu * hv);
+      const std::array<int, 2> at[4] = {{i, j}, {i, j + 1}, {i + 1, j}, {i + 1, j + 1}};
+      const double c[4] = {f, -f, -f, f};
+      add(at, c, 2 * hu * hv);
+    }
+}
+
+namespace {
+
+// Dot products of the columns in blocks of a fixed size, the blocks' sums added in
+// order: the same bits on any number of threads.
+constexpr std::size_t dot_block = 4096;
+
+void dots(std::span<const double> x, std::span<const double> y, int cols, double* out, std::vector<double>& partial) {
+  const std::size_t c = static_cast<std::size_t>(cols), rows = x.size() / c;
+  const std::size_t blocks = (rows + dot_block - 1) / dot_block;
+  partial.assign(blocks * c, 0.0);
+#pragma omp parallel for schedule(static) if (x.size() >= parallel_min_work / 4)
+  for (long long b = 0; b < static_cast<long long>(blocks); ++b) {
+    const std::size_t r0 = static_cast<std::size_t>(b) * dot_block, r1 = std::min(rows, r0 + dot_block);
+    double acc[3] = {0, 0, 0};
+    for (std::size_t r = r0; r < r1; ++r)
+      for (std::size_t k = 0; k < c; ++k) acc[k] += x[r * c + k] * y[r * c + k];
+    for (std::size_t k = 0; k < c; ++k) partial[static_cast<std::size_t>(b) * c + k] = acc[k];
+  }
+  for (std::size_t k = 0; k < c; ++k) out[k] = 0;
+  for (std::size_t b = 0; b < blocks; ++b)
+    for (std::size_t k = 0; k < c; ++k) out[k] += partial[b * c + k];
+}
+
+}  // namespace
+
+Solved solve_cg(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols, double rel, int max_iter) {
+  const std::size_t c = static_cast<std::size_t>(cols), n = a.rows(), len = n * c;
+  std::vector<double> inv(n), r(len), z(len), p(len), ap(len), partial;
+  for (std::size_t i = 0; i < n; ++i) inv[i] = a.at(i, 0) > 0 ? 1 / a.at(i, 0) : 1.0;
+  a.multiply(x, ap, cols);
+  for (std::size_t i = 0; i < len; ++i) r[i] = b[i] - ap[i];
+  for (std::size_t i = 0; i < len; ++i) z[i] = r[i] * inv[i / c];
+  p = z;
+  double bb[3], rz[3], rr[3], pap[3];
+  dots(b, b, cols, bb, partial);
+  dots(r, z, cols, rz, partial);
+  bool active[3] = {true, true, true};
+  Solved out;
+  auto worst = [&] {
+    dots(r, r, cols, rr, partial);
+    double w = 0;
+    for (std::size_t k = 0; k < c; ++k) {
+      const double rel_k = bb[k] > 0 ? std::sqrt(rr[k] / bb[k]) : std::sqrt(rr[k]);
+      active[k] = rel_k > rel;
+      w = std::max(w, rel_k);
+    }
+    return w;
+  };
+  out.residual = worst();
+  for (; out.iterations < max_iter && out.residual > rel; ++out.iterations) {
+    a.multiply(p, ap, cols);
+    dots(p, ap, cols, pap, partial);
+    double alpha[3] = {0, 0, 0};
+    for (std::size_t k = 0; k < c; ++k) alpha[k] = active[k] && pap[k] > 0 ? rz[k] / pap[k] : 0.0;
+    for (std::size_t i = 0; i < len; ++i) {
+      x[i] += alpha[i % c] * p[i];
+      r[i] -= alpha[i % c] * ap[i];
+      z[i] = r[i] * inv[i / c];
+    }
+    double rz_new[3];
+    dots(r, z, cols, rz_new, partial);
+    for (std::size_t k = 0; k < c; ++k) {
+      const double beta = rz[k] > 0 ? rz_new[k] / rz[k] : 0.0;
+      rz[k] = rz_new[k];
+      for (std::size_t i = k; i < len; i += c) p[i] = z[i] + beta * p[i];
+    }
+    out.residual = worst();
+  }
+  return out;
+}
+
+bool solve_direct(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols) {
+  const auto n = static_cast<Eigen::Index>(a.rows());
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(a.rows() * static_cast<std::size_t>(2 * a.hu() * a.hv() + a.hu() + a.hv() + 1));
+  for (int i = 0; i < a.nu(); ++i)
+    for (int j = 0; j < a.nv(); ++j) {
+      const std::size_t r = static_cast<std::size_t>(i) * static_cast<std::size_t>(a.nv()) + static_cast<std::size_t>(j);
+      for (int di = 0; di <= a.hu() && i + di < a.nu(); ++di)
+        for (int dj = di == 0 ? 0 : std::max(-a.hv(), -j); dj <= std::min(a.hv(), a.nv() - 1 - j); ++dj) {
+          const double v = a.at(r, a.offset(di, dj));
+          if (v == 0) continue;
+          const auto c = static_cast<Eigen::Index>(r + static_cast<std::size_t>(di) * static_cast<std::size_t>(a.nv())) + dj;
+          entries.emplace_back(static_cast<Eigen::Index>(r), c, v);  // upper triangle: row < column
+        }
+    }
+  Eigen::SparseMatrix<double> m(n, n);
+  m.setFromTriplets(entries.begin(), entries.end());
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Upper> ldlt(m);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) return false;
+  Eigen::VectorXd rhs(n);
+  for (int c = 0; c < cols; ++c) {
+    for (Eigen::Index r = 0; r < n; ++r) rhs[r] = b[static_cast<std::size_t>(r) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)];
+    const Eigen::VectorXd sol = ldlt.solve(rhs);
+    for (Eigen::Index r = 0; r < n; ++r) x[static_cast<std::size_t>(r) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)] = sol[r];
+  }
+  return true;
+}
+
+}  // namespace interpatch::detail::scattered

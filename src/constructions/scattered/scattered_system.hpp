@@ -1,0 +1,99 @@
+#pragma once
+// The normal equations of a scattered fit on a net of uniform knots over a rectangle: a symmetric banded matrix of the control net (the data term, assembled in
+// one pass over the points, and the thin-plate fairness term), with its right-hand
+// sides, and the conjugate-gradient solver that takes them.
+
+#include <array>
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "interpatch/knot_vector.hpp"
+
+namespace interpatch::detail::scattered {
+
+/// A net of nu × nv control points over uniform knots on [0, range[0]] × [0, range[1]],
+/// index i·nv + j.
+struct Net {
+  int p = 3, q = 3, nu = 0, nv = 0;
+  KnotVector ku, kv;
+  Net(int p_, int q_, int nu_, int nv_, std::array<double, 2> range = {1, 1});
+  [[nodiscard]] std::size_t size() const { return static_cast<std::size_t>(nu) * static_cast<std::size_t>(nv); }
+};
+
+/// A symmetric matrix whose row (i, j) couples only the control points (i + di, j + dj)
+/// with |di| ≤ hu, |dj| ≤ hv. Row r keeps the upper half: offsets k = (di, dj) with
+/// di > 0, or di = 0 and dj ≥ 0.
+class NetMatrix {
+ public:
+  NetMatrix(int nu, int nv, int hu, int hv);
+  [[nodiscard]] int nu() const { return nu_; }
+  [[nodiscard]] int nv() const { return nv_; }
+  [[nodiscard]] int hu() const { return hu_; }
+  [[nodiscard]] int hv() const { return hv_; }
+  [[nodiscard]] std::size_t rows() const { return static_cast<std::size_t>(nu_) * static_cast<std::size_t>(nv_); }
+  /// Index of offset (di, dj) in a row (di ≥ 0; dj ≥ 0 when di = 0).
+  [[nodiscard]] int offset(int di, int dj) const { return di == 0 ? dj : hv_ + 1 + (di - 1) * (2 * hv_ + 1) + dj + hv_; }
+  [[nodiscard]] double& at(std::size_t row, int k) { return a_[row * static_cast<std::size_t>(width_) + static_cast<std::size_t>(k)]; }
+  [[nodiscard]] double at(std::size_t row, int k) const { return a_[row * static_cast<std::size_t>(width_) + static_cast<std::size_t>(k)]; }
+  /// Adds s·v vᵀ for v with entries `coef` at the control points `at` (each (i, j)).
+  void add_outer(std::span<const std::array<int, 2>> at, std::span<const double> coef, double s);
+  /// y = A x for `cols` interleaved columns (x[r·cols + c]); rows shared by the threads.
+  void multiply(std::span<const double> x, std::span<double> y, int cols) const;
+  /// Scales every entry by s.
+  void scale(double s);
+
+ private:
+  int nu_, nv_, hu_, hv_, width_;
+  std::vector<double> a_;
+};
+
+/// A fit's system: the matrix (the data term, then the fairness term added to it) and
+/// the data term's right-hand sides, `cols` of them interleaved.
+struct System {
+  NetMatrix a;
+  std::vector<double> rhs;
+  int cols = 1;
+};
+
+/// The points a fit takes: unit sites, weights (0: not present), and the values fitted
+/// (cols per point, interleaved).
+struct Samples {
+  std::span<const std::array<double, 2>> site;  ///< in the net's domain
+  std::span<const double> weight;
+  std::span<const double> value;
+  int cols = 1;
+};
+
+/// The normal equations of the data term, Σ w_k B(s_k) B(s_k)ᵀ and Σ w_k B(s_k) Q_k,
+/// in one pass over the points sorted by knot cell, cells of one colour of a
+/// (p+1) × (q+1) pattern in parallel: no two write the same entry, and each entry's
+/// sum runs in the same order on any number of threads.
+void add_data_term(const Net& net, const Samples& s, System& sys);
+
+/// Adds `s` times the thin-plate term ∫∫ S_uu² + 2 S_uv² + S_vv² of the control net
+/// over its domain (second divided differences over the Greville abscissae), or,
+/// when `diagonal` is given, only sums its diagonal there (one entry per control point).
+void add_fairness(const Net& net, NetMatrix* a, double s, std::vector<double>* diagonal = nullptr);
+
+/// The mean of a matrix's diagonal.
+double mean_diagonal(const NetMatrix& m);
+
+/// What a solve reached.
+struct Solved {
+  int iterations = 0;
+  double residual = 0;  ///< the largest over the columns of |r| / |b|
+};
+
+/// Solves A x = b by conjugate gradients
+/// with the diagonal as preconditioner, from the x given, each column to a residual of
+/// `rel` of its right-hand side or `max_iter` steps. Every sum runs in blocks of fixed
+/// size: the same bits on any number of threads.
+Solved solve_cg(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols, double rel, int max_iter);
+
+/// Solves A x = b by a sparse LDLᵀ decomposition (Eigen's, fill-reducing ordering):
+/// exact to rounding whatever the conditioning, for nets small enough that its fill
+/// stays cheap. False when A is not positive definite.
+bool solve_direct(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols);
+
+}  // namespace interpatch::detail::scattered
