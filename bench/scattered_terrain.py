@@ -22,7 +22,7 @@ Methods (--only takes these groups, comma separated):
   gmt             gmt blockmean | gmt surface -T0.25 on the DEM's grid | gmt grdtrack at
                   the held-out sites: the whole chain of processes.
   interpatch-py   interpatch.approximate_surface(train, param="xy", domain=...) with a
-                  tolerance D, smoothing="auto" and a fixed control net; evaluated
+                  tolerance D, a fairness weight --smoothing and a fixed control net; evaluated
                   through to_bspline() and this script's vectorised de Boor.
   interpatch-cli  `interpatch build spec.json -o out.json`, the whole process; its
                   output is evaluated afterwards, untimed, for the RMS.
@@ -259,13 +259,13 @@ def import_interpatch(args):
 
 
 def interpatch_options(data, args):
-    """The three ways to ask for the fit: the tolerance D, GCV, a fixed control net."""
+    """The three ways to ask for the fit: the tolerance D, a fairness weight, a fixed net."""
     n = len(data["train"])
     (x0, x1), (y0, y1) = data["domain"]
     # About 8 training points per control point, never finer than the DEM itself.
     nu = int(max(4, min(data["dem_shape"][1], math.sqrt(n / 8 * (x1 - x0) / (y1 - y0)))))
     nv = int(max(4, min(data["dem_shape"][0], n / 8 / nu)))
-    return {"tolerance": {"tolerance": args.tolerance}, "auto": {"smoothing": "auto"},
+    return {"tolerance": {"tolerance": args.tolerance}, "smoothing": {"smoothing": args.smoothing},
             "net": {"control_points": [nu, nv]}}
 
 
@@ -303,7 +303,7 @@ def methods(data, args, work):
     for name, kwargs in interpatch_options(data, args).items():
         rows.append(("interpatch-py", f"interpatch py {name}",
                      lambda d, a, w, k=kwargs: run_module(d, a, w, k)))
-    for name in ("tolerance", "auto"):
+    for name in ("tolerance", "net"):
         rows.append(("interpatch-cli", f"interpatch cli {name}",
                      lambda d, a, w, n=name: run_cli(d, a, w, n)))
     rows.append(("io-floor", "pure I/O floor (cat)", run_io_floor))
@@ -317,7 +317,7 @@ def prepare(data, args, work):
     data["test_xy"].astype("<f8").tofile(work / "test.bin")
     spec = {"type": "approximate", "points": {"npy": "train.npy"}, "param": "xy", "domain": data["domain"]}
     options = interpatch_options(data, args)
-    for name in ("tolerance", "auto"):
+    for name in ("tolerance", "net"):
         (work / f"spec_{name}.json").write_text(json.dumps({**spec, **options[name]}))
 
 
@@ -413,6 +413,7 @@ def parse_args():
     ap.add_argument("--tolerance", type=float,
                     help="interpatch's D; default sigma sqrt(2 ln n): see main()")
     ap.add_argument("--rbf-smoothing", type=float, default=RBF_SMOOTHING)
+    ap.add_argument("--smoothing", type=float, default=1e-7, help="interpatch's fairness weight (no unit)")
     ap.add_argument("--bispline-max", type=int, default=50000)
     ap.add_argument("--dir", type=Path, help="keep the files here (default: a temporary folder)")
     args = ap.parse_args()

@@ -59,12 +59,31 @@ void volume() {
   std::printf("volume of 8 x 9 x 10 points in 5 x 5 x 5 control points: rms error %g\n", r.report.rms_error);
 }
 
+void scattered() {
+  using namespace interpatch;
+  std::vector<Vec3> q;
+  for (int k = 0; k < 2000; ++k) {
+    const double x = std::fmod(k * 0.618034, 1.0), y = std::fmod(k * 0.414214, 1.0);
+    q.push_back({100 * x, 80 * y, 5 * std::sin(x * 6) * std::cos(y * 4)});
+  }
+  ScatteredApproximationOptions o;
+  o.param = ScatteredParam::xy;
+  o.tolerance = 0.05;
+  auto r = approximate_scattered(q, o);  // z = f(x, y); every point within 0.05
+  example::expect(r.report.max_error <= 0.05, "every scattered point within the tolerance");
+  // A height field: x(u, v) = u, to rounding.
+  example::expect_near(r.surface.point(50, 40).x, 50, "x(u, v) = u", 1e-12);
+  std::printf("2000 scattered points within 0.05: %d x %d control points\n", r.report.control_points[0],
+              r.report.control_points[1]);
+}
+
 }  // namespace
 
 int main() {
   return example::run("approximation", [] {
     curve();
     surface();
+    scattered();
     volume();
   });
 }

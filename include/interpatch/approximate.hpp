@@ -244,15 +244,16 @@ struct ScatteredApproximation {
 ///
 /// The normal equations are assembled in one pass over the points, each touching
 /// (p+1)(q+1) basis functions, into a banded matrix of the control net (no dense
-/// matrix, memory O(N + control points)), and solved by conjugate gradients started
-/// from the previous, coarser net. The result has the same bits on any number of threads.
+/// matrix, memory O(N + control points)), and solved by a sparse LDLᵀ decomposition up
+/// to 40 000 control points, by conjugate gradients started from the fit on half the
+/// spans beyond. The result has the same bits on any number of threads.
 ///
 /// Example:
 /// @code
 ///   using namespace interpatch;
 ///   std::vector<Vec3> q;
 ///   for (int k = 0; k < 2000; ++k) {
-///     const double x = (k * 0.618034) - std::floor(k * 0.618034), y = (k * 0.414214) - std::floor(k * 0.414214);
+///     const double x = std::fmod(k * 0.618034, 1.0), y = std::fmod(k * 0.414214, 1.0);
 ///     q.push_back({100 * x, 80 * y, 5 * std::sin(x * 6) * std::cos(y * 4)});
 ///   }
 ///   ScatteredApproximationOptions o;
