@@ -86,6 +86,14 @@ def test_approximate_surface(a, how):
 
 
 @FUZZ
+@given(st.integers(0, 60).flatmap(lambda n: hnp.arrays(np.float64, (n, 3), elements=VALUES)),
+       st.sampled_from([{"tolerance": 0.5, "param": "xy"}, {"control_points": (4, 5)},
+                        {"smoothing": 1e-3, "param": "xy"}, {"tolerance": 1e-3}]))
+def test_approximate_scattered_points(a, how):
+    finite_or_error(lambda: interpatch.approximate_surface(a, **how), lambda s: s.evaluate(T, T))
+
+
+@FUZZ
 @given(arrays(3))
 def test_interpolate_volume(a):
     finite_or_error(lambda: interpatch.interpolate_volume(a), lambda v: v.evaluate(T, T, T))

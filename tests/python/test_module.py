@@ -450,6 +450,44 @@ def test_approximate_surface_fills_holes_and_reports(tmp_path):
     assert inside.min() >= lo - 0.05 * (hi - lo) and inside.max() <= hi + 0.05 * (hi - lo)
 
 
+def test_approximate_scattered_points(tmp_path):
+    rng = np.random.default_rng(4)
+    xy = rng.uniform((0, 0), (400, 300), (3000, 2))
+    pts = np.column_stack([xy, 20 * np.sin(xy[:, 0] / 60) * np.cos(xy[:, 1] / 50)])
+    pts[:40, 2] = np.nan  # missing heights
+    s = interpatch.approximate_surface(pts, param="xy", tolerance=0.05)
+    p = s.info()["parameters"]
+    assert (p["points"], p["missing_points"], p["param"]) == (3000, 40, "xy") and p["max_error"] <= 0.05
+    # Every point within the tolerance at its own site, measured here point by point.
+    (x0, x1), (y0, y1) = p["domain"]
+    at = np.array([s.point((x - x0) / (x1 - x0), (y - y0) / (y1 - y0)) for x, y in xy[40:]])
+    assert np.linalg.norm(at - pts[40:], axis=1).max() <= 0.05
+    # x and y of a height field are the domain's, to rounding.
+    assert np.allclose(s.point(0.25, 0.5)[:2], [x0 + 0.25 * (x1 - x0), y0 + 0.5 * (y1 - y0)], rtol=0, atol=1e-10)
+    # The same spec from a file gives the same surface.
+    np.save(tmp_path / "survey.npy", pts)
+    f = interpatch.build({"type": "approximate", "points": {"npy": "survey.npy"}, "param": "xy", "tolerance": 0.05},
+                         str(tmp_path))
+    us, vs = np.linspace(0, 1, 11), np.linspace(0, 1, 9)
+    assert np.array_equal(f.evaluate(us, vs), s.evaluate(us, vs))
+    # Sites given: x and y scaled make the same fit as "xy" in z.
+    g = interpatch.approximate_surface(pts, params=xy / 100, control_points=(9, 8))
+    h = interpatch.approximate_surface(pts, param="xy", control_points=(9, 8))
+    assert np.allclose(g.to_bspline()["control_points"][..., 2], h.to_bspline()["control_points"][..., 2], atol=1e-6)
+    with pytest.raises(interpatch.Error) as e:
+        interpatch.approximate_surface(pts, params=xy[:10], control_points=(9, 8))
+    assert e.value.code == "size_mismatch" and "/param" in str(e.value)
+    with pytest.raises(interpatch.Error) as e:
+        interpatch.approximate_surface(pts, params=np.ones((3000, 3)), control_points=(9, 8))
+    assert e.value.code == "size_mismatch"
+    with pytest.raises(interpatch.Error) as e:
+        interpatch.approximate_surface(pts, param="xy", smoothing="auto")
+    assert e.value.code == "wrong_type" and "/smoothing" in str(e.value)
+    with pytest.raises(interpatch.Error) as e:
+        interpatch.approximate_surface(pts[:, [0, 0, 2]], param="xy", tolerance=0.1)  # x = y: one line
+    assert e.value.code == "singular"
+
+
 def test_approximate_options_and_errors():
     grid = terrain(20, 16)
     a = interpatch.approximate_surface(grid, control_points=(8, 6), param="uniform")
