@@ -211,7 +211,9 @@ struct ScatteredApproximationOptions {
   /// (at most smoothing_max_control_points a direction).
   std::optional<double> smoothing;
   /// The largest net a tolerance may reach, per direction; unset: 4096 a direction and
-  /// at most 4 control points per point present (and never fewer than 64 × 64).
+  /// at most one control point per 4 points present (and never fewer than 64 × 64):
+  /// finer nets leave most knot cells without a point, held by the small fairness term
+  /// alone, and the fit swings between the points.
   std::optional<std::array<int, 2>> max_control_points;
   /// Non-negative weights, one per point; empty means 1.
   std::vector<double> weights;

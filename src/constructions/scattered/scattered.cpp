@@ -211,7 +211,7 @@ bool within(const std::array<int, 2>& net, const std::array<int, 2>& limit, cons
   if (net[0] > limit[0] || net[1] > limit[1]) return false;
   if (o.max_control_points) return true;
   const double total = static_cast<double>(net[0]) * static_cast<double>(net[1]);
-  return total <= std::max(4.0 * static_cast<double>(s.present), 4096.0);
+  return total <= std::max(static_cast<double>(s.present) / 4, 4096.0);
 }
 
 [[noreturn]] void refuse_tolerance(double tolerance, const ApproxDistance& e, const Problem& pr, const Net& net,
@@ -219,7 +219,7 @@ bool within(const std::array<int, 2>& net, const std::array<int, 2>& limit, cons
   fail(errc::tolerance_not_met, "tolerance ", tolerance, " not met: point [", e.worst, "] is ", e.max * pr.unit_length,
        " from the approximation with ", net.nu, " x ", net.nv, " control points, and doubling the knots would pass the ",
        "largest net allowed (", limit[0], " x ", limit[1], given ? " control points, max_control_points" :
-       " control points, and at most 4 per point present", "): points closer together than the knots can separate, ",
+       " control points, and at most one per 4 points present", "): points closer together than the knots can separate, ",
        "with values farther apart than twice the tolerance, or a tolerance below the rounding of the coordinates");
 }
 
