@@ -39,10 +39,13 @@ TEST_DEBS := libgtest-dev libgmock-dev pkg-config python3-numpy python3-scipy py
 # The benchmarks: `make bench` adds these.
 #   libbenchmark-dev                 Google Benchmark (bench/interpatch_bench)
 #   libocct-*-dev libsisl-dev        OpenCASCADE and SISL race interpatch (bench/compare)
-#   python3-matplotlib               make bench draws docs/bench_interpolation.png
-#   python3-scipy                    tools/bench_fitpack.py races FITPACK (run by hand)
+#   python3-matplotlib               make bench draws docs/bench_interpolation.png; its
+#                                    terrain DEM feeds bench/scattered_terrain.py
+#   python3-scipy                    tools/bench_fitpack.py races FITPACK (run by hand);
+#                                    griddata and RBFInterpolator in bench/scattered_terrain.py
+#   gmt                              GMT's blockmean + surface in bench/scattered_terrain.py
 BENCH_DEBS := libbenchmark-dev libocct-data-exchange-dev libocct-modeling-algorithms-dev \
-        libocct-modeling-data-dev libocct-foundation-dev libsisl-dev python3-matplotlib python3-scipy
+        libocct-modeling-data-dev libocct-foundation-dev libsisl-dev python3-matplotlib python3-scipy gmt
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
