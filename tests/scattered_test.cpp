@@ -9,11 +9,13 @@
 
 #include <algorithm>
 #include <cstring>
+#include <functional>
 #include <cmath>
 #include <numeric>
 #include <random>
 
 #include "interpatch/approximate.hpp"
+#include "interpatch/io/spec.hpp"
 #include "constructions/scattered/scattered_system.hpp"
 #include "property/promise_harness.hpp"
 
@@ -307,6 +309,44 @@ TEST(Scattered, Refusals) {
     EXPECT_NE(std::string(e.what()).find("point ["), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("control points"), std::string::npos) << e.what();
   }
+}
+
+// The spec's own refusals for scattered points, each with its code and its place.
+TEST(Scattered, SpecRefusalsNameTheField) {
+  std::mt19937_64 g(20);
+  const auto q = survey(g, 60);
+  nlohmann::json pts = nlohmann::json::array();
+  for (const Vec3& p : q) pts.push_back({p.x, p.y, p.z});
+  const nlohmann::json base = {{"type", "approximate"}, {"param", "xy"}, {"tolerance", 1.0}, {"points", pts}};
+  auto refused = [&](const std::function<void(nlohmann::json&)>& change, errc code, const std::string& text) {
+    nlohmann::json spec = base;
+    change(spec);
+    try {
+      (void)io::build(spec);
+      ADD_FAILURE() << "built: " << text;
+    } catch (const error& e) {
+      EXPECT_EQ(e.code(), code) << e.what();
+      EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+    }
+  };
+  refused([](nlohmann::json& s) { s["max_control_points"] = 10; s.erase("tolerance"); s["control_points"] = 6; },
+          errc::wrong_type, "/max_control_points: it limits a tolerance's refinement");
+  refused([](nlohmann::json& s) { s["param"] = {{"base", {{"type", "bilinear"}}}}; }, errc::wrong_type,
+          "/param/base: sites from the closest points on a base surface are not available yet");
+  refused([](nlohmann::json& s) { s["domain"] = {{1000, 0}, {0, 800}}; }, errc::non_increasing,
+          "domain along u is [1000, 0]: it must increase");
+  refused([](nlohmann::json& s) { s["domain"] = {{0, 500}, {0, 800}}; }, errc::out_of_domain, "outside the domain [0, 500]");
+  refused([](nlohmann::json& s) { s.erase("tolerance"); s["smoothing"] = "auto"; }, errc::wrong_type,
+          "/smoothing: scattered points take a number for smoothing");
+  refused([](nlohmann::json& s) { s["periodic"] = {true, false}; }, errc::wrong_type,
+          "/periodic: scattered points have no closed directions");
+  refused([](nlohmann::json& s) { s["weights"] = {1, 2}; }, errc::size_mismatch, "/weights: 2 weights for 60 points");
+  refused([](nlohmann::json& s) { s["weights"] = std::vector<double>(60, 1.0); s["weights"][5] = -1; }, errc::invalid_weight,
+          "/weights/5: weight -1 is negative");
+  refused([](nlohmann::json& s) { s["param"] = std::vector<std::vector<double>>(60, {0.0, 0.0}); s["param"][3] = {1, 2, 3}; },
+          errc::size_mismatch, "/param/3: a site is 2 numbers [u, v], got 3");
+  refused([](nlohmann::json& s) { s.erase("tolerance"); s["control_points"] = {3, 6}; }, errc::too_few_points,
+          "/control_points/0: 3 control points along u are fewer than degree 3 needs (4)");
 }
 
 }  // namespace

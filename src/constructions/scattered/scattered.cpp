@@ -81,7 +81,6 @@ BSplineSurface unit_surface(const Net& net, std::span<const double> x, int cols)
 struct Level {
   std::vector<double> x;
   double lambda = 0;  // in E's units: the weight of J against the mean squared distance
-  int iterations = 0;
 };
 
 // One net solved: the normal equations assembled, λ (at least the small one that fills
@@ -102,7 +101,17 @@ Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoot
   out.lambda = std::max(fill, smoothing.value_or(0.0));
   add_fairness(net, &sys.a, s.weight_sum * out.lambda);
 
+  // Nets up to direct_limit control points are factored: exact whatever λ and the
+  // points' spacing. Larger ones take conjugate gradients to a residual of 1e-12 of the
+  // right-hand side, the fit to about twelve digits of the data's size; their λ is the
+  // small one of tolerance and control_points (smoothing's nets stay below the limit).
   out.x.assign(sys.rhs.size(), 0.0);
+  if (net.size() <= direct_limit) {
+    if (!solve_direct(sys.a, sys.rhs, out.x, pr.cols))
+      fail(errc::singular, "scattered approximation with ", net.nu, " x ", net.nv, " control points: the normal ",
+           "equations are not positive definite (points all on one line of the parameter plane)");
+    return out;
+  }
   if (coarser) {
     const std::vector<double> gu = net.ku.greville(), gv = net.kv.greville();
     std::vector<Vec3> at(net.size());
@@ -112,22 +121,11 @@ Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoot
       else out.x[3 * r] = at[r].x, out.x[3 * r + 1] = at[r].y, out.x[3 * r + 2] = at[r].z;
     }
   }
-  // Nets up to direct_limit control points are factored: exact whatever λ and the
-  // points' spacing. Larger ones take conjugate gradients to a residual of 1e-12 of the
-  // right-hand side, the fit to about twelve digits of the data's size; their λ is the
-  // small one of tolerance and control_points (smoothing's nets stay below the limit).
-  if (net.size() <= direct_limit) {
-    if (!solve_direct(sys.a, sys.rhs, out.x, pr.cols))
-      fail(errc::singular, "scattered approximation with ", net.nu, " x ", net.nv, " control points: the normal ",
-           "equations are not positive definite (points all on one line of the parameter plane)");
-    return out;
-  }
   const int cap = 200 + 40 * (net.nu + net.nv);
   const Solved sol = solve_cg(sys.a, sys.rhs, out.x, pr.cols, 1e-12, cap);
   if (!(sol.residual <= 1e-9))
     fail(errc::ill_conditioned, "scattered approximation with ", net.nu, " x ", net.nv, " control points: conjugate gradients ",
          "left a residual of ", sol.residual, " of the data after ", sol.iterations, " steps");
-  out.iterations = sol.iterations;
   return out;
 }
 

@@ -114,7 +114,7 @@ void add_cell(const Net& net, const Samples& s, const Cells& cells, std::size_t 
   const std::size_t first = cells.start[cell], last = cells.start[cell + 1];
   if (first == last) return;
   const std::size_t pairs = static_cast<std::size_t>(m * (m + 1) / 2);
-  local.assign(pairs + static_cast<std::size_t>(m * cols), 0.0);
+  std::fill(local.begin(), local.end(), 0.0);  // sized before the region: nothing allocates on the threads
   double nu_b[max_degree + 1], nv_b[max_degree + 1], basis[(max_degree + 1) * (max_degree + 1)];
   const int span_u = static_cast<int>(a) + p, span_v = static_cast<int>(b) + q;
   for (std::size_t x = first; x < last; ++x) {
@@ -150,7 +150,8 @@ void add_data_term(const Net& net, const Samples& s, System& sys) {
   const std::size_t pu = static_cast<std::size_t>(net.p + 1), pv = static_cast<std::size_t>(net.q + 1);
   const bool parallel = cells.order.size() * pu * pv * pu * pv >= parallel_min_work;
   const std::size_t threads = parallel ? max_threads() : 1;
-  std::vector<std::vector<double>> local(threads);
+  const std::size_t m = pu * pv;
+  std::vector<std::vector<double>> local(threads, std::vector<double>(m * (m + 1) / 2 + m * static_cast<std::size_t>(s.cols)));
   // Cells of one colour (a mod (p+1), b mod (q+1)) touch disjoint blocks of control points.
   for (std::size_t ca = 0; ca < pu; ++ca)
     for (std::size_t cb = 0; cb < pv; ++cb) {
