@@ -105,8 +105,10 @@ demo: viewer-deps
 	cmake --build --preset release --target interpatch_cli -j $(JOBS)
 	./build/release/interpatch demo -o demo-output
 
+# A failed run ends with the last lines each failed test printed (tools/failed_tests.py):
+# a log read from its end then says why, not only which.
 test-release: test-deps build
-	ctest --preset release -j $(JOBS)
+	ctest --preset release -j $(JOBS) || { python3 tools/failed_tests.py build/release; exit 1; }
 
 # The sanitizer build with line tables alone (-g1, CMakePresets.json): three quarters of
 # the compile time of -g, and the reports still name every function, file and line. It
@@ -118,7 +120,7 @@ test-release: test-deps build
 test-asan: test-deps viewer-deps
 	cmake --preset asan
 	cmake --build --preset asan -j $(JOBS)
-	ctest --preset asan -j $(JOBS)
+	ctest --preset asan -j $(JOBS) || { python3 tools/failed_tests.py build/asan; exit 1; }
 
 # The parsers under libFuzzer (clang, ASan + UBSan): every checked-in seed and
 # regression input once, then FUZZ_TEST_SECONDS of fuzzing per target. `make fuzz`
