@@ -19,6 +19,7 @@
 #include "interpatch/hermite.hpp"
 #include "interpatch/interpolate.hpp"
 #include "interpatch/knot_vector.hpp"
+#include "interpatch/loft.hpp"
 #include "interpatch/memory.hpp"
 #include "interpatch/network.hpp"
 #include "interpatch/patches.hpp"

@@ -97,7 +97,7 @@ class RefitShortfall : public error {
 
 /// One curve to re-express: C (the prepared curve), the curve as given (both over
 /// [0, 1]; null when C is it, up to rounding), the correction G the surface adds along the curve's line (see
-/// place_curves: S = D + G there), and the map.
+/// place_curves: S = D + G there; null for none: a loft's sections), and the map.
 struct FitJob {
   const BSplineCurve* c;
   const BSplineCurve* given;
@@ -126,6 +126,16 @@ struct Refit {
   double distance = 0;  ///< the largest |D(u) + G(u) − given(map(u))| at the same points
 };
 std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<double>& nodes, bool closed, double target);
+
+/// Where refit starts: the family's shared interior knots (every curve's corners, its
+/// simple knots averaged quantile by quantile), each curve's own knots pulled back
+/// (with the seam of a closed one), and how many those are together.
+struct FamilyKnots {
+  std::vector<double> interior;
+  std::vector<std::vector<double>> own;
+  std::size_t all = 0;
+};
+FamilyKnots family_knots(const std::vector<FitJob>& jobs, const std::vector<double>& nodes, bool closed);
 
 /// The work of checking a fit, per span, in multiply-adds: 4 points, each 3 curve
 /// points of about 30 (a cubic's basis functions and their sum); for parallel_min_work.

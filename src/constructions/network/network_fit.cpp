@@ -139,7 +139,7 @@ Checked check_fit(const FitJob& job, const BSplineCurve& fit, const std::vector<
   }
   if (out.error > target) return out;
   for (const At& a : at)
-    out.distance = std::max(out.distance, distance(a.d + job.G->point(a.u), job.given ? job.given->point(a.y) : a.c));
+    out.distance = std::max(out.distance, distance(job.G ? a.d + job.G->point(a.u) : a.d, job.given ? job.given->point(a.y) : a.c));
   return out;
 }
 

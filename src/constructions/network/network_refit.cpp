@@ -53,7 +53,7 @@ std::vector<double> merged(std::vector<Knot> k) {
 
 }  // namespace
 
-std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<double>& nodes, bool closed, double target) {
+FamilyKnots family_knots(const std::vector<FitJob>& jobs, const std::vector<double>& nodes, bool closed) {
   const std::size_t m = jobs.size();
   // The knots of each curve, pulled back through its map: its corners (multiple knots)
   // and its simple knots.
@@ -122,6 +122,12 @@ std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<doub
     own[j] = merged(std::move(k));
     all += own[j].size();
   }
+  return {std::move(interior), std::move(own), all};
+}
+
+std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<double>& nodes, bool closed, double target) {
+  const std::size_t m = jobs.size();
+  auto [interior, own, all] = family_knots(jobs, nodes, closed);
   std::vector<std::size_t> family(m);
   std::iota(family.begin(), family.end(), 0);
   if (auto shared = fit_group(jobs, family, interior, nodes, closed, target, all, nullptr)) return std::move(*shared);

@@ -29,6 +29,7 @@
 #include "interpatch/blended_surface.hpp"
 #include "interpatch/blended_volume.hpp"
 #include "interpatch/io/spec.hpp"
+#include "interpatch/network.hpp"
 
 namespace interpatch::io::reader {
 
@@ -181,6 +182,15 @@ struct SpecCurve {
 SpecCurve read_curve(const json& j, std::string_view ptr, Context& ctx);
 /// read_curve's curve alone, for the constructions made of curves.
 BSplineCurve curve_impl(const json& j, std::string_view ptr, Context& ctx);
+/// The curves at items[i] (null: none there, an empty entry), each as curve_impl reads
+/// it at ptrs[i]: on every thread when the spec names no in-memory arrays, their
+/// warnings and the first error in the spec's order (surfaces.cpp).
+std::vector<std::optional<BSplineCurve>> read_curve_list(const std::vector<const json*>& items,
+                                                         const std::vector<std::string>& ptrs, Context& ctx);
+/// A curve of the spec sampled for the data check (65 points): S(u, fixed) (axis 0) or
+/// S(fixed, v) against the curve at map(u), or at u itself without a map.
+DataSet curve_data(const BSplineCurve& c, int axis, double fixed, std::string pointer,
+                   const std::optional<Reparametrization>& map = std::nullopt);
 
 // ---------------------------------------------------------------------------
 // Construction types (types.def lists them, spec.cpp holds their table).

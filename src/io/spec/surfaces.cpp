@@ -22,14 +22,11 @@
 
 namespace interpatch::io::reader {
 
-namespace {
-
-constexpr std::size_t curve_samples = 65;
-
 // A curve of the spec sampled for the data check: S(u, fixed) (axis 0) or S(fixed, v)
 // against the curve at map(u) (a network's curves) or at u itself.
 DataSet curve_data(const BSplineCurve& c, int axis, double fixed, std::string pointer,
-                   const std::optional<Reparametrization>& map = std::nullopt) {
+                   const std::optional<Reparametrization>& map) {
+  constexpr std::size_t curve_samples = 65;
   DataSet d;
   const std::vector<double> t = linspace(0, 1, curve_samples);
   d.params = axis == 0 ? std::vector<std::vector<double>>{t, {fixed}} : std::vector<std::vector<double>>{{fixed}, t};
@@ -37,6 +34,8 @@ DataSet curve_data(const BSplineCurve& c, int axis, double fixed, std::string po
   d.pointer = std::move(pointer);
   return d;
 }
+
+namespace {
 
 DataSet corner_data(const std::array<Vec3, 4>& p, std::string pointer) {
   DataSet d;
@@ -244,6 +243,15 @@ BSplineCurve take(CurveRead& r, Context& ctx) {
 
 }  // namespace
 
+std::vector<std::optional<BSplineCurve>> read_curve_list(const std::vector<const json*>& items,
+                                                         const std::vector<std::string>& ptrs, Context& ctx) {
+  std::vector<CurveRead> read = read_curves(items, ptrs, ctx);
+  std::vector<std::optional<BSplineCurve>> out(read.size());
+  for (std::size_t i = 0; i < read.size(); ++i)
+    if (items[i] != nullptr) out[i] = take(read[i], ctx);
+  return out;
+}
+
 Construction build_coons(const json& spec, Context& ctx) {
   const char* sides[4] = {"v0", "v1", "u0", "u1"};
   auto four_curves = [&](const json& obj, const std::string& ptr) {
@@ -315,9 +323,8 @@ Construction build_network(const json& spec, Context& ctx) {
       items.push_back(&a[i]);
       ptrs.push_back(child(ptr, i));
     }
-    std::vector<CurveRead> read = read_curves(items, ptrs, ctx);
     std::vector<BSplineCurve> c;
-    for (CurveRead& r : read) c.push_back(take(r, ctx));
+    for (auto& r : read_curve_list(items, ptrs, ctx)) c.push_back(std::move(*r));
     return c;
   };
   const std::array<bool, 3> closed = periodic_flags(spec, "", 2);

@@ -1,0 +1,123 @@
+#pragma once
+/// @file loft.hpp
+/// A surface through a row of section curves (skinning, The NURBS Book §10.3): the
+/// sections made compatible (one degree, one knot vector), closed ones turned and
+/// shifted so that the surface does not twist, then interpolated across.
+
+#include <cstddef>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "interpatch/bspline_curve.hpp"
+#include "interpatch/bspline_surface.hpp"
+#include "interpatch/interpolate.hpp"
+#include "interpatch/network.hpp"
+
+namespace interpatch {
+
+struct LoftOptions {
+  /// Degree across the sections (v); lowered to the count of conditions − 1 when there
+  /// are too few sections (N sections, and the tangents given, count).
+  int degree = 3;
+  /// How the sections' parameters v_k follow from the distances between them, measured
+  /// between points at equal u and averaged along u.
+  Parametrization param = Parametrization::chord;
+  /// Given v_k instead: increasing from 0 to 1, or for a periodic loft from 0 to below 1
+  /// (1 is the first section again).
+  std::vector<double> params;
+  /// Closed across the sections: the first section follows the last (a ring of
+  /// sections makes a torus), C^(q−1) across that seam too.
+  bool periodic = false;
+  /// How close the ends of an open section must be for it to be closed, and how far
+  /// a section may move when the merged knots would grow too many and the sections are
+  /// re-expressed on common knots. Unset: 1e-7 of the diagonal of the sections'
+  /// control points.
+  std::optional<double> tolerance;
+  /// ∂S/∂v along sections: none; two, at the first and the last section; or one per
+  /// section, where an empty entry leaves that section free. Curves in any form,
+  /// each over its own domain, taken at the same u as its section (turned and shifted
+  /// with it). Open lofts of polynomial sections only.
+  std::vector<std::optional<BSplineCurve>> tangents;
+  /// Messages name sections, tangents and given parameters as "sections[3]",
+  /// "tangents[1]", "params[2]"; with spec_pointers, by JSON Pointer into a loft spec:
+  /// "/sections/3", "/tangents/1", "/param/2".
+  bool spec_pointers = false;
+};
+
+/// How the loft used one of its sections.
+struct LoftSectionReport {
+  bool closed = false;    ///< a periodic curve, or one whose ends meet within the tolerance
+  bool reversed = false;  ///< turned round to run with the section before
+  /// Surface parameter u → the section's own parameter: S(u, v_k) = C_k(map(u)).
+  /// For a closed section map(0) is where the surface's seam falls on it.
+  Reparametrization map;
+  /// Largest |S(u, v_k) − C_k(map(u))| measured at 4 points of every span of the
+  /// surface in u and at the section's own knots: rounding, or the re-expression's
+  /// deviation when the sections were re-expressed.
+  double deviation = 0;
+  /// With a tangent: the largest |∂S/∂v(u, v_k) − T_k(u)| measured at 9 points.
+  double tangent_deviation = 0;
+};
+
+/// What loft found and did.
+struct LoftReport {
+  std::vector<double> params;  ///< v_k of each section (periodic: the first section again at 1)
+  std::vector<LoftSectionReport> sections;
+  bool closed = false;        ///< the sections are closed: the surface is closed in u
+  int degree_u = 0;           ///< the sections' common degree
+  int degree_v = 0;           ///< the degree across, as used
+  /// True when the merged knots would have exceeded 4 times the largest section's
+  /// and the sections were re-expressed on common knots within the tolerance.
+  bool reexpressed = false;
+  std::size_t merged_knots = 0;   ///< the size of the knot vector merging makes (or would have made)
+  std::size_t section_knots = 0;  ///< the largest section's knot count, at the common degree
+  double max_deviation = 0;       ///< the largest section deviation
+  double tolerance = 0;           ///< LoftOptions::tolerance in effect
+  double diagonal = 0;            ///< of the sections' control points' bounding box
+};
+
+struct LoftSurface {
+  BSplineSurface surface;  ///< over [0, 1]²: u along the sections, v across them
+  LoftReport report;
+};
+
+/// The surface through N ≥ 2 section curves: S(u, v_k) = C_k(map_k(u)), C^(q−1) in v.
+/// Each section is used over its own domain mapped onto [0, 1]. Sections are all open
+/// or all closed (periodic, or ends within the tolerance). Every section after the
+/// first is turned round when it runs against the one before; closed ones also start
+/// where the summed squared distance, between points at equal u of the two sections
+/// taken about their centres, is least, among the section's knots and points that cut
+/// its spans evenly (64 or more candidates), so the surface does not twist and sections given with other
+/// starts at those points or the other way round make the same surface. The first
+/// section sets the seam and the direction. Periodic sections make a surface periodic
+/// in u; closed open-knotted ones a surface whose edges u = 0 and u = 1 meet.
+/// Every result is checked before it is returned: each section within rounding (or
+/// the re-expression's tolerance) of the surface along v = v_k.
+///
+/// Example: a cone frustum from two circles and a ring between them.
+/// @code
+///   using namespace interpatch;
+///   CurveInterpolationOptions ring;
+///   ring.periodic = true;
+///   auto circle = [&](double r, double z) {
+///     std::vector<Vec3> p;
+///     for (int i = 0; i < 8; ++i) p.push_back({r * std::cos(i * M_PI / 4), r * std::sin(i * M_PI / 4), z});
+///     return interpolate_curve(p, ring).curve;
+///   };
+///   std::vector<BSplineCurve> sections{circle(1, 0), circle(0.8, 1), circle(0.5, 2)};
+///   LoftSurface s = loft(sections);
+///   Vec3 p = s.surface.point(0.25, s.report.params[1]);  // == sections[1].point(0.25)
+/// @endcode
+/// @throws error too_few_points (fewer than 2 sections), invalid_degree, not_finite,
+///   closing_gap (closed and open sections mixed, naming both), zero_chord (two
+///   sections at the same place everywhere), non_increasing, out_of_domain and
+///   size_mismatch (given parameters), size_mismatch (tangents), wrong_type
+///   (tangents of a periodic loft or of rational sections), tolerance_not_met (the
+///   sections cannot be re-expressed within the tolerance), invalid_weight (rational
+///   sections whose weights, interpolated across, fall to 0), ill_conditioned (a
+///   section not reproduced).
+[[nodiscard]] LoftSurface loft(std::span<const BSplineCurve> sections, const LoftOptions& options = {});
+
+}  // namespace interpatch

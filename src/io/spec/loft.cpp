@@ -1,0 +1,91 @@
+// "loft": a surface through section curves. Each section as given is checked against
+// the surface along its line by `info`, through the map that turned and shifted it.
+#include <optional>
+#include <string>
+
+#include "interpatch/loft.hpp"
+#include "io/spec/reader.hpp"
+
+namespace interpatch::io::reader {
+
+namespace {
+
+// An array of curves at `key` (entries null allowed when `nulls`): the curves, read on
+// every thread when it can.
+std::vector<std::optional<BSplineCurve>> curve_array(const json& spec, const char* key, bool nulls, Context& ctx) {
+  const std::string ptr = child("", key);
+  const json& a = *find_member(spec, key);
+  const char* expected = nulls ? "an array of curves (null for none)" : "an array of curves";
+  if (!a.is_array()) wrong_type(ptr, expected, a);
+  std::vector<const json*> items;
+  std::vector<std::string> ptrs;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    items.push_back(nulls && a[i].is_null() ? nullptr : &a[i]);
+    ptrs.push_back(child(ptr, i));
+  }
+  return read_curve_list(items, ptrs, ctx);
+}
+
+}  // namespace
+
+Construction build_loft(const json& spec, Context& ctx) {
+  const json& given = member(spec, "sections", "", "an array of curves [c0, c1, ...]");
+  if (given.is_array() && given.size() < 2)
+    fail(errc::too_few_points, "/sections: a loft needs at least 2 sections, got ", given.size());
+  std::vector<BSplineCurve> sections;
+  for (auto& c : curve_array(spec, "sections", false, ctx)) sections.push_back(std::move(*c));
+  LoftOptions o;
+  if (const json* d = find_member(spec, "degree")) o.degree = degree_value(*d, "/degree");
+  std::string param = "chord";
+  if (const json* p = find_member(spec, "param"); p != nullptr && p->is_array()) {
+    o.params = numbers(*p, "/param", "an array of numbers, one per section");
+    param = "given";
+  } else {
+    o.param = parametrization(spec, "");
+    param = param_name(o.param);
+  }
+  o.periodic = periodic_flags(spec, "", 1)[0];
+  o.tolerance = tolerance_of(spec);
+  if (find_member(spec, "tangents") != nullptr) o.tangents = curve_array(spec, "tangents", true, ctx);
+  o.spec_pointers = true;
+  ctx.parsed();
+  // The library's messages name their sections, tangents and parameters by pointer.
+  LoftSurface built = loft(sections, o);
+  const LoftReport& r = built.report;
+  std::vector<DataSet> data;
+  nlohmann::ordered_json reported = nlohmann::ordered_json::object();
+  for (std::size_t k = 0; k < sections.size(); ++k) {
+    const std::string ptr = child("/sections", k);
+    const LoftSectionReport& s = r.sections[k];
+    data.push_back(curve_data(sections[k], 0, r.params[k], ptr, s.map));
+    reported[ptr] = {{"closed", s.closed}, {"reversed", s.reversed}};
+    if (s.closed) reported[ptr]["seam"] = s.map(0.0);  // where u = 0 falls on it
+    reported[ptr]["deviation"] = s.deviation;
+    if (k < o.tangents.size() || (o.tangents.size() == 2 && k + 1 == sections.size()))
+      if (s.tangent_deviation > 0) reported[ptr]["tangent_deviation"] = s.tangent_deviation;
+  }
+  nlohmann::ordered_json parameters = {{"degree", {r.degree_u, r.degree_v}},
+                                       {"param", param},
+                                       {"params", r.params},
+                                       {"periodic", o.periodic},
+                                       {"closed", r.closed},
+                                       {"sections", sections.size()},
+                                       {"knots", {{"merged", r.merged_knots},
+                                                  {"largest_section", r.section_knots},
+                                                  {"reexpressed", r.reexpressed}}},
+                                       {"max_deviation", r.max_deviation},
+                                       {"tolerance", r.tolerance}};
+  parameters["loft_sections"] = std::move(reported);
+  if (r.reexpressed)
+    ctx.warn(cat("/sections: merging the sections' knots would make ", r.merged_knots, " knots, more than 4 times the ",
+                 r.section_knots, " of the largest section: they were re-expressed on common knots, each within ",
+                 r.max_deviation, " (tolerance ", r.tolerance, ")"));
+  Construction c;
+  c.type = "loft";
+  c.exact = std::move(built.surface);
+  c.data = std::move(data);
+  c.parameters = std::move(parameters);
+  return c;
+}
+
+}  // namespace interpatch::io::reader
