@@ -90,6 +90,14 @@ std::string ruled_with(const json& c) {
   return json{{"type", "ruled"}, {"curves", {c, line({0, 1, 0}, {3, 1, 0})}}}.dump();
 }
 
+// A loft through three lines (the middle one raised), with `change` applied.
+std::string loft_with(const std::function<void(json&)>& change) {
+  json s{{"type", "loft"},
+         {"sections", {line({0, 0, 0}, {1, 0, 0}), line({0, 1, 0.5}, {1, 1, 0.5}), line({0, 2, 0}, {1, 2, 0})}}};
+  change(s);
+  return s.dump();
+}
+
 json network_with_params(const json& u_params) {
   json s = example("network_gordon");
   s["u_params"] = u_params;
@@ -282,6 +290,34 @@ std::vector<Row> rows() {
        {"build", grid_file, "-o", "out.json"}, 3,
        R"(/curves/0/interpolate/3: point 3 \(1, 0, 0\) coincides with point 0 \(the closing chord of a closed curve has zero length\))",
        errc::zero_chord},
+      {"LoftOneSection", {{grid_file, loft_with([](json& s) { s["sections"] = json::array({s["sections"][0]}); })}}, {"info", grid_file}, 3,
+       R"(/sections: a loft needs at least 2 sections, got 1)", errc::too_few_points},
+      {"LoftClosedAndOpenSections",
+       {{grid_file, loft_with([](json& s) {
+           s["sections"][1] = {{"interpolate", {{1, 0, 1}, {0, 1, 1}, {-1, 0, 1}, {0, -1, 1}}}, {"periodic", true}};
+         })}},
+       {"build", grid_file, "-o", "out.json"}, 3,
+       R"(/sections/0 is open \(its ends are 1 apart, more than the tolerance .*\) and /sections/1 is closed: a loft's sections are all closed or all open)",
+       errc::closing_gap},
+      {"LoftSectionsAtOnePlace", {{grid_file, loft_with([](json& s) { s["sections"][2] = s["sections"][1]; })}},
+       {"info", grid_file}, 3,
+       R"(/sections/2 lies on /sections/1 everywhere: two sections at one place give the loft no room between them)",
+       errc::zero_chord},
+      {"LoftParamsNotIncreasing", {{grid_file, loft_with([](json& s) { s["param"] = {0, 0.7, 0.5}; })}},
+       {"info", grid_file}, 3, R"(/param/2 = 0.5 is not greater than /param/1 = 0.7)", errc::non_increasing},
+      {"LoftParamsOfAnotherCount", {{grid_file, loft_with([](json& s) { s["param"] = {0, 1}; })}}, {"info", grid_file}, 3,
+       R"(/param: 3 sections need 3 parameters, got 2)", errc::size_mismatch},
+      {"LoftParamsNotFromZeroToOne", {{grid_file, loft_with([](json& s) { s["param"] = {0, 0.5, 0.9}; })}},
+       {"info", grid_file}, 3, R"(/param must run from 0 to 1, got 0 to 0.9)", errc::out_of_domain},
+      {"LoftOneTangent", {{grid_file, loft_with([](json& s) { s["tangents"] = {line({0, 1, 0}, {1, 1, 0})}; })}},
+       {"info", grid_file}, 3, R"(/tangents: 2 \(the first and the last section\) or 3 \(one per section\), got 1)",
+       errc::size_mismatch},
+      {"LoftTangentOfAPeriodicLoft",
+       {{grid_file, loft_with([](json& s) {
+           s["periodic"] = true;
+           s["tangents"] = {line({0, 1, 0}, {1, 1, 0}), nullptr};
+         })}},
+       {"info", grid_file}, 3, R"(/tangents/0: a periodic loft has no first or last section to join at)", errc::wrong_type},
       {"ClosedCurveWithAnEndDerivative",
        {{grid_file, ruled_with({{"interpolate", {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}}}, {"periodic", true}, {"start_derivative", {0, 1, 0}}})}},
        {"eval", grid_file, "--grid", "3", "-o", "out.csv"}, 3,

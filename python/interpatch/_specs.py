@@ -21,7 +21,7 @@ from ._core import build as _build
 
 __all__ = ["build", "interpolate_surface", "bilinear", "ruled", "coons", "curve_network", "hermite_patch",
            "interpolate_volume", "trilinear", "coons_volume", "hermite_volume", "interpolate_curve", "bspline_curve",
-           "hermite_curve", "line", "approximate_surface", "approximate_volume", "approximate_curve"]
+           "hermite_curve", "line", "approximate_surface", "approximate_volume", "approximate_curve", "loft"]
 
 _Path = Union[str, PathLike[str]]
 _CurveLike = Union[Curve, npt.ArrayLike]
@@ -390,6 +390,46 @@ def curve_network(u_curves: Sequence[_CurveLike], v_curves: Sequence[_CurveLike]
     if v_params is not None:
         spec["v_params"] = _reals(v_params, "v_params")
     return cast(Surface, _build(_options(spec, method=method, tolerance=tolerance, periodic=periodic), ".", a.table))
+
+
+def loft(sections: Sequence[_CurveLike], degree: Optional[int] = None, param: Union[str, Sequence[float], None] = None,
+         periodic: Optional[bool] = None, tolerance: Optional[float] = None,
+         tangents: Optional[Sequence[Optional[_CurveLike]]] = None) -> Surface:
+    """The surface through a row of section curves (Curve objects, or arrays of points
+    to interpolate): S(u, v_k) = C_k(u), C^(q-1) across (docs/spec-format.md, type
+    loft). Closed sections given from other starts or the other way round are turned
+    and shifted to follow the first, so the surface does not twist. `degree` across
+    (default 3, lowered for few sections); `param` "chord" (default), "centripetal",
+    "uniform" or the v_k; `periodic` closes it across the sections; `tolerance` for
+    closed ends and the re-expression of sections with unrelated knots; `tangents`
+    dS/dv at the first and last section, or one per section (None for none).
+
+    Examples
+    --------
+    >>> t = np.linspace(0, 2 * np.pi, 12, endpoint=False)
+    >>> def ring(r, z, start=0, turned=False):
+    ...     p = np.column_stack([r * np.cos(t), r * np.sin(t), np.full(12, z)])
+    ...     p = np.roll(p, -start, axis=0)
+    ...     return interpatch.interpolate_curve(p[::-1] if turned else p, periodic=True)
+    >>> s = interpatch.loft([ring(1, 0), ring(0.7, 1, start=4), ring(0.5, 2, start=9, turned=True)],
+    ...                     degree=2, param="centripetal", tolerance=1e-9)
+    >>> u_line = np.array([s.point(0.25, v) for v in np.linspace(0, 1, 5)])
+    >>> np.allclose(u_line[:, 0], 0, atol=1e-9)                      # no twist: u = 0.25 stays at x = 0
+    True
+    >>> [sec["reversed"] for sec in s.info()["parameters"]["loft_sections"].values()]
+    [False, False, True]
+    >>> duct = interpatch.loft([[[0, 0, 0], [1, 0, 0]], [[0, 0, 1], [1, 0, 1]]], param=[0, 1], periodic=False,
+    ...                        tangents=[interpatch.line([0, 1, 0], [0, 1, 0]), interpatch.line([0, -1, 0], [0, -1, 0])])
+    >>> duct.point(0.5, 0.5).round(6).tolist()                        # bulges by a quarter of the tangent
+    [0.5, 0.25, 0.5]"""
+    a = _Arrays()
+    spec: dict[str, Any] = {"type": "loft", "sections": [_curve(c, a, f"sections[{i}]") for i, c in enumerate(sections)]}
+    if tangents is not None:
+        spec["tangents"] = [None if c is None else _curve(c, a, f"tangents[{i}]") for i, c in enumerate(tangents)]
+    if param is not None and not isinstance(param, str):
+        param = _reals(param, "param")
+    return cast(Surface, _build(_options(spec, degree=degree, param=param, periodic=periodic, tolerance=tolerance), ".",
+                                a.table))
 
 
 def hermite_patch(corners: dict[str, dict[str, npt.ArrayLike]]) -> Surface:
