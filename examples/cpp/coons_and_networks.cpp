@@ -1,8 +1,9 @@
 // Surfaces from corners, curves and networks of curves: the README's Coons and
-// network example, then the examples of bspline_surface.hpp, patches.hpp, coons.hpp
-// and network.hpp. Every comment that states a value or a property is checked.
+// network example, then the examples of bspline_surface.hpp, patches.hpp, coons.hpp,
+// network.hpp and loft.hpp. Every comment that states a value or a property is checked.
 // Links interpatch::core only.
 
+#include <cmath>
 #include <cstdio>
 #include <vector>
 
@@ -144,6 +145,38 @@ void gordon_surfaces() {
               b.control_points().extent(1));
 }
 
+// loft.hpp's example: rings lofted, the middle one given from another start.
+void lofts() {
+  using namespace interpatch;
+  auto ring = [](double r, double z, int start) {
+    std::vector<Vec3> p;
+    for (int i = 0; i < 8; ++i) {
+      const double a = 0.7853981633974483 * (i + start);  // 45° steps
+      p.push_back({r * std::cos(a), r * std::sin(a), z});
+    }
+    CurveInterpolationOptions closed;
+    closed.periodic = true;
+    return interpolate_curve(p, closed).curve;
+  };
+  std::vector<BSplineCurve> sections{ring(1, 0, 0), ring(0.8, 1, 3), ring(0.5, 2, 0)};
+  LoftSurface s = loft(sections);
+  Vec3 p = s.surface.point(0.25, s.report.params[1]);  // (0, 0.8, 1): the middle ring, not twisted
+  double seam = s.report.sections[1].map(0.0);           // 0.625: where u = 0 falls on it
+
+  example::expect_near(p, {0, 0.8, 1}, "the middle ring at u = 0.25");
+  example::expect_near(seam, 0.625, "the middle ring's seam");
+  // Every ring is the surface's line at its v, through its map; every u-line stays in
+  // its half-plane of angle (no twist).
+  for (std::size_t k = 0; k < sections.size(); ++k)
+    for (double u : linspace(0, 1, 17))
+      example::expect_near(s.surface.point(u, s.report.params[k]), sections[k].point(s.report.sections[k].map(u)),
+                           "a ring on the loft");
+  for (double v : linspace(0, 1, 9)) {
+    const Vec3 q = s.surface.point(0.25, v);
+    example::expect_near(q.x, 0.0, "u = 0.25 stays at x = 0");
+  }
+}
+
 }  // namespace
 
 int main() {
@@ -153,5 +186,6 @@ int main() {
     bilinear_patches();
     coons_patches();
     gordon_surfaces();
+    lofts();
   });
 }

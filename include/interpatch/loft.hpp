@@ -96,19 +96,23 @@ struct LoftSurface {
 /// Every result is checked before it is returned: each section within rounding (or
 /// the re-expression's tolerance) of the surface along v = v_k.
 ///
-/// Example: a cone frustum from two circles and a ring between them.
+/// Example: rings around z, the middle one given from another start.
 /// @code
 ///   using namespace interpatch;
-///   CurveInterpolationOptions ring;
-///   ring.periodic = true;
-///   auto circle = [&](double r, double z) {
+///   auto ring = [](double r, double z, int start) {
 ///     std::vector<Vec3> p;
-///     for (int i = 0; i < 8; ++i) p.push_back({r * std::cos(i * M_PI / 4), r * std::sin(i * M_PI / 4), z});
-///     return interpolate_curve(p, ring).curve;
+///     for (int i = 0; i < 8; ++i) {
+///       const double a = 0.7853981633974483 * (i + start);  // 45° steps
+///       p.push_back({r * std::cos(a), r * std::sin(a), z});
+///     }
+///     CurveInterpolationOptions closed;
+///     closed.periodic = true;
+///     return interpolate_curve(p, closed).curve;
 ///   };
-///   std::vector<BSplineCurve> sections{circle(1, 0), circle(0.8, 1), circle(0.5, 2)};
+///   std::vector<BSplineCurve> sections{ring(1, 0, 0), ring(0.8, 1, 3), ring(0.5, 2, 0)};
 ///   LoftSurface s = loft(sections);
-///   Vec3 p = s.surface.point(0.25, s.report.params[1]);  // == sections[1].point(0.25)
+///   Vec3 p = s.surface.point(0.25, s.report.params[1]);  // (0, 0.8, 1): the middle ring, not twisted
+///   double seam = s.report.sections[1].map(0.0);           // 0.625: where u = 0 falls on it
 /// @endcode
 /// @throws error too_few_points (fewer than 2 sections), invalid_degree, not_finite,
 ///   closing_gap (closed and open sections mixed, naming both), zero_chord (two
