@@ -2,10 +2,10 @@
 pages `interpatch view` writes, rendered by headless Chromium (tools/viewer_browser.py),
 so that they show what the code builds today.
 
-    make_pictures.py INTERPATCH OUT_DIR
+    make_pictures.py INTERPATCH OUT_DIR [NAME ...]
 
 Writes OUT_DIR/view_NAME.png (the 3D view of the page, without its side panel) for
-each example of PICTURES.
+each example of PICTURES, or for the NAMEs given.
 """
 
 import os
@@ -22,6 +22,7 @@ EXAMPLES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__
 PICTURES = {
     "ruled": ("height", True, "a ruled surface between two curves, with its control net"),
     "coons": ("height", False, "a Coons patch from four boundary curves (orange)"),
+    "loft_wing": ("height", False, "a wing lofted through six airfoils given from mixed starts and directions (orange)"),
     "network_drawn": ("mean", False, "a Gordon surface through a network of curves drawn freehand, by mean curvature"),
     "pipe": ("gaussian", False, "a closed surface: a bent pipe, by Gaussian curvature"),
     "terrain": ("height", False, "terrain heights interpolated, the survey points in orange"),
@@ -32,12 +33,14 @@ PICTURES = {
 
 
 def main():
-    interpatch, out_dir = sys.argv[1:3]
+    interpatch, out_dir, only = sys.argv[1], sys.argv[2], sys.argv[3:]
     os.makedirs(out_dir, exist_ok=True)
     driver = vb.chromium(width=960, height=540)
     try:
         with tempfile.TemporaryDirectory() as work:
             for name, (colouring, net, caption) in PICTURES.items():
+                if only and name not in only:
+                    continue
                 page = os.path.join(work, name + ".html")
                 subprocess.run([interpatch, "view", os.path.join(EXAMPLES, name + ".json"), "-o", page], check=True)
                 vb.open_page(driver, page)

@@ -76,10 +76,6 @@ Construction build_loft(const json& spec, Context& ctx) {
                                        {"max_deviation", r.max_deviation},
                                        {"tolerance", r.tolerance}};
   parameters["loft_sections"] = std::move(reported);
-  if (r.reexpressed)
-    ctx.warn(cat("/sections: merging the sections' knots would make ", r.merged_knots, " knots, more than 4 times the ",
-                 r.section_knots, " of the largest section: they were re-expressed on common knots, each within ",
-                 r.max_deviation, " (tolerance ", r.tolerance, ")"));
   Construction c;
   c.type = "loft";
   c.exact = std::move(built.surface);
