@@ -69,7 +69,8 @@ struct LoftReport {
   int degree_u = 0;           ///< the sections' common degree
   int degree_v = 0;           ///< the degree across, as used
   /// True when the merged knots would have exceeded 4 times the largest section's
-  /// and the sections were re-expressed on common knots within the tolerance.
+  /// and the sections were re-expressed on common knots within the tolerance (on fewer
+  /// knots than merging makes; otherwise they are merged).
   bool reexpressed = false;
   std::size_t merged_knots = 0;   ///< the size of the knot vector merging makes (or would have made)
   std::size_t section_knots = 0;  ///< the largest section's knot count, at the common degree

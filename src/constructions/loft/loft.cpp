@@ -220,8 +220,8 @@ std::vector<PreparedSection> prepare(std::span<const BSplineCurve> given, const 
 }
 
 // The sections (then the tangents present) of one degree on one knot vector: merged,
-// or re-expressed on common knots when merging would make more than 4 times the
-// largest section's knots.
+// or re-expressed on common knots within the tolerance when merging would make more
+// than 4 times the largest section's knots (and would still make more than that).
 struct Common {
   std::vector<BSplineCurve> curves;
   std::vector<std::size_t> tangent_at;  // index in curves of section k's tangent
@@ -260,13 +260,20 @@ Common common_knots(const std::vector<PreparedSection>& s, double tol, LoftRepor
   std::iota(all.begin(), all.end(), 0);
   std::vector<detail::Refit> fits;
   try {
-    fits = std::move(*detail::fit_group(jobs, all, start.interior, {}, periodic, 0.5 * tol, 0, nullptr));
+    fits = std::move(*detail::fit_group(jobs, all, start.interior, {}, periodic, tol, 0, nullptr));
   } catch (const detail::RefitShortfall& e) {
     const std::size_t j = e.job();
     std::size_t k = 0;
     while (j >= n && k < n && c.tangent_at[k] != j) ++k;
     fail(errc::tolerance_not_met, j < n ? names.section(j) : names.tangent(tangent_given[k]),
-         ": cannot be re-expressed on knots common to the sections within half the tolerance ", tol, ": ", e.what());
+         ": cannot be re-expressed on knots common to the sections within the tolerance ", tol,
+         ": refining the common knots did not get there; give a larger \"tolerance\"");
+  }
+  // Re-expressed on as many knots as merging makes, or more: merging, which is exact.
+  if (fits.front().curve.knots().size() >= r.merged_knots) {
+    r.reexpressed = false;
+    c.curves = make_compatible(c.curves);
+    return c;
   }
   for (std::size_t j = 0; j < c.curves.size(); ++j) c.curves[j] = std::move(fits[j].curve);
   return c;
@@ -340,8 +347,8 @@ const std::vector<double> nine{0.0, 0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875,
 // (32 units in the last place of the largest coordinate beside 1e-10 of the diagonal,
 // for the solve across), or within the tolerance when re-expressed. A tangent against
 // ∂S/∂v: rounding relative to its size and to the slope the sections' spacing alone
-// gives (diagonal / smallest gap in v); re-expressed, it moved by up to half the
-// tolerance itself.
+// gives (diagonal / smallest gap in v); re-expressed, it moved by up to the tolerance
+// itself.
 void check_sections(LoftSurface& out, std::span<const BSplineCurve> given, const std::vector<PreparedSection>& s,
                     const Frame& f, const Names& names, const std::vector<std::size_t>& tangent_given) {
   LoftReport& r = out.report;
