@@ -1,8 +1,8 @@
 // Volumes: the Jacobian and the search for inverted cells (volume.hpp), B-spline
 // volumes (bspline_volume.hpp), the trilinear and tricubic Hermite volumes of corner
-// data (volume_patches.hpp), transfinite volumes from six faces (coons_volume.hpp)
-// and interpolation of a grid of points (interpolate.hpp). Every comment that states
-// a value is checked. Links interpatch::core only.
+// data (volume_patches.hpp), transfinite volumes from six faces (coons_volume.hpp),
+// interpolation of a grid of points (interpolate.hpp) and volumes through section
+// surfaces (loft.hpp). Every comment that states a value is checked. Links interpatch::core only.
 
 #include <array>
 #include <cmath>
@@ -128,6 +128,25 @@ void interpolated_volumes() {
   std::printf("volume through 5 × 6 × 4 points: S(u2, v3, w1) = %s\n", example::str(p).c_str());
 }
 
+// loft.hpp's volume example: a solid between a flat square and a lid above it.
+void loft_volumes() {
+  using namespace interpatch;
+  BSplineSurface floor = bilinear({0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}).to_bspline();
+  BSplineSurface lid = bilinear({0, 0, 1}, {0, 1, 1}, {1, 0, 1}, {1, 1, 1}).to_bspline().elevated(1, 1);
+  LoftVolume body = loft_volume(std::vector<BSplineSurface>{floor, lid});
+  Vec3 p = body.volume.point(0.5, 0.5, 1.0);  // (0.5, 0.5, 1): the lid
+  int q = body.report.degree[2];              // 1: two sections, straight across
+
+  example::expect_near(p, {0.5, 0.5, 1}, "the lid at w = 1");
+  example::expect(q == 1, "two sections give degree 1 across");
+  example::expect(body.report.degree[0] == 2 && body.report.degree[1] == 2, "the floor raised to the lid's degrees");
+  for (double u : linspace(0, 1, 5))
+    for (double v : linspace(0, 1, 5)) {
+      example::expect_near(body.volume.point(u, v, 0.0), floor.point(u, v), "the floor at w = 0");
+      example::expect_near(body.volume.point(u, v, 0.25), Vec3{u, v, 0.25}, "straight between them");
+    }
+}
+
 }  // namespace
 
 int main() {
@@ -139,5 +158,6 @@ int main() {
     hermite_volumes();
     coons_volumes();
     interpolated_volumes();
+    loft_volumes();
   });
 }

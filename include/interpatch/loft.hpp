@@ -2,8 +2,10 @@
 /// @file loft.hpp
 /// A surface through a row of section curves (skinning, The NURBS Book §10.3): the
 /// sections made compatible (one degree, one knot vector), closed ones turned and
-/// shifted so that the surface does not twist, then interpolated across.
+/// shifted so that the surface does not twist, then interpolated across. A volume
+/// through a row of section surfaces likewise.
 
+#include <array>
 #include <cstddef>
 #include <optional>
 #include <span>
@@ -12,6 +14,7 @@
 
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/bspline_surface.hpp"
+#include "interpatch/bspline_volume.hpp"
 #include "interpatch/interpolate.hpp"
 #include "interpatch/network.hpp"
 
@@ -124,5 +127,55 @@ struct LoftSurface {
 ///   sections whose weights, interpolated across, fall to 0), ill_conditioned (a
 ///   section not reproduced).
 [[nodiscard]] LoftSurface loft(std::span<const BSplineCurve> sections, const LoftOptions& options = {});
+
+struct LoftVolumeOptions {
+  /// Degree across the sections (w); lowered to N − 1 for N sections.
+  int degree = 3;
+  /// The places w_k from the distances between points at equal (u, v) of neighbouring
+  /// sections, averaged over a 17 × 17 grid of (u, v).
+  Parametrization param = Parametrization::chord;
+  /// Given w_k instead: increasing from 0 to 1 (periodic: from 0 to below 1).
+  std::vector<double> params;
+  /// Closed across the sections: the first section follows the last.
+  bool periodic = false;
+  /// Messages name sections as "/sections/3" rather than "sections[3]" (a spec's).
+  bool spec_pointers = false;
+};
+
+struct LoftVolumeReport {
+  std::vector<double> params;       ///< w_k of each section (periodic: the first again at 1)
+  std::array<int, 3> degree{0, 0, 0};
+  /// Largest |V(u, v, w_k) − S_k(u, v)| of each section, at 4 × 4 points of every
+  /// patch of the volume's (u, v) spans.
+  std::vector<double> deviation;
+  double max_deviation = 0;
+  double diagonal = 0;  ///< of the sections' control points
+};
+
+struct LoftVolume {
+  BSplineVolume volume;  ///< over [0, 1]³: u, v along the sections, w across them
+  LoftVolumeReport report;
+};
+
+/// The volume through N ≥ 2 section surfaces: V(u, v, w_k) = S_k(u, v) to rounding,
+/// C^(q−1) in w. Each section is used over its own domain mapped onto [0, 1]²; the
+/// sections are raised to the highest degrees among them and their knots merged in u
+/// and in v (they must be closed in the same directions), then interpolated across
+/// control point by control point (homogeneous when rational). Checked before it is
+/// returned: every section within rounding of the volume at w = w_k.
+///
+/// Example: a solid between a flat square and a bulged one above it.
+/// @code
+///   using namespace interpatch;
+///   BSplineSurface floor = bilinear({0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}).to_bspline();
+///   BSplineSurface lid = bilinear({0, 0, 1}, {0, 1, 1}, {1, 0, 1}, {1, 1, 1}).to_bspline().elevated(1, 1);
+///   LoftVolume body = loft_volume(std::vector<BSplineSurface>{floor, lid});
+///   Vec3 p = body.volume.point(0.5, 0.5, 1.0);  // (0.5, 0.5, 1): the lid
+///   int q = body.report.degree[2];              // 1: two sections, straight across
+/// @endcode
+/// @throws error too_few_points, invalid_degree, closing_gap (sections closed in
+///   different directions), zero_chord, size_mismatch, non_increasing, out_of_domain
+///   (given parameters), invalid_weight, ill_conditioned (a section not reproduced).
+[[nodiscard]] LoftVolume loft_volume(std::span<const BSplineSurface> sections, const LoftVolumeOptions& options = {});
 
 }  // namespace interpatch

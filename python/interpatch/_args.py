@@ -7,7 +7,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from ._core import Curve
+from ._core import Curve, Surface
 from ._core import Error as Error_
 
 
@@ -108,6 +108,17 @@ def _approximation(spec: dict[str, Any], control_points: Any, tolerance: Optiona
 
 
 def _surface_spec(face: Any, arrays: _Arrays, name: str) -> dict[str, Any]:
+    """A surface argument as a spec: a dict as it is, a Surface by its exact form (bit
+    for bit), a grid of points (n, m, 3) as the surface through them."""
     if isinstance(face, dict):
         return face
+    if isinstance(face, Surface):
+        b = face.to_bspline()
+        spec: dict[str, Any] = {"type": "bspline_surface", "degree": list(b["degree"]),
+                                "knots": {"u": b["knots_u"].tolist(), "v": b["knots_v"].tolist()},
+                                "control_points": arrays.add(b["control_points"], f"{name}.control_points"),
+                                "periodic": list(b["periodic"])}
+        if b["weights"] is not None:
+            spec["weights"] = b["weights"].tolist()
+        return spec
     return {"type": "interpolate", "points": arrays.add(face, name)}

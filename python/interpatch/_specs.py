@@ -21,7 +21,8 @@ from ._core import build as _build
 
 __all__ = ["build", "interpolate_surface", "bilinear", "ruled", "coons", "curve_network", "hermite_patch",
            "interpolate_volume", "trilinear", "coons_volume", "hermite_volume", "interpolate_curve", "bspline_curve",
-           "hermite_curve", "line", "approximate_surface", "approximate_volume", "approximate_curve", "loft"]
+           "hermite_curve", "line", "approximate_surface", "approximate_volume", "approximate_curve", "loft",
+           "loft_volume"]
 
 _Path = Union[str, PathLike[str]]
 _CurveLike = Union[Curve, npt.ArrayLike]
@@ -430,6 +431,33 @@ def loft(sections: Sequence[_CurveLike], degree: Optional[int] = None, param: Un
         param = _reals(param, "param")
     return cast(Surface, _build(_options(spec, degree=degree, param=param, periodic=periodic, tolerance=tolerance), ".",
                                 a.table))
+
+
+def loft_volume(sections: Sequence[Any], degree: Optional[int] = None, param: Union[str, Sequence[float], None] = None,
+                periodic: Optional[bool] = None) -> Volume:
+    """The volume through a row of section surfaces (Surface objects, surface spec dicts,
+    or grids of points (n, m, 3) to interpolate): V(u, v, w_k) = S_k(u, v), C^(q-1)
+    across (docs/spec-format.md, type loft_volume). `degree` across (default 3,
+    lowered for few sections); `param` "chord" (default), "centripetal", "uniform" or
+    the w_k; `periodic` closes it across the sections.
+
+    Examples
+    --------
+    >>> floor = interpatch.bilinear([0, 0, 0], [0, 1, 0], [1, 0, 0], [1, 1, 0])
+    >>> middle = np.array([[[0, 0, 1], [0, 0.5, 1.2], [0, 1, 1]], [[0.5, 0, 1.1], [0.5, 0.5, 1.4], [0.5, 1, 1.1]],
+    ...                    [[1, 0, 1], [1, 0.5, 1.2], [1, 1, 1]]])
+    >>> lid = {"type": "bilinear", "p00": [0, 0, 2], "p01": [0, 1, 2], "p10": [1, 0, 2], "p11": [1, 1, 2]}
+    >>> body = interpatch.loft_volume([floor, middle, lid], degree=2, param="uniform", periodic=False)
+    >>> body.point(0.5, 0.5, 0.5).round(9).tolist()                  # the middle section's top
+    [0.5, 0.5, 1.4]
+    >>> interpatch.loft_volume([floor, lid], param=[0, 1]).info()["degree"]    # two sections: straight across
+    [1, 1, 1]"""
+    a = _Arrays()
+    spec: dict[str, Any] = {"type": "loft_volume",
+                            "sections": [_surface_spec(s, a, f"sections[{i}]") for i, s in enumerate(sections)]}
+    if param is not None and not isinstance(param, str):
+        param = _reals(param, "param")
+    return cast(Volume, _build(_options(spec, degree=degree, param=param, periodic=periodic), ".", a.table))
 
 
 def hermite_patch(corners: dict[str, dict[str, npt.ArrayLike]]) -> Surface:

@@ -10,6 +10,7 @@
 
 #include "base/text.hpp"
 #include "constructions/interpolate/interpolate_internal.hpp"
+#include "constructions/loft/loft_across.hpp"
 #include "constructions/loft/loft_sections.hpp"
 #include "constructions/network/network_curves.hpp"
 #include "interpatch/loft.hpp"
@@ -21,79 +22,6 @@ namespace {
 
 using detail::fail;
 using detail::PreparedSection;
-
-// The sections' parameters across: the chord (or its root) between points at equal u
-// of consecutive sections, each line of points scaled to run from 0 to 1 and the
-// lines averaged; lines of zero length (an apex the sections share) are left out.
-std::vector<double> across_params(const std::vector<PreparedSection>& s, Parametrization param, bool periodic,
-                                  const std::function<std::string(std::size_t)>& name) {
-  const std::size_t n = s.size();
-  const std::size_t chords = periodic ? n : n - 1;
-  std::vector<double> v(n, 0.0);
-  if (param == Parametrization::uniform) {
-    for (std::size_t k = 0; k < n; ++k) v[k] = static_cast<double>(k) / static_cast<double>(chords);
-    return v;
-  }
-  constexpr std::size_t lines = 129;
-  std::vector<double> sum(n, 0.0), d(chords);
-  std::size_t used = 0;
-  std::vector<bool> moves(chords, false);  // some line has a non-zero chord there
-  for (std::size_t i = 0; i < lines; ++i) {
-    const double u = static_cast<double>(i) / static_cast<double>(lines - 1);
-    double total = 0;
-    for (std::size_t k = 0; k < chords; ++k) {
-      const double c = distance(s[k].curve.point(u), s[(k + 1) % n].curve.point(u));
-      d[k] = param == Parametrization::centripetal ? std::sqrt(c) : c;
-      total += d[k];
-    }
-    if (!(total > 0)) continue;
-    ++used;
-    double run = 0;
-    for (std::size_t k = 0; k < chords; ++k) {
-      if (d[k] > 0) moves[k] = true;
-      run += d[k];
-      if (k + 1 < n) sum[k + 1] += run / total;
-    }
-  }
-  for (std::size_t k = 0; k < chords; ++k)
-    if (!moves[k])
-      fail(errc::zero_chord, name((k + 1) % n), " lies on ", name(k),
-           " everywhere: two sections at one place give the loft no room between them");
-  for (std::size_t k = 1; k < n; ++k) v[k] = sum[k] / static_cast<double>(used);
-  return v;
-}
-
-void check_given_params(const std::vector<double>& v, std::size_t n, bool periodic,
-                        const std::function<std::string(std::size_t)>& at, const char* whole) {
-  if (v.size() != n) fail(errc::size_mismatch, whole, ": ", n, " sections need ", n, " parameters, got ", v.size());
-  for (std::size_t k = 0; k < n; ++k) {
-    if (!std::isfinite(v[k])) fail(errc::not_finite, at(k), " is ", v[k]);
-    if (k > 0 && !(v[k] > v[k - 1]))
-      fail(errc::non_increasing, at(k), " = ", v[k], " is not greater than ", at(k - 1), " = ", v[k - 1]);
-  }
-  if (periodic ? (v.front() != 0.0 || !(v.back() < 1.0)) : (v.front() != 0.0 || v.back() != 1.0))
-    fail(errc::out_of_domain, whole, " must run from 0 to ",
-         periodic ? "below 1 (1 is the first section again)" : "1", ", got ", v.front(), " to ", v.back());
-}
-
-// The knots across for open lofts: by averaging (The NURBS Book eq. 9.8) over the
-// sites, each site with a derivative counted twice, so that every span holds a
-// condition (Schoenberg–Whitney) and the spline is C^(q−1) with simple knots.
-KnotVector open_knots(const std::vector<double>& v, const std::vector<bool>& derivative, int q) {
-  const bool inner = std::any_of(derivative.begin() + 1, derivative.end() - 1, [](bool b) { return b; });
-  if (!inner) return averaged_knots(v, q, derivative.front(), derivative.back());
-  std::vector<double> sites;
-  for (std::size_t k = 0; k < v.size(); ++k) sites.insert(sites.end(), derivative[k] ? 2 : 1, v[k]);
-  const std::size_t m = sites.size(), qz = static_cast<std::size_t>(q);
-  std::vector<double> k(qz + 1, v.front());
-  for (std::size_t j = 1; j + qz < m; ++j) {
-    double a = 0;
-    for (std::size_t i = j; i < j + qz; ++i) a += sites[i];
-    k.push_back(a / static_cast<double>(q));
-  }
-  k.insert(k.end(), qz + 1, v.back());
-  return KnotVector(q, std::move(k));
-}
 
 // The identity map of [0, 1] (closed: with period 1): the re-expression's jobs are
 // the sections themselves.
@@ -305,25 +233,7 @@ BSplineSurface across(const Common& c, const std::vector<double>& v, const std::
     push(c.curves[k], false, v[k]);
     if (derivative[k] && !last) push(c.curves[c.tangent_at[k]], true, v[k]);
   }
-  KnotVector kv = KnotVector::bezier(1);
-  if (periodic) {
-    kv = periodic_knots(v, q);
-    detail::factor_periodic_collocation(kv, v).solve(rows.data(), width, width);
-    if (q % 2 == 0) {  // the domain starts at a midpoint: start it at the first section
-      detail::SeamInsertion seam = detail::seam_insertion(kv, v.front());
-      std::vector<double> moved(seam.rows.size() * width);
-      for (std::size_t j = 0; j < seam.rows.size(); ++j) {
-        const auto& r = seam.rows[j];
-        for (std::size_t a = 0; a < width; ++a)
-          moved[j * width + a] = r.alpha * rows[r.x * width + a] + (1.0 - r.alpha) * rows[r.y * width + a];
-      }
-      rows = std::move(moved);
-      kv = std::move(seam.knots);
-    }
-  } else {
-    kv = open_knots(v, derivative, q);
-    detail::factor_collocation(kv, conds).solve(rows.data(), width, width);
-  }
+  KnotVector kv = detail::interpolate_across(rows, width, v, derivative, conds, q, periodic);
   const std::size_t nv = rows.size() / width;
   PointGrid cp({nu, nv});
   Grid<double, 2> weights;
@@ -404,10 +314,12 @@ LoftSurface loft(std::span<const BSplineCurve> given, const LoftOptions& o) {
   // The parameters across, and the degree across (lowered to the conditions − 1).
   std::vector<double> v;
   if (!o.params.empty()) {
-    check_given_params(o.params, n, o.periodic, [&](std::size_t k) { return names.param(k); }, names.whole("params"));
+    detail::check_given_params(o.params, n, o.periodic, [&](std::size_t k) { return names.param(k); }, names.whole("params"));
     v = o.params;
   } else {
-    v = across_params(s, o.param, o.periodic, [&](std::size_t k) { return names.section(k); });
+    v = detail::across_params(
+        n, 129, [&](std::size_t k, std::size_t i) { return s[k].curve.point(static_cast<double>(i) / 128.0); },
+        o.param, o.periodic, [&](std::size_t k) { return names.section(k); });
   }
   std::vector<bool> derivative(n, false);
   std::size_t conditions = n;

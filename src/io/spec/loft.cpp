@@ -1,5 +1,6 @@
-// "loft": a surface through section curves. Each section as given is checked against
-// the surface along its line by `info`, through the map that turned and shifted it.
+// "loft": a surface through section curves, and "loft_volume": a volume through
+// section surfaces. Each section as given is checked against the result along its
+// line (its face) by `info`, through the map that turned and shifted it.
 #include <optional>
 #include <string>
 
@@ -81,6 +82,43 @@ Construction build_loft(const json& spec, Context& ctx) {
   c.exact = std::move(built.surface);
   c.data = std::move(data);
   c.parameters = std::move(parameters);
+  return c;
+}
+
+Construction build_loft_volume(const json& spec, Context& ctx) {
+  const json& given = member(spec, "sections", "", "an array of surface specs [s0, s1, ...]");
+  if (!given.is_array()) wrong_type("/sections", "an array of surface specs [s0, s1, ...]", given);
+  if (given.size() < 2) fail(errc::too_few_points, "/sections: a loft needs at least 2 sections, got ", given.size());
+  std::vector<BSplineSurface> sections;
+  for (std::size_t k = 0; k < given.size(); ++k) sections.push_back(face_surface(given[k], child("/sections", k), ctx));
+  LoftVolumeOptions o;
+  if (const json* d = find_member(spec, "degree")) o.degree = degree_value(*d, "/degree");
+  std::string param = "chord";
+  if (const json* p = find_member(spec, "param"); p != nullptr && p->is_array()) {
+    o.params = numbers(*p, "/param", "an array of numbers, one per section");
+    param = "given";
+  } else {
+    o.param = parametrization(spec, "");
+    param = param_name(o.param);
+  }
+  o.periodic = periodic_flags(spec, "", 1)[0];
+  o.spec_pointers = true;
+  ctx.parsed();
+  LoftVolume built = loft_volume(sections, o);
+  const LoftVolumeReport& r = built.report;
+  std::vector<DataSet> data;
+  nlohmann::ordered_json deviation = nlohmann::ordered_json::object();
+  for (std::size_t k = 0; k < sections.size(); ++k) {
+    data.push_back(face_data(sections[k], 2, r.params[k], child("/sections", k)));
+    deviation[child("/sections", k)] = r.deviation[k];
+  }
+  Construction c;
+  c.type = "loft_volume";
+  c.parameters = {{"degree", r.degree},  {"param", param},       {"params", r.params},
+                  {"periodic", o.periodic}, {"sections", sections.size()}, {"max_deviation", r.max_deviation},
+                  {"deviation", std::move(deviation)}};
+  c.exact = std::move(built.volume);
+  c.data = std::move(data);
   return c;
 }
 

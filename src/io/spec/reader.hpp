@@ -187,6 +187,13 @@ BSplineCurve curve_impl(const json& j, std::string_view ptr, Context& ctx);
 /// warnings and the first error in the spec's order (surfaces.cpp).
 std::vector<std::optional<BSplineCurve>> read_curve_list(const std::vector<const json*>& items,
                                                          const std::vector<std::string>& ptrs, Context& ctx);
+/// A surface spec inside another spec (a volume's face, a loft's section, a
+/// cross-derivative field): built by the surface constructions, its exact form over
+/// [0, 1]²; its messages and warnings placed under `ptr` (volumes.cpp).
+BSplineSurface face_surface(const json& j, const std::string& ptr, Context& ctx);
+/// A surface sampled on 17 × 17 of its own parameters for the data check: at (i, v, w)
+/// (axis 0, i = fixed), (u, j, w) (axis 1) or (u, v, k) (axis 2) of a volume.
+DataSet face_data(const BSplineSurface& f, std::size_t axis, double fixed, std::string pointer);
 /// A curve of the spec sampled for the data check (65 points): S(u, fixed) (axis 0) or
 /// S(fixed, v) against the curve at map(u), or at u itself without a map.
 DataSet curve_data(const BSplineCurve& c, int axis, double fixed, std::string pointer,

@@ -26,6 +26,19 @@ DataSet volume_corner_data(const std::array<Vec3, 8>& p, std::string pointer) {
 // Samples per direction of a boundary surface checked against a Coons volume.
 constexpr std::size_t face_samples = 17;
 
+
+// A message of a nested spec, whose places are pointers from the nested object,
+// placed under `ptr`: "/points/3: ..." becomes "/faces/u1/points/3: ...".
+std::string rebased(std::string_view message, std::string_view ptr) {
+  constexpr std::string_view top = "(top level)";
+  if (message.substr(0, top.size()) == top) return cat(ptr, message.substr(top.size()));
+  if (!message.empty() && message[0] == '/') return cat(ptr, message);
+  return cat(ptr, ": ", message);
+}
+
+
+}  // namespace
+
 // A face of a volume sampled for the data check: face u_i at (i, v, w), v_j at
 // (u, j, w), w_k at (u, v, k), the face's own parameters running over [0, 1]².
 DataSet face_data(const BSplineSurface& f, std::size_t axis, double fixed, std::string pointer) {
@@ -37,15 +50,6 @@ DataSet face_data(const BSplineSurface& f, std::size_t axis, double fixed, std::
   d.points.assign(g.values().begin(), g.values().end());
   d.pointer = std::move(pointer);
   return d;
-}
-
-// A message of a nested spec, whose places are pointers from the nested object,
-// placed under `ptr`: "/points/3: ..." becomes "/faces/u1/points/3: ...".
-std::string rebased(std::string_view message, std::string_view ptr) {
-  constexpr std::string_view top = "(top level)";
-  if (message.substr(0, top.size()) == top) return cat(ptr, message.substr(top.size()));
-  if (!message.empty() && message[0] == '/') return cat(ptr, message);
-  return cat(ptr, ": ", message);
 }
 
 // A surface spec inside a volume spec (a face, a cross-derivative field): built by
@@ -80,8 +84,6 @@ BSplineSurface face_surface(const json& j, const std::string& ptr, Context& ctx)
          "); a face needs one");
   return std::get<BSplineSurface>(exact_form(c));
 }
-
-}  // namespace
 
 Construction build_trilinear(const json& spec, Context& ctx) {
   std::array<Vec3, 8> p;
