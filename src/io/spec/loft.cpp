@@ -27,6 +27,21 @@ std::vector<std::optional<BSplineCurve>> curve_array(const json& spec, const cha
   return read_curve_list(items, ptrs, ctx);
 }
 
+// The options both lofts take: degree, param (a name or the places), periodic; the
+// param's name as info shows it ("given" for places).
+template <class Options>
+std::string across_options(const json& spec, Options& o) {
+  if (const json* d = find_member(spec, "degree")) o.degree = degree_value(*d, "/degree");
+  o.periodic = periodic_flags(spec, "", 1)[0];
+  o.spec_pointers = true;
+  if (const json* p = find_member(spec, "param"); p != nullptr && p->is_array()) {
+    o.params = numbers(*p, "/param", "an array of numbers, one per section");
+    return "given";
+  }
+  o.param = parametrization(spec, "");
+  return param_name(o.param);
+}
+
 }  // namespace
 
 Construction build_loft(const json& spec, Context& ctx) {
@@ -36,19 +51,9 @@ Construction build_loft(const json& spec, Context& ctx) {
   std::vector<BSplineCurve> sections;
   for (auto& c : curve_array(spec, "sections", false, ctx)) sections.push_back(std::move(*c));
   LoftOptions o;
-  if (const json* d = find_member(spec, "degree")) o.degree = degree_value(*d, "/degree");
-  std::string param = "chord";
-  if (const json* p = find_member(spec, "param"); p != nullptr && p->is_array()) {
-    o.params = numbers(*p, "/param", "an array of numbers, one per section");
-    param = "given";
-  } else {
-    o.param = parametrization(spec, "");
-    param = param_name(o.param);
-  }
-  o.periodic = periodic_flags(spec, "", 1)[0];
+  const std::string param = across_options(spec, o);
   o.tolerance = tolerance_of(spec);
   if (find_member(spec, "tangents") != nullptr) o.tangents = curve_array(spec, "tangents", true, ctx);
-  o.spec_pointers = true;
   ctx.parsed();
   // The library's messages name their sections, tangents and parameters by pointer.
   LoftSurface built = loft(sections, o);
@@ -92,17 +97,7 @@ Construction build_loft_volume(const json& spec, Context& ctx) {
   std::vector<BSplineSurface> sections;
   for (std::size_t k = 0; k < given.size(); ++k) sections.push_back(face_surface(given[k], child("/sections", k), ctx));
   LoftVolumeOptions o;
-  if (const json* d = find_member(spec, "degree")) o.degree = degree_value(*d, "/degree");
-  std::string param = "chord";
-  if (const json* p = find_member(spec, "param"); p != nullptr && p->is_array()) {
-    o.params = numbers(*p, "/param", "an array of numbers, one per section");
-    param = "given";
-  } else {
-    o.param = parametrization(spec, "");
-    param = param_name(o.param);
-  }
-  o.periodic = periodic_flags(spec, "", 1)[0];
-  o.spec_pointers = true;
+  const std::string param = across_options(spec, o);
   ctx.parsed();
   LoftVolume built = loft_volume(sections, o);
   const LoftVolumeReport& r = built.report;
