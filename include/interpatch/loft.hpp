@@ -43,6 +43,13 @@ struct LoftOptions {
   /// each over its own domain, taken at the same u as its section (turned and shifted
   /// with it). Open lofts of polynomial sections only.
   std::vector<std::optional<BSplineCurve>> tangents;
+  /// Curves that run across the sections, from the first to the last. With them the
+  /// loft is the Gordon surface of the network (curve_network) whose u-curves are the
+  /// sections and whose v-curves are the guides: curves in any order and direction,
+  /// crossing at different parameters, re-expressed to cross at common ones; `param`
+  /// and `degree` then come from the network (`params` gives the sections' v), and
+  /// tangents are not taken.
+  std::vector<BSplineCurve> guides;
   /// Messages name sections, tangents and given parameters as "sections[3]",
   /// "tangents[1]", "params[2]"; with spec_pointers, by JSON Pointer into a loft spec:
   /// "/sections/3", "/tangents/1", "/param/2".
@@ -75,6 +82,9 @@ struct LoftReport {
   /// and the sections were re-expressed on common knots within the tolerance (on fewer
   /// knots than merging makes; otherwise they are merged).
   bool reexpressed = false;
+  /// With guides: how each guide was used (its map runs along v), and what the network found.
+  std::vector<LoftSectionReport> guides;
+  std::optional<NetworkReport> network;
   std::size_t merged_knots = 0;   ///< the size of the knot vector merging makes (or would have made)
   std::size_t section_knots = 0;  ///< the largest section's knot count, at the common degree
   double max_deviation = 0;       ///< the largest section deviation
@@ -123,7 +133,9 @@ struct LoftSurface {
 ///   sections at the same place everywhere), non_increasing, out_of_domain and
 ///   size_mismatch (given parameters), size_mismatch (tangents), wrong_type
 ///   (tangents of a periodic loft or of rational sections), tolerance_not_met (the
-///   sections cannot be re-expressed within the tolerance), invalid_weight (rational
+///   sections cannot be re-expressed within the tolerance; with guides, a curve the
+///   surface departs from by more than 4 times the tolerance), the errors of
+///   curve_network with guides (network_gap, network_order), invalid_weight (rational
 ///   sections whose weights, interpolated across, fall to 0), ill_conditioned (a
 ///   section not reproduced).
 [[nodiscard]] LoftSurface loft(std::span<const BSplineCurve> sections, const LoftOptions& options = {});

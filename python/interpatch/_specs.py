@@ -395,7 +395,8 @@ def curve_network(u_curves: Sequence[_CurveLike], v_curves: Sequence[_CurveLike]
 
 def loft(sections: Sequence[_CurveLike], degree: Optional[int] = None, param: Union[str, Sequence[float], None] = None,
          periodic: Optional[bool] = None, tolerance: Optional[float] = None,
-         tangents: Optional[Sequence[Optional[_CurveLike]]] = None) -> Surface:
+         tangents: Optional[Sequence[Optional[_CurveLike]]] = None,
+         guides: Optional[Sequence[_CurveLike]] = None) -> Surface:
     """The surface through a row of section curves (Curve objects, or arrays of points
     to interpolate): S(u, v_k) = C_k(u), C^(q-1) across (docs/spec-format.md, type
     loft). Closed sections given from other starts or the other way round are turned
@@ -403,7 +404,9 @@ def loft(sections: Sequence[_CurveLike], degree: Optional[int] = None, param: Un
     (default 3, lowered for few sections); `param` "chord" (default), "centripetal",
     "uniform" or the v_k; `periodic` closes it across the sections; `tolerance` for
     closed ends and the re-expression of sections with unrelated knots; `tangents`
-    dS/dv at the first and last section, or one per section (None for none).
+    dS/dv at the first and last section, or one per section (None for none); `guides`
+    curves across the sections: the loft is then the Gordon surface of sections and
+    guides (as curve_network).
 
     Examples
     --------
@@ -422,11 +425,17 @@ def loft(sections: Sequence[_CurveLike], degree: Optional[int] = None, param: Un
     >>> duct = interpatch.loft([[[0, 0, 0], [1, 0, 0]], [[0, 0, 1], [1, 0, 1]]], param=[0, 1], periodic=False,
     ...                        tangents=[interpatch.line([0, 1, 0], [0, 1, 0]), interpatch.line([0, -1, 0], [0, -1, 0])])
     >>> duct.point(0.5, 0.5).round(6).tolist()                        # bulges by a quarter of the tangent
-    [0.5, 0.25, 0.5]"""
+    [0.5, 0.25, 0.5]
+    >>> arch = interpatch.loft([[[0, 0, 0], [1, 0, 0]], [[1, 2, 0], [0, 2, 0]]],   # the second given the other way
+    ...                        guides=[[[0, 0, 0], [0, 1, 1], [0, 2, 0]], [[1, 0, 0], [1, 1, 1], [1, 2, 0]]])
+    >>> arch.point(0.5, 0.5).round(6).tolist(), arch.info()["parameters"]["loft_sections"]["/sections/1"]["reversed"]
+    ([0.5, 1.0, 1.0], True)"""
     a = _Arrays()
     spec: dict[str, Any] = {"type": "loft", "sections": [_curve(c, a, f"sections[{i}]") for i, c in enumerate(sections)]}
     if tangents is not None:
         spec["tangents"] = [None if c is None else _curve(c, a, f"tangents[{i}]") for i, c in enumerate(tangents)]
+    if guides is not None:
+        spec["guides"] = [_curve(c, a, f"guides[{i}]") for i, c in enumerate(guides)]
     if param is not None and not isinstance(param, str):
         param = _reals(param, "param")
     return cast(Surface, _build(_options(spec, degree=degree, param=param, periodic=periodic, tolerance=tolerance), ".",

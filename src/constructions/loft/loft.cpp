@@ -294,12 +294,58 @@ void check_sections(LoftSurface& out, std::span<const BSplineCurve> given, const
   }
 }
 
+// With guides: the Gordon surface of the network of sections (u-curves) and guides
+// (v-curves), its exact form, and each curve within 4 times the tolerance (curves
+// missing each other by the tolerance move the surface by half of it, the
+// re-expression by half more, and the cardinal functions spread a correction by less
+// than twice).
+LoftSurface loft_with_guides(std::span<const BSplineCurve> given, const LoftOptions& o, const Names& names) {
+  if (std::any_of(o.tangents.begin(), o.tangents.end(), [](const auto& t) { return t.has_value(); }))
+    fail(errc::wrong_type, names.whole("tangents"), ": a loft with guides takes its slopes from them, not tangents");
+  const Frame f = frame_of(given, o.tolerance);
+  bool closed = true;
+  for (const BSplineCurve& c : given)
+    closed = closed && (c.periodic() || distance(c.point(c.domain().first), c.point(c.domain().second)) <= f.tol);
+  CurveNetwork net{{given.begin(), given.end()}, o.guides, {}, o.params, {closed, o.periodic}};
+  NetworkOptions no;
+  no.tolerance = o.tolerance;
+  no.curve_name = [&](int family, std::size_t i) { return family == 0 ? names.section(i) : names.at("guides", i); };
+  NetworkSurface ns = network_surface(net, no);
+  LoftSurface out{ns.surface.to_bspline(), LoftReport{}};
+  LoftReport& r = out.report;
+  r.closed = closed;
+  r.degree_u = out.surface.degree_u();
+  r.degree_v = out.surface.degree_v();
+  r.tolerance = ns.report.tolerance;
+  r.diagonal = ns.report.diagonal;
+  r.params = ns.report.v_params;
+  if (o.periodic && r.params.size() == given.size()) r.params.push_back(1.0);
+  const auto used = [&](const NetworkCurveReport& c, std::size_t i, int family) {
+    LoftSectionReport s;
+    s.closed = family == 0 && closed;
+    s.reversed = c.reversed;
+    s.map = c.map;
+    s.deviation = c.distance;
+    r.reexpressed = r.reexpressed || c.reexpressed;
+    r.max_deviation = std::max(r.max_deviation, c.distance);
+    if (!(c.distance <= 4 * r.tolerance))
+      fail(errc::tolerance_not_met, family == 0 ? names.section(i) : names.at("guides", i),
+           ": the loft departs from it by ", c.distance, ", more than 4 times the tolerance ", r.tolerance);
+    return s;
+  };
+  for (std::size_t i = 0; i < ns.report.u_curves.size(); ++i) r.sections.push_back(used(ns.report.u_curves[i], i, 0));
+  for (std::size_t i = 0; i < ns.report.v_curves.size(); ++i) r.guides.push_back(used(ns.report.v_curves[i], i, 1));
+  r.network = std::move(ns.report);
+  return out;
+}
+
 }  // namespace
 
 LoftSurface loft(std::span<const BSplineCurve> given, const LoftOptions& o) {
   const std::size_t n = given.size();
   const Names names{o.spec_pointers};
   if (n < 2) fail(errc::too_few_points, "a loft needs at least 2 sections, got ", n);
+  if (!o.guides.empty()) return loft_with_guides(given, o, names);
   if (o.degree < 1 || o.degree > max_degree) fail(errc::invalid_degree, "degree ", o.degree, " is outside 1..", max_degree);
   std::vector<std::size_t> tangent_given;
   const std::vector<const BSplineCurve*> tangent = tangent_slots(o, n, names, tangent_given);

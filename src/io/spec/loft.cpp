@@ -54,6 +54,8 @@ Construction build_loft(const json& spec, Context& ctx) {
   const std::string param = across_options(spec, o);
   o.tolerance = tolerance_of(spec);
   if (find_member(spec, "tangents") != nullptr) o.tangents = curve_array(spec, "tangents", true, ctx);
+  if (find_member(spec, "guides") != nullptr)
+    for (auto& c : curve_array(spec, "guides", false, ctx)) o.guides.push_back(std::move(*c));
   ctx.parsed();
   // The library's messages name their sections, tangents and parameters by pointer.
   LoftSurface built = loft(sections, o);
@@ -70,6 +72,13 @@ Construction build_loft(const json& spec, Context& ctx) {
     if (k < o.tangents.size() || (o.tangents.size() == 2 && k + 1 == sections.size()))
       if (s.tangent_deviation > 0) reported[ptr]["tangent_deviation"] = s.tangent_deviation;
   }
+  // Guides run along v: each against S(u_i, v) through its map.
+  nlohmann::ordered_json guides = nlohmann::ordered_json::object();
+  for (std::size_t i = 0; i < r.guides.size(); ++i) {
+    const std::string ptr = child("/guides", i);
+    data.push_back(curve_data(o.guides[i], 1, r.network->u_params[i], ptr, r.guides[i].map));
+    guides[ptr] = {{"reversed", r.guides[i].reversed}, {"deviation", r.guides[i].deviation}};
+  }
   nlohmann::ordered_json parameters = {{"degree", {r.degree_u, r.degree_v}},
                                        {"param", param},
                                        {"params", r.params},
@@ -82,6 +91,11 @@ Construction build_loft(const json& spec, Context& ctx) {
                                        {"max_deviation", r.max_deviation},
                                        {"tolerance", r.tolerance}};
   parameters["loft_sections"] = std::move(reported);
+  if (r.network) {
+    parameters.erase("knots");
+    parameters["guides"] = std::move(guides);
+    parameters["crossings"] = {{"max_gap", r.network->max_gap}, {"tolerance", r.network->tolerance}};
+  }
   Construction c;
   c.type = "loft";
   c.exact = std::move(built.surface);
