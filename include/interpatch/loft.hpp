@@ -33,15 +33,19 @@ struct LoftOptions {
   /// Closed across the sections: the first section follows the last (a ring of
   /// sections makes a torus), C^(q−1) across that seam too.
   bool periodic = false;
-  /// How close the ends of an open section must be for it to be closed, and how far
-  /// a section may move when the merged knots would grow too many and the sections are
-  /// re-expressed on common knots. Unset: 1e-7 of the diagonal of the sections'
-  /// control points.
+  /// How close the ends of an open-knotted section must be for it to be closed, and how
+  /// far a section may move when the merged knots would grow too many and the sections
+  /// are re-expressed on common knots. Unset: 1e-7 of the diagonal of the sections'
+  /// control points (or 16 units in the last place of the largest coordinate, where
+  /// that is more: a small part far from the origin).
   std::optional<double> tolerance;
   /// ∂S/∂v along sections: none; two, at the first and the last section; or one per
-  /// section, where an empty entry leaves that section free. Curves in any form,
-  /// each over its own domain, taken at the same u as its section (turned and shifted
-  /// with it). Open lofts of polynomial sections only.
+  /// section, where an empty entry leaves that section free. Polynomial curves in any
+  /// form, each over its own domain, taken at the same u as its section (turned and
+  /// shifted with it: a closed section's tangent is periodic when its section is, and
+  /// its ends meet otherwise). Not for periodic lofts, nor for rational sections; a
+  /// degree of 2 or more across. The tangents count with the sections for degree_u
+  /// and the knots.
   std::vector<std::optional<BSplineCurve>> tangents;
   /// Curves that run across the sections, from the first to the last. With them the
   /// loft is the Gordon surface of the network (curve_network) whose u-curves are the
@@ -106,7 +110,9 @@ struct LoftSurface {
 /// its spans evenly (64 or more candidates), so the surface does not twist and sections given with other
 /// starts at those points or the other way round make the same surface. The first
 /// section sets the seam and the direction. Periodic sections make a surface periodic
-/// in u; closed open-knotted ones a surface whose edges u = 0 and u = 1 meet.
+/// in u; closed open-knotted ones (or a mix of both kinds, all then taken open-knotted)
+/// a surface whose edges u = 0 and u = 1 meet; restarting such a section joins its
+/// ends at their midpoint, which moves it by half their gap at most.
 /// Every result is checked before it is returned: each section within rounding (or
 /// the re-expression's tolerance) of the surface along v = v_k.
 ///
@@ -132,9 +138,9 @@ struct LoftSurface {
 ///   closing_gap (closed and open sections mixed, naming both), zero_chord (two
 ///   sections at the same place everywhere), non_increasing, out_of_domain and
 ///   size_mismatch (given parameters), size_mismatch (tangents), wrong_type
-///   (tangents of a periodic loft or of rational sections), tolerance_not_met (the
-///   sections cannot be re-expressed within the tolerance; with guides, a curve the
-///   surface departs from by more than 4 times the tolerance), the errors of
+///   (tangents of a periodic loft or of rational sections), tolerance_not_met (with
+///   guides, a curve the surface departs from by more than 4 times the tolerance; sections
+///   that cannot be re-expressed within the tolerance are merged instead), the errors of
 ///   curve_network with guides (network_gap, network_order), invalid_weight (rational
 ///   sections whose weights, interpolated across, fall to 0), ill_conditioned (a
 ///   section not reproduced).

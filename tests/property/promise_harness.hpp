@@ -320,6 +320,19 @@ inline std::vector<double> random_periodic_knots(std::mt19937_64& g, int p, std:
   return k;
 }
 
+/// A periodic B-spline curve of degree p on random periodic knots over [0, 1] with the
+/// control points q.
+inline Tensor random_periodic_curve(std::mt19937_64& g, int p, const std::vector<Vec3>& q) {
+  Tensor t;
+  t.dims = 1;
+  t.p[0] = p;
+  t.n[0] = q.size();
+  t.periodic[0] = true;
+  t.knots[0] = random_periodic_knots(g, p, q.size());
+  t.cp = q;
+  return t;
+}
+
 /// A random polynomial B-spline of `dims` parameters over [0, 1]^dims: control
 /// point (i, j, k) near the frame's image of (i, j, k) / count (a gently bent
 /// block), `noise` of that; a periodic direction's control points go round a
@@ -530,16 +543,9 @@ inline std::optional<Tensor> own_interpolant(const std::vector<Vec3>& q, const s
   return c;
 }
 
-/// The 1-norm condition number ||A|| ||A^-1|| of the collocation matrix of degree p
-/// at `t` with averaged knots (A^-1 column by column: n <= 8 here).
-inline double own_condition(const std::vector<double>& t, int p) {
-  const auto k = averaged_knots(t, p);
-  const std::size_t n = t.size();
-  std::vector<double> A(n * n, 0.0);
-  for (std::size_t r = 0; r < n; ++r) {
-    const Basis b = own_basis(k, p, t[r]);
-    for (std::size_t j = 0; j < b.N.size(); ++j) A[r * n + static_cast<std::size_t>(b.first) + j] = b.N[j];
-  }
+/// The 1-norm condition number ||A|| ||A^-1|| of an n × n matrix (A^-1 column by
+/// column: small n only); infinite when A is singular.
+inline double own_matrix_condition(const std::vector<double>& A, std::size_t n) {
   double norm_a = 0, norm_inv = 0;
   for (std::size_t c = 0; c < n; ++c) {
     double col = 0;
@@ -553,6 +559,19 @@ inline double own_condition(const std::vector<double>& t, int p) {
     norm_inv = std::max(norm_inv, s);
   }
   return norm_a * norm_inv;
+}
+
+/// The 1-norm condition number of the collocation matrix of degree p at `t` with
+/// averaged knots (n <= 8 here).
+inline double own_condition(const std::vector<double>& t, int p) {
+  const auto k = averaged_knots(t, p);
+  const std::size_t n = t.size();
+  std::vector<double> A(n * n, 0.0);
+  for (std::size_t r = 0; r < n; ++r) {
+    const Basis b = own_basis(k, p, t[r]);
+    for (std::size_t j = 0; j < b.N.size(); ++j) A[r * n + static_cast<std::size_t>(b.first) + j] = b.N[j];
+  }
+  return own_matrix_condition(A, n);
 }
 
 /// A curve Tensor evaluated over [0, 1] mapped onto its domain.

@@ -73,13 +73,7 @@ SpecCurve random_closed_curve(std::mt19937_64& g, const Frame& f, double z) {
   for (const Vec3& x : q) c.box.add(x);
   if (chance(g, 0.5)) {
     const int p = pick(g, 1, static_cast<int>(n) - 1);
-    Tensor t;
-    t.dims = 1;
-    t.p[0] = p;
-    t.n[0] = n;
-    t.periodic[0] = true;
-    t.knots[0] = random_periodic_knots(g, p, n);
-    t.cp = q;
+    Tensor t = random_periodic_curve(g, p, q);
     c.spec = curve_spec(t);
     c.eval = unit_eval(std::move(t));
     return c;

@@ -10,8 +10,9 @@
 namespace interpatch::detail {
 
 std::vector<double> across_params(std::size_t n, std::size_t lines, const std::function<Vec3(std::size_t, std::size_t)>& point,
-                                  Parametrization param, bool periodic,
+                                  Parametrization param, bool periodic, double largest,
                                   const std::function<std::string(std::size_t)>& name) {
+  const double root = root_scale(scale_exponent(largest));
   const std::size_t chords = periodic ? n : n - 1;
   std::vector<double> v(n, 0.0);
   if (param == Parametrization::uniform) {
@@ -25,7 +26,7 @@ std::vector<double> across_params(std::size_t n, std::size_t lines, const std::f
     double total = 0;
     for (std::size_t k = 0; k < chords; ++k) {
       const double c = distance(point(k, i), point((k + 1) % n, i));
-      d[k] = param == Parametrization::centripetal ? std::sqrt(c) : c;
+      d[k] = param == Parametrization::centripetal ? std::sqrt(c * root) : c;
       total += d[k];
     }
     if (!(total > 0)) continue;

@@ -19,11 +19,13 @@ namespace interpatch::detail {
 /// between point(k, i) and point(k + 1, i), i one of `lines` lines across (points at
 /// equal parameters of the sections), each line scaled to run from 0 to 1 and the lines
 /// averaged; lines of zero length (an apex the sections share) are left out. Periodic:
-/// the closing chord too, v in [0, 1). name(k) names section k in messages.
+/// the closing chord too, v in [0, 1). `largest`: the data's largest coordinate, whose
+/// exponent keeps centripetal places exact under scaling by powers of two (root_scale).
+/// name(k) names section k in messages.
 /// @throws error zero_chord (two neighbouring sections at one place on every line).
 std::vector<double> across_params(std::size_t n, std::size_t lines,
                                   const std::function<Vec3(std::size_t, std::size_t)>& point, Parametrization param,
-                                  bool periodic, const std::function<std::string(std::size_t)>& name);
+                                  bool periodic, double largest, const std::function<std::string(std::size_t)>& name);
 
 /// Given places: n of them, finite, increasing, from 0 to 1 (periodic: to below 1).
 /// at(k) names entry k, `whole` the array.

@@ -32,6 +32,7 @@ struct PreparedSection {
   bool closed = false;
   bool reversed = false;
   double shift = 0;  ///< where u = 0 falls on the section (over [0, 1], after turning)
+  double gap = 0;    ///< how far apart the ends of an open-knotted closed section are
 };
 
 /// How a section's own parameter follows the surface's u: over its own domain [lo, hi].

@@ -134,7 +134,7 @@ LoftVolume loft_volume(std::span<const BSplineSurface> given, const LoftVolumeOp
         [&](std::size_t k, std::size_t i) {
           return s[k].point(static_cast<double>(i / side) / (side - 1), static_cast<double>(i % side) / (side - 1));
         },
-        o.param, o.periodic, name);
+        o.param, o.periodic, largest, name);
   }
   const int q = std::min<int>(o.degree, static_cast<int>(n) - 1);
   const bool rational = std::any_of(s.begin(), s.end(), [](const BSplineSurface& x) { return x.rational(); });
