@@ -38,7 +38,8 @@ TEST_DEBS := libgtest-dev libgmock-dev pkg-config python3-numpy python3-scipy py
         chromium chromium-driver python3-selenium libopenmpi-dev openmpi-bin
 # The benchmarks: `make bench` adds these.
 #   libbenchmark-dev                 Google Benchmark (bench/interpatch_bench)
-#   libocct-*-dev libsisl-dev        OpenCASCADE and SISL race interpatch (bench/compare)
+#   libocct-*-dev libsisl-dev        OpenCASCADE and SISL race interpatch (bench/compare);
+#                                    OpenCASCADE's ThruSections lofts (bench/loft_compare)
 #   python3-matplotlib               make bench draws docs/bench_interpolation.png; its
 #                                    terrain DEM feeds bench/scattered_terrain.py
 #   python3-scipy                    tools/bench_fitpack.py races FITPACK (run by hand);
@@ -161,6 +162,9 @@ BENCH_OUT ?= build/bench/results.json
 # docs/bench_interpolation.png and prints the Markdown tables of docs/BENCHMARKS.md.
 COMPARE_FLAGS ?= --reps 5
 COMPARE_OUT ?= build/bench/compare.json
+# bench/loft_compare last: interpatch's loft against OpenCASCADE's ThruSections on the
+# same section points, both on one thread (ThruSections runs on one).
+LOFT_COMPARE_OUT ?= build/bench/loft_compare.json
 bench: bench-deps viewer-deps
 	cmake --preset bench
 	cmake --build --preset bench -j $(JOBS)
@@ -170,6 +174,7 @@ bench: bench-deps viewer-deps
 	env $(BENCH_ENV) ./build/bench/bench/compare $(COMPARE_FLAGS) --json $(COMPARE_OUT) \
 	  --workdir build/bench/compare-work --commit "$$(git describe --always --dirty 2>/dev/null || echo unknown)"
 	/usr/bin/python3 tools/plot_bench.py $(COMPARE_OUT) -o docs/bench_interpolation.png
+	env $(BENCH_ENV) OMP_NUM_THREADS=1 ./build/bench/bench/loft_compare --json $(LOFT_COMPARE_OUT)
 
 # The README's pictures: viewer pages of the examples rendered to docs/images/*.png
 # by headless Chromium (tools/make_pictures.py; the test list brings the browser).
