@@ -179,23 +179,51 @@ Reparametrization section_map(const PreparedSection& s, double lo, double hi) {
   return m;
 }
 
+namespace {
+
+// Points t_i along a section: closed, m of them over [0, 1); open, from 0 to 1.
+std::vector<double> sample_params(std::size_t m, bool closed) {
+  std::vector<double> t(m);
+  for (std::size_t i = 0; i < m; ++i)
+    t[i] = closed ? static_cast<double>(i) / static_cast<double>(m) : static_cast<double>(i) / static_cast<double>(m - 1);
+  return t;
+}
+
+struct Candidate {
+  bool reversed;
+  double start;
+  double sum = 0;
+};
+
+// Each candidate's sum against the reference's samples at t, in its own slot: the same
+// bits for any thread count.
+void score(std::vector<Candidate>& cands, const BSplineCurve& given, const BSplineCurve& turned,
+           const std::vector<double>& t, bool closed, const std::vector<Vec3>& ref, const Vec3& near) {
+  const std::size_t work = cands.size() * t.size() * 60;
+  parallel_for(cands.size(), work >= parallel_min_work, Share::blocks, [&](std::size_t i) {
+    Candidate& cd = cands[i];
+    cd.sum = twist(cd.reversed ? turned : given, t, cd.start, closed, ref, near);
+  });
+}
+
+}  // namespace
+
 void align_sections(std::vector<PreparedSection>& sections, bool closed) {
-  std::vector<Vec3> ref;
+  // Every candidate is scored at 32 points first, and the 8 best again at 128 or more
+  // (4 a span of the denser of the two sections): the best start is far ahead of the
+  // others at either count, and most of the evaluations are saved.
+  constexpr std::size_t coarse = 32, kept = 8;
+  std::vector<Vec3> ref, ref_coarse;
+  const std::vector<double> tc = sample_params(coarse, closed);
   for (std::size_t k = 1; k < sections.size(); ++k) {
     PreparedSection& s = sections[k];
     const std::size_t m = std::max<std::size_t>({128, 4 * span_count(sections[k - 1].curve), 4 * span_count(s.curve)});
-    std::vector<double> t(m);
-    for (std::size_t i = 0; i < m; ++i)
-      t[i] = closed ? static_cast<double>(i) / static_cast<double>(m) : static_cast<double>(i) / static_cast<double>(m - 1);
+    const std::vector<double> t = sample_params(m, closed);
     centred_samples(sections[k - 1].curve, t, ref);
+    centred_samples(sections[k - 1].curve, tc, ref_coarse);
     const BSplineCurve turned = reversed_curve(s.curve);
     Vec3 near{0, 0, 0};
     for (const Vec3& p : s.curve.control_points()) near += p / static_cast<double>(s.curve.control_points().size());
-    struct Candidate {
-      bool reversed;
-      double start;
-      double sum = 0;
-    };
     std::vector<Candidate> cands;
     for (bool rev : {false, true}) {
       const BSplineCurve& c = rev ? turned : s.curve;
@@ -203,12 +231,21 @@ void align_sections(std::vector<PreparedSection>& sections, bool closed) {
       else
         for (double x : candidate_starts(c)) cands.push_back({rev, x});
     }
-    // Each candidate's sum on its own, in its own slot: the same bits for any thread count.
-    const std::size_t work = cands.size() * m * 60;
-    parallel_for(cands.size(), work >= parallel_min_work, Share::blocks, [&](std::size_t i) {
-      Candidate& cd = cands[i];
-      cd.sum = twist(cd.reversed ? turned : s.curve, t, cd.start, closed, ref, near);
-    });
+    if (cands.size() > kept) {
+      score(cands, s.curve, turned, tc, closed, ref_coarse, near);
+      // The kept ones in their order as candidates, so that ties fall the same way.
+      std::vector<std::size_t> order(cands.size());
+      for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+      std::partial_sort(order.begin(), order.begin() + kept, order.end(), [&](std::size_t x, std::size_t y) {
+        return cands[x].sum < cands[y].sum || (cands[x].sum == cands[y].sum && x < y);
+      });
+      order.resize(kept);
+      std::sort(order.begin(), order.end());
+      std::vector<Candidate> best;
+      for (std::size_t i : order) best.push_back(cands[i]);
+      cands = std::move(best);
+    }
+    score(cands, s.curve, turned, t, closed, ref, near);
     std::size_t best = 0;
     for (std::size_t i = 1; i < cands.size(); ++i)
       if (cands[i].sum < cands[best].sum) best = i;
