@@ -2,7 +2,7 @@
 // (smooth, not ruled, not a solid) on the same section points.
 //
 //   loft_compare [--spec LOFT.json] [--cases wing,duct,duct_reversed] [--duct-counts 17,23,...]
-//                [--reps N] [--samples M] [--json OUT]
+//                [--reps N] [--samples M] [--tolerance T] [--json OUT]
 //
 // Cases:
 //   wing           the sections of a loft spec (default examples/loft_wing.json), each
@@ -557,6 +557,7 @@ struct Options {
   int reps = 20;
   int samples = 400;
   std::string json_out;
+  std::optional<double> tolerance;  // interpatch's loft tolerance (its default: 1e-7 of the diagonal)
 };
 
 std::string fmt(const char* f, double x) {
@@ -616,10 +617,12 @@ json run_case(const Case& c, const Options& o) {
   std::vector<Closest> ip_closest;
   {
     std::optional<interpatch::LoftSurface> made;
-    const double loft_ms = best_ms(o.reps, [&] { made = interpatch::loft(ip); });
+    interpatch::LoftOptions lo;
+    lo.tolerance = o.tolerance;
+    const double loft_ms = best_ms(o.reps, [&] { made = interpatch::loft(ip, lo); });
     const double job_ms = best_ms(o.reps, [&] {
       const auto cs = ip_curves(c);
-      made = interpatch::loft(cs);
+      made = interpatch::loft(cs, lo);
     });
     const BSplineSurface& s = made->surface;
     const interpatch::LoftReport& r = made->report;
@@ -770,9 +773,11 @@ Options parse(int argc, char** argv) {
       o.samples = std::max(2, std::stoi(value()));
     } else if (a == "--json") {
       o.json_out = value();
+    } else if (a == "--tolerance") {
+      o.tolerance = std::stod(value());
     } else {
       throw std::runtime_error("usage: loft_compare [--spec LOFT.json] [--cases wing,duct,duct_reversed] "
-                               "[--duct-counts 17,23,...] [--reps N] [--samples M] [--json OUT]");
+                               "[--duct-counts 17,23,...] [--reps N] [--samples M] [--tolerance T] [--json OUT]");
     }
   }
   return o;

@@ -191,7 +191,13 @@ std::optional<std::vector<BSplineCurve>> reexpressed(const std::vector<BSplineCu
   for (double target = tol; target >= 0.25 * tol; target *= 0.5) {
     std::vector<detail::Refit> fits;
     try {
-      fits = std::move(*detail::fit_group(jobs, all, start.interior, {}, periodic, target, 0, nullptr));
+      // The fit gives up at once (empty) when its distance calls for more halvings of
+      // every span than would keep the knots within 4 times the merged count (each
+      // halving divides the distance by 8 or more; most spans need fewer than the
+      // worst): a tolerance near rounding, where merging is exact and smaller.
+      auto got = detail::fit_group(jobs, all, start.interior, {}, periodic, target, 4 * merged, nullptr);
+      if (!got) return std::nullopt;
+      fits = std::move(*got);
     } catch (const detail::RefitShortfall&) {
       return std::nullopt;
     }
