@@ -127,7 +127,11 @@ FamilyKnots family_knots(const std::vector<FitJob>& jobs, const std::vector<doub
 
 std::vector<Refit> refit(const std::vector<FitJob>& jobs, const std::vector<double>& nodes, bool closed, double target) {
   const std::size_t m = jobs.size();
-  auto [interior, own, all] = family_knots(jobs, nodes, closed);
+  // Not structured bindings: the lambda below captures `own` (clang before 16 refuses a binding).
+  const FamilyKnots knots = family_knots(jobs, nodes, closed);
+  const std::vector<double>& interior = knots.interior;
+  const std::vector<std::vector<double>>& own = knots.own;
+  const std::size_t all = knots.all;
   std::vector<std::size_t> family(m);
   std::iota(family.begin(), family.end(), 0);
   if (auto shared = fit_group(jobs, family, interior, nodes, closed, target, all, nullptr)) return std::move(*shared);
