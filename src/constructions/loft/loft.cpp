@@ -37,17 +37,9 @@ Reparametrization identity(bool closed) {
 
 // The largest |S(u, v) − C(u)| at 4 points of every span of the surface in u.
 double deviation(const BSplineSurface& s, double v, const BSplineCurve& c) {
-  std::vector<double> b{0.0};
-  for (const auto& [x, mult] : s.knots_u().interior_breaks())
-    if (x > 0.0 && x < 1.0) b.push_back(x);
-  b.push_back(1.0);
   double worst = 0;
-  for (std::size_t i = 0; i + 1 < b.size(); ++i)
-    for (int j = 0; j < 4; ++j) {
-      const double u = b[i] + (b[i + 1] - b[i]) * j / 4.0;
-      worst = std::max(worst, distance(s.point(u, v), c.point(u)));
-    }
-  return std::max(worst, distance(s.point(1.0, v), c.point(1.0)));
+  for (double u : detail::span_samples(s.knots_u())) worst = std::max(worst, distance(s.point(u, v), c.point(u)));
+  return worst;
 }
 
 // How messages name the loft's parts (LoftOptions::spec_pointers).

@@ -82,6 +82,18 @@ KnotVector open_knots(const std::vector<double>& v, const std::vector<bool>& der
 
 }  // namespace
 
+std::vector<double> span_samples(const KnotVector& k) {
+  std::vector<double> b{0.0};
+  for (const auto& [x, mult] : k.interior_breaks())
+    if (x > 0.0 && x < 1.0) b.push_back(x);
+  b.push_back(1.0);
+  std::vector<double> t;
+  for (std::size_t i = 0; i + 1 < b.size(); ++i)
+    for (int j = 0; j < 4; ++j) t.push_back(b[i] + (b[i + 1] - b[i]) * j / 4.0);
+  t.push_back(1.0);
+  return t;
+}
+
 KnotVector interpolate_across(std::vector<double>& rows, std::size_t width, const std::vector<double>& v,
                               const std::vector<bool>& derivative, const std::vector<Condition>& conds, int q,
                               bool periodic) {

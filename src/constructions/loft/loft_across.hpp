@@ -33,6 +33,10 @@ std::vector<double> across_params(std::size_t n, std::size_t lines,
 void check_given_params(const std::vector<double>& v, std::size_t n, bool periodic,
                         const std::function<std::string(std::size_t)>& at, const char* whole);
 
+/// 4 points of every span of a knot vector over [0, 1] (its distinct breaks), and 1:
+/// where a loft checks its sections.
+std::vector<double> span_samples(const KnotVector& k);
+
 /// `rows` holds one block of `width` doubles per condition of `conds` (a value, or a
 /// first derivative where derivative[k], at v_k; in the order Q_0, D_0, ..., D_{n−1},
 /// Q_{n−1}); solved in place into the control points across, degree q, and their knots

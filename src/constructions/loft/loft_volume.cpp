@@ -69,18 +69,7 @@ void check_sections(LoftVolume& out, std::span<const BSplineSurface> given, doub
   LoftVolumeReport& rep = out.report;
   const std::vector<double>& w = rep.params;
   const double bound = 1e-10 * rep.diagonal + 32 * std::numeric_limits<double>::epsilon() * largest;
-  const auto points_of = [](const KnotVector& k) {
-    std::vector<double> b{0.0};
-    for (const auto& [x, m] : k.interior_breaks())
-      if (x > 0.0 && x < 1.0) b.push_back(x);
-    b.push_back(1.0);
-    std::vector<double> t;
-    for (std::size_t i = 0; i + 1 < b.size(); ++i)
-      for (int j = 0; j < 4; ++j) t.push_back(b[i] + (b[i + 1] - b[i]) * j / 4.0);
-    t.push_back(1.0);
-    return t;
-  };
-  const std::vector<double> us = points_of(out.volume.knots_u()), vs = points_of(out.volume.knots_v());
+  const std::vector<double> us = detail::span_samples(out.volume.knots_u()), vs = detail::span_samples(out.volume.knots_v());
   for (std::size_t k = 0; k < given.size(); ++k) {
     const auto [u0, u1] = given[k].domain_u();
     const auto [v0, v1] = given[k].domain_v();

@@ -69,8 +69,9 @@ Construction build_loft(const json& spec, Context& ctx) {
     reported[ptr] = {{"closed", s.closed}, {"reversed", s.reversed}};
     if (s.closed) reported[ptr]["seam"] = s.map(0.0);  // where u = 0 falls on it
     reported[ptr]["deviation"] = s.deviation;
-    if (k < o.tangents.size() || (o.tangents.size() == 2 && k + 1 == sections.size()))
-      if (s.tangent_deviation > 0) reported[ptr]["tangent_deviation"] = s.tangent_deviation;
+    // The tangent given for this section, if any: one per section, or the first and the last.
+    const std::size_t n = sections.size(), t = o.tangents.size() == n ? k : (k == 0 ? 0 : (k + 1 == n ? 1 : 2));
+    if (t < o.tangents.size() && o.tangents[t]) reported[ptr]["tangent_deviation"] = s.tangent_deviation;
   }
   // Guides run along v: each against S(u_i, v) through its map.
   nlohmann::ordered_json guides = nlohmann::ordered_json::object();
