@@ -18,6 +18,7 @@
 #include "interpatch/error.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/io/json_out.hpp"
+#include "interpatch/io/project.hpp"
 #include "interpatch/io/view.hpp"
 #include "progress.hpp"
 
@@ -255,6 +256,39 @@ int info_command(const Input& in, const std::optional<fs::path>& out) {
   }
   report_warnings(warnings_of(b));
   return 0;
+}
+
+namespace {
+
+// What project and intersect share: the output's format checked first, the
+// construction built with its exact form deferred (the query makes it), the work under
+// a progress line.
+template <class Work>
+int query_command(const Input& in, const fs::path& out, const char* doing, Work&& work) {
+  as_usage([&] { io::check_projection_output(out); });
+  io::check_writable(out);
+  io::Built b = cli::build_any_input(in, {.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}});
+  {
+    ProgressLine progress(doing);
+    work(b, progress.callback());
+  }
+  report_warnings(warnings_of(b));
+  return 0;
+}
+
+}  // namespace
+
+int project_command(const Input& in, const fs::path& points, const fs::path& out) {
+  return query_command(in, out, "projecting", [&](io::Built& b, const progress_callback& progress) {
+    (void)io::write_projection(b, points, out, progress);
+  });
+}
+
+int intersect_command(const Input& in, const fs::path& rays, const fs::path& out) {
+  return query_command(in, out, "intersecting", [&](io::Built& b, const progress_callback& progress) {
+    if (curve_of(b)) throw usage_error("'" + in.path.string() + "' is a curve spec: rays meet surfaces");
+    (void)io::write_intersections(std::get<io::Construction>(b), rays, out, progress);
+  });
 }
 
 int view_command(const Input& in, const fs::path& out, std::string_view res_text) {

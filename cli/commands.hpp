@@ -115,6 +115,10 @@ int info_command(const Input& in, const std::optional<std::filesystem::path>& ou
 /// The viewer page (io::write_view); `res` empty: io::view_default_resolution.
 int view_command(const Input& in, const std::filesystem::path& out, std::string_view res);
 int demo_command(const std::filesystem::path& dir);
+/// The closest points of the construction to the points of a file (io::write_projection).
+int project_command(const Input& in, const std::filesystem::path& points, const std::filesystem::path& out);
+/// The hits of the rays of a file on a surface (io::write_intersections).
+int intersect_command(const Input& in, const std::filesystem::path& rays, const std::filesystem::path& out);
 
 /// Prints the warnings of a spec (ignored fields) on stderr.
 void report_warnings(const std::vector<std::string>& warnings);

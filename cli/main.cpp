@@ -1,4 +1,4 @@
-// The interpatch command: build, mesh, eval, info, view, demo.
+// The interpatch command: build, mesh, eval, info, view, project, intersect, demo.
 // Exit status: 0 ok, 2 bad usage, 3 invalid input, 4 files, 5 too large, 1 else;
 // every failure prints exactly one line on stderr, "interpatch: <message>".
 
@@ -64,13 +64,13 @@ int mpi_run(const interpatch::cli::MpiRequest& request, const std::function<int(
 
 // What the command line gives the subcommands.
 struct Options {
-  std::string spec, shape, out, res, grid, demo_dir = "interpatch-demo";
+  std::string spec, shape, out, res, grid, points, demo_dir = "interpatch-demo";
   std::optional<std::string> info_out;
 };
 
 // The subcommands, of which CLI11 marks the one given.
 struct Commands {
-  CLI::App *build, *mesh, *eval, *info, *view, *demo;
+  CLI::App *build, *mesh, *eval, *info, *view, *project, *intersect, *demo;
 };
 
 // SPEC and --shape, the same for the four commands that read a construction.
@@ -134,6 +134,24 @@ void add_viewers(CLI::App& app, Commands& c, Options& o, const std::string& foot
                      "Samples along u and v, NUxNV (default 257x257); for a volume NUxNVxNW (default 33x33x33);\n"
                      "more than the page holds (512x512, 65x65x65) are decimated for display");
 
+  // project and intersect: SPEC, a file of points (rays), -o.
+  const auto query = [&](const char* name, const char* about, const char* input, const char* input_help,
+                         const char* output_help) {
+    CLI::App* command = app.add_subcommand(name, about);
+    add_input(command, o, footer);
+    command->add_option(input, o.points, input_help)->required();
+    command->add_option("-o,--output", o.out, output_help)->required();
+    return command;
+  };
+  c.project = query("project", "The closest point of a curve or surface to each point of a file, or where a volume holds it",
+                    "POINTS", "Points: .npy of shape (..., 3) (float64 or float32), or .csv of x,y,z lines",
+                    "Output file: .npz (params, points, distance; volumes also inside), .npy (one row a point:\n"
+                    "the parameters, x, y, z, distance[, inside]) or .csv (the same with a header)");
+  c.intersect = query("intersect", "Every point where each ray of a file meets a surface", "RAYS",
+                      "Rays: .npy of shape (..., 2, 3), origin then direction, or .csv of 6 numbers a line",
+                      "Output file: .npz (ray, t, params, points; by ray, then t), .npy (one row a hit: ray, t,\n"
+                      "u, v, x, y, z) or .csv (the same with a header)");
+
   c.demo = app.add_subcommand("demo", "Run every construction on built-in examples");
   c.demo->add_option("-o,--output", o.demo_dir, "Directory for the outputs (created if missing; its parent must exist)")
       ->capture_default_str();
@@ -149,6 +167,8 @@ int run(const Commands& c, const Options& o) {
     if (*c.mesh) return cli::mesh_command(input, o.out, o.res);
     if (*c.eval) return cli::eval_command(input, o.out, o.grid);
     if (*c.view) return cli::view_command(input, o.out, o.res);
+    if (*c.project) return cli::project_command(input, o.points, o.out);
+    if (*c.intersect) return cli::intersect_command(input, o.points, o.out);
     if (*c.info) {
       std::optional<std::filesystem::path> out;
       if (o.info_out) out = *o.info_out;
@@ -187,8 +207,9 @@ int main(int argc, char** argv) {
   if (argc > 1 && argv[1][0] != '-') {
     const std::string first = argv[1];
     if (first != "build" && first != "mesh" && first != "eval" && first != "info" && first != "view" &&
-        first != "demo")
-      return cli::fail_with(2, "unknown command '" + first + "'; the commands are build, mesh, eval, info, view, demo (see interpatch --help)");
+        first != "project" && first != "intersect" && first != "demo")
+      return cli::fail_with(2, "unknown command '" + first +
+                                   "'; the commands are build, mesh, eval, info, view, project, intersect, demo (see interpatch --help)");
   }
 
   try {

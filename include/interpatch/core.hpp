@@ -24,6 +24,7 @@
 #include "interpatch/network.hpp"
 #include "interpatch/patches.hpp"
 #include "interpatch/progress.hpp"
+#include "interpatch/projection.hpp"
 #include "interpatch/surface.hpp"
 #include "interpatch/threads.hpp"
 #include "interpatch/vec3.hpp"

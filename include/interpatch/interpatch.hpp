@@ -13,6 +13,7 @@
 #include "interpatch/io/npy.hpp"
 #include "interpatch/io/npz.hpp"
 #include "interpatch/io/outputs.hpp"
+#include "interpatch/io/project.hpp"
 #include "interpatch/io/spec.hpp"
 #include "interpatch/io/step.hpp"
 #include "interpatch/io/view.hpp"

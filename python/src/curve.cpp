@@ -13,6 +13,7 @@
 
 #include "arrays.hpp"
 #include "inputs.hpp"
+#include "locate.hpp"
 #include "interpatch/error.hpp"
 #include "interpatch/io/json_out.hpp"
 #include "interpatch/io/outputs.hpp"
@@ -41,6 +42,16 @@ class PyCurve {
 
   [[nodiscard]] const std::string& type() const { return c_->form; }
   [[nodiscard]] int degree() const { return c_->curve.degree(); }
+
+  // The projector is cheap to make (a curve's pieces), so each call makes its own.
+  py::dict closest_points(const py::object& points) const {
+    std::unique_ptr<ip::CurveProjector> on;
+    {
+      py::gil_scoped_release free;
+      on = std::make_unique<ip::CurveProjector>(c_->curve);
+    }
+    return ip::python::closest_points(*on, points);
+  }
   [[nodiscard]] py::tuple domain() const {
     const auto [a, b] = c_->curve.domain();
     return py::make_tuple(a, b);
@@ -196,6 +207,10 @@ void bind_curve(py::module_& m) {
            "The unit tangent C'(t) / |C'(t)|, shape (3,); the zero vector where C' vanishes.")
       .def("curvature", &PyCurve::curvature, py::arg("t"),
            "The curvature |C' × C''| / |C'|³ at t (1 / radius); NaN where C' vanishes.")
+      .def("closest_points", &PyCurve::closest_points, py::arg("points"),
+           "The closest point of the curve to each point, shape (..., 3): a dict of params (...,), points "
+           "(..., 3) and distance (...,). The global answer: no point of the curve is nearer than distance "
+           "less 1e-10 of its diagonal.")
       .def("to_bspline", &PyCurve::to_bspline,
            "The exact B-spline form: {'degree': p, 'knots' (n + p + 1,; a closed curve's extended knots, "
            "n + 2p + 1), 'control_points' (n, 3), 'weights' (n,) or None, 'periodic': bool}; "

@@ -29,6 +29,7 @@
 #include "interpatch/io/view.hpp"
 #include "arrays.hpp"
 #include "curve.hpp"
+#include "locate.hpp"
 #include "inputs.hpp"
 
 namespace py = pybind11;
@@ -62,6 +63,9 @@ using Sources = std::map<std::string, py::object>;
 struct Built {
   ip::io::Construction c;
   std::mutex lock;
+  // Made on the first query and kept: the pieces of the exact form and their tree.
+  std::unique_ptr<const ip::SurfaceProjector> projector;
+  std::unique_ptr<const ip::VolumeLocator> locator;
 };
 
 // "(3, 3)", as Python prints a tuple.
@@ -318,7 +322,20 @@ class PySurface : public PyBuilt {
     return d;
   }
 
+  py::dict closest_points(const py::object& points) const { return ip::python::closest_points(projector(), points); }
+  py::dict intersect(const py::object& origins, const py::object& directions) const {
+    return ip::python::intersect(projector(), origins, directions);
+  }
+
  private:
+  // The projector over the exact form (made now if it is not yet), answering with its points.
+  const ip::SurfaceProjector& projector() const {
+    const ip::BSplineSurface& e = exact<ip::BSplineSurface>();
+    py::gil_scoped_release free;
+    std::lock_guard<std::mutex> hold(b_->lock);
+    if (!b_->projector) b_->projector = std::make_unique<const ip::SurfaceProjector>(e, e);
+    return *b_->projector;
+  }
   const ip::Surface& surface(std::size_t points, ip::io::Sample what) const {
     std::lock_guard<std::mutex> hold(b_->lock);
     return ip::io::evaluator(b_->c, points, what);
@@ -382,6 +399,18 @@ class PyVolume : public PyBuilt {
         e->rational() ? py::object(read_only(py::array_t<double>({n0, n1, n2}, e->weights().data(), keep))) : py::none();
     d["periodic"] = py::make_tuple(e->knots_u().periodic(), e->knots_v().periodic(), e->knots_w().periodic());
     return d;
+  }
+
+  py::dict locate(const py::object& points) const {
+    const ip::BSplineVolume& e = exact<ip::BSplineVolume>();
+    const ip::VolumeLocator* in = nullptr;
+    {
+      py::gil_scoped_release free;
+      std::lock_guard<std::mutex> hold(b_->lock);
+      if (!b_->locator) b_->locator = std::make_unique<const ip::VolumeLocator>(e, e);
+      in = b_->locator.get();
+    }
+    return ip::python::locate(*in, points);
   }
 };
 
@@ -494,6 +523,14 @@ void bind_constructions(py::module_& m) {
       .def("normal", &PySurface::normal, py::arg("u"), py::arg("v"), "The unit normal Su × Sv / |Su × Sv|, shape (3,).")
       .def("curvature", &PySurface::curvature, py::arg("u"), py::arg("v"),
            "{'gaussian', 'mean', 'k1', 'k2'} at (u, v), with respect to normal().")
+      .def("closest_points", &PySurface::closest_points, py::arg("points"),
+           "The closest point of the surface to each point, shape (..., 3): a dict of params (..., 2),\n"
+           "points (..., 3) and distance (...,). The global answer: no point of the surface is nearer than\n"
+           "distance less 1e-10 of its diagonal. Example: s.closest_points(scan)['distance'].max()")
+      .def("intersect", &PySurface::intersect, py::arg("origins"), py::arg("directions"),
+           "Every point where the rays origins[i] + t * directions[i], t >= 0, meet the surface\n"
+           "(origins (n, 3); directions (n, 3), or (3,) for all): a dict of ray (h,) int64, t (h,),\n"
+           "params (h, 2) and points (h, 3), by ray and then by t.")
       .def("to_bspline", &PySurface::to_bspline,
            "The exact B-spline form: {'degree': (p, q), 'knots_u', 'knots_v', 'control_points' (shape (nu, nv, 3)), "
            "'weights' (shape (nu, nv), or None), 'periodic': (bool, bool)}; the arrays view the construction's memory.")
@@ -513,7 +550,11 @@ void bind_constructions(py::module_& m) {
            "det J < 0 where the volume folds.")
       .def("point", &PyVolume::point, py::arg("u"), py::arg("v"), py::arg("w"), "S(u, v, w), shape (3,).")
       .def("to_bspline", &PyVolume::to_bspline,
-           "The exact B-spline form: degree (p, q, r), knots_u/v/w, control_points (n0, n1, n2, 3), weights or None.");
+           "The exact B-spline form: degree (p, q, r), knots_u/v/w, control_points (n0, n1, n2, 3), weights or None.")
+      .def("locate", &PyVolume::locate, py::arg("points"),
+           "The parameters of points of space, shape (..., 3): a dict of params (..., 3), points (..., 3),\n"
+           "inside (...,) bool and residual (...,). Inside: V(params) = the point within 1e-10 of the\n"
+           "diagonal; outside: params and points of the nearest point of the boundary, residual its distance.");
 }
 
 void bind_spec_fields(py::module_& m) {

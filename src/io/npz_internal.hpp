@@ -5,6 +5,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
+#include <ostream>
+#include <vector>
 #include <span>
 #include <string>
 
@@ -35,5 +38,36 @@ struct NpzFrame {
 };
 [[nodiscard]] NpzFrame exact_npz_frame(std::span<const int> degrees, std::span<const KnotVector* const> knots,
                                        std::span<const std::size_t> shape, std::uint32_t points_crc);
+
+/// An .npz archive of members whose sizes are known before their data (a dtype and
+/// a shape each): every member has its place in the file from the start, so pieces
+/// of different members can be written in any interleaving, each member's in order
+/// (a run that makes a row of every array at a time, streamed). The stream must
+/// seek (io::write_atomically's does).
+class NpzColumns {
+ public:
+  struct Member {
+    std::string name;   ///< without ".npy"
+    std::string descr;  ///< "<f8", "|b1", "<i8"
+    std::vector<std::size_t> shape;
+  };
+  explicit NpzColumns(const std::vector<Member>& members);
+  ~NpzColumns();
+  NpzColumns(const NpzColumns&) = delete;
+  NpzColumns& operator=(const NpzColumns&) = delete;
+  /// The archive's size in bytes.
+  [[nodiscard]] std::uint64_t total() const;
+  /// Every member's headers.
+  void begin(std::ostream& os);
+  /// The next n bytes of a member's data.
+  void append(std::ostream& os, std::size_t member, const void* bytes, std::size_t n);
+  /// The checksums and the directory. @throws error internal when a member did not
+  /// get all its bytes.
+  void finish(std::ostream& os);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> i_;
+};
 
 }  // namespace interpatch::io::internal

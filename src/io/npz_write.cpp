@@ -291,3 +291,65 @@ void write_exact_npz(const fs::path& path, const ExactForm& exact) { internal::w
 void write_exact_npz(const fs::path& path, const BSplineCurve& curve) { write_archive(path, view(curve), false); }
 
 }  // namespace interpatch::io
+
+namespace interpatch::io::internal {
+
+struct NpzColumns::Impl {
+  std::vector<std::string> names;  // the members' file names, which OutMember views
+  std::vector<OutMember> members;
+  std::vector<std::uint64_t> at;  // where each member's next bytes go
+  Layout layout;
+};
+
+NpzColumns::NpzColumns(const std::vector<Member>& members) : i_(std::make_unique<Impl>()) {
+  i_->names.reserve(members.size());
+  for (const Member& m : members) {
+    i_->names.push_back(m.name + ".npy");
+    const auto dtype = parse_npy_dtype(m.descr);
+    std::uint64_t count = 1;
+    for (const std::size_t e : m.shape) count *= e;
+    OutMember o{i_->names.back(), npy_header(m.descr, m.shape), {}, {}};
+    o.elsewhere = count * (dtype ? dtype->size : 8);
+    i_->members.push_back(std::move(o));
+  }
+  i_->layout = lay_out(i_->members, false);
+  for (const OutMember& m : i_->members) i_->at.push_back(m.offset + local_header(m).size() + m.head.size());
+}
+
+NpzColumns::~NpzColumns() = default;
+
+std::uint64_t NpzColumns::total() const { return i_->layout.total; }
+
+void NpzColumns::begin(std::ostream& os) {
+  for (OutMember& m : i_->members) {
+    os.seekp(static_cast<std::streamoff>(m.offset));
+    os << local_header(m) << m.head;  // its checksum 0 for now
+    m.crc = crc32(m.head.data(), m.head.size());
+  }
+}
+
+void NpzColumns::append(std::ostream& os, std::size_t member, const void* bytes, std::size_t n) {
+  OutMember& m = i_->members[member];
+  os.seekp(static_cast<std::streamoff>(i_->at[member]));
+  os.write(static_cast<const char*>(bytes), static_cast<std::streamsize>(n));
+  m.crc = crc32(bytes, n, m.crc);
+  i_->at[member] += n;
+}
+
+void NpzColumns::finish(std::ostream& os) {
+  for (std::size_t k = 0; k < i_->members.size(); ++k) {
+    const OutMember& m = i_->members[k];
+    if (i_->at[k] != m.offset + local_header(m).size() + m.size())
+      detail::fail(errc::internal, "the archive's member ", m.name, " got ", i_->at[k] - m.offset, " bytes of ",
+                   local_header(m).size() + m.size());
+    std::string crc;
+    put_le(crc, m.crc, 4);
+    os.seekp(static_cast<std::streamoff>(m.offset + 14));
+    os << crc;
+  }
+  os.seekp(static_cast<std::streamoff>(i_->layout.directory_offset));
+  for (const OutMember& m : i_->members) os << central_header(m);
+  os << end_records(i_->members.size(), i_->layout.directory_offset, i_->layout.directory_size, i_->layout.zip64_end, false);
+}
+
+}  // namespace interpatch::io::internal

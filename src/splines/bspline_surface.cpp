@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <new>
 
 #include "splines/basis_table.hpp"
 #include "base/kernel.hpp"
@@ -128,8 +129,12 @@ Vec3 BSplineSurface::derivative(double u, double v, int du, int dv) const {
   double Nu[W * W], Nv[W * W];
   ku_.basis_derivatives(su, u, du, Nu);
   kv_.basis_derivatives(sv, v, dv, Nv);
-  // Homogeneous partials A^(k,l), w^(k,l) for k <= du, l <= dv.
-  Vec3 A[W][W];
+  // Homogeneous partials A^(k,l), w^(k,l) for k <= du, l <= dv; only those used are
+  // made (whole W × W arrays of Vec3 would be zeroed on every call, most of a point's cost).
+  alignas(Vec3) unsigned char a_store[sizeof(Vec3) * W * W], s_store[sizeof(Vec3) * W * W];
+  const auto slot = [](unsigned char* store, int k, int l) { return store + sizeof(Vec3) * static_cast<std::size_t>(k * W + l); };
+  const auto A = [&](int k, int l) -> const Vec3& { return *std::launder(reinterpret_cast<const Vec3*>(slot(a_store, k, l))); };
+  const auto S = [&](int k, int l) -> const Vec3& { return *std::launder(reinterpret_cast<const Vec3*>(slot(s_store, k, l))); };
   double Wt[W][W];
   for (int k = 0; k <= du; ++k)
     for (int l = 0; l <= dv; ++l) {
@@ -146,15 +151,14 @@ Vec3 BSplineSurface::derivative(double u, double v, int du, int dv) const {
           wsum += c;
         }
       }
-      A[k][l] = a;
+      ::new (slot(a_store, k, l)) Vec3(a);
       Wt[k][l] = wsum;
     }
-  if (!rational()) return A[du][dv];
+  if (!rational()) return A(du, dv);
   // Quotient rule for surfaces (The NURBS Book eq. 4.20), built up from low orders.
-  Vec3 S[W][W];
   for (int k = 0; k <= du; ++k)
     for (int l = 0; l <= dv; ++l) {
-      Vec3 r = A[k][l];
+      Vec3 r = A(k, l);
       double bk = 1;
       for (int i = 0; i <= k; ++i) {
         if (i > 0) bk = bk * (k - i + 1) / i;
@@ -162,12 +166,12 @@ Vec3 BSplineSurface::derivative(double u, double v, int du, int dv) const {
         for (int j = 0; j <= l; ++j) {
           if (j > 0) bl = bl * (l - j + 1) / j;
           if (i == 0 && j == 0) continue;
-          r -= (bk * bl * Wt[i][j]) * S[k - i][l - j];
+          r -= (bk * bl * Wt[i][j]) * S(k - i, l - j);
         }
       }
-      S[k][l] = r / Wt[0][0];
+      ::new (slot(s_store, k, l)) Vec3(r / Wt[0][0]);
     }
-  return S[du][dv];
+  return S(du, dv);
 }
 
 SurfaceDerivatives BSplineSurface::derivatives(double u, double v) const {
