@@ -56,6 +56,14 @@ class Surface(Construction):
     def to_bspline(self) -> dict[str, Any]:
         """{'degree': (p, q), 'knots_u', 'knots_v', 'control_points' (nu, nv, 3), 'weights' (nu, nv) or None, 'periodic'};
         the arrays are read-only views of the construction's memory (copy them to change them)."""
+    def closest_points(self, points: npt.ArrayLike) -> dict[str, _Array]:
+        """The closest point of the surface to each of points (..., 3): {'params' (..., 2), 'points' (..., 3),
+        'distance' (...,)}; global: nothing on the surface is nearer than distance less 1e-10 of its diagonal.
+        A NaN point is refused naming its index ('not_finite'); no exact form: 'no_exact_form'."""
+    def intersect(self, origins: npt.ArrayLike, directions: npt.ArrayLike) -> dict[str, Any]:
+        """Every hit of the rays origins[i] + t * directions[i], t >= 0 (origins (n, 3), directions (n, 3) or (3,)):
+        {'ray' (h,) int64, 't' (h,), 'params' (h, 2), 'points' (h, 3)}, by ray, then by t. A zero direction:
+        'wrong_type', naming the ray."""
 
 class Volume(Construction):
     """A volume over [0, 1]³; repr: Volume(type='trilinear', degree=(1, 1, 1), control_points=(2, 2, 2))."""
@@ -67,6 +75,10 @@ class Volume(Construction):
     def to_bspline(self) -> dict[str, Any]:
         """{'degree': (p, q, r), 'knots_u', 'knots_v', 'knots_w', 'control_points' (n0, n1, n2, 3), 'weights', 'periodic'};
         read-only views of the construction's memory."""
+    def locate(self, points: npt.ArrayLike) -> dict[str, Any]:
+        """Where the volume holds each of points (..., 3): {'params' (..., 3), 'points' (..., 3), 'inside' (...,) bool,
+        'residual' (...,)}; inside: V(params) is the point within 1e-10 of the diagonal; outside: the nearest
+        point of the boundary and its distance."""
 
 class Curve:
     """A curve C(t) over [0, 1], built from a curve spec: interpolate_curve, approximate_curve,
@@ -100,6 +112,9 @@ class Curve:
         """The dict `interpatch info` prints for the curve spec."""
     def write(self, path: _Path) -> None:
         """.json .npz .step .igs, as `interpatch build` writes the curve spec ('wrong_type' for another format)."""
+    def closest_points(self, points: npt.ArrayLike) -> dict[str, _Array]:
+        """The closest point of the curve to each of points (..., 3): {'params' (...,), 'points' (..., 3),
+        'distance' (...,)}; global, as Surface.closest_points."""
 
 def build(spec: Union[dict[str, Any], _Path], base_dir: _Path = ".",
           arrays: dict[str, npt.ArrayLike] = ...) -> Union[Surface, Volume, Curve]:

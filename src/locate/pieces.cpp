@@ -1,6 +1,7 @@
 #include "locate/pieces.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <new>
 #include <numeric>
 
@@ -160,6 +161,7 @@ struct Cutter {
       for (const H4& h : net.h) piece.box.add(euclid(h));
       piece.tight = oriented(net, s.dims);
       piece.turn = turn;
+      if (s.dims == 2) piece.convex = net.convex_radius(piece.hi[0] - piece.lo[0], piece.hi[1] - piece.lo[1]);
       if (nets && nets->h.size() + net.h.size() <= budget) {
         piece.net = nets->h.size();
         nets->h.insert(nets->h.end(), net.h.begin(), net.h.end());
@@ -202,6 +204,61 @@ void BezierNet::halve(int axis, BezierNet& left, BezierNet& right) const {
 OrientedBox BezierNet::bounds(int dims) const { return oriented(*this, dims); }
 
 double BezierNet::turning(int axis) const { return line_turning(*this, axis); }
+
+double BezierNet::convex_radius(double hu, double hv) const {
+  const int p = n[0] - 1, q = n[1] - 1;
+  for (const H4& x : h)
+    if (x.w != h[0].w) return 0;  // rational: no bound here
+  const auto P = [&](int i, int j) {
+    const H4& x = h[index(*this, i, j, 0)];
+    return Vec3{x.x, x.y, x.z} / x.w;
+  };
+  // Bounds of |S_uu|, |S_uv|, |S_vv| over the piece: the largest point of each
+  // second-difference net (the convex hull of a Bézier net holds its patch).
+  double muu = 0, muv = 0, mvv = 0;
+  for (int i = 0; i <= p; ++i)
+    for (int j = 0; j <= q; ++j) {
+      if (i + 2 <= p) muu = std::max(muu, norm(P(i + 2, j) - 2 * P(i + 1, j) + P(i, j)));
+      if (j + 2 <= q) mvv = std::max(mvv, norm(P(i, j + 2) - 2 * P(i, j + 1) + P(i, j)));
+      if (i + 1 <= p && j + 1 <= q) muv = std::max(muv, norm(P(i + 1, j + 1) - P(i + 1, j) - P(i, j + 1) + P(i, j)));
+    }
+  muu *= p * (p - 1) / (hu * hu), mvv *= q * (q - 1) / (hv * hv), muv *= p * q / (hu * hv);
+  // The largest eigenvalue of [[muu, muv], [muv, mvv]]: the most r·(S_uu e1² + 2 S_uv e1 e2 +
+  // S_vv e2²) can be for |r| = 1 and a unit e.
+  const double m2 = 0.5 * (muu + mvv) + std::sqrt(0.25 * (muu - mvv) * (muu - mvv) + muv * muv);
+  // The Jacobian at the centre: de Casteljau's first differences at 1/2.
+  Vec3 su{}, sv{};
+  std::array<double, max_degree + 1> bu{}, bv{};
+  const auto bern = [](int d, std::array<double, max_degree + 1>& b) {
+    b[0] = 1;
+    for (int k = 1; k <= d; ++k) {
+      for (int i = k; i > 0; --i) b[static_cast<std::size_t>(i)] = 0.5 * (b[static_cast<std::size_t>(i)] + b[static_cast<std::size_t>(i - 1)]);
+      b[0] *= 0.5;
+    }
+  };
+  bern(p - 1, bu);
+  std::array<double, max_degree + 1> cv{};
+  bern(q, cv);
+  for (int i = 0; i < p; ++i)
+    for (int j = 0; j <= q; ++j) su += (bu[static_cast<std::size_t>(i)] * cv[static_cast<std::size_t>(j)]) * (P(i + 1, j) - P(i, j));
+  su *= p / hu;
+  std::array<double, max_degree + 1> cu{};
+  bern(p, cu);
+  bern(q - 1, bv);
+  for (int i = 0; i <= p; ++i)
+    for (int j = 0; j < q; ++j) sv += (cu[static_cast<std::size_t>(i)] * bv[static_cast<std::size_t>(j)]) * (P(i, j + 1) - P(i, j));
+  sv *= q / hv;
+  const double a = dot(su, su), b = dot(su, sv), c = dot(sv, sv);
+  const double lmin = 0.5 * (a + c) - std::sqrt(0.25 * (a - c) * (a - c) + b * b);
+  const double sigma = std::sqrt(std::max(0.0, lmin));
+  // How far the Jacobian moves from its centre value over the box.
+  const double eu = 0.5 * (muu * hu + muv * hv), ev = 0.5 * (muv * hu + mvv * hv);
+  const double eps = std::sqrt(eu * eu + ev * ev);
+  if (!(sigma > eps)) return 0;
+  if (!(m2 > 0)) return std::numeric_limits<double>::infinity();
+  // 0.9: a margin for the rounding of these bounds.
+  return 0.9 * (sigma - eps) * (sigma - eps) / m2;
+}
 
 std::vector<Piece> make_pieces(const Spline& s, PieceNets* nets) {
   std::array<int, 3> deg{0, 0, 0}, spans{1, 1, 1};

@@ -71,6 +71,17 @@ struct OrientedBox {
     }
     return s;
   }
+  /// The largest distance from q to a point of the box.
+  [[nodiscard]] double farthest(const Vec3& q) const noexcept {
+    const Vec3 d = q - c;
+    double s = 0;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const double x = dot(d, a[i]);
+      const double e = std::max(std::abs(x - lo[i]), std::abs(x - hi[i]));
+      s += e * e;
+    }
+    return std::sqrt(s);
+  }
   [[nodiscard]] bool meets_ray(const Vec3& o, const Vec3& d, double slack) const noexcept {
     Box local;
     local.lo = {lo[0], lo[1], lo[2]}, local.hi = {hi[0], hi[1], hi[2]};
@@ -115,6 +126,7 @@ struct Piece {
   Box box;
   OrientedBox tight;  // along the piece's own directions
   double turn = 0;    // the most its control lines turn along one direction, radians
+  double convex = 0;  // BezierNet::convex_radius of its net
 };
 
 /// A Bézier net: n[0] × n[1] × n[2] homogeneous points in C order, which can be
@@ -128,6 +140,13 @@ struct BezierNet {
   [[nodiscard]] OrientedBox bounds(int dims) const;
   /// The most its control lines along `axis` turn, radians.
   [[nodiscard]] double turning(int axis) const;
+  /// For a polynomial surface net over a parameter box hu × hv: a distance r such that
+  /// for every point q closer than r to every point of the piece, |S − q|² is strictly
+  /// convex over the box, so that it has one minimum there. From bounds of the second
+  /// derivatives (the nets of the second differences) and of the Jacobian's smallest
+  /// singular value (at the centre, less what the second derivatives can change it):
+  /// Hess ≥ (σ − ε)² − r·m2 > 0. 0 for a rational net, or where the bound says nothing.
+  [[nodiscard]] double convex_radius(double hu, double hv) const;
 };
 
 /// The Bézier nets of the pieces, (p+1) × (q+1) × (r+1) homogeneous points each in C

@@ -116,14 +116,10 @@ Local descend(const Spline& s, const PieceNets& nets, const Piece& pc, const Reg
   return {u, v, f};
 }
 
-// Whether f = |S − q|² may have more than one minimum in a piece: where the distance
-// times the curvature (its turning over its size, the turning of the control lines
-// bounding the surface's) reaches 1, the Hessian of f can fail to be positive
-// definite. A quarter keeps a margin for the estimate.
-bool may_bend(const Piece& pc, double f) {
-  const double size = distance(pc.box.lo, pc.box.hi);
-  return std::sqrt(f) * pc.turn >= 0.25 * size;
-}
+// Whether f = |S − q|² may have more than one minimum in a piece whose net's convex
+// radius (BezierNet::convex_radius) is `convex`: unless every point of the piece is
+// nearer to q than that, the Hessian of f may fail to be positive definite somewhere.
+bool may_bend(const OrientedBox& box, double convex, const Vec3& q) { return !(box.farthest(q) < convex); }
 
 }  // namespace
 
@@ -158,14 +154,17 @@ void search_bent_in(const Spline& s, const PieceNets& nets, const Piece& pc, con
   for (const auto& [lb, k] : order) {
     if (lb >= bound2) continue;
     const Region& x = r[k];
-    if (depth + 1 < 3) {
+    const bool bends = may_bend(parts[k].bounds(2), parts[k].convex_radius(x.u1 - x.u0, x.v1 - x.v0), q);
+    if (bends && depth + 1 < 3) {
       search_bent_in(s, nets, pc, parts[k], x, depth + 1, q, bound2, keep);
       continue;
     }
     const auto [sa, sb] = bilinear_seed(parts[k].h.data(), parts[k].n[0], parts[k].n[1], q);
+    // One minimum here, or cut as far as it goes: from the bilinear seed, and then from
+    // the corners.
     const double seeds[5][2] = {{sa, sb}, {0, 0}, {1, 0}, {0, 1}, {1, 1}};
-    for (const auto& sd : seeds)
-      keep(descend(s, nets, pc, x, x.u0 + sd[0] * (x.u1 - x.u0), x.v0 + sd[1] * (x.v1 - x.v0), q));
+    for (int m = 0; m < (bends ? 5 : 1); ++m)
+      keep(descend(s, nets, pc, x, x.u0 + seeds[m][0] * (x.u1 - x.u0), x.v0 + seeds[m][1] * (x.v1 - x.v0), q));
   }
 }
 
@@ -203,7 +202,7 @@ SurfacePoint SurfaceSearch::closest(const Vec3& q) const {
     const auto [a, b] = bilinear_seed(net, nets.n[0], nets.n[1], qc);
     const Local l = descend(spline, nets, pc, whole, pc.lo[0] + a * (pc.hi[0] - pc.lo[0]), pc.lo[1] + b * (pc.hi[1] - pc.lo[1]), qc);
     keep(l);
-    if (may_bend(pc, l.f)) search_bent(pc, qc, bound2, keep);
+    if (may_bend(pc.tight, pc.convex, qc)) search_bent(pc, qc, bound2, keep);
   });
   SurfacePoint out{best.u, best.v, surface->point(best.u, best.v), 0};
   out.distance = distance(out.point, q);

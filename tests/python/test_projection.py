@@ -165,3 +165,18 @@ def test_bad_points_are_named():
         s.intersect(np.zeros((2, 3)), [[0, 0, 1], [0, 0, 0]])
     with pytest.raises(interpatch.Error, match="no exact B-spline form"):
         _built("coons_gregory.json").closest_points(q[:2])
+
+
+def test_the_readmes_projection_example_runs(tmp_path, monkeypatch):
+    import re
+    readme = open(os.path.join(os.path.dirname(__file__), "..", "..", "README.md")).read()
+    blocks = [re.search(start + r".*?```python\n(.*?)```", readme, re.S).group(1)
+              for start in ("A terrain grid to a surface", "Curves are objects of their own", "Where points are, on every")]
+    monkeypatch.chdir(tmp_path)
+    scope = {}
+    for code in blocks:  # the surface s and the ring c of the blocks before
+        exec(compile(code, "README.md", "exec"), scope)
+    assert scope["near"]["params"].shape == (49, 2) and scope["near"]["distance"].shape == (49,)
+    assert np.array_equal(scope["hits"]["ray"], np.arange(49)), "one hit a ray, straight down"
+    assert np.abs(scope["hits"]["points"][:, :2] - scope["probes"][:, :2]).max() < 1e-14
+    assert 4.7 < scope["far"][0] < 5.3, "the wavy ring of radius 1 lies about 5 below"
