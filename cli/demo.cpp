@@ -219,6 +219,8 @@ std::string report_lines(const io::Construction& c, const Example& ex, const ojs
   if (const auto& par = description["parameters"]; par.contains("rms_error"))  // an approximation
     line += " at " + par["max_error_at"].get<std::string>() + ", rms " + short_number(par["rms_error"].get<double>()) +
             ", " + par["missing_points"].dump() + " missing points filled";
+  if (description.contains("max_closest_distance"))  // the same data by their closest points (interpatch project)
+    line += ", by closest points at most " + short_number(description["max_closest_distance"]["absolute"].get<double>());
   const ojson spec = ojson::parse(ex.spec);
   if (const std::string type = spec.value("type", ""); type == "bspline_surface" || type == "bspline_volume") {
     // An exact form read back and built again: the same bytes as the file it came from.

@@ -1,4 +1,5 @@
 #include "interpatch/io/json_out.hpp"
+#include "interpatch/projection.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -475,9 +476,37 @@ std::optional<DataError> max_data_error(const Construction& c, const progress_ca
   return e;
 }
 
+// An approximation's data against its surface by the closest point (SurfaceProjector),
+// not at each point's own parameters: how far the points lie from the surface as a
+// user measures it. Null for what is not a surface approximation with its exact form.
+ojson closest_distance(const Construction& c) {
+  const auto* s = c.exact ? std::get_if<BSplineSurface>(&*c.exact) : nullptr;
+  if (!s || c.data.empty() || !c.parameters.contains("max_error")) return nullptr;
+  const SurfaceProjector on(*s, *s);
+  double worst = -1;
+  std::string at;
+  for (const DataSet& d : c.data) {
+    std::vector<Vec3> q;
+    std::vector<std::size_t> index;
+    for (std::size_t i = 0; i < d.points.size(); ++i)
+      if (is_finite(d.points[i])) q.push_back(d.points[i]), index.push_back(i);  // NaN: a missing point
+    std::vector<SurfacePoint> a(q.size());
+    on.closest(q, a);
+    const std::size_t nv = d.scattered || d.params.size() < 2 ? 0 : d.params[1].size();
+    for (std::size_t k = 0; k < a.size(); ++k)
+      if (a[k].distance > worst) {
+        worst = a[k].distance;
+        at = nv ? cat(d.pointer, "/", index[k] / nv, "/", index[k] % nv) : cat(d.pointer, "/", index[k]);
+      }
+  }
+  if (worst < 0) return nullptr;
+  return {{"absolute", worst}, {"at", at}};
+}
+
 nlohmann::ordered_json info_json(const Construction& c, const progress_callback& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::optional<DataError> err = max_data_error(c, progress);
+  const ojson closest = closest_distance(c);
   const bool volume = is_volume(c);
   const ojson jac = volume ? jacobian_info(volume_evaluator(c)) : ojson();
   const double check_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -499,6 +528,7 @@ nlohmann::ordered_json info_json(const Construction& c, const progress_callback&
     j["no_exact_form"] = c.no_exact_form;
   }
   put_data_error(j, err);
+  if (!closest.is_null()) j["max_closest_distance"] = closest;
   if (volume) j["jacobian"] = jac;
   put_data(j, c.data, uvw, c.parameters, c.warnings, c.timings, check_ms);
   return j;

@@ -180,3 +180,16 @@ def test_the_readmes_projection_example_runs(tmp_path, monkeypatch):
     assert np.array_equal(scope["hits"]["ray"], np.arange(49)), "one hit a ray, straight down"
     assert np.abs(scope["hits"]["points"][:, :2] - scope["probes"][:, :2]).max() < 1e-14
     assert 4.7 < scope["far"][0] < 5.3, "the wavy ring of radius 1 lies about 5 below"
+
+
+@pytest.mark.parametrize("name", ["approximate_terrain.json", "approximate_scattered.json"])
+def test_info_measures_an_approximation_by_closest_points(name):
+    s = _built(name)
+    info = s.info()
+    closest = info["max_closest_distance"]
+    # The closest point is never farther than the point at the datum's own parameters.
+    assert closest["absolute"] <= info["max_data_error"]["absolute"] * (1 + 1e-12)
+    spec = json.load(open(os.path.join(EXAMPLES, name)))
+    pts = np.load(os.path.join(EXAMPLES, spec["points"]["npy"])).reshape(-1, 3)
+    pts = pts[~np.isnan(pts).any(axis=1)]
+    assert closest["absolute"] == s.closest_points(pts)["distance"].max()
