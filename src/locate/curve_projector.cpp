@@ -69,7 +69,7 @@ CurveSearch::CurveSearch(const BSplineCurve& c) : curve(c), tree({}) {
 }
 
 CurvePoint CurveSearch::closest(const Vec3& q) const {
-  const Vec3 qc = q - spline.centre;
+  const Vec3 qc = spline.local(q);
   double bound2 = std::numeric_limits<double>::infinity();
   Local best{0, std::numeric_limits<double>::infinity()};
   const double slack = prune_slack * spline.diagonal;
@@ -84,9 +84,10 @@ CurvePoint CurveSearch::closest(const Vec3& q) const {
   });
   CurvePoint out{best.t, curve.point(best.t), 0};
   out.distance = distance(out.point, q);
-  if (!is_finite(out.point) || std::abs(out.distance - std::sqrt(best.f)) > 1e-9 * spline.diagonal + 1e-12 * norm(q))
+  if (!is_finite(out.point) || std::abs(out.distance - std::sqrt(best.f) * spline.scale) >
+                                     1e-9 * spline.diagonal * spline.scale + rounding_of(q, out.point))
     fail(errc::internal, "the closest point of ", num(q), " is ", num(out.point), " on the curve but ",
-         std::sqrt(best.f), " away on its clamped form");
+         std::sqrt(best.f) * spline.scale, " away on its clamped form");
   return out;
 }
 

@@ -1,6 +1,7 @@
 #include "locate/pieces.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <new>
 #include <numeric>
@@ -13,12 +14,14 @@ void Spline::set_points(const Vec3* points, const double* weights, std::size_t c
   Box b;
   for (std::size_t i = 0; i < count; ++i) b.add(points[i]);
   centre = (b.lo + b.hi) * 0.5;
-  diagonal = distance(b.lo, b.hi);
+  const double d = distance(b.lo, b.hi);
+  scale = d > 0 && std::isfinite(d) ? std::ldexp(1.0, std::ilogb(d) + 1) : 1.0;
+  diagonal = d / scale;
   rational = weights != nullptr;
   cp.resize(count);
   for (std::size_t i = 0; i < count; ++i) {
     const double w = weights ? weights[i] : 1.0;
-    const Vec3 p = (points[i] - centre) * w;
+    const Vec3 p = local(points[i]) * w;
     cp[i] = {p.x, p.y, p.z, w};
   }
 }
@@ -207,57 +210,53 @@ double BezierNet::turning(int axis) const { return line_turning(*this, axis); }
 
 double BezierNet::convex_radius(double hu, double hv) const {
   const int p = n[0] - 1, q = n[1] - 1;
+  if (p < 1 || q < 1) return 0;
   for (const H4& x : h)
     if (x.w != h[0].w) return 0;  // rational: no bound here
   const auto P = [&](int i, int j) {
     const H4& x = h[index(*this, i, j, 0)];
     return Vec3{x.x, x.y, x.z} / x.w;
   };
-  // Bounds of |S_uu|, |S_uv|, |S_vv| over the piece: the largest point of each
-  // second-difference net (the convex hull of a Bézier net holds its patch).
-  double muu = 0, muv = 0, mvv = 0;
+  // The piece as a whole: a normal n0 and two directions in its plane (its box's axes).
+  const OrientedBox box = bounds(2);
+  const Vec3 e0 = box.a[0], e1 = box.a[1], n0 = box.a[2];
+  // The nets of S_u and S_v (their points hold every value of the derivative: the convex
+  // hull), and the bounds they give: the least speed along e0 and e1, the largest S_u·S_v,
+  // how far the tangents rise out of the plane of n0.
+  std::vector<Vec3> du, dv;
+  for (int i = 0; i < p; ++i)
+    for (int j = 0; j <= q; ++j) du.push_back((P(i + 1, j) - P(i, j)) * (p / hu));
+  for (int i = 0; i <= p; ++i)
+    for (int j = 0; j < q; ++j) dv.push_back((P(i, j + 1) - P(i, j)) * (q / hv));
+  double su = std::numeric_limits<double>::infinity(), sv = su, cross_most = 0, rise = 0;
+  for (const Vec3& a : du) su = std::min(su, dot(a, e0)), rise = std::max(rise, std::abs(dot(a, n0)) / norm(a));
+  for (const Vec3& b : dv) sv = std::min(sv, dot(b, e1)), rise = std::max(rise, std::abs(dot(b, n0)) / norm(b));
+  for (const Vec3& a : du)
+    for (const Vec3& b : dv) cross_most = std::max(cross_most, std::abs(dot(a, b)));
+  if (!(su > 0 && sv > 0)) return 0;
+  // λ_min(JᵀJ) by Gershgorin: the least squared speed less the largest S_u·S_v.
+  const double lmin = std::min(su * su, sv * sv) - cross_most;
+  if (!(lmin > 0) || !(rise < 0.5)) return 0;  // a piece whose tangents leave its plane by 30° and more
+  // The second derivatives' components along the normal: along n0, plus what the
+  // normal's tilt (at most `rise`) lets the whole vector add.
+  double nuu = 0, nuv = 0, nvv = 0;
   for (int i = 0; i <= p; ++i)
     for (int j = 0; j <= q; ++j) {
-      if (i + 2 <= p) muu = std::max(muu, norm(P(i + 2, j) - 2 * P(i + 1, j) + P(i, j)));
-      if (j + 2 <= q) mvv = std::max(mvv, norm(P(i, j + 2) - 2 * P(i, j + 1) + P(i, j)));
-      if (i + 1 <= p && j + 1 <= q) muv = std::max(muv, norm(P(i + 1, j + 1) - P(i + 1, j) - P(i, j + 1) + P(i, j)));
+      const auto part = [&](const Vec3& x) { return std::abs(dot(x, n0)) + rise * norm(x); };
+      if (i + 2 <= p) nuu = std::max(nuu, part(P(i + 2, j) - 2 * P(i + 1, j) + P(i, j)) * (p * (p - 1) / (hu * hu)));
+      if (j + 2 <= q) nvv = std::max(nvv, part(P(i, j + 2) - 2 * P(i, j + 1) + P(i, j)) * (q * (q - 1) / (hv * hv)));
+      if (i + 1 <= p && j + 1 <= q)
+        nuv = std::max(nuv, part(P(i + 1, j + 1) - P(i + 1, j) - P(i, j + 1) + P(i, j)) * (p * q / (hu * hv)));
     }
-  muu *= p * (p - 1) / (hu * hu), mvv *= q * (q - 1) / (hv * hv), muv *= p * q / (hu * hv);
-  // The largest eigenvalue of [[muu, muv], [muv, mvv]]: the most r·(S_uu e1² + 2 S_uv e1 e2 +
-  // S_vv e2²) can be for |r| = 1 and a unit e.
-  const double m2 = 0.5 * (muu + mvv) + std::sqrt(0.25 * (muu - mvv) * (muu - mvv) + muv * muv);
-  // The Jacobian at the centre: de Casteljau's first differences at 1/2.
-  Vec3 su{}, sv{};
-  std::array<double, max_degree + 1> bu{}, bv{};
-  const auto bern = [](int d, std::array<double, max_degree + 1>& b) {
-    b[0] = 1;
-    for (int k = 1; k <= d; ++k) {
-      for (int i = k; i > 0; --i) b[static_cast<std::size_t>(i)] = 0.5 * (b[static_cast<std::size_t>(i)] + b[static_cast<std::size_t>(i - 1)]);
-      b[0] *= 0.5;
-    }
-  };
-  bern(p - 1, bu);
-  std::array<double, max_degree + 1> cv{};
-  bern(q, cv);
-  for (int i = 0; i < p; ++i)
-    for (int j = 0; j <= q; ++j) su += (bu[static_cast<std::size_t>(i)] * cv[static_cast<std::size_t>(j)]) * (P(i + 1, j) - P(i, j));
-  su *= p / hu;
-  std::array<double, max_degree + 1> cu{};
-  bern(p, cu);
-  bern(q - 1, bv);
-  for (int i = 0; i <= p; ++i)
-    for (int j = 0; j < q; ++j) sv += (cu[static_cast<std::size_t>(i)] * bv[static_cast<std::size_t>(j)]) * (P(i, j + 1) - P(i, j));
-  sv *= q / hv;
-  const double a = dot(su, su), b = dot(su, sv), c = dot(sv, sv);
-  const double lmin = 0.5 * (a + c) - std::sqrt(0.25 * (a - c) * (a - c) + b * b);
-  const double sigma = std::sqrt(std::max(0.0, lmin));
-  // How far the Jacobian moves from its centre value over the box.
-  const double eu = 0.5 * (muu * hu + muv * hv), ev = 0.5 * (muv * hu + mvv * hv);
-  const double eps = std::sqrt(eu * eu + ev * ev);
-  if (!(sigma > eps)) return 0;
-  if (!(m2 > 0)) return std::numeric_limits<double>::infinity();
-  // 0.9: a margin for the rounding of these bounds.
-  return 0.9 * (sigma - eps) * (sigma - eps) / m2;
+  // The largest normal curvature: the second fundamental form's largest value over the
+  // first's least, II(e, e) / I(e, e) <= m / λ_min.
+  const double m = 0.5 * (nuu + nvv) + std::sqrt(0.25 * (nuu - nvv) * (nuu - nvv) + nuv * nuv);
+  // Where every point of the piece is nearer to q than 1/κ, the squared distance is
+  // geodesically convex on the piece (its Hessian is I − (q − S)·II > 0), so it has one
+  // minimum there, whatever the parametrization; half of that for the bounds' rounding
+  // and for a piece that is only nearly convex in the surface's own metric.
+  if (!(m > 0)) return std::numeric_limits<double>::infinity();
+  return 0.5 * lmin / m;
 }
 
 std::vector<Piece> make_pieces(const Spline& s, PieceNets* nets) {

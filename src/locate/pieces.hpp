@@ -106,7 +106,15 @@ struct Spline {
   std::vector<H4> cp;
   bool rational = false;
   Vec3 centre;
-  double diagonal = 0;  // of the control points' box: every tolerance of a query is relative to it
+  /// A power of two about the size of the control points' box: the points are stored
+  /// (and queries taken) as (x − centre) / scale, exact, so that squares of tiny or huge
+  /// coordinates neither underflow nor overflow.
+  double scale = 1;
+  /// The diagonal of the control points' box over scale (about 1): every tolerance of
+  /// a query is relative to it.
+  double diagonal = 0;
+  /// A point of space in the stored units.
+  [[nodiscard]] Vec3 local(const Vec3& x) const noexcept { return (x - centre) * (1 / scale); }
 
   [[nodiscard]] const H4& at(int i, int j, int k) const noexcept {
     return cp[(static_cast<std::size_t>(i) * static_cast<std::size_t>(n[1]) + static_cast<std::size_t>(j)) *

@@ -67,7 +67,7 @@ std::vector<RayHit> SurfaceSearch::intersect(const Vec3& origin, const Vec3& dir
     fail(errc::not_finite, "the ray ", num(origin), " + t ", num(direction), " is not finite");
   const double len = norm(direction);
   if (!(len > 0)) fail(errc::wrong_type, "the ray from ", num(origin), " has the zero vector as its direction");
-  const Line l = frame(origin - spline.centre, direction / len);
+  const Line l = frame(spline.local(origin), direction / len);
   // A hit is a point within 1e-12 of the diagonal of the ray's line (rounding of the
   // evaluation, far below the 1e-10 the answers promise).
   const double tol = 1e-12 * spline.diagonal;
@@ -84,7 +84,7 @@ std::vector<RayHit> SurfaceSearch::intersect(const Vec3& origin, const Vec3& dir
                  if (!meet(spline, nets, pc, l, tol, u, v)) continue;
                  const Vec3 p = surface->point(u, v);
                  const double t = dot(p - origin, direction) / (len * len);
-                 if (t >= -1e-12 * spline.diagonal / len) raw.push_back({std::max(t, 0.0), u, v, p});
+                 if (t >= -1e-12 * spline.diagonal * spline.scale / len) raw.push_back({std::max(t, 0.0), u, v, p});
                }
              });
   std::sort(raw.begin(), raw.end(), [](const RayHit& a, const RayHit& b) {
@@ -92,7 +92,7 @@ std::vector<RayHit> SurfaceSearch::intersect(const Vec3& origin, const Vec3& dir
   });
   std::vector<RayHit> hits;
   for (const RayHit& h : raw)
-    if (hits.empty() || distance(hits.back().point, h.point) > 1e-9 * spline.diagonal) hits.push_back(h);
+    if (hits.empty() || distance(hits.back().point, h.point) > 1e-9 * spline.diagonal * spline.scale) hits.push_back(h);
   return hits;
 }
 

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <vector>
@@ -21,6 +22,13 @@ namespace interpatch::detail {
 /// skipped: what they could hold is no more than that nearer, well inside the
 /// 1e-10 of the diagonal the answers promise.
 inline constexpr double prune_slack = 1e-11;
+
+/// What the evaluation of points at q and p rounds by, and so how far an answer's
+/// distance (from the construction's own point) may differ from the search's (about
+/// the centre): 64 roundings of their largest coordinate.
+inline double rounding_of(const Vec3& q, const Vec3& p) noexcept {
+  return 64 * std::numeric_limits<double>::epsilon() * std::max(max_abs(q), max_abs(p));
+}
 
 struct CurveSearch {
   BSplineCurve curve;  // the answers' points

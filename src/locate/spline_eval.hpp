@@ -1,7 +1,7 @@
 #pragma once
 // Points and derivatives of a Spline (pieces.hpp) in a known knot span: the
 // queries' inner loop, which knows its span from its piece and needs no search.
-// Points are about s.centre.
+// Points are in the spline's own units (Spline::local).
 
 #include <array>
 #include <utility>

@@ -116,10 +116,15 @@ Local descend(const Spline& s, const PieceNets& nets, const Piece& pc, const Reg
   return {u, v, f};
 }
 
-// Whether f = |S − q|² may have more than one minimum in a piece whose net's convex
-// radius (BezierNet::convex_radius) is `convex`: unless every point of the piece is
-// nearer to q than that, the Hessian of f may fail to be positive definite somewhere.
-bool may_bend(const OrientedBox& box, double convex, const Vec3& q) { return !(box.farthest(q) < convex); }
+// Whether a piece (its box, and its net's convex radius, BezierNet::convex_radius, half
+// of 1/κ) may hold a point nearer to q than `found` (a minimum of f = |S − q|² in it,
+// found) other than that one. No, when the ball about q through `found`, or every point
+// of the piece, lies within 0.9/κ: the piece (its normals within 30° of one another)
+// meets such a ball in one connected patch, on which f's Hessian I − (q − S)·II is
+// positive definite, so f has one minimum there. Yes otherwise: it is searched further.
+bool may_bend(const OrientedBox& box, double convex, const Vec3& q, double found) {
+  return !(std::min(box.farthest(q), found) < 1.8 * convex);
+}
 
 }  // namespace
 
@@ -154,7 +159,8 @@ void search_bent_in(const Spline& s, const PieceNets& nets, const Piece& pc, con
   for (const auto& [lb, k] : order) {
     if (lb >= bound2) continue;
     const Region& x = r[k];
-    const bool bends = may_bend(parts[k].bounds(2), parts[k].convex_radius(x.u1 - x.u0, x.v1 - x.v0), q);
+    const bool bends =
+        may_bend(parts[k].bounds(2), parts[k].convex_radius(x.u1 - x.u0, x.v1 - x.v0), q, std::numeric_limits<double>::infinity());
     if (bends && depth + 1 < 3) {
       search_bent_in(s, nets, pc, parts[k], x, depth + 1, q, bound2, keep);
       continue;
@@ -178,7 +184,7 @@ void SurfaceSearch::search_bent(const Piece& pc, const Vec3& q, const double& bo
 }
 
 SurfacePoint SurfaceSearch::closest(const Vec3& q) const {
-  const Vec3 qc = q - spline.centre;
+  const Vec3 qc = spline.local(q);
   double bound2 = std::numeric_limits<double>::infinity();
   Local best{0, 0, std::numeric_limits<double>::infinity()};
   const double slack = prune_slack * spline.diagonal;
@@ -202,14 +208,15 @@ SurfacePoint SurfaceSearch::closest(const Vec3& q) const {
     const auto [a, b] = bilinear_seed(net, nets.n[0], nets.n[1], qc);
     const Local l = descend(spline, nets, pc, whole, pc.lo[0] + a * (pc.hi[0] - pc.lo[0]), pc.lo[1] + b * (pc.hi[1] - pc.lo[1]), qc);
     keep(l);
-    if (may_bend(pc.tight, pc.convex, qc)) search_bent(pc, qc, bound2, keep);
+    if (may_bend(pc.tight, pc.convex, qc, std::sqrt(l.f))) search_bent(pc, qc, bound2, keep);
   });
   SurfacePoint out{best.u, best.v, surface->point(best.u, best.v), 0};
   out.distance = distance(out.point, q);
   // The surface and its exact form agree to rounding; more is a defect to report.
-  if (!is_finite(out.point) || std::abs(out.distance - std::sqrt(best.f)) > 1e-9 * spline.diagonal + 1e-12 * norm(q))
+  if (!is_finite(out.point) || std::abs(out.distance - std::sqrt(best.f) * spline.scale) >
+                                     1e-9 * spline.diagonal * spline.scale + rounding_of(q, out.point))
     fail(errc::internal, "the closest point of ", num(q), " is ", num(out.point), " on the surface but ",
-         std::sqrt(best.f), " away on its exact form");
+         std::sqrt(best.f) * spline.scale, " away on its exact form");
   return out;
 }
 

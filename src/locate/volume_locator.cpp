@@ -128,8 +128,8 @@ VolumeSearch::VolumeSearch(const Volume& v, const BSplineVolume& e) : volume(&v)
 }
 
 VolumePoint VolumeSearch::locate(const Vec3& x) const {
-  const Vec3 xc = x - spline.centre;
-  const double tol = inside_share * spline.diagonal;
+  const Vec3 xc = spline.local(x);
+  const double tol = inside_share * spline.diagonal;  // in the spline's units
   // Newton's iteration aims well inside the promise, so that the volume's own point
   // (its rounding differs from the exact form's) still keeps it.
   const double aim = 0.25 * tol;
@@ -160,7 +160,7 @@ VolumePoint VolumeSearch::locate(const Vec3& x) const {
   out.point = volume->point(out.u, out.v, out.w);
   out.residual = distance(out.point, x);
   if (!is_finite(out.point)) fail(errc::internal, "the volume's point at the parameters of ", num(x), " is not finite");
-  out.inside = out.residual <= tol;
+  out.inside = out.residual <= tol * spline.scale;
   return out;
 }
 
