@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "interpatch/io/project.hpp"
 #include "example_assets.hpp"
 #include "interpatch/error.hpp"
 #include "interpatch/grid.hpp"
@@ -237,6 +238,17 @@ std::string report_lines(const io::Construction& c, const Example& ex, const ojs
   return line;
 }
 
+// Where points are (interpatch project): a scan of the terrain built above,
+// examples/terrain_scan.csv, measured by the closest points of the surface.
+std::string scan_report(const fs::path& dir, std::size_t& files) {
+  write_text(dir / "terrain_scan.csv", std::string(example_file("terrain_scan.csv")));
+  io::Built terrain = build_spec(dir / "terrain.spec.json");
+  const io::ProjectionSummary r = io::write_projection(terrain, dir / "terrain_scan.csv", dir / "terrain_scan.project.npz");
+  files += 2;
+  return "project: " + std::to_string(r.points) + " scanned points (terrain_scan.csv) onto terrain, by their closest points: " +
+         "the farthest " + short_number(r.max_distance) + " away\n      terrain_scan.csv terrain_scan.project.npz\n";
+}
+
 }  // namespace
 
 int demo_command(const fs::path& requested) {
@@ -258,6 +270,7 @@ int demo_command(const fs::path& requested) {
     summary += line + "\n";
     files += written.size();
   }
+  summary += scan_report(dir, files);
   write_gallery(dir / "index.html", gallery);
   std::printf("interpatch demo: %zu examples\n%soutputs in %s: %zu files\nopen %s in a web browser to see every example\n",
               all.size(), summary.c_str(), dir.string().c_str(), files + 1, (dir / "index.html").string().c_str());
