@@ -331,8 +331,10 @@ TEST(Scattered, SpecRefusalsNameTheField) {
   };
   refused([](nlohmann::json& s) { s["max_control_points"] = 10; s.erase("tolerance"); s["control_points"] = 6; },
           errc::wrong_type, "/max_control_points: it limits a tolerance's refinement");
-  refused([](nlohmann::json& s) { s["param"] = {{"base", {{"type", "bilinear"}}}}; }, errc::wrong_type,
-          "/param/base: sites from the closest points on a base surface are not available yet");
+  refused([](nlohmann::json& s) { s["param"] = {{"base", {{"type", "bilinear"}}}}; }, errc::missing_field,
+          "/param/base/p00: missing field");
+  refused([](nlohmann::json& s) { s["param"] = {{"base", {{"type", "trilinear"}}}, {"more", 1}}; }, errc::wrong_type,
+          "/param: {\"base\": surface spec} takes nothing beside the surface");
   refused([](nlohmann::json& s) { s["domain"] = {{1000, 0}, {0, 800}}; }, errc::non_increasing,
           "domain along u is [1000, 0]: it must increase");
   refused([](nlohmann::json& s) { s["domain"] = {{0, 500}, {0, 800}}; }, errc::out_of_domain, "outside the domain [0, 500]");

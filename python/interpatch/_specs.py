@@ -171,7 +171,7 @@ def approximate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int],
                         control_points: Union[int, Sequence[int], None] = None, tolerance: Optional[float] = None,
                         smoothing: Union[float, str, None] = None, weights: Optional[npt.ArrayLike] = None,
                         params: Optional[npt.ArrayLike] = None, domain: Optional[Sequence[Sequence[float]]] = None,
-                        max_control_points: Union[int, Sequence[int], None] = None) -> Surface:
+                        max_control_points: Union[int, Sequence[int], None] = None, base: Any = None) -> Surface:
     """A B-spline surface near a grid of points, shape (n, m, 3), or near scattered
     points, shape (N, 3); any float dtype and memory order. NaN in a point, or a masked
     entry of a masked array, marks it missing (the fairness term fills the hole).
@@ -181,7 +181,10 @@ def approximate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int],
     on a grid); optional `weights`, one per point, non-negative. For a grid, `degree`,
     `param` and `periodic` as for interpolate_surface. For scattered points, `param`
     is "plane" (the default: the points' least-squares plane) or "xy" (a height field,
-    u = x and v = y), or `params` gives the sites, shape (N, 2); `domain`
+    u = x and v = y), or `params` gives the sites, shape (N, 2), or `base` (a Surface, a
+    surface spec dict or a grid (n, m, 3) to interpolate) gives each point the
+    parameters of its closest point on that surface, for sheets folded over every
+    plane; `domain`
     ((u0, u1), (v0, v1)) the rectangle covered (default: the sites' bounding box) and
     `max_control_points` the largest net a tolerance may reach. The surface is over
     [0, 1]²: with "xy", x = u0 + u (u1 − u0). info()["parameters"] reports max_error
@@ -218,7 +221,18 @@ def approximate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int],
     (True, 'xy', 5000, [150.0, 100.0])
     >>> s = interpatch.approximate_surface(survey, params=xy / 100, control_points=(12, 10))
     >>> s.info()["parameters"]["param"], s.info()["control_points"]
-    ('sites', [12, 10])"""
+    ('sites', [12, 10])
+
+    A sheet wrapped 300 degrees round an axis, so that no plane sees all of it, placed
+    by a coarse surface round it:
+
+    >>> t, h = np.meshgrid(np.linspace(0, 5.2, 9), [0.0, 1.0, 2.0], indexing="ij")
+    >>> coarse = np.stack([np.cos(t), np.sin(t), h], axis=-1)
+    >>> a, z = rng.uniform(0, 5.2, 600), rng.uniform(0, 2, 600)
+    >>> sheet = np.column_stack([np.cos(a), np.sin(a), z])
+    >>> s = interpatch.approximate_surface(sheet, base=coarse, tolerance=0.01)
+    >>> s.info()["parameters"]["param"], s.info()["parameters"]["max_error"] <= 0.01
+    ('base', True)"""
     a = _Arrays()
     spec = _options({"type": "approximate", "points": a.add(points, "points", missing=True)}, degree=degree, param=param,
                     periodic=periodic, domain=domain, max_control_points=max_control_points)
@@ -229,6 +243,10 @@ def approximate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int],
         if sites.ndim != 2 or sites.shape[1] != 2:
             raise _error("size_mismatch", f"params: shape {sites.shape}; the sites of scattered points are (N, 2)")
         spec["param"] = a.add(np.column_stack([sites, np.zeros(len(sites))]), "params")
+    if base is not None:
+        if param is not None or params is not None:
+            raise _error("wrong_type", "base: give one of param, params and base")
+        spec["param"] = {"base": _surface_spec(base, a, "base")}
     return cast(Surface, _build(_approximation(spec, control_points, tolerance, smoothing, weights), ".", a.table))
 
 

@@ -193,3 +193,20 @@ def test_info_measures_an_approximation_by_closest_points(name):
     pts = np.load(os.path.join(EXAMPLES, spec["points"]["npy"])).reshape(-1, 3)
     pts = pts[~np.isnan(pts).any(axis=1)]
     assert closest["absolute"] == s.closest_points(pts)["distance"].max()
+
+
+def test_scattered_points_of_a_folded_sheet_take_their_sites_from_a_base_surface():
+    # A sheet that wraps 300 degrees round an axis: it folds over every plane, so
+    # neither "xy" nor "plane" can place its points; a coarse base surface near it can.
+    rng = np.random.default_rng(SEED)
+    a, z = rng.uniform(0, 5.2, 800), rng.uniform(0, 2, 800)
+    r = 1 + 0.05 * np.sin(3 * a) * np.cos(2 * z)
+    pts = np.stack([r * np.cos(a), r * np.sin(a), z], axis=-1)
+    ring = [[float(np.cos(t)), float(np.sin(t)), 0.0] for t in np.linspace(0, 5.2, 9)]
+    top = [[x, y, 2.0] for x, y, _ in ring]
+    base = {"type": "ruled", "curves": [{"interpolate": ring}, {"interpolate": top}]}
+    s = interpatch.build({"type": "approximate", "param": {"base": base}, "tolerance": 0.01, "points": pts.tolist()})
+    info = s.info()
+    assert info["parameters"]["param"] == "base"
+    assert info["max_data_error"]["absolute"] <= 0.01
+    assert s.closest_points(pts)["distance"].max() <= 0.01

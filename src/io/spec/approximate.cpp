@@ -11,6 +11,7 @@
 #include "interpatch/io/npy.hpp"
 #include "interpatch/memory.hpp"
 #include "io/spec/forms.hpp"
+#include "interpatch/projection.hpp"
 #include "io/spec/reader.hpp"
 
 namespace interpatch::io::reader {
@@ -180,7 +181,24 @@ std::vector<std::array<double, 2>> read_sites(const json& j, std::size_t n, Cont
   return out;
 }
 
-void scattered_param(const json& spec, std::size_t n, ScatteredApproximationOptions& o, Context& ctx) {
+// Sites from the closest points of a base surface (its exact form over [0, 1]²): for
+// sheets that fold over every plane, which neither "xy" nor "plane" can take. A missing
+// point (NaN) gets the centre, which the fit does not look at.
+std::vector<std::array<double, 2>> base_sites(const json& base, const PointStorage& points, Context& ctx) {
+  const BSplineSurface s = face_surface(base, "/param/base", ctx);
+  const SurfaceProjector on(s, s);
+  std::vector<Vec3> q(points.begin(), points.end());
+  for (Vec3& x : q)
+    if (!is_finite(x)) x = s.point(0.5, 0.5);
+  std::vector<SurfacePoint> a(q.size());
+  on.closest(q, a);
+  std::vector<std::array<double, 2>> sites(q.size());
+  for (std::size_t k = 0; k < q.size(); ++k) sites[k] = {a[k].u, a[k].v};
+  return sites;
+}
+
+void scattered_param(const json& spec, const PointStorage& points, ScatteredApproximationOptions& o, Context& ctx) {
+  const std::size_t n = points.size();
   const json* j = find_member(spec, "param");
   if (!j) return;
   if (j->is_string()) {
@@ -192,10 +210,12 @@ void scattered_param(const json& spec, std::size_t n, ScatteredApproximationOpti
            "(a height field), \"plane\" (the default) or their sites ([[u, v], ...] or {\"npy\": file})");
     return;
   }
-  if (j->is_object() && find_member(*j, "base"))
-    fail(errc::wrong_type, "/param/base: sites from the closest points on a base surface are not available yet; ",
-         "give \"xy\", \"plane\" or the sites");
   o.param = ScatteredParam::sites;
+  if (j->is_object() && find_member(*j, "base")) {
+    if (j->size() != 1) fail(errc::wrong_type, "/param: {\"base\": surface spec} takes nothing beside the surface");
+    o.sites = base_sites(j->at("base"), points, ctx);
+    return;
+  }
   o.sites = read_sites(*j, n, ctx);
 }
 
@@ -215,14 +235,15 @@ std::array<int, 2> net_counts(const json& j, const std::string& ptr, const std::
   return c;
 }
 
-ScatteredApproximationOptions scattered_options(const json& spec, std::size_t n, Context& ctx) {
+ScatteredApproximationOptions scattered_options(const json& spec, const PointStorage& points, Context& ctx) {
+  const std::size_t n = points.size();
   ScatteredApproximationOptions o;
   const auto deg = degrees(spec, "", 2);
   o.degree = {deg[0], deg[1]};
   const std::array<int, 2> p{deg[0].value_or(3), deg[1].value_or(3)};
   if (find_member(spec, "periodic"))
     fail(errc::wrong_type, "/periodic: scattered points have no closed directions (a grid of points does)");
-  scattered_param(spec, n, o, ctx);
+  scattered_param(spec, points, o, ctx);
   const std::string given = approximation_way(spec, "");
   const std::string at_way = child("", given);
   const json& way = spec.at(given);
@@ -266,10 +287,15 @@ const char* scattered_param_name(ScatteredParam p) {
   return p == ScatteredParam::xy ? "xy" : p == ScatteredParam::plane ? "plane" : "sites";
 }
 
+bool on_base(const json& spec) {
+  const json* p = find_member(spec, "param");
+  return p && p->is_object() && p->contains("base");
+}
+
 Construction approximate_scattered_points(const json& spec, Context& ctx) {
   PointArray pts = points_impl(spec.at("points"), 1, "/points", ctx, true);
   const std::size_t n = pts.shape[0];
-  const ScatteredApproximationOptions o = scattered_options(spec, n, ctx);
+  const ScatteredApproximationOptions o = scattered_options(spec, pts.points, ctx);
   DataSet data = grid_data(spec.at("points"), pts.points, pts.shape, ctx);
   ctx.parsed();
   ScatteredApproximation r = at("/points", [&] { return approximate_scattered(pts.points, o); });
@@ -279,7 +305,7 @@ Construction approximate_scattered_points(const json& spec, Context& ctx) {
   c.exact = r.surface.mapped(0.0, 1.0, 0.0, 1.0);
   c.parameters = {{"points", n},
                   {"degree", {r.surface.degree_u(), r.surface.degree_v()}},
-                  {"param", scattered_param_name(o.param)},
+                  {"param", on_base(spec) ? "base" : scattered_param_name(o.param)},
                   {"domain", r.domain}};
   if (o.param == ScatteredParam::plane)
     c.parameters["plane"] = {{"origin", {r.origin.x, r.origin.y, r.origin.z}},
