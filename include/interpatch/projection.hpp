@@ -104,8 +104,11 @@ class CurveProjector {
 /// @endcode
 class SurfaceProjector {
  public:
-  /// @throws error no_exact_form (the search bounds the pieces of the exact form),
-  ///   too_large.
+  /// Over the surface's exact form; a surface without one (Gregory's twist correction)
+  /// is searched through a stand-in, the bicubic through its points on a 65 × 65 grid
+  /// of its parameters, whose boxes are widened by 4 times the largest gap measured
+  /// between the two, with Newton's iteration on the surface itself.
+  /// @throws error too_large.
   explicit SurfaceProjector(const Surface& surface);
   /// The same with the surface's exact form given (one made already; it is searched,
   /// and must outlive the projector too). @throws error too_large.

@@ -122,3 +122,17 @@ def _surface_spec(face: Any, arrays: _Arrays, name: str) -> dict[str, Any]:
             spec["weights"] = b["weights"].tolist()
         return spec
     return {"type": "interpolate", "points": arrays.add(face, name)}
+
+
+def _scattered_sites(spec: dict[str, Any], arrays: _Arrays, param: Any, params: Any, base: Any) -> None:
+    """Where scattered points sit, as approximate_surface takes it: a name (`param`,
+    already in the spec), the sites (`params`, (N, 2)) or a base surface (`base`)."""
+    if sum(x is not None for x in (param, params, base)) > 1:
+        raise _error("wrong_type", "give one of param (a name), params (the sites) and base (a surface)")
+    if params is not None:
+        sites = np.asarray(params, dtype=float)
+        if sites.ndim != 2 or sites.shape[1] != 2:
+            raise _error("size_mismatch", f"params: shape {sites.shape}; the sites of scattered points are (N, 2)")
+        spec["param"] = arrays.add(np.column_stack([sites, np.zeros(len(sites))]), "params")
+    if base is not None:
+        spec["param"] = {"base": _surface_spec(base, arrays, "base")}

@@ -15,7 +15,7 @@ from typing import Any, Callable, Optional, Sequence, Union, cast
 import numpy as np
 import numpy.typing as npt
 
-from ._args import _approximation, _Arrays, _curve, _error, _options, _point, _real, _reals, _surface_spec
+from ._args import _approximation, _Arrays, _curve, _error, _options, _point, _real, _reals, _scattered_sites, _surface_spec
 from ._core import Curve, Surface, Volume
 from ._core import build as _build
 
@@ -181,10 +181,8 @@ def approximate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int],
     on a grid); optional `weights`, one per point, non-negative. For a grid, `degree`,
     `param` and `periodic` as for interpolate_surface. For scattered points, `param`
     is "plane" (the default: the points' least-squares plane) or "xy" (a height field,
-    u = x and v = y), or `params` gives the sites, shape (N, 2), or `base` (a Surface, a
-    surface spec dict or a grid (n, m, 3) to interpolate) gives each point the
-    parameters of its closest point on that surface, for sheets folded over every
-    plane; `domain`
+    u = x and v = y), or `params` gives the sites, shape (N, 2), or `base` (a Surface, spec
+    or grid) the parameters of each point's closest point on it (folded sheets); `domain`
     ((u0, u1), (v0, v1)) the rectangle covered (default: the sites' bounding box) and
     `max_control_points` the largest net a tolerance may reach. The surface is over
     [0, 1]²: with "xy", x = u0 + u (u1 − u0). info()["parameters"] reports max_error
@@ -222,31 +220,17 @@ def approximate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int],
     >>> s = interpatch.approximate_surface(survey, params=xy / 100, control_points=(12, 10))
     >>> s.info()["parameters"]["param"], s.info()["control_points"]
     ('sites', [12, 10])
-
-    A sheet wrapped 300 degrees round an axis, so that no plane sees all of it, placed
-    by a coarse surface round it:
-
+    >>> # A sheet wrapped 300 degrees round an axis, placed by a coarse surface round it:
     >>> t, h = np.meshgrid(np.linspace(0, 5.2, 9), [0.0, 1.0, 2.0], indexing="ij")
-    >>> coarse = np.stack([np.cos(t), np.sin(t), h], axis=-1)
     >>> a, z = rng.uniform(0, 5.2, 600), rng.uniform(0, 2, 600)
-    >>> sheet = np.column_stack([np.cos(a), np.sin(a), z])
-    >>> s = interpatch.approximate_surface(sheet, base=coarse, tolerance=0.01)
+    >>> s = interpatch.approximate_surface(np.column_stack([np.cos(a), np.sin(a), z]), tolerance=0.01,
+    ...                                    base=np.stack([np.cos(t), np.sin(t), h], axis=-1))
     >>> s.info()["parameters"]["param"], s.info()["parameters"]["max_error"] <= 0.01
     ('base', True)"""
     a = _Arrays()
     spec = _options({"type": "approximate", "points": a.add(points, "points", missing=True)}, degree=degree, param=param,
                     periodic=periodic, domain=domain, max_control_points=max_control_points)
-    if params is not None:
-        if param is not None:
-            raise _error("wrong_type", "params: give either param (a name) or params (the sites), not both")
-        sites = np.asarray(params, dtype=float)
-        if sites.ndim != 2 or sites.shape[1] != 2:
-            raise _error("size_mismatch", f"params: shape {sites.shape}; the sites of scattered points are (N, 2)")
-        spec["param"] = a.add(np.column_stack([sites, np.zeros(len(sites))]), "params")
-    if base is not None:
-        if param is not None or params is not None:
-            raise _error("wrong_type", "base: give one of param, params and base")
-        spec["param"] = {"base": _surface_spec(base, a, "base")}
+    _scattered_sites(spec, a, param, params, base)
     return cast(Surface, _build(_approximation(spec, control_points, tolerance, smoothing, weights), ".", a.table))
 
 

@@ -25,6 +25,7 @@
 #include "interpatch/io/json_out.hpp"
 #include "interpatch/io/mesh.hpp"
 #include "interpatch/io/outputs.hpp"
+#include "interpatch/io/project.hpp"
 #include "interpatch/io/spec.hpp"
 #include "interpatch/io/view.hpp"
 #include "arrays.hpp"
@@ -328,12 +329,12 @@ class PySurface : public PyBuilt {
   }
 
  private:
-  // The projector over the exact form (made now if it is not yet), answering with its points.
+  // The projector (io::surface_projector), made on the first query and kept.
   const ip::SurfaceProjector& projector() const {
-    const ip::BSplineSurface& e = exact<ip::BSplineSurface>();
+    const ip::progress_callback progress = interruptible();  // Ctrl-C stops a long conversion
     py::gil_scoped_release free;
     std::lock_guard<std::mutex> hold(b_->lock);
-    if (!b_->projector) b_->projector = std::make_unique<const ip::SurfaceProjector>(e, e);
+    if (!b_->projector) b_->projector = ip::io::surface_projector(b_->c, progress);
     return *b_->projector;
   }
   const ip::Surface& surface(std::size_t points, ip::io::Sample what) const {

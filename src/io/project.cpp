@@ -155,6 +155,17 @@ std::vector<Vec3> as_points(const std::vector<double>& b, std::size_t n, std::si
 
 }  // namespace
 
+std::unique_ptr<SurfaceProjector> surface_projector(Construction& c, const progress_callback& progress) {
+  if (has_exact_form_after_conversion(c, progress)) {
+    const auto& s = std::get<BSplineSurface>(exact_form(c, progress));
+    return std::make_unique<SurfaceProjector>(s, s);
+  }
+  // No exact form (Gregory's twists): searched through a stand-in, answered by the formula.
+  if (c.formula) return std::make_unique<SurfaceProjector>(*c.formula);
+  (void)exact_form(c, progress);  // says why there is none
+  fail(errc::no_exact_form, c.type, ": neither an exact form nor a formula to search");
+}
+
 void check_projection_output(const fs::path& out) { (void)format_of(out); }
 
 ProjectionSummary write_projection(Built& built, const fs::path& points, const fs::path& out,
@@ -179,17 +190,8 @@ ProjectionSummary write_projection(Built& built, const fs::path& points, const f
     };
   } else {
     Construction& c = std::get<Construction>(built);
-    const ExactForm& e = exact_form(c, progress);
-    if (const auto* s = std::get_if<BSplineSurface>(&e)) {
-      surface = std::make_unique<SurfaceProjector>(*s, *s);
-      names = {"u", "v"};
-      ask = [&](const std::vector<Vec3>& q, std::vector<Row>& rows) {
-        std::vector<SurfacePoint> a(q.size());
-        surface->closest(q, a);
-        for (std::size_t i = 0; i < q.size(); ++i) rows[i] = {{a[i].u, a[i].v, 0}, a[i].point, a[i].distance, false};
-      };
-    } else {
-      const auto& v = std::get<BSplineVolume>(e);
+    if (is_volume(c)) {
+      const auto& v = std::get<BSplineVolume>(exact_form(c, progress));
       located = std::make_unique<VolumeLocator>(v, v);
       names = {"u", "v", "w"};
       volume = true;
@@ -197,6 +199,14 @@ ProjectionSummary write_projection(Built& built, const fs::path& points, const f
         std::vector<VolumePoint> a(q.size());
         located->locate(q, a);
         for (std::size_t i = 0; i < q.size(); ++i) rows[i] = {{a[i].u, a[i].v, a[i].w}, a[i].point, a[i].residual, a[i].inside};
+      };
+    } else {
+      surface = surface_projector(c, progress);
+      names = {"u", "v"};
+      ask = [&](const std::vector<Vec3>& q, std::vector<Row>& rows) {
+        std::vector<SurfacePoint> a(q.size());
+        surface->closest(q, a);
+        for (std::size_t i = 0; i < q.size(); ++i) rows[i] = {{a[i].u, a[i].v, 0}, a[i].point, a[i].distance, false};
       };
     }
   }
@@ -231,8 +241,8 @@ std::size_t write_intersections(Construction& c, const fs::path& rays, const fs:
   check_writable(out);
   if (is_volume(c)) fail(errc::wrong_type, "intersect: rays meet surfaces; this is a volume construction");
   internal::RowReader reader(rays, 6, "rays");
-  const auto& surface = std::get<BSplineSurface>(exact_form(c, progress));
-  const SurfaceProjector on(surface, surface);
+  const std::unique_ptr<SurfaceProjector> projector = surface_projector(c, progress);
+  const SurfaceProjector& on = *projector;
   // The hits of every block, kept in a file of their own until their number is known.
   struct Hit {
     double ray, t, u, v, x, y, z;

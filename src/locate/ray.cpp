@@ -28,8 +28,8 @@ Line frame(const Vec3& o, const Vec3& d) {
 
 // Newton's iteration from (u, v) on g = ((S − o)·e1, (S − o)·e2) = 0, bounded to the
 // piece; a step that does not lower |g| is halved. Whether |g| reached `tol`.
-bool meet(const Spline& s, const PieceNets& nets, const Piece& pc, const Line& l, double tol, double& u, double& v) {
-  SurfaceDerivatives d = piece_derivatives(s, nets, pc, u, v);
+bool meet(const SurfaceSearch& S, const Piece& pc, const Line& l, double tol, double& u, double& v) {
+  SurfaceDerivatives d = S.at(pc, u, v);
   const auto residual = [&](const Vec3& p) {
     const Vec3 r = p - l.o;
     return std::array<double, 2>{dot(r, l.e1), dot(r, l.e2)};
@@ -47,7 +47,7 @@ bool meet(const Spline& s, const PieceNets& nets, const Piece& pc, const Line& l
     for (int h = 0; h < 40; ++h, t *= 0.5) {
       const double nu = std::clamp(u + t * du, pc.lo[0], pc.hi[0]), nv = std::clamp(v + t * dv, pc.lo[1], pc.hi[1]);
       if (nu == u && nv == v) break;
-      const SurfaceDerivatives nd = piece_derivatives(s, nets, pc, nu, nv);
+      const SurfaceDerivatives nd = S.at(pc, nu, nv);
       const auto ng = residual(nd.s);
       const double n2 = ng[0] * ng[0] + ng[1] * ng[1];
       if (n2 < g2) {
@@ -81,7 +81,7 @@ std::vector<RayHit> SurfaceSearch::intersect(const Vec3& origin, const Vec3& dir
                const double seeds[5][2] = {{0.5, 0.5}, {0.25, 0.25}, {0.75, 0.25}, {0.25, 0.75}, {0.75, 0.75}};
                for (const auto& sd : seeds) {
                  double u = pc.lo[0] + sd[0] * (pc.hi[0] - pc.lo[0]), v = pc.lo[1] + sd[1] * (pc.hi[1] - pc.lo[1]);
-                 if (!meet(spline, nets, pc, l, tol, u, v)) continue;
+                 if (!meet(*this, pc, l, tol, u, v)) continue;
                  const Vec3 p = surface->point(u, v);
                  const double t = dot(p - origin, direction) / (len * len);
                  if (t >= -1e-12 * spline.diagonal * spline.scale / len) raw.push_back({std::max(t, 0.0), u, v, p});

@@ -46,10 +46,18 @@ struct SurfaceSearch {
   PieceNets nets;
   std::vector<Piece> pieces;
   BoxTree tree;
+  /// A surface without an exact form is searched through a stand-in, a bicubic through
+  /// its points on a grid of its parameters: the stand-in's pieces, their boxes widened
+  /// by `widen` (4 times the largest gap measured between the two, in the spline's
+  /// units), and Newton's iteration on the surface itself (`formula`).
+  const Surface* formula = nullptr;
+  double widen = 0;
   explicit SurfaceSearch(const Surface& s);
   /// A search on b, whose answers are points of `answers` (b's own, or a surface b is
   /// the exact form of); both outlive the search.
   SurfaceSearch(const BSplineSurface& b, const Surface& answers);
+  /// S and its derivatives at (u, v) of piece pc, in the spline's units.
+  [[nodiscard]] SurfaceDerivatives at(const Piece& pc, double u, double v) const;
   [[nodiscard]] SurfacePoint closest(const Vec3& q) const;
   /// The rest of a piece where the distance may have several minima (cut further).
   template <class Keep>

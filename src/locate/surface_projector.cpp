@@ -5,7 +5,10 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 
+#include "interpatch/interpolate.hpp"
+#include "interpatch/evaluate.hpp"
 #include "interpatch/projection.hpp"
 #include "locate/search.hpp"
 #include "locate/spline_eval.hpp"
@@ -57,10 +60,10 @@ std::array<double, 2> bilinear_seed(const H4* net, int nu, int nv, const Vec3& q
 // f = |S − q|², bounded to the region. Where the Hessian of f is not positive
 // definite, Gauss–Newton's JᵀJ (with a trace-relative shift where that too is
 // singular, as at a pole); a step that does not lower f is halved.
-Local descend(const Spline& s, const PieceNets& nets, const Piece& pc, const Region& rg, double u, double v,
-              const Vec3& q) {
+Local descend(const SurfaceSearch& S, const Piece& pc, const Region& rg, double u, double v, const Vec3& q) {
+  const Spline& s = S.spline;
   const double u0 = rg.u0, u1 = rg.u1, v0 = rg.v0, v1 = rg.v1;
-  SurfaceDerivatives d = piece_derivatives(s, nets, pc, u, v);
+  SurfaceDerivatives d = S.at(pc, u, v);
   double f = dot(d.s - q, d.s - q);
   for (int it = 0; it < 50; ++it) {
     const Vec3 r = d.s - q;
@@ -101,7 +104,7 @@ Local descend(const Spline& s, const PieceNets& nets, const Piece& pc, const Reg
     for (; t * moves >= 1e-13 * s.diagonal; t *= 0.5) {
       const double a = std::clamp(u + t * du, u0, u1), b = std::clamp(v + t * dv, v0, v1);
       if (a == u && b == v) break;
-      const SurfaceDerivatives e = piece_derivatives(s, nets, pc, a, b);
+      const SurfaceDerivatives e = S.at(pc, a, b);
       const Vec3 nr = e.s - q;
       const double g = dot(nr, nr);
       if (g < f) {
@@ -138,15 +141,75 @@ SurfaceSearch::SurfaceSearch(const BSplineSurface& b, const Surface& answers) : 
   tree = BoxTree(pieces);
 }
 
-SurfaceSearch::SurfaceSearch(const Surface& s) : SurfaceSearch(exact_form(s), s) {}
+namespace {
+
+// The stand-in of a surface without an exact form: the bicubic through its points on a
+// 65 × 65 grid of its parameters (uniform: the stand-in's parameters are the surface's),
+// and the largest gap between the two at the centres of the grid's cells and of their
+// quarters.
+std::pair<BSplineSurface, double> stand_in(const Surface& s) {
+  const auto d = s.domain();
+  const std::size_t m = 65;
+  const auto us = linspace(d[0].first, d[0].second, m), vs = linspace(d[1].first, d[1].second, m);
+  SurfaceInterpolationOptions o;
+  o.param = Parametrization::uniform;
+  BSplineSurface b = interpolate_surface(s.evaluate(us, vs), o).surface.mapped(d[0].first, d[0].second, d[1].first, d[1].second);
+  const auto half = [](std::span<const double> t) {
+    std::vector<double> h;
+    for (std::size_t i = 0; i + 1 < t.size(); ++i)
+      for (const double f : {0.25, 0.5, 0.75}) h.push_back(t[i] + f * (t[i + 1] - t[i]));
+    return h;
+  };
+  const auto hu = half(us), hv = half(vs);
+  const PointGrid a = s.evaluate(hu, hv), c = b.evaluate(hu, hv);
+  double gap = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) gap = std::max(gap, distance(a.values()[k], c.values()[k]));
+  return {std::move(b), gap};
+}
+
+}  // namespace
+
+SurfaceSearch::SurfaceSearch(const Surface& s) : surface(&s), tree({}) {
+  std::optional<BSplineSurface> exact;
+  try {
+    exact = exact_form(s);
+  } catch (const error& e) {
+    if (e.code() != errc::no_exact_form) throw;
+  }
+  if (exact) {
+    *this = SurfaceSearch(*exact, s);
+    return;
+  }
+  auto [b, gap] = stand_in(s);
+  SurfaceSearch near(b, s);
+  *this = std::move(near);
+  formula = &s;
+  // Four times the gap measured: between samples it can be larger than at them.
+  widen = (4 * gap + 1e-12 * spline.diagonal * spline.scale) / spline.scale;
+  for (Piece& pc : pieces) {
+    pc.box.lo -= Vec3{widen, widen, widen}, pc.box.hi += Vec3{widen, widen, widen};
+    for (std::size_t i = 0; i < 3; ++i) pc.tight.lo[i] -= widen, pc.tight.hi[i] += widen;
+    pc.convex = 0;  // the stand-in's curvature is not the surface's: search every piece further
+  }
+  tree = BoxTree(pieces);
+}
+
+SurfaceDerivatives SurfaceSearch::at(const Piece& pc, double u, double v) const {
+  if (!formula) return piece_derivatives(spline, nets, pc, u, v);
+  SurfaceDerivatives d = formula->derivatives(u, v);
+  const double k = 1 / spline.scale;
+  d.s = spline.local(d.s);
+  d.su *= k, d.sv *= k, d.suu *= k, d.suv *= k, d.svv *= k;
+  return d;
+}
 
 // A piece where f may have several minima: halved three times in both directions, the
 // quarters nearest first and those whose boxes lie beyond the best distance skipped, and
 // in each quarter left Newton's iteration from the bilinear seed and from its corners.
 // Boxes of small quarters are tight, so few are searched.
 template <class Keep>
-void search_bent_in(const Spline& s, const PieceNets& nets, const Piece& pc, const BezierNet& net, const Region& rg,
-                    int depth, const Vec3& q, const double& bound2, Keep&& keep) {
+void search_bent_in(const SurfaceSearch& S, const Piece& pc, const BezierNet& net, const Region& rg, int depth,
+                    const Vec3& q, const double& bound2, Keep&& keep) {
   BezierNet a, b, parts[4];
   net.halve(0, a, b);
   a.halve(1, parts[0], parts[1]);
@@ -154,15 +217,20 @@ void search_bent_in(const Spline& s, const PieceNets& nets, const Piece& pc, con
   const double um = 0.5 * (rg.u0 + rg.u1), vm = 0.5 * (rg.v0 + rg.v1);
   const Region r[4] = {{rg.u0, um, rg.v0, vm}, {rg.u0, um, vm, rg.v1}, {um, rg.u1, rg.v0, vm}, {um, rg.u1, vm, rg.v1}};
   std::array<std::pair<double, int>, 4> order;
-  for (int k = 0; k < 4; ++k) order[static_cast<std::size_t>(k)] = {parts[k].bounds(2).distance2(q), k};
+  OrientedBox boxes[4];
+  for (int k = 0; k < 4; ++k) {
+    boxes[k] = parts[k].bounds(2);
+    for (std::size_t i = 0; i < 3; ++i) boxes[k].lo[i] -= S.widen, boxes[k].hi[i] += S.widen;
+    order[static_cast<std::size_t>(k)] = {boxes[k].distance2(q), k};
+  }
   std::sort(order.begin(), order.end());
   for (const auto& [lb, k] : order) {
     if (lb >= bound2) continue;
     const Region& x = r[k];
     const bool bends =
-        may_bend(parts[k].bounds(2), parts[k].convex_radius(x.u1 - x.u0, x.v1 - x.v0), q, std::numeric_limits<double>::infinity());
+        may_bend(boxes[k], parts[k].convex_radius(x.u1 - x.u0, x.v1 - x.v0), q, std::numeric_limits<double>::infinity());
     if (bends && depth + 1 < 3) {
-      search_bent_in(s, nets, pc, parts[k], x, depth + 1, q, bound2, keep);
+      search_bent_in(S, pc, parts[k], x, depth + 1, q, bound2, keep);
       continue;
     }
     const auto [sa, sb] = bilinear_seed(parts[k].h.data(), parts[k].n[0], parts[k].n[1], q);
@@ -170,7 +238,7 @@ void search_bent_in(const Spline& s, const PieceNets& nets, const Piece& pc, con
     // the corners.
     const double seeds[5][2] = {{sa, sb}, {0, 0}, {1, 0}, {0, 1}, {1, 1}};
     for (int m = 0; m < (bends ? 5 : 1); ++m)
-      keep(descend(s, nets, pc, x, x.u0 + seeds[m][0] * (x.u1 - x.u0), x.v0 + seeds[m][1] * (x.v1 - x.v0), q));
+      keep(descend(S, pc, x, x.u0 + seeds[m][0] * (x.u1 - x.u0), x.v0 + seeds[m][1] * (x.v1 - x.v0), q));
   }
 }
 
@@ -180,7 +248,7 @@ void SurfaceSearch::search_bent(const Piece& pc, const Vec3& q, const double& bo
   net.n = nets.n;
   net.h.assign(nets.h.begin() + static_cast<std::ptrdiff_t>(pc.net),
                nets.h.begin() + static_cast<std::ptrdiff_t>(pc.net + static_cast<std::size_t>(nets.n[0] * nets.n[1])));
-  search_bent_in(spline, nets, pc, net, {pc.lo[0], pc.hi[0], pc.lo[1], pc.hi[1]}, 0, q, bound2, keep);
+  search_bent_in(*this, pc, net, {pc.lo[0], pc.hi[0], pc.lo[1], pc.hi[1]}, 0, q, bound2, keep);
 }
 
 SurfacePoint SurfaceSearch::closest(const Vec3& q) const {
@@ -201,12 +269,12 @@ SurfacePoint SurfaceSearch::closest(const Vec3& q) const {
     if (!nets.kept()) {
       // Without the nets: from the centre and from each corner.
       for (const auto& [a, b] : {std::pair{0.5, 0.5}, {0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}, {1.0, 1.0}})
-        keep(descend(spline, nets, pc, whole, pc.lo[0] + a * (pc.hi[0] - pc.lo[0]), pc.lo[1] + b * (pc.hi[1] - pc.lo[1]), qc));
+        keep(descend(*this, pc, whole, pc.lo[0] + a * (pc.hi[0] - pc.lo[0]), pc.lo[1] + b * (pc.hi[1] - pc.lo[1]), qc));
       return;
     }
     const H4* net = &nets.h[pc.net];
     const auto [a, b] = bilinear_seed(net, nets.n[0], nets.n[1], qc);
-    const Local l = descend(spline, nets, pc, whole, pc.lo[0] + a * (pc.hi[0] - pc.lo[0]), pc.lo[1] + b * (pc.hi[1] - pc.lo[1]), qc);
+    const Local l = descend(*this, pc, whole, pc.lo[0] + a * (pc.hi[0] - pc.lo[0]), pc.lo[1] + b * (pc.hi[1] - pc.lo[1]), qc);
     keep(l);
     if (may_bend(pc.tight, pc.convex, qc, std::sqrt(l.f))) search_bent(pc, qc, bound2, keep);
   });

@@ -27,9 +27,11 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <memory>
 
 #include "interpatch/io/spec.hpp"
 #include "interpatch/progress.hpp"
+#include "interpatch/projection.hpp"
 
 namespace interpatch::io {
 
@@ -39,6 +41,13 @@ struct ProjectionSummary {
   double max_distance = 0;  ///< the largest distance (residual, for a volume)
   std::size_t outside = 0;  ///< volumes: the points outside
 };
+
+/// The projector of a surface construction: over its exact form (made now if it is
+/// deferred), answering with its points; without one (Gregory's twist correction),
+/// over a stand-in of its formula, answering with the formula's points (see
+/// SurfaceProjector). The construction must outlive it. @throws error no_exact_form
+/// when it has neither, wrong_type for a volume.
+[[nodiscard]] std::unique_ptr<SurfaceProjector> surface_projector(Construction& c, const progress_callback& progress = {});
 
 /// Refuses (error wrong_type) an output `project` or `intersect` does not write:
 /// .npz, .npy and .csv.
