@@ -163,6 +163,8 @@ def test_bad_points_are_named():
         s.closest_points(np.zeros((5, 2)))
     with pytest.raises(interpatch.Error, match=r"ray 1: its direction is the zero vector"):
         s.intersect(np.zeros((2, 3)), [[0, 0, 1], [0, 0, 0]])
+    with pytest.raises(interpatch.Error, match=r"give one of param \(a name\), params \(the sites\) and base"):
+        interpatch.approximate_surface(np.zeros((20, 3)), param="xy", base=s, tolerance=0.1)
 
 
 def test_the_readmes_projection_example_runs(tmp_path, monkeypatch):
