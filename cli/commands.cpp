@@ -204,7 +204,7 @@ int mesh_command(const Input& in, const fs::path& out, std::string_view res_text
   io::Built b = cli::build_any_input(in, {.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}});
   refuse_curve(in, b, "mesh");
   io::Construction& c = std::get<io::Construction>(b);
-  const Resolution res = given ? *given : (io::is_volume(c) ? default_volume_resolution : default_surface_resolution);
+  const Resolution res = given ? *given : io::default_resolution(c);
   check_mesh_kind(c, out, res);
   if (!given) require_mesh_room(res, out);
   write_mesh(c, out, res);

@@ -165,7 +165,7 @@ fs::path write_spec(const Example& ex, const fs::path& dir, std::vector<std::str
 ojson write_outputs(io::Construction& c, const Example& ex, const fs::path& dir,
                     std::vector<std::string>& written) {
   constexpr Resolution eval_grid{33, 33, 0}, volume_eval_grid{17, 17, 17};
-  const Resolution res = default_surface_resolution, volume_res = default_volume_resolution;
+  const Resolution res = io::default_resolution(c), volume_res = res;
   // The viewer pages of the demo are lighter than the command's default (257 x 257).
   constexpr std::array<std::size_t, 3> view_res{129, 129, 0}, volume_view_res{17, 17, 17};
   const auto out = [&](const std::string& suffix) {

@@ -30,7 +30,7 @@ if sys.argv[1:] == ["--self-test"]:
         print("the check finds every planted breach")
         sys.exit(0)
 
-LAYERS = ["base", "linalg", "splines", "blends", "constructions", "locate", "io", "mpi"]
+LAYERS = ["base", "linalg", "splines", "blends", "constructions", "locate", "mesh", "io", "mpi"]
 root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".").resolve()
 src = root / "src"
 include = re.compile(r'^\s*#\s*include\s*"([^"]+)"', re.M)

@@ -15,6 +15,7 @@
 #include "interpatch/coons_volume.hpp"
 #include "interpatch/error.hpp"
 #include "interpatch/evaluate.hpp"
+#include "interpatch/grading.hpp"
 #include "interpatch/grid.hpp"
 #include "interpatch/hermite.hpp"
 #include "interpatch/interpolate.hpp"

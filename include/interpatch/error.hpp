@@ -37,6 +37,7 @@ enum class errc {
   closing_gap,             ///< a closed shape's last point nearly, but not quite, repeats the first
   tolerance_not_met,       ///< an approximation cannot bring every data point within the tolerance asked for; a network cannot re-express its curves within theirs
   ill_conditioned,         ///< a fit's control points swing far outside its data (a near-singular system)
+  invalid_grading,         ///< a mesh grading that cannot be: a non-positive length or ratio, an end longer than its direction
   // --- files; the command line exits with 4 ---
   file_unreadable,         ///< a file cannot be opened or read
   file_unwritable,         ///< an output file cannot be written

@@ -28,12 +28,15 @@ class Construction:
     def info(self) -> dict[str, Any]:
         """The dict `interpatch info` prints. Its check at the data (max_data_error) compares
         with the arrays the construction was built from as they are now: it keeps them, not a copy."""
-    def write(self, path: _Path, res: Optional[Sequence[int]] = None) -> None:
+    def write(self, path: _Path, res: Optional[Sequence[int]] = None,
+              sampling: Optional[dict[str, dict[str, float]]] = None) -> None:
         """.json .npz .step .igs (the exact form), .obj .ply .stl .vtk .vts .xyz (a mesh of res vertices)
         or .html (a viewer page of res samples, as `interpatch view` writes it). Checked before any
         work as the command line checks it: res (nu, nv) for a surface, (nu, nv, nw) for a volume, each
         at least 2 ('too_few_points', 'size_mismatch'); a mesh too large for the memory or the
-        disk ('too_large'); res with another format, or an unknown format ('wrong_type')."""
+        disk ('too_large'); res with another format, or an unknown format ('wrong_type').
+        A mesh's nodes follow `sampling`, a dict as a spec's "sampling" ({'w': {'count': 41,
+        'first': 1e-3}}), or else the spec's own; its counts give way to res."""
     @property
     def params_u(self) -> Optional[_Array]: ...
     @property

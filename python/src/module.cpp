@@ -106,7 +106,7 @@ class PyBuilt {
   // Written as the commands write: .json .npz .step/.stp .igs/.iges (the exact form),
   // a mesh (.obj .ply .stl .vtk .vts .xyz) of `res` vertices, or a viewer page (.html)
   // of `res` samples; checked as the command line checks them (io/outputs.hpp).
-  void write(const py::object& path_in, const py::object& res_in) const {
+  void write(const py::object& path_in, const py::object& res_in, const py::object& sampling_in) const {
     namespace io = ip::io;
     const std::filesystem::path path = ip::python::path_arg(path_in, "write: the path is a str or an os.PathLike");
     const std::string ext = path.extension().string();
@@ -121,6 +121,14 @@ class PyBuilt {
       if (mesh) io::require_mesh_room(*res, path);  // before the lock and any work
     }
     if (!mesh && !view) io::check_build_output(path);
+    // Read as the spec's "sampling" is, for this write alone.
+    std::optional<ip::Sampling> sampling;
+    if (!sampling_in.is_none()) {
+      if (!mesh)
+        throw ip::error(ip::errc::wrong_type, "sampling: only a mesh places its nodes by a sampling, not '" +
+                                                  path.string() + "'");
+      sampling = io::read_sampling(ip::python::spec_json(sampling_in), io::is_volume(b_->c) ? 3 : 2);
+    }
     // A viewer page shows the data points.
     LentPoints lent = view ? lent_data() : LentPoints();
     const ip::progress_callback progress = interruptible();
@@ -129,10 +137,9 @@ class PyBuilt {
       py::gil_scoped_release free;
       std::lock_guard<std::mutex> hold(b_->lock);
       const WithData with(b_->c, lent);
-      const bool volume = io::is_volume(b_->c);
       if (mesh) {
-        const io::Resolution r = res ? *res : volume ? io::default_volume_resolution : io::default_surface_resolution;
-        warned = io::write_mesh(b_->c, path, r, mesh_res, progress);
+        const io::Resolution r = res ? *res : io::default_resolution(b_->c);
+        warned = io::write_mesh(b_->c, path, r, mesh_res, progress, sampling ? &*sampling : nullptr);
       } else if (view) {
         if (io::has_exact_form(b_->c)) (void)io::exact_form(b_->c, progress);  // the page shows it, as the command does
         const auto d = io::view_default_resolution(b_->c);
@@ -495,11 +502,12 @@ void bind_constructions(py::module_& m) {
            "The dict `interpatch info` prints for this construction. Its check at the data "
            "(max_data_error) compares with the NumPy arrays the construction was built from as they "
            "are when info() is called: the construction keeps those arrays, not a copy of them.")
-      .def("write", &PyBuilt::write, py::arg("path"), py::arg("res") = py::none(),
+      .def("write", &PyBuilt::write, py::arg("path"), py::arg("res") = py::none(), py::arg("sampling") = py::none(),
            "Write as `interpatch build` (.json .npz .step .igs: the exact form), `interpatch mesh` "
            "(.obj .ply .stl .vtk .vts .xyz: res = (nu, nv) vertices, 64 x 64 by default; a volume's "
            "(nu, nv, nw), 33 x 33 x 33) or `interpatch view` (.html: a viewer page of res samples, "
-           "257 x 257 by default, a volume's 33 x 33 x 33) would.")
+           "257 x 257 by default, a volume's 33 x 33 x 33) would. A mesh's nodes follow `sampling`, a dict "
+           "as a spec's \"sampling\" (e.g. {'w': {'count': 41, 'first': 1e-3}}), or else the spec's own.")
       .def_property_readonly("params_u", [](const PyBuilt& s) { return s.data_params(0); },
                              "Parameters of the data along u (None without data).")
       .def_property_readonly("params_v", [](const PyBuilt& s) { return s.data_params(1); },

@@ -32,7 +32,8 @@ void tell(const std::function<void()>& evaluated) {
 void eval_volume(const Construction& c, const fs::path& out, const Resolution& grid, const progress_callback& progress,
                  const std::function<void()>& evaluated) {
   const Volume& v = volume_evaluator(c);
-  const std::vector<std::vector<double>> params{linspace(0, 1, grid.nu), linspace(0, 1, grid.nv), linspace(0, 1, grid.nw)};
+  const GradedParameters graded = sample_parameters(c, grid);
+  const std::vector<std::vector<double>> params(graded.params.begin(), graded.params.end());
   if (lower_extension(out) == ".npy") {
     const std::size_t shape[4] = {grid.nu, grid.nv, grid.nw, 3};
     // A few u values a call, on every thread, while the block before is written.
@@ -50,8 +51,8 @@ void eval_volume(const Construction& c, const fs::path& out, const Resolution& g
 void eval_surface(Construction& c, const fs::path& out, const Resolution& grid, const progress_callback& progress,
                   const std::function<void()>& evaluated) {
   const Surface& s = evaluator(c, grid.nu * grid.nv, Sample::points);
-  constexpr double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  // every construction is over the unit square
-  std::vector<std::vector<double>> params{linspace(u0, u1, grid.nu), linspace(v0, v1, grid.nv)};
+  const GradedParameters graded = sample_parameters(c, grid);
+  const std::vector<std::vector<double>> params{graded.params[0], graded.params[1]};
   if (lower_extension(out) == ".npy") {
     const std::size_t shape[3] = {grid.nu, grid.nv, 3};
     const auto rows = s.rows(params[1]);  // what depends on v alone, once for every block

@@ -46,11 +46,11 @@ std::optional<std::size_t> point_count(const Resolution& r) {
   return n;
 }
 
-void mesh_volume(const Construction& c, const fs::path& out, const Resolution& res, const progress_callback& progress) {
+void mesh_volume(const Construction& c, const fs::path& out, const Resolution& res, const progress_callback& progress,
+                 const Sampling* sampling) {
   const Volume& v = volume_evaluator(c);
-  // Every construction is over the unit cube.
-  const std::vector<double> us = linspace(0, 1, res.nu), vs = linspace(0, 1, res.nv), ws = linspace(0, 1, res.nw);
-  const VolumeJacobians j = v.evaluate_jacobians(us, vs, ws, progress);
+  const GradedParameters p = sample_parameters(c, res, sampling);
+  const VolumeJacobians j = v.evaluate_jacobians(p.params[0], p.params[1], p.params[2], progress);
   write_volume_mesh(out, j.points, j.determinants);
 }
 
@@ -60,6 +60,29 @@ std::string counts_text(const CountsOption& option, std::span<const std::size_t>
   std::string t = std::string(option.name) + std::string(option.open);
   for (std::size_t k = 0; k < counts.size(); ++k) t += (k ? std::string(option.separator) : "") + std::to_string(counts[k]);
   return t + std::string(option.close);
+}
+
+Resolution default_resolution(const Construction& c) {
+  Resolution r = is_volume(c) ? default_volume_resolution : default_surface_resolution;
+  if (c.sampling) {
+    std::size_t* counts[] = {&r.nu, &r.nv, &r.nw};
+    for (std::size_t d = 0; d < (is_volume(c) ? 3u : 2u); ++d)
+      if ((*c.sampling)[d].count != 0) *counts[d] = (*c.sampling)[d].count;
+  }
+  return r;
+}
+
+GradedParameters sample_parameters(const Construction& c, const Resolution& res, const Sampling* sampling) {
+  const bool volume = is_volume(c);
+  const std::size_t counts[] = {res.nu, res.nv, res.nw};
+  if (!sampling && !c.sampling) {  // every construction is over the unit square (cube)
+    GradedParameters p;
+    for (std::size_t d = 0; d < (volume ? 3u : 2u); ++d) p.params[d] = linspace(0, 1, counts[d]);
+    return p;
+  }
+  Sampling s = sampling ? *sampling : *c.sampling;
+  for (std::size_t d = 0; d < 3; ++d) s[d].count = counts[d];
+  return volume ? graded_parameters(volume_evaluator(c), s) : graded_parameters(evaluator(c), s);
 }
 
 std::span<const std::size_t> counts_of(const Resolution& r) noexcept { return {&r.nu, r.nw ? 3u : 2u}; }
@@ -192,19 +215,19 @@ void write_build(const CurveConstruction& c, const fs::path& out) {
 }
 
 std::vector<std::string> write_mesh(Construction& c, const fs::path& out, const Resolution& res,
-                                    const CountsOption& option, const progress_callback& progress) {
+                                    const CountsOption& option, const progress_callback& progress,
+                                    const Sampling* sampling) {
   check_mesh_output(out);
   check_counts(counts_of(res), option);
   check_mesh_kind(c, out, res, option);
   require_mesh_room(res, out);
   if (is_volume(c)) {
-    mesh_volume(c, out, res, progress);
+    mesh_volume(c, out, res, progress, sampling);
     return {};
   }
   const Surface& s = evaluator(c, res.nu * res.nv, Sample::derivatives);
-  // Every construction is over the unit square.
-  const std::vector<double> us = linspace(0, 1, res.nu), vs = linspace(0, 1, res.nv);
-  return write_surface_mesh(out, s, us, vs, progress);  // a .vts or .vtk a block at a time
+  const GradedParameters p = sample_parameters(c, res, sampling);
+  return write_surface_mesh(out, s, p.params[0], p.params[1], progress);  // a .vts or .vtk a block at a time
 }
 
 }  // namespace interpatch::io

@@ -19,6 +19,7 @@
 #include "interpatch/evaluate.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/io/json_out.hpp"
+#include "interpatch/io/outputs.hpp"
 #include "interpatch/memory.hpp"
 #include "interpatch/volume.hpp"
 #include "io/box.hpp"
@@ -236,8 +237,9 @@ ojson control_net_json(const Construction& c, const PageFrame& frame) {
 
 // The samples in the page's frame, with their curvatures in its unit (K unit², H
 // unit): a 1e-200 part's curvatures would overflow float32, its own do not.
-ojson surface_json(const Surface& s, const std::array<std::size_t, 3>& res, const PageFrame& frame) {
-  const std::vector<double> us = linspace(0, 1, res[0]), vs = linspace(0, 1, res[1]);
+ojson surface_json(const Surface& s, const GradedParameters& p, const PageFrame& frame) {
+  const std::vector<double>&us = p.params[0], &vs = p.params[1];
+  const std::array<std::size_t, 3> res{us.size(), vs.size(), 0};
   const std::size_t n = res[0] * res[1];
   Float32Base64 points(3 * n), normals(3 * n), gaussian(n), mean(n);
   // A block of u rows at a time: the derivatives of the whole grid would be six
@@ -269,8 +271,9 @@ ojson surface_json(const Surface& s, const std::array<std::size_t, 3>& res, cons
 }
 
 // The samples in the page's frame, det J in its unit (det J / unit³).
-ojson volume_json(const Volume& v, const std::array<std::size_t, 3>& res, const PageFrame& frame) {
-  const std::vector<double> us = linspace(0, 1, res[0]), vs = linspace(0, 1, res[1]), ws = linspace(0, 1, res[2]);
+ojson volume_json(const Volume& v, const GradedParameters& p, const PageFrame& frame) {
+  const std::vector<double>&us = p.params[0], &vs = p.params[1], &ws = p.params[2];
+  const std::array<std::size_t, 3> res{us.size(), vs.size(), ws.size()};
   const VolumeJacobians j = v.evaluate_jacobians(us, vs, ws);
   const std::size_t n = j.points.size();
   const std::size_t shape[4] = {res[0], res[1], res[2], 3};
@@ -450,8 +453,9 @@ std::string view_html(const Construction& c, const ViewOptions& options) {
   data["info"] = info_json(c);
   const PageFrame frame = construction_frame(c);
   data["frame"] = frame.json();
-  if (volume) data["volume"] = volume_json(volume_evaluator(c), res, frame);
-  else data["surface"] = surface_json(evaluator(c), res, frame);
+  const GradedParameters nodes = sample_parameters(c, {res[0], res[1], res[2]});
+  if (volume) data["volume"] = volume_json(volume_evaluator(c), nodes, frame);
+  else data["surface"] = surface_json(evaluator(c), nodes, frame);
   data["control_net"] = control_net_json(c, frame);
   data["data"] = data_json(c, frame);
   data["frames"] = frames_json(c);

@@ -28,7 +28,7 @@ using Documented = std::map<std::string, std::set<std::string>>;  // "kind name"
 Documented read_documented(const std::string& path) {
   std::ifstream in(path);
   EXPECT_TRUE(in) << "cannot read " << path;
-  const std::regex heading(R"(^### (type|curve|points) `([a-z_0-9]+)`\s*$)");
+  const std::regex heading(R"(^### (type|curve|points|sampling) `([a-z_0-9]+)`\s*$)");
   const std::regex other_heading(R"(^#{1,6} )");
   const std::regex row(R"(^\| `([^`]+)` \|)");
   Documented doc;

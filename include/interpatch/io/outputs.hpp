@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "interpatch/grading.hpp"
 #include "interpatch/io/spec.hpp"
 #include "interpatch/progress.hpp"
 
@@ -27,6 +28,18 @@ struct Resolution {
 /// The default mesh resolutions: 64 × 64 for a surface, 33 × 33 × 33 for a volume.
 inline constexpr Resolution default_surface_resolution{64, 64, 0};
 inline constexpr Resolution default_volume_resolution{33, 33, 33};
+
+/// The resolution of a mesh when none is asked for: the counts the spec's "sampling"
+/// gives, the kind's default (64 × 64, 33 × 33 × 33) along the other directions.
+[[nodiscard]] Resolution default_resolution(const Construction& c);
+
+/// The parameters of `res` nodes along each direction (each over [0, 1]): the
+/// construction's sampling (or `sampling`, when given) with the counts of `res`,
+/// graded_parameters() of its evaluator, which reports what the nodes achieve; without
+/// any sampling, even steps and an empty report.
+/// @throws error as graded_parameters.
+[[nodiscard]] GradedParameters sample_parameters(const Construction& c, const Resolution& res,
+                                                 const Sampling* sampling = nullptr);
 
 /// How messages name counts along each direction: the option or argument that gave
 /// them, what they make and count, and how its user writes them (the command line's
@@ -104,9 +117,11 @@ void write_build(Construction& c, const std::filesystem::path& out);
 void write_build(const CurveConstruction& c, const std::filesystem::path& out);
 
 /// Writes a mesh of `res` vertices, sampled through the cheaper exact evaluator
-/// (evaluator()), which may make the exact form of `c`. Every check above comes
-/// first: the format, counts of at least 2 of the construction's kind (messages
-/// naming `option`), the room. `progress` may throw to stop the work.
+/// (evaluator()), which may make the exact form of `c`, at the nodes
+/// sample_parameters() places (the construction's sampling, or `sampling` when given).
+/// Every check above comes first: the format, counts of at least 2 of the
+/// construction's kind (messages naming `option`), the room. `progress` may throw to
+/// stop the work.
 ///
 /// Example:
 /// @code
@@ -121,10 +136,12 @@ void write_build(const CurveConstruction& c, const std::filesystem::path& out);
 ///   the origin for its size), to be shown: the file is written.
 [[nodiscard]] std::vector<std::string> write_mesh(Construction& c, const std::filesystem::path& out,
                                                   const Resolution& res, const CountsOption& option,
-                                                  const progress_callback& progress = {});
+                                                  const progress_callback& progress = {},
+                                                  const Sampling* sampling = nullptr);
 
-/// Writes the points of a uniform grid over [0, 1]^2 ([0, 1]^3 for a volume) of
-/// `grid` points, u index first: a .npy of shape (NU, NV, 3) or (NU, NV, NW, 3),
+/// Writes the points of a grid over [0, 1]^2 ([0, 1]^3 for a volume) of `grid`
+/// points, at the parameters sample_parameters() places (even steps unless the spec
+/// grades its sampling), u index first: a .npy of shape (NU, NV, 3) or (NU, NV, NW, 3),
 /// float64, or a .csv of one row per point in the same order (write_csv_grid). It
 /// samples through the cheaper exact evaluator (evaluator()), which may make the
 /// exact form of `c`. Every check comes first: the format, counts of at least 2 of

@@ -25,6 +25,7 @@
 #include "interpatch/bspline_curve.hpp"
 #include "interpatch/bspline_surface.hpp"
 #include "interpatch/bspline_volume.hpp"
+#include "interpatch/grading.hpp"
 #include "interpatch/progress.hpp"
 #include "interpatch/surface.hpp"
 #include "interpatch/vec3.hpp"
@@ -94,6 +95,9 @@ struct Construction {
   /// Built with BuildOptions::defer_exact: the conversion of the formula to its exact
   /// form, which exact_form() runs on first use (and then empties). Empty otherwise.
   std::function<ExactForm(const progress_callback&)> convert;
+  /// The spec's "sampling": how mesh, eval and view place their nodes along each
+  /// direction (a count 0 where the spec gives none). Empty: even steps.
+  std::optional<Sampling> sampling;
 };
 
 struct PointArray;
@@ -192,8 +196,9 @@ enum class Sample {
 /// (kind "type": its top-level fields, "type" included), a curve form (kind
 /// "curve": interpolate, bspline, hermite, line — for bspline and hermite the fields
 /// of the object under that key), or a point array given as a file (kind "points":
-/// npy, csv). docs/spec-format.md documents exactly these; a field not listed is
-/// reported as unknown and ignored.
+/// npy, csv), or one direction of the "sampling" every construction takes (kind
+/// "sampling", name "direction"). docs/spec-format.md documents exactly these; a
+/// field not listed is reported as unknown and ignored.
 struct SpecForm {
   std::string_view kind;
   std::string_view name;
@@ -202,6 +207,14 @@ struct SpecForm {
 
 /// Every form a spec may hold, construction types first in documented order.
 [[nodiscard]] std::vector<SpecForm> spec_forms();
+
+/// A spec's "sampling" object, {"u": {"count": 41, "first": 1e-3}, ...}, read as the
+/// spec reader reads it, for a construction of `dims` (2 or 3) directions: what the
+/// Python module's write(sampling=...) takes.
+/// @throws error invalid_grading (a direction the construction lacks, a length,
+///   ratio or max_growth out of range, ratio with an end length), too_few_points (a
+///   count below 2), wrong_type.
+[[nodiscard]] Sampling read_sampling(const nlohmann::json& j, std::size_t dims);
 
 /// Parses JSON text. `source` names the text in messages (the file name).
 /// NaN and Infinity literals, which some writers emit, are refused as non-finite

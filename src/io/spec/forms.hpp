@@ -29,4 +29,8 @@ inline constexpr auto approximate_curve =
     std::to_array({"approximate"sv, "degree"sv, "param"sv, "periodic"sv, "weights"sv, "control_points"sv, "tolerance"sv,
                    "smoothing"sv});
 
+// One direction of a spec's "sampling".
+inline constexpr auto sampling_direction =
+    std::to_array({"count"sv, "ratio"sv, "first"sv, "last"sv, "max_growth"sv});
+
 }  // namespace interpatch::io::reader::forms

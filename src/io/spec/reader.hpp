@@ -211,6 +211,8 @@ struct ConstructionType {
 
 /// The type of that name; nullptr when there is none.
 const ConstructionType* find_type(std::string_view name);
+// A spec's "sampling" (at `ptr`) for a construction of `dims` directions.
+Sampling read_sampling(const json& j, std::string_view ptr, std::size_t dims, Context& ctx);
 /// The names of the types, comma-separated; only those of `dims` dimensions when it is not 0.
 std::string type_list(int dims = 0);
 

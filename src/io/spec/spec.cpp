@@ -81,8 +81,14 @@ Construction build_impl(const json& spec, Context& ctx) {
   const ConstructionType* type = find_type(name);
   if (!type)
     fail(errc::unknown_type, "/type: unknown type \"", interpatch::detail::excerpt(name), "\"; known types: ", type_list());
-  check_fields(spec, "", type->fields, ctx);
+  std::vector<std::string_view> fields(type->fields.begin(), type->fields.end());
+  fields.push_back("sampling");  // every construction's: how mesh, eval and view sample it
+  check_fields(spec, "", fields, ctx);
+  std::optional<Sampling> sampling;
+  if (const json* s = find_member(spec, "sampling"))
+    sampling = read_sampling(*s, "/sampling", static_cast<std::size_t>(type->dims), ctx);
   Construction c = type->build(spec, ctx);
+  c.sampling = sampling;
   if (!ctx.defer_exact && c.convert) (void)has_exact_form_after_conversion(c);
   c.type = name;
   c.warnings = std::move(ctx.warnings);
@@ -162,6 +168,7 @@ std::vector<SpecForm> spec_forms() {
   add("curve", "approximate", forms::approximate_curve);
   add("points", "npy", forms::npy);
   add("points", "csv", forms::csv);
+  add("sampling", "direction", forms::sampling_direction);
   return v;
 }
 
