@@ -178,10 +178,12 @@ bench: bench-deps viewer-deps
 
 # The README's pictures: viewer pages of the examples rendered to docs/images/*.png
 # by headless Chromium (tools/make_pictures.py; the test list brings the browser), and
-# the deviation map of a survey from its surface (tools/deviation_map.py, matplotlib).
+# the deviation map of a survey from its surface (tools/deviation_map.py, matplotlib)
+# and the graded duct's nodes (tools/graded_duct.py).
 pictures: test-deps build
 	/usr/bin/python3 tools/make_pictures.py ./build/release/interpatch docs/images
 	/usr/bin/python3 tools/deviation_map.py ./build/release/interpatch docs/images/deviation_map.png
+	/usr/bin/python3 tools/graded_duct.py ./build/release/interpatch docs/images/graded_duct.png
 
 # A 1000 x 1000 surface's viewer page: its size, the time `interpatch view` takes to
 # write it and the time Chromium takes to open and draw it (docs/BENCHMARKS.md).

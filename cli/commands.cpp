@@ -18,6 +18,7 @@
 #include "interpatch/error.hpp"
 #include "interpatch/io/atomic_file.hpp"
 #include "interpatch/io/json_out.hpp"
+#include "interpatch/io/mesh.hpp"
 #include "interpatch/io/project.hpp"
 #include "interpatch/io/view.hpp"
 #include "progress.hpp"
@@ -198,7 +199,8 @@ int build_command(const Input& in, const fs::path& out) {
 int mesh_command(const Input& in, const fs::path& out, std::string_view res_text) {
   const std::optional<Resolution> given = res_text.empty() ? std::nullopt : std::optional(parse_resolution(res_text));
   check_mesh_output(out);
-  io::check_writable(out);
+  if (io::is_polymesh_path(out)) io::check_writable_directory(out);
+  else io::check_writable(out);
   if (given) require_mesh_room(*given, out);
   // A mesh samples the construction; its exact form is made only if that costs less.
   io::Built b = cli::build_any_input(in, {.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}});

@@ -179,8 +179,10 @@ ojson write_outputs(io::Construction& c, const Example& ex, const fs::path& dir,
     write_build(c, out(".step"));  // a face (a closed shell of six for a volume) for CAD systems
     write_build(c, out(".igs"));
   }
-  write_eval(c, out(".eval.npy"), volume ? volume_eval_grid : eval_grid);
-  write_eval(c, out(".eval.csv"), volume ? volume_eval_grid : eval_grid);
+  // A graded example is evaluated at its own nodes: fewer would not hold its grading.
+  const Resolution grid = c.sampling ? io::default_resolution(c) : volume ? volume_eval_grid : eval_grid;
+  write_eval(c, out(".eval.npy"), grid);
+  write_eval(c, out(".eval.csv"), grid);
   if (volume) {
     write_mesh(c, out(".vts"), volume_res);
     write_mesh(c, out(".vtk"), volume_res);
@@ -194,7 +196,8 @@ ojson write_outputs(io::Construction& c, const Example& ex, const fs::path& dir,
   }
   ojson description = info(c);
   write_text(out(".info.json"), io::pretty_json(description));
-  io::write_view(out(".view.html"), c, {.resolution = volume ? volume_view_res : view_res, .title = ex.name});
+  const std::array<std::size_t, 3> page = c.sampling ? io::view_default_resolution(c) : volume ? volume_view_res : view_res;
+  io::write_view(out(".view.html"), c, {.resolution = page, .title = ex.name});
   return description;
 }
 

@@ -170,6 +170,11 @@ const char* const grid_file = "s.json";
 std::vector<Row> rows() {
   const std::string grid = grid_spec().dump();
   const std::string vol = example("trilinear").dump();
+  const auto graded = [](const char* sampling) {
+    nlohmann::json j = grid_spec();
+    j["sampling"] = nlohmann::json::parse(sampling);
+    return j.dump();
+  };
   const std::string misaligned_ruled = R"({"type": "ruled", "curves": [
       {"degree": 1, "param": "uniform", "periodic": true, "interpolate": [[0.186, 1.019, 0.061],
         [-0.765, 0.896, -0.020], [-1.031, -0.403, 0.098], [0.369, -1.065, 0.055], [1.008, -0.308, -0.029]]},
@@ -567,6 +572,20 @@ std::vector<Row> rows() {
       {"IntersectACurve", {{grid_file, R"({"line": [[0, 0, 0], [1, 0, 0]]})"}, {"r.csv", "0,0,5,0,0,-1\n"}},
        {"intersect", grid_file, "r.csv", "-o", "out.csv"}, 2, R"('s\.json' is a curve spec: rays meet surfaces)",
        std::nullopt, false},
+      {"SamplingOnADirectionTheSurfaceLacks", {{grid_file, graded(R"({"w": {"count": 9}})")}},
+       {"mesh", grid_file, "-o", "out.vts"}, 3,
+       R"(/sampling/w: a surface has no direction "w"; its directions are u and v)", errc::invalid_grading},
+      {"SamplingFirstNotPositive", {{grid_file, graded(R"({"u": {"count": 9, "first": -0.1}})")}},
+       {"mesh", grid_file, "-o", "out.vts"}, 3, R"(/sampling/u/first: -0\.1; it must be a positive length)",
+       errc::invalid_grading},
+      {"SamplingCountTooSmall", {{grid_file, graded(R"({"u": {"count": 5, "first": 1e-4}})")}},
+       {"mesh", grid_file, "-o", "out.vts"}, 3,
+       R"(sampling u: count 5 would grow by [0-9.]+ from one cell to the next \(max_growth 1\.3\); count [0-9]+ would do)",
+       errc::too_few_points, false},
+      {"SamplingFirstLongerThanTheDirection", {{grid_file, graded(R"({"v": {"first": 50}})")}},
+       {"eval", grid_file, "--grid", "5", "-o", "out.npy"}, 3,
+       R"(sampling v: first 50 is longer than the direction: its longest chord from that end is [0-9.]+)",
+       errc::invalid_grading, false},
       {"ProjectToAnUnknownFormat", {{grid_file, grid}, {"p.csv", "0,0,0\n"}}, {"project", grid_file, "p.csv", "-o", "out.vtk"}, 2,
        R"(project and intersect write \.npz, \.npy or \.csv)", std::nullopt, false},
       {"EvalOverflowsToNpy", {{grid_file, overflowing}}, {"eval", grid_file, "--grid", "5", "-o", "out.npy"}, 3,

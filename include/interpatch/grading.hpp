@@ -56,7 +56,8 @@ struct GradedParameters {
 /// The graded nodes of a surface (directions u, v of `sampling`).
 ///
 /// A first (last) length is met on the mesh itself: the largest first cell over every
-/// line of the mesh is `first` to 1e-9 of it, and never more. Each direction's lines
+/// line of the mesh is `first` to 1e-9 of it (or to the rounding of its coordinates,
+/// 16 units in their last place, when that is more), and never more. Each direction's lines
 /// are those through the other direction's nodes, so the directions are solved in
 /// turn until their nodes stop moving.
 ///

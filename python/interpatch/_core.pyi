@@ -37,6 +37,12 @@ class Construction:
         disk ('too_large'); res with another format, or an unknown format ('wrong_type').
         A mesh's nodes follow `sampling`, a dict as a spec's "sampling" ({'w': {'count': 41,
         'first': 1e-3}}), or else the spec's own; its counts give way to res."""
+    def mesh_params(self, res: Optional[Sequence[int]] = None,
+                    sampling: Optional[dict[str, dict[str, float]]] = None) -> tuple[_Array, ...]:
+        """The parameters of the nodes write() places along each direction for a mesh of res
+        vertices (the spec's sampling counts, or the kind's default): (u, v) or (u, v, w), graded
+        as `sampling` (or else the spec's "sampling") says, even steps otherwise.
+        Example: s.evaluate(*s.mesh_params()) gives the mesh's points."""
     @property
     def params_u(self) -> Optional[_Array]: ...
     @property

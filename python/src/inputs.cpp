@@ -213,4 +213,22 @@ progress_callback interruptible() {
   };
 }
 
+void bind_spec_fields(py::module_& m) {
+  m.def("spec_fields", [] {
+    py::dict forms;
+    for (const io::SpecForm& f : io::spec_forms()) {
+      const py::str kind(f.kind.data(), f.kind.size());
+      if (!forms.contains(kind)) forms[kind] = py::dict();
+      py::list fields;
+      for (std::string_view field : f.fields) fields.append(py::str(field.data(), field.size()));
+      py::dict of_kind = forms[kind];
+      of_kind[py::str(f.name.data(), f.name.size())] = py::tuple(fields);
+    }
+    return forms;
+  }, "Every form a spec may hold, as the reader checks it: {kind: {name: (field, ...)}}, kind 'type' (the "
+     "construction types, their top-level fields, \"type\" included), 'curve' (the curve forms) or 'points' (point "
+     "arrays given as files).");
+}
+
+
 }  // namespace interpatch::python

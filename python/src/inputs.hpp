@@ -55,4 +55,8 @@ std::filesystem::path path_arg(const py::handle& x, std::string_view what);
 /// KeyboardInterrupt) stops the work and is raised by the call.
 progress_callback interruptible();
 
+/// _core.spec_fields(): the reader's own field lists, so that
+/// tests/python/test_spec_fields.py holds the keyword constructors (_specs.py) to them.
+void bind_spec_fields(py::module_& m);
+
 }  // namespace interpatch::python

@@ -31,6 +31,7 @@
 #include "arrays.hpp"
 #include "curve.hpp"
 #include "locate.hpp"
+#include "sampling.hpp"
 #include "inputs.hpp"
 
 namespace py = pybind11;
@@ -122,13 +123,10 @@ class PyBuilt {
     }
     if (!mesh && !view) io::check_build_output(path);
     // Read as the spec's "sampling" is, for this write alone.
-    std::optional<ip::Sampling> sampling;
-    if (!sampling_in.is_none()) {
-      if (!mesh)
-        throw ip::error(ip::errc::wrong_type, "sampling: only a mesh places its nodes by a sampling, not '" +
-                                                  path.string() + "'");
-      sampling = io::read_sampling(ip::python::spec_json(sampling_in), io::is_volume(b_->c) ? 3 : 2);
-    }
+    if (!sampling_in.is_none() && !mesh)
+      throw ip::error(ip::errc::wrong_type, "sampling: only a mesh places its nodes by a sampling, not '" +
+                                                path.string() + "'");
+    const std::optional<ip::Sampling> sampling = ip::python::sampling_arg(sampling_in, b_->c);
     // A viewer page shows the data points.
     LentPoints lent = view ? lent_data() : LentPoints();
     const ip::progress_callback progress = interruptible();
@@ -138,7 +136,7 @@ class PyBuilt {
       std::lock_guard<std::mutex> hold(b_->lock);
       const WithData with(b_->c, lent);
       if (mesh) {
-        const io::Resolution r = res ? *res : io::default_resolution(b_->c);
+        const io::Resolution r = res ? *res : io::default_resolution(b_->c, sampling ? &*sampling : nullptr);
         warned = io::write_mesh(b_->c, path, r, mesh_res, progress, sampling ? &*sampling : nullptr);
       } else if (view) {
         if (io::has_exact_form(b_->c)) (void)io::exact_form(b_->c, progress);  // the page shows it, as the command does
@@ -186,6 +184,11 @@ class PyBuilt {
   }
 
   // The data's parameters along an axis, where the construction has data.
+  // The parameters of a mesh's nodes, as write() places them: a tuple (u, v[, w]).
+  [[nodiscard]] py::tuple mesh_params(const py::object& res, const py::object& sampling) const {
+    return ip::python::mesh_params(b_->c, b_->lock, res, sampling, mesh_res);
+  }
+
   [[nodiscard]] py::object data_params(std::size_t axis) const {
     const auto& data = b_->c.data;
     if (data.empty() || data.front().params.size() <= axis) return py::none();
@@ -508,6 +511,11 @@ void bind_constructions(py::module_& m) {
            "(nu, nv, nw), 33 x 33 x 33) or `interpatch view` (.html: a viewer page of res samples, "
            "257 x 257 by default, a volume's 33 x 33 x 33) would. A mesh's nodes follow `sampling`, a dict "
            "as a spec's \"sampling\" (e.g. {'w': {'count': 41, 'first': 1e-3}}), or else the spec's own.")
+      .def("mesh_params", &PyBuilt::mesh_params, py::arg("res") = py::none(), py::arg("sampling") = py::none(),
+           "The parameters of the nodes write() places along each direction for a mesh of res vertices "
+           "(the spec's sampling counts, or the kind's default): a tuple of arrays (u, v) or (u, v, w), graded "
+           "as `sampling` (or else the spec's \"sampling\") says, even steps otherwise. "
+           "Example: s.evaluate(*s.mesh_params()) gives the mesh's points.")
       .def_property_readonly("params_u", [](const PyBuilt& s) { return s.data_params(0); },
                              "Parameters of the data along u (None without data).")
       .def_property_readonly("params_v", [](const PyBuilt& s) { return s.data_params(1); },
@@ -566,25 +574,6 @@ void bind_constructions(py::module_& m) {
            "diagonal; outside: params and points of the nearest point of the boundary, residual its distance.");
 }
 
-void bind_spec_fields(py::module_& m) {
-  // The reader's own field lists, so that tests/python/test_spec_fields.py holds the
-  // keyword constructors (_specs.py) to them.
-  m.def("spec_fields", [] {
-    py::dict forms;
-    for (const ip::io::SpecForm& f : ip::io::spec_forms()) {
-      const py::str kind(f.kind.data(), f.kind.size());
-      if (!forms.contains(kind)) forms[kind] = py::dict();
-      py::list fields;
-      for (std::string_view field : f.fields) fields.append(py::str(field.data(), field.size()));
-      py::dict of_kind = forms[kind];
-      of_kind[py::str(f.name.data(), f.name.size())] = py::tuple(fields);
-    }
-    return forms;
-  }, "Every form a spec may hold, as the reader checks it: {kind: {name: (field, ...)}}, kind 'type' (the "
-     "construction types, their top-level fields, \"type\" included), 'curve' (the curve forms) or 'points' (point "
-     "arrays given as files).");
-}
-
 }  // namespace
 
 PYBIND11_MODULE(_core, m) {
@@ -592,7 +581,7 @@ PYBIND11_MODULE(_core, m) {
   bind_errors(m);
   bind_constructions(m);
   ip::python::bind_curve(m);
-  bind_spec_fields(m);
+  ip::python::bind_spec_fields(m);
   m.def("build", &build, py::arg("spec"), py::arg("base_dir") = py::str("."), py::arg("arrays") = py::dict(),
         "A spec (docs/spec-format.md) as a dict, or the path of a spec file, built: a Surface, a Volume, or "
         "a Curve for a curve spec (a curve at the top level, without \"type\").\n\n"

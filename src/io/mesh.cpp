@@ -162,6 +162,11 @@ std::vector<std::string> write_surface_mesh(const fs::path& path, const SurfaceM
 
 void write_volume_mesh(const fs::path& path, const PointGrid3& points, const Grid<double, 3>& jacobian) {
   const std::string ext = lower_extension(path);
+  if (is_polymesh_path(path)) {
+    const std::size_t shape[4] = {points.extent(0), points.extent(1), points.extent(2), 3};
+    internal::require_finite(&points.data()->x, 3 * points.size(), 0, shape, "the points of " + quoted(path));
+    return internal::mesh_io::write_polymesh(path, points);
+  }
   check_extension(path, ext, volume_formats, "volume");
   if (points.empty()) {
     fail(errc::size_mismatch, "cannot write ", quoted(path), ": the volume grid has no points (",

@@ -84,6 +84,12 @@ std::string vts_count(std::uint64_t bytes);
 void write_structured(const std::filesystem::path& path, const std::string& ext, const Structured& g);
 
 // ---------------------------------------------------------------------------
+// Unstructured volume meshes (polymesh.cpp).
+
+/// The hexahedra of a structured grid of nodes as an OpenFOAM polyMesh directory.
+void write_polymesh(const std::filesystem::path& dir, const PointGrid3& nodes);
+
+// ---------------------------------------------------------------------------
 // Sampling (mesh_sample.cpp).
 
 /// write_surface_mesh(path, sample_mesh(surface, us, vs, progress)) for a .vts or

@@ -62,12 +62,13 @@ std::string counts_text(const CountsOption& option, std::span<const std::size_t>
   return t + std::string(option.close);
 }
 
-Resolution default_resolution(const Construction& c) {
+Resolution default_resolution(const Construction& c, const Sampling* sampling) {
   Resolution r = is_volume(c) ? default_volume_resolution : default_surface_resolution;
-  if (c.sampling) {
+  if (!sampling && c.sampling) sampling = &*c.sampling;
+  if (sampling) {
     std::size_t* counts[] = {&r.nu, &r.nv, &r.nw};
     for (std::size_t d = 0; d < (is_volume(c) ? 3u : 2u); ++d)
-      if ((*c.sampling)[d].count != 0) *counts[d] = (*c.sampling)[d].count;
+      if ((*sampling)[d].count != 0) *counts[d] = (*sampling)[d].count;
   }
   return r;
 }
@@ -114,9 +115,9 @@ void check_build_output(const fs::path& out) {
 }
 
 void check_mesh_output(const fs::path& out) {
-  if (is_mesh_format(out.extension().string())) return;
-  throw error(errc::wrong_type,
-              "cannot tell the mesh format of '" + out.string() + "': use .obj, .stl, .ply, .vtk, .vts or .xyz");
+  if (is_mesh_format(out.extension().string()) || is_polymesh_path(out)) return;
+  throw error(errc::wrong_type, "cannot tell the mesh format of '" + out.string() +
+                                    "': use .obj, .stl, .ply, .vtk, .vts or .xyz, or a directory CASE/constant/polyMesh");
 }
 
 void check_eval_output(const fs::path& out) {
@@ -138,9 +139,13 @@ void check_view_output(const fs::path& out) {
 
 void check_mesh_kind(const Construction& c, const fs::path& out, const Resolution& res, const CountsOption& option) {
   const std::string ext = lower_extension(out);
-  if (is_volume(c) && ext != ".vts" && ext != ".vtk" && ext != ".xyz")
+  if (!is_volume(c) && is_polymesh_path(out))
+    throw error(errc::wrong_type, "'" + out.string() + "': " + c.type +
+                                      " is a surface; an OpenFOAM polyMesh holds the cells of a volume");
+  if (is_volume(c) && ext != ".vts" && ext != ".vtk" && ext != ".xyz" && !is_polymesh_path(out))
     throw error(errc::wrong_type, "'" + out.string() + "': " + c.type + " is a volume; " + ext +
-                                      " holds surfaces only, a volume mesh is written to .vts, .vtk or .xyz (Plot3D)");
+                                      " holds surfaces only, a volume mesh is written to .vts, .vtk, .xyz (Plot3D) or a "
+                                      "polyMesh directory (OpenFOAM)");
   check_counts_kind(c, option, res);
 }
 

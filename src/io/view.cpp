@@ -386,8 +386,12 @@ std::string html_escaped(std::string_view text) {
 }  // namespace
 
 std::array<std::size_t, 3> view_default_resolution(const Construction& c) noexcept {
-  if (is_volume(c)) return {33, 33, 33};
-  return {257, 257, 0};
+  std::array<std::size_t, 3> r = is_volume(c) ? std::array<std::size_t, 3>{33, 33, 33} : std::array<std::size_t, 3>{257, 257, 0};
+  // A graded spec is shown at its own nodes.
+  if (c.sampling)
+    for (std::size_t d = 0; d < (is_volume(c) ? 3u : 2u); ++d)
+      if ((*c.sampling)[d].count != 0) r[d] = (*c.sampling)[d].count;
+  return r;
 }
 
 std::array<std::size_t, 3> view_resolution(std::array<std::size_t, 3> asked, std::size_t limit) noexcept {

@@ -167,40 +167,44 @@ std::vector<double> geometric_cells(double a, std::size_t m) {
 }
 
 // Vinokur's two-sided stretching over m cells with end slopes set by d0 and d1 (the
-// first and last cells of a total of 1, to first order): node k's position.
-std::vector<double> vinokur_nodes(double d0, double d1, std::size_t m) {
-  const double fm = static_cast<double>(m);
-  const double b = 1 / (fm * std::sqrt(d0 * d1)), a = std::sqrt(d1 / d0);
-  double delta = 0;
-  if (b > 1 + 1e-12) {  // sinh(δ)/δ = b, in logarithms so that large δ stays finite
-    const double lb = std::log(b);
-    double lo = 0, hi = 800;
-    for (int i = 0; i < 200; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      const double f = mid > 20 ? mid - std::log(2 * mid) : std::log(std::sinh(mid) / mid);
-      (f < lb ? lo : hi) = mid;
+// first and last cells of a total of 1, to first order).
+struct Vinokur {
+  double a = 1, b = 1, delta = 0;
+  std::size_t m = 1;
+
+  Vinokur(double d0, double d1, std::size_t cells) : m(cells) {
+    const double fm = static_cast<double>(m);
+    b = 1 / (fm * std::sqrt(d0 * d1));
+    a = std::sqrt(d1 / d0);
+    if (b > 1 + 1e-12) {  // sinh(δ)/δ = b, in logarithms so that large δ stays finite
+      const double lb = std::log(b);
+      double lo = 0, hi = 800;
+      for (int i = 0; i < 200; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        const double f = mid > 20 ? mid - std::log(2 * mid) : std::log(std::sinh(mid) / mid);
+        (f < lb ? lo : hi) = mid;
+      }
+      delta = 0.5 * (lo + hi);
+    } else if (b < 1 - 1e-12) {  // sin(δ)/δ = b, δ in (0, π)
+      double lo = 0, hi = M_PI;
+      for (int i = 0; i < 200; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (std::sin(mid) / mid > b ? lo : hi) = mid;
+      }
+      delta = 0.5 * (lo + hi);
     }
-    delta = 0.5 * (lo + hi);
-  } else if (b < 1 - 1e-12) {  // sin(δ)/δ = b, δ in (0, π)
-    double lo = 0, hi = M_PI;
-    for (int i = 0; i < 200; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      (std::sin(mid) / mid > b ? lo : hi) = mid;
-    }
-    delta = 0.5 * (lo + hi);
   }
-  std::vector<double> s(m + 1);
-  for (std::size_t k = 0; k <= m; ++k) {
-    const double xi = static_cast<double>(k) / fm;
+  // Node k's position.
+  [[nodiscard]] double node(std::size_t k) const {
+    if (k == 0) return 0;
+    if (k == m) return 1;
+    const double xi = static_cast<double>(k) / static_cast<double>(m);
     double u = xi;
     if (b > 1 + 1e-12) u = 0.5 * (1 + std::tanh(delta * (xi - 0.5)) / std::tanh(0.5 * delta));
     else if (b < 1 - 1e-12) u = 0.5 * (1 + std::tan(delta * (xi - 0.5)) / std::tan(0.5 * delta));
-    s[k] = u / (a + (1 - a) * u);
+    return u / (a + (1 - a) * u);
   }
-  s.front() = 0;
-  s.back() = 1;
-  return s;
-}
+};
 
 // The nodes σ_0 = 0 < ... < σ_m = 1 of a distribution over m cells: a ratio, a first
 // cell a, a last cell b, or both ends. Empty when none fits m cells.
@@ -208,12 +212,17 @@ std::vector<double> sigma_nodes(const Grading& g, double a, double b, std::size_
   std::vector<double> s(m + 1, 0.0);
   if (g.first != 0 && g.last != 0) {
     if (m < 2 || a + b >= 1) return {};
+    // The end slopes that give the end cells asked for: a fixed point on the two
+    // end nodes alone, then every node.
     double d0 = a, d1 = b;
     for (int i = 0; i < 500; ++i) {
-      s = vinokur_nodes(d0, d1, m);
-      const double fa = s[1], fb = 1 - s[m - 1];
+      const Vinokur v(d0, d1, m);
+      const double fa = v.node(1), fb = 1 - v.node(m - 1);
       if (!(fa > 0 && fb > 0)) return {};
-      if (std::fabs(fa / a - 1) < 1e-13 && std::fabs(fb / b - 1) < 1e-13) return s;
+      if (std::fabs(fa / a - 1) < 1e-13 && std::fabs(fb / b - 1) < 1e-13) {
+        for (std::size_t k = 0; k <= m; ++k) s[k] = v.node(k);
+        return s;
+      }
       d0 *= a / fa;
       d1 *= b / fb;
     }
@@ -252,9 +261,13 @@ bool fits(const Grading& g, double a, double b, std::size_t m) {
   return !s.empty() && growth_of(s) <= g.max_growth * (1 + 1e-12);
 }
 
+// The largest count the search for one that fits tries: more nodes than any mesh
+// needs along one direction.
+constexpr std::size_t count_limit = 100'000;
+
 // The count nearest `count` whose distribution fits within max_growth, or 0.
 std::size_t count_that_fits(const Grading& g, double a, double b, std::size_t count) {
-  constexpr std::size_t limit = 10'000'000;
+  constexpr std::size_t limit = count_limit;
   std::size_t hi = count;
   while (hi < limit && !fits(g, a, b, hi - 1)) hi = std::min(limit, 2 * hi);
   if (fits(g, a, b, hi - 1)) {
@@ -265,9 +278,15 @@ std::size_t count_that_fits(const Grading& g, double a, double b, std::size_t co
     }
     return hi;
   }
-  for (std::size_t c = count - 1; c >= 2; --c)
-    if (fits(g, a, b, c - 1)) return c;
-  return 0;
+  // Cells that must shrink (a first cell longer than an even one) fit fewer nodes:
+  // the most below `count` that fit.
+  if (count <= 2 || !fits(g, a, b, 1)) return 0;
+  std::size_t lo = 2, up = count;  // lo fits, up does not
+  while (up - lo > 1) {
+    const std::size_t mid = lo + (up - lo) / 2;
+    (fits(g, a, b, mid - 1) ? lo : up) = mid;
+  }
+  return lo;
 }
 
 void check_grading(const Grading& g, std::size_t d) {
@@ -289,6 +308,14 @@ void check_grading(const Grading& g, std::size_t d) {
     fail(errc::invalid_grading, "sampling ", axis_name[d],
          ": ratio is given with first or last; give the ratio, or the end lengths");
 }
+
+// A count too small for direction d's grading, and the count that would do there
+// (0: none) for the other directions' nodes of the pass that found it.
+struct TooFew {
+  std::size_t d;
+  std::string grows;
+  std::size_t would;
+};
 
 struct Solved {
   double first_t = 0, last_t = 0;  // the end nodes' parameters, when first (last) is given
@@ -313,16 +340,10 @@ std::vector<double> direction_nodes(const Shape& shape, const Params& p, std::si
          " overlap: together they are longer than the direction");
   const std::size_t m = g.count - 1;
   const std::vector<double> s = sigma_nodes(g, a, b, m);
-  if (s.empty() || growth_of(s) > g.max_growth * (1 + 1e-12)) {
-    const std::size_t would = count_that_fits(g, a, b, g.count);
-    const std::string grows = s.empty() ? std::string("cannot hold the grading")
-                                        : cat("would grow by ", growth_of(s), " from one cell to the next");
-    if (would == 0)
-      fail(errc::too_few_points, "sampling ", axis_name[d], ": count ", g.count, " ", grows, " (max_growth ",
-           g.max_growth, "), and no count up to 10^7 would do");
-    fail(errc::too_few_points, "sampling ", axis_name[d], ": count ", g.count, " ", grows, " (max_growth ",
-         g.max_growth, "); count ", would, " would do");
-  }
+  if (s.empty() || growth_of(s) > g.max_growth * (1 + 1e-12))
+    throw TooFew{d, s.empty() ? std::string("cannot hold the grading")
+                              : cat("would grow by ", growth_of(s), " from one cell to the next"),
+                 count_that_fits(g, a, b, g.count)};
   std::vector<double> t(g.count);
   for (std::size_t k = 0; k < g.count; ++k) t[k] = ref.param(s[k]);
   t.front() = t0;
@@ -363,10 +384,26 @@ double measured_growth(const Shape& shape, const Params& p, std::size_t d) {
   return g;
 }
 
-// Within 1e-9 below the length asked for, never above it.
-bool holds(double got, double asked) { return asked == 0 || (got <= asked && got >= asked * (1 - 1e-9)); }
+// Within 1e-9 below the length asked for, never above it; below by the rounding of
+// a chord at most (`noise`: a part far from the origin for its size measures its
+// chords to that).
+bool holds(double got, double asked, double noise) {
+  return asked == 0 || (got <= asked && got >= asked * (1 - 1e-9) - noise);
+}
 
-bool ends_hold(const GradingReport& r, const Grading& g) { return holds(r.first, g.first) && holds(r.last, g.last); }
+bool ends_hold(const GradingReport& r, const Grading& g, double noise) {
+  return holds(r.first, g.first, noise) && holds(r.last, g.last, noise);
+}
+
+// The rounding of a chord between two points of the shape: 16 units in the last
+// place of its largest coordinate (each point's sums round by a few).
+double chord_rounding(const Shape& shape) {
+  Params p;
+  for (std::size_t a = 0; a < shape.dims; ++a) p[a] = linspace(shape.domain[a].first, shape.domain[a].second, 9);
+  double m = 0;
+  for (const Vec3& x : shape.grid(p)) m = std::max({m, std::fabs(x.x), std::fabs(x.y), std::fabs(x.z)});
+  return 16 * std::numeric_limits<double>::epsilon() * m;
+}
 
 GradedParameters graded(const Shape& shape, const Sampling& sampling) {
   for (std::size_t d = 0; d < shape.dims; ++d) check_grading(sampling[d], d);
@@ -374,6 +411,7 @@ GradedParameters graded(const Shape& shape, const Sampling& sampling) {
   Params& p = r.params;
   for (std::size_t d = 0; d < shape.dims; ++d)
     p[d] = linspace(shape.domain[d].first, shape.domain[d].second, sampling[d].count);
+  const double noise = chord_rounding(shape);
   std::array<Reference, 3> refs;
   for (std::size_t d = 0; d < shape.dims; ++d)
     if (sampling[d].graded()) refs[d] = reference(shape, d);
@@ -392,12 +430,12 @@ GradedParameters graded(const Shape& shape, const Sampling& sampling) {
       GradingReport& rep = r.report[d];
       rep.first = longest_chord(shape, p, d, t0, p[d][1]);
       rep.last = longest_chord(shape, p, d, p[d][p[d].size() - 2], t1);
-      met = met && ends_hold(rep, g);
+      met = met && ends_hold(rep, g, noise);
     }
     if (met) break;
     if (pass + 1 == passes) {
       std::size_t d = 0;
-      while (d + 1 < shape.dims && ends_hold(r.report[d], sampling[d])) ++d;
+      while (d + 1 < shape.dims && ends_hold(r.report[d], sampling[d], noise)) ++d;
       fail(errc::invalid_grading, "sampling ", axis_name[d], ": the end cells did not settle after ", passes,
            " passes over the directions (first ", r.report[d].first, ", last ", r.report[d].last, ")");
     }
@@ -408,13 +446,43 @@ GradedParameters graded(const Shape& shape, const Sampling& sampling) {
 
 }  // namespace
 
+// graded(), and where a count is too small, the error naming a count that does: the
+// count a direction's search names was found on the other directions' nodes of that
+// pass, which the final passes move a little, so it is tried before it is named.
+GradedParameters checked(const Shape& shape, const Sampling& sampling) {
+  try {
+    return graded(shape, sampling);
+  } catch (const TooFew& first) {
+    const Grading& g = sampling[first.d];
+    Sampling trial = sampling;
+    std::size_t would = first.would;
+    for (int attempt = 0; attempt < 4 && would != 0; ++attempt) {
+      trial[first.d].count = would;
+      try {
+        (void)graded(shape, trial);
+        fail(errc::too_few_points, "sampling ", axis_name[first.d], ": count ", g.count, " ", first.grows,
+             " (max_growth ", g.max_growth, "); count ", would, " would do");
+      } catch (const TooFew& again) {
+        if (again.d != first.d) break;  // another direction's count: the user's next step
+        would = again.would;
+      }
+    }
+    if (would == 0)
+      fail(errc::too_few_points, "sampling ", axis_name[first.d], ": count ", g.count, " ", first.grows,
+           " (max_growth ", g.max_growth, "), and no count from 2 to ", count_limit,
+           " would do: allow a larger max_growth");
+    fail(errc::too_few_points, "sampling ", axis_name[first.d], ": count ", g.count, " ", first.grows, " (max_growth ",
+         g.max_growth, "); a count near ", would, " may do");
+  }
+}
+
 GradedParameters graded_parameters(const Surface& surface, const Sampling& sampling) {
   const auto dom = surface.domain();
   Shape shape{2, {dom[0], dom[1], {0.0, 1.0}}, [&](const Params& p) {
     const PointGrid g = surface.evaluate(p[0], p[1]);
     return std::vector<Vec3>(g.data(), g.data() + g.size());
   }};
-  return graded(shape, sampling);
+  return checked(shape, sampling);
 }
 
 GradedParameters graded_parameters(const Volume& volume, const Sampling& sampling) {
@@ -422,7 +490,7 @@ GradedParameters graded_parameters(const Volume& volume, const Sampling& samplin
     const PointGrid3 g = volume.evaluate(p[0], p[1], p[2]);
     return std::vector<Vec3>(g.data(), g.data() + g.size());
   }};
-  return graded(shape, sampling);
+  return checked(shape, sampling);
 }
 
 }  // namespace interpatch

@@ -444,6 +444,33 @@ inline json surface_spec(const Tensor& s) {
   return j;
 }
 
+/// A bspline_volume spec of a Tensor of three parameters.
+inline json volume_spec(const Tensor& t) {
+  json cps = json::array(), ws = json::array();
+  for (std::size_t i = 0; i < t.n[0]; ++i) {
+    json a = json::array(), wa = json::array();
+    for (std::size_t j = 0; j < t.n[1]; ++j) {
+      json b = json::array(), wb = json::array();
+      for (std::size_t k = 0; k < t.n[2]; ++k) {
+        const std::size_t at = (i * t.n[1] + j) * t.n[2] + k;
+        b.push_back(to_json(t.cp[at]));
+        if (!t.w.empty()) wb.push_back(t.w[at]);
+      }
+      a.push_back(b);
+      wa.push_back(wb);
+    }
+    cps.push_back(a);
+    ws.push_back(wa);
+  }
+  json spec = {{"type", "bspline_volume"},
+               {"degree", {t.p[0], t.p[1], t.p[2]}},
+               {"knots", {{"u", t.knots[0]}, {"v", t.knots[1]}, {"w", t.knots[2]}}},
+               {"control_points", cps}};
+  if (!t.w.empty()) spec["weights"] = ws;
+  if (t.periodic[0] || t.periodic[1] || t.periodic[2]) spec["periodic"] = {t.periodic[0], t.periodic[1], t.periodic[2]};
+  return spec;
+}
+
 /// Box of a Tensor's control points.
 inline Box box_of(const Tensor& t) {
   Box b;

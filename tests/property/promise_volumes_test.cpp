@@ -295,29 +295,7 @@ TEST(PromiseVolumes, BSplineVolumeRoundTrip) {
           const double lo = uni(g, -100, 100), len = std::pow(10.0, uni(g, -2, 2));
           for (double& k : given.knots[a]) k = lo + k * len;
         }
-        json cps = json::array(), ws = json::array();
-        for (std::size_t i = 0; i < n[0]; ++i) {
-          json a = json::array(), wa = json::array();
-          for (std::size_t j = 0; j < n[1]; ++j) {
-            json b = json::array(), wb = json::array();
-            for (std::size_t k = 0; k < n[2]; ++k) {
-              const std::size_t at = (i * n[1] + j) * n[2] + k;
-              b.push_back(to_json(given.cp[at]));
-              if (!given.w.empty()) wb.push_back(given.w[at]);
-            }
-            a.push_back(b);
-            wa.push_back(wb);
-          }
-          cps.push_back(a);
-          ws.push_back(wa);
-        }
-        json spec = {{"type", "bspline_volume"},
-                     {"degree", {p[0], p[1], p[2]}},
-                     {"knots", {{"u", given.knots[0]}, {"v", given.knots[1]}, {"w", given.knots[2]}}},
-                     {"control_points", cps}};
-        if (!given.w.empty()) spec["weights"] = ws;
-        if (periodic[0] || periodic[1] || periodic[2]) spec["periodic"] = {periodic[0], periodic[1], periodic[2]};
-        return spec;
+        return volume_spec(given);
       },
       [&](const json&, io::Construction& c, Findings& f) {
         const Box box = box_of(given);

@@ -43,8 +43,14 @@ def test_examples_give_the_command_lines_points(name, tmp_path):
     path = os.path.join(EXAMPLES, name)
     built = interpatch.build(path)
     # Counts whose parameters k / (n - 1) are exact in binary, so NumPy's linspace and
-    # the command's are the same numbers.
-    if isinstance(built, interpatch.Volume):
+    # the command's are the same numbers. A graded spec's nodes are its own.
+    with open(path) as f:
+        sampling = json.load(f).get("sampling")  # not info(): it would make the exact form, 1 ulp off the formula
+    if sampling:
+        counts = [sampling[d]["count"] for d in "uvw"[:3 if isinstance(built, interpatch.Volume) else 2]]
+        want = cli_eval(path, "x".join(map(str, counts)), str(tmp_path / "out.npy"))
+        got = built.evaluate(*built.mesh_params())
+    elif isinstance(built, interpatch.Volume):
         want = cli_eval(path, "5x3x2", str(tmp_path / "out.npy"))
         got = built.evaluate(np.linspace(0, 1, 5), np.linspace(0, 1, 3), np.linspace(0, 1, 2))
     else:
@@ -294,6 +300,8 @@ def _hole_filled_far_past_the_data():
 
 
 ERRORS += [
+    ("invalid_grading", {"type": "bilinear", "p00": [0, 0, 0], "p01": [0, 1, 0], "p10": [1, 0, 0], "p11": [1, 1, 0],
+                         "sampling": {"u": {"count": 9, "ratio": 2, "first": 0.1}}}),
     ("out_of_domain", network_with_params([0, 0.25, 0.5, 0.75, 1.5])),
     ("tolerance_not_met", _tolerance_below_rounding()),
     ("ill_conditioned", _hole_filled_far_past_the_data()),

@@ -76,4 +76,19 @@ void set_durable_writes(bool on) noexcept;
 void write_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& write,
                       std::uintmax_t size = 0);
 
+/// Refuses an output directory (an OpenFOAM polyMesh) before any work: its parent must
+/// exist (it is never created) and be writable, and the path must be a directory or
+/// nothing. Creates nothing. @throws error file_unwritable naming the path and the reason.
+void check_writable_directory(const std::filesystem::path& path);
+
+/// Runs `write` on a new, empty directory beside `path` (".name.interpatch-tmp.<pid>.XXXXXX"),
+/// then puts it at `path`: a new output by one rename, an existing directory swapped
+/// with it in one step (renameat2 RENAME_EXCHANGE) and then removed. `path` holds the
+/// old directory or the whole new one at every moment. If `write` throws, the new
+/// directory is removed and the exception propagates; a process killed while writing
+/// leaves the temporary directory behind.
+/// @throws error file_unwritable, and what `write` throws.
+void write_directory_atomically(const std::filesystem::path& path,
+                                const std::function<void(const std::filesystem::path&)>& write);
+
 }  // namespace interpatch::io

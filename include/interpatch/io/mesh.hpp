@@ -97,8 +97,17 @@ std::vector<std::string> write_surface_mesh(const std::filesystem::path& path, c
 std::vector<std::string> write_surface_mesh(const std::filesystem::path& path, const Surface& surface, std::span<const double> us,
                         std::span<const double> vs, const progress_callback& progress = {});
 
+/// Whether `path` names an OpenFOAM polyMesh directory (its last component is
+/// "polyMesh", as in CASE/constant/polyMesh): a volume mesh format.
+[[nodiscard]] bool is_polymesh_path(const std::filesystem::path& path);
+
 /// Writes a structured NU × NV × NW grid of points (a volume mesh, first index
-/// along u) to .vtk (legacy STRUCTURED_GRID), .vts or .xyz (Plot3D); `jacobian`,
+/// along u) to .vtk (legacy STRUCTURED_GRID), .vts or .xyz (Plot3D), or as the
+/// hexahedral cells of an OpenFOAM polyMesh directory (is_polymesh_path: points,
+/// faces, owner, neighbour and boundary, ASCII; internal faces in upper-triangular
+/// order, every face's normal out of its owner, the outer faces in the patches u0,
+/// u1, v0, v1, w0, w1; written whole or not at all, write_directory_atomically;
+/// the jacobian is not written there); `jacobian`,
 /// if not empty, is written as a point field named "jacobian". Plot3D grid files
 /// hold coordinates only, so for .xyz the field goes to a Plot3D function file
 /// beside it (same name, extension .f: block count, "ni nj nk 1", values).

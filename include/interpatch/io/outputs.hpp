@@ -30,8 +30,9 @@ inline constexpr Resolution default_surface_resolution{64, 64, 0};
 inline constexpr Resolution default_volume_resolution{33, 33, 33};
 
 /// The resolution of a mesh when none is asked for: the counts the spec's "sampling"
-/// gives, the kind's default (64 × 64, 33 × 33 × 33) along the other directions.
-[[nodiscard]] Resolution default_resolution(const Construction& c);
+/// (or `sampling`, when given) gives, the kind's default (64 × 64, 33 × 33 × 33)
+/// along the other directions.
+[[nodiscard]] Resolution default_resolution(const Construction& c, const Sampling* sampling = nullptr);
 
 /// The parameters of `res` nodes along each direction (each over [0, 1]): the
 /// construction's sampling (or `sampling`, when given) with the counts of `res`,

@@ -23,8 +23,9 @@ struct ViewOptions {
   std::string title;
 };
 
-/// The samples of a page when ViewOptions::resolution is not given: 257 × 257 for a
-/// surface, 33 × 33 × 33 for a volume.
+/// The samples of a page when ViewOptions::resolution is not given: the counts of the
+/// spec's "sampling" where it gives them, otherwise 257 × 257 for a surface,
+/// 33 × 33 × 33 for a volume.
 [[nodiscard]] std::array<std::size_t, 3> view_default_resolution(const Construction& c) noexcept;
 
 /// What a page holds at most: larger resolutions, data sets and control nets are
