@@ -161,6 +161,26 @@ fs::path write_spec(const Example& ex, const fs::path& dir, std::vector<std::str
   return path;
 }
 
+// A graded volume as an OpenFOAM case, NAME_case: its mesh in constant/polyMesh and
+// the dictionaries checkMesh reads (`checkMesh -case NAME_case`).
+void write_openfoam_case(io::Construction& c, const fs::path& dir, const std::string& name,
+                         std::vector<std::string>& written) {
+  const fs::path cs = dir / (name + "_case");
+  fs::create_directories(cs / "constant");
+  fs::create_directories(cs / "system");
+  const std::string head = "FoamFile { version 2.0; format ascii; class dictionary; object ";
+  write_text(cs / "system" / "controlDict",
+             head + "controlDict; }\napplication potentialFoam; startFrom startTime; startTime 0; stopAt endTime;\n"
+                    "endTime 1; deltaT 1; writeControl timeStep; writeInterval 1;\n");
+  write_text(cs / "system" / "fvSchemes",
+             head + "fvSchemes; }\nddtSchemes { default steadyState; }\ngradSchemes { default Gauss linear; }\n"
+                    "divSchemes { default none; }\nlaplacianSchemes { default Gauss linear corrected; }\n"
+                    "interpolationSchemes { default linear; }\nsnGradSchemes { default corrected; }\n");
+  write_text(cs / "system" / "fvSolution", head + "fvSolution; }\n");
+  write_mesh(c, cs / "constant" / "polyMesh", io::default_resolution(c));
+  written.push_back(name + "_case/");
+}
+
 // Every output of the command line of `c` into DIR as NAME.*; returns what info prints.
 ojson write_outputs(io::Construction& c, const Example& ex, const fs::path& dir,
                     std::vector<std::string>& written) {
@@ -188,6 +208,7 @@ ojson write_outputs(io::Construction& c, const Example& ex, const fs::path& dir,
     write_mesh(c, out(".vtk"), volume_res);
     write_mesh(c, out(".xyz"), volume_res);
     written.push_back(ex.name + ".f");  // the Jacobian beside the Plot3D grid
+    if (c.sampling) write_openfoam_case(c, dir, ex.name, written);
   } else {
     write_mesh(c, out(".obj"), res);
     write_mesh(c, out(".vtk"), res);
@@ -232,6 +253,11 @@ std::string report_lines(const io::Construction& c, const Example& ex, const ojs
     const bool same = read_text(original) == read_text(dir / (ex.name + ".bspline" + original.extension().string()));
     line += same ? ", rebuilt identically" : ", rebuilt with differences";
   }
+  if (description.contains("sampling"))  // a graded mesh: its first cells as asked
+    for (const auto& [d, s] : description["sampling"].items())
+      if (s.contains("first"))
+        line += ", first cells along " + d + " " + short_number(s["achieved"]["first"].get<double>()) + " (asked " +
+                short_number(s["first"].get<double>()) + ")";
   if (io::is_volume(c)) {
     const auto& jac = description["jacobian"];
     line += ", " + jac["inverted_cells"].dump() + " of " + jac["cells"].dump() + " cells inverted (det J from " +

@@ -535,6 +535,11 @@ std::vector<Row> rows() {
        R"(cannot write 'missing/out\.npy': directory 'missing' does not exist)", errc::file_unwritable, false},
       {"MeshIntoAMissingDirectory", {{grid_file, grid}}, {"mesh", grid_file, "-o", "missing/out.obj"}, 4,
        R"(cannot write 'missing/out\.obj': directory 'missing' does not exist)", errc::file_unwritable, false},
+      {"PolyMeshIntoAMissingCase", {{grid_file, vol}}, {"mesh", grid_file, "-o", "case/constant/polyMesh"}, 4,
+       R"(cannot write 'case/constant/polyMesh': directory 'case/constant' does not exist)", errc::file_unwritable,
+       false},
+      {"PolyMeshOverAFile", {{grid_file, vol}, {"polyMesh", "a file"}}, {"mesh", grid_file, "-o", "polyMesh"}, 4,
+       R"(cannot write 'polyMesh': it exists and is not a directory)", errc::file_unwritable, false},
       {"InfoIntoAMissingDirectory", {{grid_file, grid}}, {"info", grid_file, "-o", "missing/info.json"}, 4,
        R"(cannot write 'missing/info\.json': directory 'missing' does not exist)", errc::file_unwritable, false},
       {"OutputIsADirectory", {{grid_file, grid}, {"out.npy/", ""}}, {"eval", grid_file, "--grid", "3", "-o", "out.npy"}, 4,
@@ -670,6 +675,8 @@ std::vector<Row> rows() {
        R"(--res '8x8': trilinear is a volume; its mesh takes three counts)"},
       {"VolumeMeshAsObj", {{grid_file, vol}}, {"mesh", grid_file, "-o", "out.obj"}, 2,
        R"('out\.obj': trilinear is a volume; \.obj holds surfaces only)"},
+      {"SurfaceMeshAsPolyMesh", {{grid_file, grid}}, {"mesh", grid_file, "-o", "polyMesh"}, 2,
+       R"('polyMesh': interpolate is a surface; an OpenFOAM polyMesh holds the cells of a volume)"},
       {"UnknownBuildExtension", {{grid_file, grid}}, {"build", grid_file, "-o", "out.txt"}, 2,
        R"(cannot tell the output format of 'out\.txt': build writes \.json, \.npz \(NumPy\), \.step/\.stp)"},
       {"UnknownEvalExtension", {{grid_file, grid}}, {"eval", grid_file, "--grid", "8", "-o", "out.txt"}, 2,
@@ -823,12 +830,18 @@ TEST_P(BadInput, OneLineNamingPlaceAndSizeAndNothingWritten) {
 
   // Twice: into an empty place, then over a good file a successful run left there.
   for (const bool existing : {false, true}) {
-    SCOPED_TRACE(existing ? "over an existing output file" : "with no output file");
+    SCOPED_TRACE(existing ? "over an existing output" : "with no output");
     test::TempDir dir;
     write_files(dir, row.files);
     if (existing) {
-      if (!output || row.files.count(*output + "/") || !fs::exists((dir / *output).parent_path())) continue;
-      std::ofstream(dir / *output, std::ios::binary) << "a good output of an earlier run\n";
+      if (!output || row.files.count(*output + "/") || row.files.count(*output) || !fs::exists((dir / *output).parent_path()))
+        continue;  // the output is the row's own input (a file where a directory goes)
+      if (fs::path(*output).filename() == "polyMesh") {  // a directory output: a good one there
+        fs::create_directory(dir / *output);
+        std::ofstream(dir / *output / "points", std::ios::binary) << "a good output of an earlier run\n";
+      } else {
+        std::ofstream(dir / *output, std::ios::binary) << "a good output of an earlier run\n";
+      }
     }
     const auto before = snapshot(dir);
     const test::CliResult r = test::run_cli(dir.path(), row.args);

@@ -111,7 +111,7 @@ class PyBuilt {
     namespace io = ip::io;
     const std::filesystem::path path = ip::python::path_arg(path_in, "write: the path is a str or an os.PathLike");
     const std::string ext = path.extension().string();
-    const bool mesh = io::is_mesh_format(ext), view = io::is_view_format(ext);
+    const bool mesh = io::is_mesh_format(ext) || io::is_polymesh_path(path), view = io::is_view_format(ext);
     std::optional<io::Resolution> res;
     if (!res_in.is_none()) {
       if (!mesh && !view)

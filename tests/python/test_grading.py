@@ -104,3 +104,21 @@ def test_sampling_errors_carry_their_codes(tmp_path):
         interpatch.build({"type": "bilinear", "p00": [0, 0, 0], "p01": [0, 1, 0], "p10": [1, 0, 0],
                           "p11": [1, 1, 0], "sampling": {"u": {"first": -1}}})
     assert e.value.code == "invalid_grading" and "/sampling/u/first" in str(e.value)
+
+
+def test_write_a_polymesh_as_the_command_does(tmp_path):
+    (tmp_path / "py" / "constant").mkdir(parents=True)
+    (tmp_path / "cli" / "constant").mkdir(parents=True)
+    duct = interpatch.build(DUCT)
+    duct.write(tmp_path / "py" / "constant" / "polyMesh")
+    subprocess.run([CLI, "mesh", DUCT, "-o", str(tmp_path / "cli" / "constant" / "polyMesh")], check=True)
+    for name in ("points", "faces", "owner", "neighbour", "boundary"):
+        py = (tmp_path / "py" / "constant" / "polyMesh" / name).read_bytes()
+        assert py == (tmp_path / "cli" / "constant" / "polyMesh" / name).read_bytes(), name
+    points = (tmp_path / "py" / "constant" / "polyMesh" / "points").read_text()
+    assert "\n102541\n(" in points  # 41 x 41 x 61 nodes, each once
+    sheet = interpatch.build({"type": "bilinear", "p00": [0, 0, 0], "p01": [0, 1, 0], "p10": [1, 0, 0],
+                              "p11": [1, 1, 0]})
+    with pytest.raises(interpatch.Error) as e:
+        sheet.write(tmp_path / "py" / "constant" / "polyMesh")
+    assert e.value.code == "wrong_type" and "holds the cells of a volume" in str(e.value)
