@@ -118,7 +118,8 @@ double longest_chord(const Shape& shape, Params p, std::size_t d, double a, doub
 // to it as bisection gets.
 double end_node(const Shape& shape, const Params& p, std::size_t d, double length, bool at_start,
                 const char* field) {
-  const auto [t0, t1] = shape.domain[d];
+  // Plain copies: clang before 16 cannot capture structured bindings in a lambda.
+  const double t0 = shape.domain[d].first, t1 = shape.domain[d].second;
   const double span = t1 - t0;
   auto chord = [&](double h) {  // the cell of parameter width h at the end
     return at_start ? longest_chord(shape, p, d, t0, t0 + h) : longest_chord(shape, p, d, t1 - h, t1);
