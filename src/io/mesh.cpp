@@ -182,7 +182,7 @@ void write_volume_mesh(const fs::path& path, const PointGrid3& points, const Gri
   internal::require_finite(&points.data()->x, 3 * points.size(), 0, shape, "the points of " + quoted(path));
   if (!jacobian.empty())
     internal::require_finite(jacobian.data(), jacobian.size(), 0, std::span(shape).first(3), "the jacobians of " + quoted(path));
-  if (ext == ".vtu" || ext == ".msh") return write_unstructured(path, ext, points, jacobian);
+  if (ext == ".vtu" || ext == ".msh") return internal::mesh_io::write_unstructured(path, ext, points, jacobian);
   Structured s;
   s.nu = points.extent(0);
   s.nv = points.extent(1);
