@@ -24,6 +24,7 @@ BUILD_DEBS := cmake ninja-build g++ python3 libcli11-dev nlohmann-json3-dev libe
 #   python3-hypothesis               its fuzz tests: random arrays into the constructors (tests/python/test_fuzz.py)
 #   python3-matplotlib               the README's Python example, run by that suite
 #   openfoam                         checkMesh and potentialFoam read the polyMesh meshes (tools/check_polymesh.py)
+#   python3-meshio python3-gmsh      read the .vtu and .msh meshes back (tests/python/test_unstructured.py)
 #   python3-venv python3-pip python3-setuptools python3-wheel
 #                                    `pip install .` into a virtual environment, then the suite against it
 #   libocct-*-dev                    OpenCASCADE reads back the STEP and IGES files
@@ -36,7 +37,8 @@ TEST_DEBS := libgtest-dev libgmock-dev pkg-config python3-numpy python3-scipy py
         python3-venv python3-pip python3-setuptools python3-wheel \
         libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
         libocct-foundation-dev clang libclang-rt-14-dev libomp-14-dev \
-        chromium chromium-driver python3-selenium libopenmpi-dev openmpi-bin openfoam
+        chromium chromium-driver python3-selenium libopenmpi-dev openmpi-bin openfoam \
+        python3-meshio python3-gmsh
 # The benchmarks: `make bench` adds these.
 #   libbenchmark-dev                 Google Benchmark (bench/interpatch_bench)
 #   libocct-*-dev libsisl-dev        OpenCASCADE and SISL race interpatch (bench/compare);

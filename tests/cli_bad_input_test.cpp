@@ -677,6 +677,8 @@ std::vector<Row> rows() {
        R"('out\.obj': trilinear is a volume; \.obj holds surfaces only)"},
       {"SurfaceMeshAsPolyMesh", {{grid_file, grid}}, {"mesh", grid_file, "-o", "polyMesh"}, 2,
        R"('polyMesh': interpolate is a surface; an OpenFOAM polyMesh holds the cells of a volume)"},
+      {"SurfaceMeshAsMsh", {{grid_file, grid}}, {"mesh", grid_file, "-o", "out.msh"}, 2,
+       R"('out\.msh': interpolate is a surface; \.msh is written with the hexahedral cells of a volume)"},
       {"UnknownBuildExtension", {{grid_file, grid}}, {"build", grid_file, "-o", "out.txt"}, 2,
        R"(cannot tell the output format of 'out\.txt': build writes \.json, \.npz \(NumPy\), \.step/\.stp)"},
       {"UnknownEvalExtension", {{grid_file, grid}}, {"eval", grid_file, "--grid", "8", "-o", "out.txt"}, 2,

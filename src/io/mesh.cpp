@@ -45,7 +45,7 @@ std::string normalized(std::string_view extension) {
 }
 
 constexpr std::array<std::string_view, 6> surface_formats = {".obj", ".stl", ".ply", ".vtk", ".vts", ".xyz"};
-constexpr std::array<std::string_view, 3> volume_formats = {".vtk", ".vts", ".xyz"};
+constexpr std::array<std::string_view, 5> volume_formats = {".vtk", ".vts", ".xyz", ".vtu", ".msh"};
 
 template <std::size_t N>
 std::string list(const std::array<std::string_view, N>& formats) {
@@ -116,7 +116,8 @@ void check_closed(const fs::path& path, const SurfaceMesh& m) {
 bool is_mesh_format(std::string_view extension) noexcept {
   try {
     const std::string ext = normalized(extension);
-    return std::find(surface_formats.begin(), surface_formats.end(), ext) != surface_formats.end();
+    return std::find(surface_formats.begin(), surface_formats.end(), ext) != surface_formats.end() ||
+           std::find(volume_formats.begin(), volume_formats.end(), ext) != volume_formats.end();
   } catch (...) {
     return false;
   }
@@ -181,6 +182,7 @@ void write_volume_mesh(const fs::path& path, const PointGrid3& points, const Gri
   internal::require_finite(&points.data()->x, 3 * points.size(), 0, shape, "the points of " + quoted(path));
   if (!jacobian.empty())
     internal::require_finite(jacobian.data(), jacobian.size(), 0, std::span(shape).first(3), "the jacobians of " + quoted(path));
+  if (ext == ".vtu" || ext == ".msh") return internal::mesh_io::write_unstructured(path, ext, points, jacobian);
   Structured s;
   s.nu = points.extent(0);
   s.nv = points.extent(1);

@@ -89,6 +89,12 @@ void write_structured(const std::filesystem::path& path, const std::string& ext,
 /// The hexahedra of a structured grid of nodes as an OpenFOAM polyMesh directory.
 void write_polymesh(const std::filesystem::path& dir, const PointGrid3& nodes);
 
+/// The same cells as a VTK UnstructuredGrid (`ext` .vtu, with the jacobian as point
+/// data when given) or a Gmsh MSH 4.1 file (.msh, the outer faces as quadrilaterals
+/// in physical groups u0 ... w1, the cells in "volume") (mesh_unstructured.cpp).
+void write_unstructured(const std::filesystem::path& path, const std::string& ext, const PointGrid3& nodes,
+                        const Grid<double, 3>& jacobian);
+
 // ---------------------------------------------------------------------------
 // Sampling (mesh_sample.cpp).
 

@@ -117,7 +117,8 @@ void check_build_output(const fs::path& out) {
 void check_mesh_output(const fs::path& out) {
   if (is_mesh_format(out.extension().string()) || is_polymesh_path(out)) return;
   throw error(errc::wrong_type, "cannot tell the mesh format of '" + out.string() +
-                                    "': use .obj, .stl, .ply, .vtk, .vts or .xyz, or a directory CASE/constant/polyMesh");
+                                    "': use .obj, .stl, .ply, .vtk, .vts, .xyz, .vtu or .msh, or a directory "
+                                    "CASE/constant/polyMesh");
 }
 
 void check_eval_output(const fs::path& out) {
@@ -142,10 +143,15 @@ void check_mesh_kind(const Construction& c, const fs::path& out, const Resolutio
   if (!is_volume(c) && is_polymesh_path(out))
     throw error(errc::wrong_type, "'" + out.string() + "': " + c.type +
                                       " is a surface; an OpenFOAM polyMesh holds the cells of a volume");
-  if (is_volume(c) && ext != ".vts" && ext != ".vtk" && ext != ".xyz" && !is_polymesh_path(out))
+  const bool volume_format = ext == ".vts" || ext == ".vtk" || ext == ".xyz" || ext == ".vtu" || ext == ".msh" ||
+                             is_polymesh_path(out);
+  if (is_volume(c) && !volume_format)
     throw error(errc::wrong_type, "'" + out.string() + "': " + c.type + " is a volume; " + ext +
-                                      " holds surfaces only, a volume mesh is written to .vts, .vtk, .xyz (Plot3D) or a "
-                                      "polyMesh directory (OpenFOAM)");
+                                      " holds surfaces only, a volume mesh is written to .vts, .vtk, .xyz (Plot3D), "
+                                      ".vtu, .msh (Gmsh) or a polyMesh directory (OpenFOAM)");
+  if (!is_volume(c) && (ext == ".vtu" || ext == ".msh"))
+    throw error(errc::wrong_type, "'" + out.string() + "': " + c.type + " is a surface; " + ext +
+                                      " is written with the hexahedral cells of a volume");
   check_counts_kind(c, option, res);
 }
 

@@ -1116,7 +1116,7 @@ TEST(Mesh, UnknownExtensionIsWrongType) {
   EXPECT_ERRC(write_surface_mesh(dir / "m", m), wrong_type, "no extension");
   const PointGrid3 g = box(2, 2, 2, nullptr);
   EXPECT_ERRC(write_volume_mesh(dir / "v.obj", g), wrong_type, "'.obj' holds surfaces, not volume grids");
-  EXPECT_ERRC(write_volume_mesh(dir / "v.npy", g), wrong_type, "'.npy' (supported: .vtk, .vts, .xyz)");
+  EXPECT_ERRC(write_volume_mesh(dir / "v.npy", g), wrong_type, "'.npy' (supported: .vtk, .vts, .xyz, .vtu, .msh)");
   EXPECT_EQ(dir.count(), 0u);
 }
 
