@@ -263,6 +263,9 @@ std::string report_lines(const io::Construction& c, const Example& ex, const ojs
     line += ", " + jac["inverted_cells"].dump() + " of " + jac["cells"].dump() + " cells inverted (det J from " +
             short_number(jac["min_determinant"].get<double>()) + " to " +
             short_number(jac["max_determinant"].get<double>()) + ")";
+    const auto& mesh = description["mesh"];  // the cells a solver gets, in checkMesh's measures
+    line += "; mesh non-orthogonality up to " + short_number(mesh["non_orthogonality"]["max"].get<double>()) +
+            " deg, skewness up to " + short_number(mesh["max_skewness"].get<double>());
   }
   return line;
 }

@@ -494,6 +494,8 @@ TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
     EXPECT_EQ(info["kind"], "volume") << name;
     EXPECT_LT(info["max_data_error"]["relative"].get<double>(), 1e-12) << name;
     EXPECT_EQ(info["jacobian"]["inverted_cells"], 0) << name;
+    EXPECT_EQ(info["mesh"]["inverted_cells"], 0) << name;
+    EXPECT_GT(info["mesh"]["min_scaled_jacobian"].get<double>(), 0.0) << name;
   }
   EXPECT_EQ(r.out.find("rebuilt with differences"), std::string::npos) << r.out;
   // The demo shows the checked-in examples, embedded when it was built: the specs and
@@ -847,6 +849,16 @@ TEST_F(CliTest, FoldedTrilinearVolumeReportsInvertedCells) {
   EXPECT_GT(j["jacobian"]["inverted_points"].get<int>(), 0);
   EXPECT_LE(j["jacobian"]["min_determinant"].get<double>(), 0.0);
   EXPECT_FALSE(j["jacobian"]["inverted_at"].empty());
+  // The mesh `mesh` writes by default has them too, and writing it warns.
+  EXPECT_GT(j["mesh"]["inverted_cells"].get<int>(), 0);
+  EXPECT_LE(j["mesh"]["min_scaled_jacobian"].get<double>(), 0.0);  // flat or turned
+  EXPECT_EQ(j["mesh"]["first_inverted"].size(), 3u);
+  const Result m = run({"mesh", "t.json", "-o", "t.vts"});
+  ASSERT_EQ(m.status, 0) << m.err;
+  EXPECT_NE(m.err.find("interpatch: warning: t.vts: " + std::to_string(j["mesh"]["inverted_cells"].get<int>()) +
+                       " of 32768 cells are inverted"),
+            std::string::npos)
+      << m.err;
 }
 
 // --- a data file in place of the spec ------------------------------------------------------

@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """OpenFOAM reads the polyMesh `interpatch mesh` writes: checkMesh must say
 "Mesh OK." of every volume example's mesh, whose points and cells are counted here
-(checkMesh does not notice nodes left unmerged), and potentialFoam runs on the
-graded duct from its inlet (face w0) to its outlet (w1).
+(checkMesh does not notice nodes left unmerged), the non-orthogonality and skewness
+`interpatch info` reports must be checkMesh's, and potentialFoam runs on the graded
+duct from its inlet (face w0) to its outlet (w1).
 
 tools/check_polymesh.py INTERPATCH EXAMPLES_DIR WORK_DIR
 OpenFOAM's environment is sourced here, from /usr/share/openfoam/etc/bashrc."""
@@ -59,8 +60,7 @@ def mesh_case(name):
     spec = os.path.join(examples, name + ".json")
     subprocess.run([cli, "mesh", spec, "-o", os.path.join(case, "constant", "polyMesh")], check=True)
     info = json.loads(subprocess.run([cli, "info", spec], check=True, capture_output=True, text=True).stdout)
-    counts = [d["count"] for d in info["sampling"].values()] if "sampling" in info else [33, 33, 33]
-    return case, counts
+    return case, info["mesh"]
 
 
 failures = []
@@ -70,7 +70,8 @@ for name in sorted(f[:-5] for f in os.listdir(examples) if f.endswith(".json")):
     if spec.get("type") not in ("trilinear", "coons_volume", "hermite_volume", "loft_volume", "interpolate_volume",
                                 "bspline_volume", "approximate_volume"):
         continue
-    case, (nu, nv, nw) = mesh_case(name)
+    case, mesh = mesh_case(name)
+    nu, nv, nw = mesh["nodes"]
     code, out = foam(case, "checkMesh")
     found = [re.search(rf"{k}:\s+(\d+)", out) for k in ("points", "cells")]
     points, cells = (int(m.group(1)) if m else -1 for m in found)
@@ -78,7 +79,14 @@ for name in sorted(f[:-5] for f in os.listdir(examples) if f.endswith(".json")):
     counted = points == nu * nv * nw and cells == (nu - 1) * (nv - 1) * (nw - 1)
     print(f"{name}: checkMesh {'Mesh OK' if ok else 'FAILED'}, {points} points, {cells} cells"
           f"{'' if counted else f' (expected {nu * nv * nw} and {(nu - 1) * (nv - 1) * (nw - 1)})'}")
-    if not ok or not counted:
+    # checkMesh prints 12 digits (writePrecision 12 above); the same formulas in
+    # another order of summation differ in the last few of them.
+    theirs = re.search(r"non-orthogonality Max: (\S+) average: (\S+)", out), re.search(r"Max skewness = (\S+)", out)
+    ours = [mesh["non_orthogonality"]["max"], mesh["non_orthogonality"]["mean"], mesh["max_skewness"]]
+    foam_values = [float(v) for m in theirs if m for v in m.groups()]
+    agree = len(foam_values) == 3 and all(abs(a - b) <= 1e-9 * max(1.0, abs(b)) for a, b in zip(ours, foam_values))
+    print(f"  non-orthogonality max, mean and skewness: info {ours}, checkMesh {foam_values}")
+    if not ok or not counted or not agree:
         failures.append(name)
         print(out[-3000:])
 

@@ -22,6 +22,7 @@
 #include "interpatch/knot_vector.hpp"
 #include "interpatch/loft.hpp"
 #include "interpatch/memory.hpp"
+#include "interpatch/mesh_quality.hpp"
 #include "interpatch/network.hpp"
 #include "interpatch/patches.hpp"
 #include "interpatch/progress.hpp"

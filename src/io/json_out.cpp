@@ -18,11 +18,14 @@
 #include "interpatch/io/outputs.hpp"
 #include "interpatch/memory.hpp"
 #include "io/box.hpp"
+#include "io/json_mesh.hpp"
 
 namespace interpatch::io {
 
 using interpatch::detail::cat;
 using interpatch::detail::fail;
+using internal::mesh_info;
+using internal::sampling_info;
 using ojson = nlohmann::ordered_json;
 
 namespace {
@@ -504,32 +507,13 @@ ojson closest_distance(const Construction& c) {
   return {{"absolute", worst}, {"at", at}};
 }
 
-// What the spec's sampling asks along each direction, and what the nodes of a mesh
-// at its counts achieve. Null without a sampling.
-ojson sampling_info(const Construction& c) {
-  if (!c.sampling) return nullptr;
-  const Resolution res = default_resolution(c);
-  const GradedParameters p = sample_parameters(c, res);
-  ojson j = ojson::object();
-  for (std::size_t d = 0; d < (is_volume(c) ? 3u : 2u); ++d) {
-    const Grading& g = (*c.sampling)[d];
-    ojson a = {{"count", p.params[d].size()}};
-    if (g.ratio != 0) a["ratio"] = g.ratio;
-    if (g.first != 0) a["first"] = g.first;
-    if (g.last != 0) a["last"] = g.last;
-    if (g.graded()) a["max_growth"] = g.max_growth;
-    a["achieved"] = {{"first", p.report[d].first}, {"last", p.report[d].last}, {"growth", p.report[d].growth}};
-    j[uvw[d]] = std::move(a);
-  }
-  return j;
-}
-
 nlohmann::ordered_json info_json(const Construction& c, const progress_callback& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::optional<DataError> err = max_data_error(c, progress);
   const ojson closest = closest_distance(c);
   const bool volume = is_volume(c);
   const ojson jac = volume ? jacobian_info(volume_evaluator(c)) : ojson();
+  const ojson mesh = volume ? mesh_info(c) : ojson();
   const double check_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
   ojson j;
@@ -551,6 +535,7 @@ nlohmann::ordered_json info_json(const Construction& c, const progress_callback&
   put_data_error(j, err);
   if (!closest.is_null()) j["max_closest_distance"] = closest;
   if (volume) j["jacobian"] = jac;
+  if (volume) j["mesh"] = mesh;
   if (c.sampling) j["sampling"] = sampling_info(c);
   put_data(j, c.data, uvw, c.parameters, c.warnings, c.timings, check_ms);
   return j;

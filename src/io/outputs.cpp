@@ -21,6 +21,8 @@
 #include "interpatch/io/step.hpp"
 #include "interpatch/io/view.hpp"
 #include "interpatch/memory.hpp"
+#include "interpatch/mesh_quality.hpp"
+#include "base/text.hpp"
 #include "io/extension.hpp"
 
 namespace interpatch::io {
@@ -29,6 +31,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using detail::cat;
 using internal::lower_extension;
 
 std::string resolution_text(const Resolution& r) {
@@ -46,12 +49,21 @@ std::optional<std::size_t> point_count(const Resolution& r) {
   return n;
 }
 
-void mesh_volume(const Construction& c, const fs::path& out, const Resolution& res, const progress_callback& progress,
-                 const Sampling* sampling) {
+// Writes the mesh; a warning when cells are inverted, which a solver refuses.
+std::vector<std::string> mesh_volume(const Construction& c, const fs::path& out, const Resolution& res,
+                                     const progress_callback& progress, const Sampling* sampling) {
   const Volume& v = volume_evaluator(c);
   const GradedParameters p = sample_parameters(c, res, sampling);
   const VolumeJacobians j = v.evaluate_jacobians(p.params[0], p.params[1], p.params[2], progress);
+  const MeshQuality q = corner_jacobians(j.points);
   write_volume_mesh(out, j.points, j.determinants);
+  if (q.inverted_cells == 0) return {};
+  const auto& at = q.first_inverted;
+  return {cat(out.filename().string(), ": ", q.inverted_cells, " of ", q.cells,
+              " cells are inverted or flat (a corner's det J against the mesh's orientation, scaled "
+              "Jacobian down to ",
+              q.min_scaled_jacobian, "), the first between nodes (", at[0], ", ", at[1], ", ", at[2], ") and (",
+              at[0] + 1, ", ", at[1] + 1, ", ", at[2] + 1, "); a solver will refuse them")};
 }
 
 }  // namespace
@@ -233,8 +245,7 @@ std::vector<std::string> write_mesh(Construction& c, const fs::path& out, const 
   check_mesh_kind(c, out, res, option);
   require_mesh_room(res, out);
   if (is_volume(c)) {
-    mesh_volume(c, out, res, progress, sampling);
-    return {};
+    return mesh_volume(c, out, res, progress, sampling);
   }
   const Surface& s = evaluator(c, res.nu * res.nv, Sample::derivatives);
   const GradedParameters p = sample_parameters(c, res, sampling);

@@ -54,6 +54,15 @@ def test_the_duct_meets_its_first_cells_and_grows_smoothly(tmp_path):
     assert info["u"]["count"] == 41 and info["u"]["first"] == 1e-3
     assert info["u"]["achieved"]["first"] == pytest.approx(u[0].max(), rel=1e-12)
     assert info["w"]["achieved"]["growth"] == pytest.approx(1, abs=1e-2)
+    # The quality of the same cells, in numpy from the written nodes: the first cells
+    # along u, and det J at the corner (0, 0, 0) of every cell.
+    mesh = duct.info()["mesh"]
+    assert mesh["nodes"] == [41, 41, 61] and mesh["cells"] == 40 * 40 * 60
+    assert mesh["end_cells"]["u"]["first"] == pytest.approx(u[0].max(), rel=1e-12)
+    a, b, c = x[1:, :-1, :-1] - x[:-1, :-1, :-1], x[:-1, 1:, :-1] - x[:-1, :-1, :-1], x[:-1, :-1, 1:] - x[:-1, :-1, :-1]
+    det = np.einsum("...i,...i", np.cross(a, b), c)
+    assert det.min() > 0 and mesh["inverted_cells"] == 0
+    assert mesh["det_j"]["min"] <= det.min() * (1 + 1e-9) and mesh["det_j"]["max"] >= det.max() * (1 - 1e-9)
 
 
 def test_write_takes_a_sampling_for_one_mesh(tmp_path):

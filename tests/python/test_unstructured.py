@@ -6,8 +6,8 @@ with PYTHONPATH, INTERPATCH_CLI and INTERPATCH_EXAMPLES set."""
 
 import json
 import os
+import signal
 
-import gmsh
 import meshio
 import numpy as np
 import pytest
@@ -61,7 +61,20 @@ def test_vtu_and_msh_read_back_by_meshio(tmp_path, mirror):
             assert "jacobian" in m.point_data
 
 
+def _gmsh():
+    """Gmsh's module, imported here and not at collection: importing it sets SIGINT to
+    the default action (Gmsh puts Python's handler back only at finalize), which would
+    take Ctrl-C from the KeyboardInterrupt tests of other files."""
+    handler = signal.getsignal(signal.SIGINT)
+    try:
+        import gmsh
+    finally:
+        signal.signal(signal.SIGINT, handler)
+    return gmsh
+
+
 def test_msh_physical_groups_read_by_gmsh(tmp_path):
+    gmsh = _gmsh()
     out = tmp_path / "duct.msh"
     _duct(False).write(out, res=(5, 4, 6))
     gmsh.initialize(["-v", "0"])
@@ -78,3 +91,4 @@ def test_msh_physical_groups_read_by_gmsh(tmp_path):
         assert len(tags) == 5 * 4 * 6
     finally:
         gmsh.finalize()
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler

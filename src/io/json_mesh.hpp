@@ -1,0 +1,19 @@
+#pragma once
+// info's descriptions of the mesh a construction gives: what its "sampling" asks
+// and achieves, and the quality of its cells.
+
+#include <nlohmann/json.hpp>
+
+#include "interpatch/io/spec.hpp"
+
+namespace interpatch::io::internal {
+
+// Per direction what the spec's sampling asks and what the nodes of a mesh at its
+// counts achieve. Null without a sampling.
+nlohmann::ordered_json sampling_info(const Construction& c);
+
+// The quality of the volume mesh `interpatch mesh` writes by default (the sampling's
+// counts and grading when the spec has one).
+nlohmann::ordered_json mesh_info(const Construction& c);
+
+}  // namespace interpatch::io::internal
