@@ -926,7 +926,12 @@ json expect_data_file_acts_as_spec(const CliTest& t, const std::vector<std::stri
     const Result a = t.run(from_data), b = t.run(from_spec);
     EXPECT_EQ(a.status, 0) << a.err;
     EXPECT_EQ(b.status, 0) << b.err;
-    EXPECT_TRUE(a.err.empty()) << a.err;
+    // No warning of its own: the same as the spec's (a noisy volume may warn of folded
+    // cells), its output named alike.
+    std::string a_err = a.err;
+    for (std::size_t at = a_err.find("data-" + out); at != std::string::npos; at = a_err.find("data-" + out))
+      a_err.replace(at, 5, "spec-");
+    EXPECT_EQ(a_err, b.err);
     if (a.status != 0 || b.status != 0) continue;
     const std::string got = read_file(t.at("data-" + out));
     EXPECT_GT(got.size(), 100u);
