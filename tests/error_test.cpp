@@ -14,7 +14,7 @@ constexpr errc kAll[] = {
     errc::ragged_grid,    errc::too_few_points, errc::invalid_degree,     errc::zero_chord,       errc::non_increasing,
     errc::invalid_knots,  errc::invalid_weight, errc::size_mismatch,      errc::out_of_domain,    errc::singular,
     errc::corner_gap,     errc::network_gap,    errc::incompatible_twist, errc::tangent_mismatch, errc::invalid_blend,
-    errc::no_exact_form,  errc::malformed_file, errc::closing_gap, errc::tolerance_not_met, errc::ill_conditioned, errc::invalid_grading, errc::network_order,       errc::file_unreadable,  errc::file_unwritable,
+    errc::no_exact_form,  errc::malformed_file, errc::closing_gap, errc::tolerance_not_met, errc::ill_conditioned, errc::invalid_grading, errc::block_mismatch, errc::network_order,       errc::file_unreadable,  errc::file_unwritable,
     errc::too_large,
     errc::internal};
 

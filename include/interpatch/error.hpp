@@ -38,6 +38,7 @@ enum class errc {
   tolerance_not_met,       ///< an approximation cannot bring every data point within the tolerance asked for; a network cannot re-express its curves within theirs
   ill_conditioned,         ///< a fit's control points swing far outside its data (a near-singular system)
   invalid_grading,         ///< a mesh grading that cannot be: a non-positive length or ratio, an end longer than its direction
+  block_mismatch,          ///< blocks whose faces nearly meet, or meet with different node counts or apart along the face
   // --- files; the command line exits with 4 ---
   file_unreadable,         ///< a file cannot be opened or read
   file_unwritable,         ///< an output file cannot be written

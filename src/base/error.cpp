@@ -31,6 +31,7 @@ std::string_view to_string(errc code) noexcept {
     case errc::tolerance_not_met: return "tolerance_not_met";
     case errc::ill_conditioned: return "ill_conditioned";
     case errc::invalid_grading: return "invalid_grading";
+    case errc::block_mismatch: return "block_mismatch";
     case errc::file_unreadable: return "file_unreadable";
     case errc::file_unwritable: return "file_unwritable";
     case errc::too_large: return "too_large";
