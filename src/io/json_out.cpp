@@ -24,6 +24,7 @@ namespace interpatch::io {
 
 using interpatch::detail::cat;
 using interpatch::detail::fail;
+using internal::blocks_info;
 using internal::mesh_info;
 using internal::sampling_info;
 using ojson = nlohmann::ordered_json;
@@ -509,6 +510,12 @@ ojson closest_distance(const Construction& c) {
 
 nlohmann::ordered_json info_json(const Construction& c, const progress_callback& progress) {
   const auto t0 = std::chrono::steady_clock::now();
+  if (c.blocks) {
+    ojson j = blocks_info(c, progress);
+    const double check_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    put_data(j, c.data, uvw, c.parameters, c.warnings, c.timings, check_ms);
+    return j;
+  }
   const std::optional<DataError> err = max_data_error(c, progress);
   const ojson closest = closest_distance(c);
   const bool volume = is_volume(c);

@@ -3,6 +3,7 @@
 // families' writers, which mesh.cpp chooses between by extension after checking
 // the mesh, and the texts of the VTK files that the streaming writer lays out.
 
+#include "mesh/hex_mesh.hpp"
 #include <bit>
 #include <cstddef>
 #include <cstdint>
@@ -88,12 +89,17 @@ void write_structured(const std::filesystem::path& path, const std::string& ext,
 
 /// The hexahedra of a structured grid of nodes as an OpenFOAM polyMesh directory.
 void write_polymesh(const std::filesystem::path& dir, const PointGrid3& nodes);
+/// Any hexahedral mesh (several blocks merged) as a polyMesh directory.
+void write_polymesh(const std::filesystem::path& dir, const mesh::HexMesh& m);
 
 /// The same cells as a VTK UnstructuredGrid (`ext` .vtu, with the jacobian as point
 /// data when given) or a Gmsh MSH 4.1 file (.msh, the outer faces as quadrilaterals
 /// in physical groups u0 ... w1, the cells in "volume") (mesh_unstructured.cpp).
 void write_unstructured(const std::filesystem::path& path, const std::string& ext, const PointGrid3& nodes,
                         const Grid<double, 3>& jacobian);
+/// Any hexahedral mesh so, `jacobian` one value a point (or empty).
+void write_unstructured(const std::filesystem::path& path, const std::string& ext, const mesh::HexMesh& m,
+                        std::span<const double> jacobian);
 
 // ---------------------------------------------------------------------------
 // Sampling (mesh_sample.cpp).

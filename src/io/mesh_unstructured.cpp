@@ -149,7 +149,12 @@ void write_msh(std::ostream& os, const mesh::HexMesh& m, const mesh::PolyMesh& p
 
 void write_unstructured(const std::filesystem::path& path, const std::string& ext, const PointGrid3& nodes,
                         const Grid<double, 3>& jacobian) {
-  const mesh::HexMesh m = mesh::structured_hex_mesh(nodes);
+  write_unstructured(path, ext, mesh::structured_hex_mesh(nodes),
+                     std::span<const double>(jacobian.data(), jacobian.empty() ? 0 : jacobian.size()));
+}
+
+void write_unstructured(const std::filesystem::path& path, const std::string& ext, const mesh::HexMesh& m,
+                        std::span<const double> jacobian) {
   const mesh::PolyMesh p = mesh::poly_mesh(m);
   write_atomically(path, [&](std::ostream& os) {
     if (ext == ".vtu") write_vtu(os, m, p.flipped, jacobian.empty() ? nullptr : jacobian.data());

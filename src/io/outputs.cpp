@@ -23,7 +23,10 @@
 #include "interpatch/memory.hpp"
 #include "interpatch/mesh_quality.hpp"
 #include "base/text.hpp"
+#include "io/blocks_mesh.hpp"
 #include "io/extension.hpp"
+#include "io/mesh_formats.hpp"
+#include "mesh/quality.hpp"
 
 namespace interpatch::io {
 
@@ -64,6 +67,18 @@ std::vector<std::string> mesh_volume(const Construction& c, const fs::path& out,
               "Jacobian down to ",
               q.min_scaled_jacobian, "), the first between nodes (", at[0], ", ", at[1], ", ", at[2], ") and (",
               at[0] + 1, ", ", at[1] + 1, ", ", at[2] + 1, "); a solver will refuse them")};
+}
+
+// The blocks' cells merged into one mesh; a warning when some are inverted.
+std::vector<std::string> mesh_of_blocks(const Construction& c, const fs::path& out, const progress_callback& progress) {
+  const internal::BlocksMesh b = internal::mesh_blocks(c, progress);
+  const MeshQuality q = mesh::corner_jacobians(b.hex);
+  if (is_polymesh_path(out)) internal::mesh_io::write_polymesh(out, b.hex);
+  else internal::mesh_io::write_unstructured(out, lower_extension(out), b.hex, b.jacobian);
+  if (q.inverted_cells == 0) return {};
+  return {cat(out.filename().string(), ": ", q.inverted_cells, " of ", q.cells,
+              " cells are inverted or flat (a corner's det J against the mesh's orientation, scaled Jacobian down to ",
+              q.min_scaled_jacobian, "), the first cell numbered ", q.first_inverted[0], "; a solver will refuse them")};
 }
 
 }  // namespace
@@ -152,6 +167,10 @@ void check_view_output(const fs::path& out) {
 
 void check_mesh_kind(const Construction& c, const fs::path& out, const Resolution& res, const CountsOption& option) {
   const std::string ext = lower_extension(out);
+  if (c.blocks && !(ext == ".vtu" || ext == ".msh" || is_polymesh_path(out)))
+    throw error(errc::wrong_type, "'" + out.string() +
+                                      "': blocks are meshed together as unstructured cells: .vtu, .msh (Gmsh) or a "
+                                      "polyMesh directory (OpenFOAM); each block's own spec gives its structured grid");
   if (!is_volume(c) && is_polymesh_path(out))
     throw error(errc::wrong_type, "'" + out.string() + "': " + c.type +
                                       " is a surface; an OpenFOAM polyMesh holds the cells of a volume");
@@ -244,6 +263,7 @@ std::vector<std::string> write_mesh(Construction& c, const fs::path& out, const 
   check_counts(counts_of(res), option);
   check_mesh_kind(c, out, res, option);
   require_mesh_room(res, out);
+  if (c.blocks) return mesh_of_blocks(c, out, progress);
   if (is_volume(c)) {
     return mesh_volume(c, out, res, progress, sampling);
   }

@@ -58,8 +58,9 @@ bool is_polymesh_path(const fs::path& path) { return path.filename() == "polyMes
 
 namespace internal::mesh_io {
 
-void write_polymesh(const fs::path& dir, const PointGrid3& nodes) {
-  const mesh::HexMesh m = mesh::structured_hex_mesh(nodes);
+void write_polymesh(const fs::path& dir, const PointGrid3& nodes) { write_polymesh(dir, mesh::structured_hex_mesh(nodes)); }
+
+void write_polymesh(const fs::path& dir, const mesh::HexMesh& m) {
   const mesh::PolyMesh p = mesh::poly_mesh(m);
   const std::string note = detail::cat("nPoints:", m.points.size(), "  nCells:", m.cells.size(), "  nFaces:",
                                        p.faces.size(), "  nInternalFaces:", p.neighbour.size());

@@ -205,7 +205,7 @@ bool left_handed(const PointGrid3& g) {
 }  // namespace
 
 HexMesh merge_blocks(std::span<const PointGrid3> blocks, std::span<const SharedFace> shared,
-                     std::span<const std::array<std::string, 6>> patch_of) {
+                     std::span<const std::array<std::string, 6>> patch_of, std::vector<std::size_t>* origin) {
   std::vector<std::size_t> offset(blocks.size() + 1, 0);
   for (std::size_t b = 0; b < blocks.size(); ++b) {
     const auto n = blocks[b].shape();
@@ -231,6 +231,7 @@ HexMesh merge_blocks(std::span<const PointGrid3> blocks, std::span<const SharedF
       }
   }
   HexMesh m;
+  if (origin) origin->clear();
   std::vector<std::uint32_t> number(offset.back(), std::numeric_limits<std::uint32_t>::max());
   for (std::size_t x = 0; x < offset.back(); ++x) {
     if (sets.find(x) != x) continue;
@@ -239,6 +240,7 @@ HexMesh merge_blocks(std::span<const PointGrid3> blocks, std::span<const SharedF
     number[x] = static_cast<std::uint32_t>(m.points.size());
     const std::size_t b = static_cast<std::size_t>(std::upper_bound(offset.begin(), offset.end(), x) - offset.begin()) - 1;
     m.points.push_back(blocks[b].data()[x - offset[b]]);
+    if (origin) origin->push_back(x);
   }
   // Patches in the order their names first appear, block by block.
   std::vector<std::array<std::int32_t, 6>> patch(blocks.size());

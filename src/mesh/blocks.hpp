@@ -46,8 +46,9 @@ std::vector<SharedFace> shared_faces(std::span<const PointGrid3> blocks, double 
 // edges and corners several blocks share) are one node, at the position of the first
 // block's; cells block after block, each block's in C order, turned so that every cell
 // is right-handed. A block's outer face is in the patch patch_of[block][face], a name
-// (several faces may share one).
+// (several faces may share one). `origin`, when given, gets for each point the
+// index of the node it came from, counting the blocks' nodes one block after another.
 HexMesh merge_blocks(std::span<const PointGrid3> blocks, std::span<const SharedFace> shared,
-                     std::span<const std::array<std::string, 6>> patch_of);
+                     std::span<const std::array<std::string, 6>> patch_of, std::vector<std::size_t>* origin = nullptr);
 
 }  // namespace interpatch::mesh

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -73,6 +74,8 @@ struct Timings {
   double build_ms = 0;  ///< the construction itself
 };
 
+struct BlockSet;
+
 /// A spec, built.
 struct Construction {
   std::string type;        ///< the spec's "type"
@@ -98,6 +101,17 @@ struct Construction {
   /// The spec's "sampling": how mesh, eval and view place their nodes along each
   /// direction (a count 0 where the spec gives none). Empty: even steps.
   std::optional<Sampling> sampling;
+  /// A "blocks" spec: its volumes, meshed together (mesh_blocks, io/blocks.hpp). It has
+  /// no exact form and no evaluator of its own: each block has them.
+  std::shared_ptr<const BlockSet> blocks;
+};
+
+/// The volumes of a "blocks" spec, with the names of their outer faces' patches.
+struct BlockSet {
+  std::vector<Construction> blocks;                  ///< each a volume, with its own "sampling"
+  std::vector<std::string> names;                    ///< each block's "name", or block0, block1, ...
+  std::vector<std::array<std::string, 6>> patches;   ///< the patch of each face u0 u1 v0 v1 w0 w1 (NAME_u0 unless "patches" names it)
+  double tolerance = 0;                              ///< how far shared faces' nodes may be apart; 0: 1e-9 of the blocks' size
 };
 
 struct PointArray;

@@ -211,6 +211,9 @@ struct ConstructionType {
 
 /// The type of that name; nullptr when there is none.
 const ConstructionType* find_type(std::string_view name);
+/// A block of a "blocks" spec at `pointer`: a volume spec built as a spec of its own,
+/// its errors and warnings placed under `pointer` (spec.cpp).
+Construction build_block(const json& spec, std::string_view pointer, Context& ctx);
 // A spec's "sampling" (at `ptr`) for a construction of `dims` directions.
 Sampling read_sampling(const json& j, std::string_view ptr, std::size_t dims, Context& ctx);
 /// The names of the types, comma-separated; only those of `dims` dimensions when it is not 0.

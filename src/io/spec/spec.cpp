@@ -68,8 +68,8 @@ void finish(Timings& t, const Context& ctx) {
   t.build_ms = ms_between(parsed, done);
 }
 
-Construction build_impl(const json& spec, Context& ctx) {
-  count_arrays(spec, ctx);
+// The construction of a spec whose arrays are counted.
+Construction build_counted(const json& spec, Context& ctx) {
   if (!spec.is_object())
     fail(errc::wrong_type, "(top level): the spec must be a JSON object with a \"type\", got ", kind(spec));
   if (is_curve_spec(spec))
@@ -94,6 +94,11 @@ Construction build_impl(const json& spec, Context& ctx) {
   c.warnings = std::move(ctx.warnings);
   finish(c.timings, ctx);
   return c;
+}
+
+Construction build_impl(const json& spec, Context& ctx) {
+  count_arrays(spec, ctx);
+  return build_counted(spec, ctx);
 }
 
 CurveConstruction build_curve_impl(const json& spec, Context& ctx) {
@@ -131,6 +136,31 @@ std::pair<std::size_t, std::size_t> line_column(std::string_view text, std::size
 }
 
 }  // namespace
+
+Construction build_block(const json& spec, std::string_view pointer, Context& ctx) {
+  if (!spec.is_object()) wrong_type(pointer, "a volume spec, an object with a \"type\"", spec);
+  if (const json* t = find_member(spec, "type"); t && t->is_string()) {
+    const ConstructionType* type = find_type(t->get<std::string>());
+    if (type && (type->dims != 3 || type->name == "blocks"))
+      fail(errc::wrong_type, pointer, "/type: a block is a volume of one of the types ", type_list(3),
+           " but blocks; \"", type->name, "\" is ", type->dims == 3 ? "blocks itself" : "a surface");
+  }
+  std::vector<std::string> outer = std::exchange(ctx.warnings, {});
+  const auto parsed_at = ctx.parsed_at;
+  Construction c;
+  try {
+    c = build_counted(spec, ctx);
+  } catch (const error& e) {
+    // The builders name places from the spec's top: from the block's, here.
+    const std::string what = e.what();
+    throw error(e.code(), what.starts_with("/") ? cat(pointer, what) : cat(pointer, ": ", what));
+  }
+  ctx.parsed_at = parsed_at;
+  for (std::string& w : c.warnings) outer.push_back(w.starts_with("/") ? cat(pointer, w) : cat(pointer, ": ", w));
+  c.warnings.clear();
+  ctx.warnings = std::move(outer);
+  return c;
+}
 
 const ConstructionType* find_type(std::string_view name) {
   const auto it = std::find_if(std::begin(construction_types), std::end(construction_types),
@@ -299,6 +329,7 @@ json read_json_file(const std::filesystem::path& path) {
 }
 
 bool is_volume(const Construction& c) noexcept {
+  if (c.blocks) return true;
   return c.exact ? std::holds_alternative<BSplineVolume>(*c.exact) : c.volume_formula != nullptr;
 }
 
@@ -359,6 +390,9 @@ const Surface& evaluator(Construction& c, std::size_t points, Sample what) {
 
 const Volume& volume_evaluator(const Construction& c) {
   if (!is_volume(c)) fail(errc::wrong_type, c.type, ": the construction is a surface, not a volume");
+  if (c.blocks)
+    fail(errc::wrong_type, c.type, ": ", c.blocks->blocks.size(), " volumes, not one: they are meshed together (mesh "
+         "-o .vtu, .msh or CASE/constant/polyMesh) and described (info); each block's own spec does the rest");
   if (c.exact) return std::get<BSplineVolume>(*c.exact);
   return *c.volume_formula;
 }
