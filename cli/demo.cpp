@@ -98,6 +98,7 @@ fs::path prepare(fs::path dir) {
 // One example in the gallery.
 struct GalleryEntry {
   std::string name, type, about, thumbnail_svg, summary;
+  std::string page;  // what the picture opens: the viewer page, or a blocks mesh's description
 };
 
 std::string html_text(const std::string& text) {
@@ -128,8 +129,7 @@ void write_gallery(const fs::path& path, const std::vector<GalleryEntry>& entrie
       "made by <code>interpatch view</code>. The other outputs of each example are beside this file.</p>\n"
       "<div class=\"cards\">\n";
   for (const GalleryEntry& e : entries) {
-    const std::string view = html_text(e.name) + ".view.html";
-    page += "<div class=\"card\"><a href=\"" + view + "\">" + e.thumbnail_svg + "<div><b>" + html_text(e.name) +
+    page += "<div class=\"card\"><a href=\"" + html_text(e.page) + "\">" + e.thumbnail_svg + "<div><b>" + html_text(e.name) +
             "</b> <small>" + html_text(e.type) + ": " + html_text(e.about) + "</small><small>" + html_text(e.summary) +
             "</small></div></a></div>\n";
   }
@@ -192,6 +192,14 @@ ojson write_outputs(io::Construction& c, const Example& ex, const fs::path& dir,
     written.push_back(ex.name + suffix);
     return dir / (ex.name + suffix);
   };
+  if (c.blocks) {  // one mesh of every block: for OpenFOAM, VTK and Gmsh
+    write_openfoam_case(c, dir, ex.name, written);
+    write_mesh(c, out(".vtu"), res);
+    write_mesh(c, out(".msh"), res);
+    ojson description = info(c);
+    write_text(out(".info.json"), io::pretty_json(description));
+    return description;
+  }
   const bool volume = io::is_volume(c);
   if (c.exact) {
     write_build(c, out(".bspline.json"));
@@ -225,7 +233,6 @@ ojson write_outputs(io::Construction& c, const Example& ex, const fs::path& dir,
 // The example's lines in the demo's report: what it is, then what info says of it.
 std::string report_lines(const io::Construction& c, const Example& ex, const ojson& description, const fs::path& dir,
                          const fs::path& spec_path) {
-  const auto& err = description["max_data_error"];
   std::string line = "  " + ex.name + std::string(ex.name.size() < 15 ? 15 - ex.name.size() : 1, ' ') + c.type + ": " +
                      ex.about + "\n      ";
   const auto joined = [](const ojson& a, const char* sep) {
@@ -233,6 +240,22 @@ std::string report_lines(const io::Construction& c, const Example& ex, const ojs
     for (const auto& e : a) t += (t.empty() ? "" : sep) + (e.is_string() ? e.get<std::string>() : e.dump());
     return t;
   };
+  if (c.blocks) {  // the blocks, what they share, and the merged mesh as a solver sees it
+    std::string blocks;
+    for (const auto& b : description["blocks"])
+      blocks += (blocks.empty() ? "" : ", ") + b["name"].get<std::string>() + " " + joined(b["nodes"], "x");
+    std::string patches;
+    for (const auto& [name, faces] : description["patches"].items()) patches += (patches.empty() ? "" : ", ") + name;
+    const auto& mesh = description["mesh"];
+    const std::size_t shared = description["shared_faces"].size();
+    return line + std::to_string(description["blocks"].size()) + " blocks (" + blocks + "), " +
+           std::to_string(shared) + (shared == 1 ? " shared face, " : " shared faces, ") + mesh["points"].dump() +
+           " points and " + mesh["cells"].dump() + " cells, patches " + patches + "; non-orthogonality up to " +
+           short_number(mesh["non_orthogonality"]["max"].get<double>()) + " deg, skewness up to " +
+           short_number(mesh["max_skewness"].get<double>()) + ", " + mesh["inverted_cells"].dump() +
+           " cells inverted";
+  }
+  const auto& err = description["max_data_error"];
   if (c.exact)
     line += joined(description["control_points"], "x") + " control points, degree " +
             joined(description["degree"], "x") + ", continuity " + joined(description["continuity"], "/");
@@ -296,7 +319,8 @@ int demo_command(const fs::path& requested) {
     const ojson description = write_outputs(c, ex, dir, written);
     report_warnings(c.warnings);
     std::string line = report_lines(c, ex, description, dir, spec_path);
-    gallery.push_back({ex.name, c.type, ex.about, io::view_thumbnail_svg(c), line.substr(line.rfind("\n      ") + 7)});
+    gallery.push_back({ex.name, c.type, ex.about, io::view_thumbnail_svg(c), line.substr(line.rfind("\n      ") + 7),
+                       ex.name + (c.blocks ? ".info.json" : ".view.html")});
     line += "\n      ";
     for (std::size_t i = 0; i < written.size(); ++i) line += (i ? " " : "") + written[i];
     summary += line + "\n";

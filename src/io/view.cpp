@@ -503,14 +503,19 @@ std::string view_thumbnail_svg(const Construction& c, std::size_t width, std::si
     std::vector<Vec3> points;
   };
   std::vector<Patch> patches;
-  if (is_volume(c)) {
-    const Volume& v = volume_evaluator(c);
+  if (is_volume(c)) {  // the faces of the volume, or of every block
+    std::vector<const Volume*> volumes;
+    if (c.blocks)
+      for (const Construction& b : c.blocks->blocks) volumes.push_back(&volume_evaluator(b));
+    else
+      volumes.push_back(&volume_evaluator(c));
     const std::vector<double> t = linspace(0, 1, 12), end0{0.0}, end1{1.0};
-    for (int axis = 0; axis < 3; ++axis)
-      for (const auto* end : {&end0, &end1}) {
-        const PointGrid3 g = v.evaluate(axis == 0 ? *end : t, axis == 1 ? *end : t, axis == 2 ? *end : t);
-        patches.push_back({12, 12, std::vector<Vec3>(g.data(), g.data() + g.size())});
-      }
+    for (const Volume* v : volumes)
+      for (int axis = 0; axis < 3; ++axis)
+        for (const auto* end : {&end0, &end1}) {
+          const PointGrid3 g = v->evaluate(axis == 0 ? *end : t, axis == 1 ? *end : t, axis == 2 ? *end : t);
+          patches.push_back({12, 12, std::vector<Vec3>(g.data(), g.data() + g.size())});
+        }
   } else {
     const std::vector<double> t = linspace(0, 1, 24);
     const PointGrid g = evaluator(c).evaluate(t, t);
