@@ -175,6 +175,21 @@ std::vector<Row> rows() {
     j["sampling"] = nlohmann::json::parse(sampling);
     return j.dump();
   };
+  // Two unit boxes along x, the second from x = x0; each block's extra fields merged in.
+  const auto two_boxes = [](double x0, const char* a = "{}", const char* b = "{}", const char* extra = "{}") {
+    nlohmann::json blocks = nlohmann::json::array();
+    for (int n = 0; n < 2; ++n) {
+      nlohmann::json box = {{"type", "trilinear"}};
+      for (int c = 0; c < 8; ++c)
+        box[std::string("p") + char('0' + (c >> 2)) + char('0' + ((c >> 1) & 1)) + char('0' + (c & 1))] = {
+            (n ? x0 : 0.0) + (c >> 2), (c >> 1) & 1, c & 1};
+      box.update(nlohmann::json::parse(n ? b : a));
+      blocks.push_back(box);
+    }
+    nlohmann::json j = {{"type", "blocks"}, {"blocks", blocks}};
+    j.update(nlohmann::json::parse(extra));
+    return j.dump();
+  };
   const std::string misaligned_ruled = R"({"type": "ruled", "curves": [
       {"degree": 1, "param": "uniform", "periodic": true, "interpolate": [[0.186, 1.019, 0.061],
         [-0.765, 0.896, -0.020], [-1.031, -0.403, 0.098], [0.369, -1.065, 0.055], [1.008, -0.308, -0.029]]},
@@ -591,6 +606,36 @@ std::vector<Row> rows() {
        {"eval", grid_file, "--grid", "5", "-o", "out.npy"}, 3,
        R"(sampling v: first 50 is longer than the direction: its longest chord from that end is [0-9.]+)",
        errc::invalid_grading, false},
+      {"BlocksThatNearlyMeet", {{grid_file, two_boxes(1.001)}}, {"mesh", grid_file, "-o", "out.vtu"}, 3,
+       R"(block 0 face u1 and block 1 face u0 nearly meet: their corners are up to 0\.001 apart \(tolerance [0-9.e-]+\); )"
+       R"(move them together, or apart)",
+       errc::block_mismatch, false},
+      {"BlocksCountedDifferentlyAcrossAFace",
+       {{grid_file, two_boxes(1, R"({"sampling": {"v": {"count": 9}}})", R"({"sampling": {"v": {"count": 11}}})")}},
+       {"mesh", grid_file, "-o", "out.vtu"}, 3,
+       R"(/blocks/1/sampling/v \(block1\) has count 11 and /blocks/0/sampling/v \(block0\) count 9; they are tied )"
+       R"(across the faces the blocks share: give them one count)",
+       errc::block_mismatch, false},
+      {"BlocksGradedDifferentlyAcrossAFace",
+       {{grid_file, two_boxes(1, R"({"sampling": {"w": {"first": 0.01}}})", R"({"sampling": {"w": {"ratio": 2}}})")}},
+       {"info", grid_file}, 3,
+       R"(/blocks/1/sampling/w \(block1\) and /blocks/0/sampling/w \(block0\) grade directions tied across the faces )"
+       R"(the blocks share, differently; grade one of them)",
+       errc::block_mismatch, false},
+      {"BlocksPatchOnASharedFace", {{grid_file, two_boxes(1, "{}", "{}", R"({"patches": {"wall": ["block0_u1"]}})")}},
+       {"mesh", grid_file, "-o", "polyMesh"}, 3,
+       R"(/patches/wall names block0_u1, which another block shares: it is inside the mesh, not on its boundary)",
+       errc::block_mismatch, false},
+      {"BlocksPatchOfNoFace", {{grid_file, two_boxes(1, "{}", "{}", R"({"patches": {"wall": ["block0_x9"]}})")}},
+       {"mesh", grid_file, "-o", "out.vtu"}, 3,
+       R"(/patches/wall/0: no block face "block0_x9"; a face is a block's name and one of _u0 _u1 _v0 _v1 _w0 _w1)",
+       errc::wrong_type},
+      {"BlocksOfASurface", {{grid_file, R"({"type": "blocks", "blocks": [)" + grid + "]}"}},
+       {"mesh", grid_file, "-o", "out.vtu"}, 3,
+       R"(/blocks/0/type: a block is a volume of one of the types [a-z_, ]+ but blocks; "interpolate" is a surface)",
+       errc::wrong_type},
+      {"BlocksEvaluated", {{grid_file, two_boxes(1)}}, {"eval", grid_file, "--grid", "5", "-o", "out.npy"}, 3,
+       R"(blocks: 2 volumes, not one: they are meshed together)", errc::wrong_type, false},
       {"ProjectToAnUnknownFormat", {{grid_file, grid}, {"p.csv", "0,0,0\n"}}, {"project", grid_file, "p.csv", "-o", "out.vtk"}, 2,
        R"(project and intersect write \.npz, \.npy or \.csv)", std::nullopt, false},
       {"EvalOverflowsToNpy", {{grid_file, overflowing}}, {"eval", grid_file, "--grid", "5", "-o", "out.npy"}, 3,
@@ -677,6 +722,8 @@ std::vector<Row> rows() {
        R"('out\.obj': trilinear is a volume; \.obj holds surfaces only)"},
       {"SurfaceMeshAsPolyMesh", {{grid_file, grid}}, {"mesh", grid_file, "-o", "polyMesh"}, 2,
        R"('polyMesh': interpolate is a surface; an OpenFOAM polyMesh holds the cells of a volume)"},
+      {"BlocksMeshAsVts", {{grid_file, two_boxes(1)}}, {"mesh", grid_file, "-o", "out.vts"}, 2,
+       R"('out\.vts': blocks are meshed together as unstructured cells: \.vtu, \.msh \(Gmsh\) or a polyMesh directory)"},
       {"SurfaceMeshAsMsh", {{grid_file, grid}}, {"mesh", grid_file, "-o", "out.msh"}, 2,
        R"('out\.msh': interpolate is a surface; \.msh is written with the hexahedral cells of a volume)"},
       {"UnknownBuildExtension", {{grid_file, grid}}, {"build", grid_file, "-o", "out.txt"}, 2,
