@@ -206,6 +206,9 @@ int mesh_command(const Input& in, const fs::path& out, std::string_view res_text
   io::Built b = cli::build_any_input(in, {.progress = {}, .keep_data = false, .defer_exact = true, .arrays = {}});
   refuse_curve(in, b, "mesh");
   io::Construction& c = std::get<io::Construction>(b);
+  if (given && c.blocks)
+    throw usage_error("--res " + std::string(res_text) +
+                      ": a blocks spec takes its counts from each block's \"sampling\", tied across the faces they share");
   const Resolution res = given ? *given : io::default_resolution(c);
   check_mesh_kind(c, out, res);
   if (!given) require_mesh_room(res, out);

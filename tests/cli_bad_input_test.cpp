@@ -634,6 +634,8 @@ std::vector<Row> rows() {
        {"mesh", grid_file, "-o", "out.vtu"}, 3,
        R"(/blocks/0/type: a block is a volume of one of the types [a-z_, ]+ but blocks; "interpolate" is a surface)",
        errc::wrong_type},
+      {"BlocksMeshedWithRes", {{grid_file, two_boxes(1)}}, {"mesh", grid_file, "-o", "out.vtu", "--res", "5x5x5"}, 2,
+       R"(--res 5x5x5: a blocks spec takes its counts from each block's "sampling", tied across the faces they share)"},
       {"BlocksEvaluated", {{grid_file, two_boxes(1)}}, {"eval", grid_file, "--grid", "5", "-o", "out.npy"}, 3,
        R"(blocks: 2 volumes, not one: they are meshed together)", errc::wrong_type, false},
       {"ProjectToAnUnknownFormat", {{grid_file, grid}, {"p.csv", "0,0,0\n"}}, {"project", grid_file, "p.csv", "-o", "out.vtk"}, 2,

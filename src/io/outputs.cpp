@@ -263,7 +263,12 @@ std::vector<std::string> write_mesh(Construction& c, const fs::path& out, const 
   check_counts(counts_of(res), option);
   check_mesh_kind(c, out, res, option);
   require_mesh_room(res, out);
-  if (c.blocks) return mesh_of_blocks(c, out, progress);
+  if (c.blocks) {
+    if (sampling)
+      throw error(errc::wrong_type, "sampling: a blocks spec's nodes come from each block's \"sampling\", tied across "
+                                    "the faces they share");
+    return mesh_of_blocks(c, out, progress);
+  }
   if (is_volume(c)) {
     return mesh_volume(c, out, res, progress, sampling);
   }
