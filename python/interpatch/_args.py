@@ -7,7 +7,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from ._core import Curve, Surface
+from ._core import Curve, Surface, Volume
 from ._core import Error as Error_
 
 
@@ -122,6 +122,24 @@ def _surface_spec(face: Any, arrays: _Arrays, name: str) -> dict[str, Any]:
             spec["weights"] = b["weights"].tolist()
         return spec
     return {"type": "interpolate", "points": arrays.add(face, name)}
+
+
+def _volume_spec(block: Any, arrays: _Arrays, name: str) -> dict[str, Any]:
+    """A volume argument as a spec: a dict as it is, a Volume by its exact form (bit
+    for bit)."""
+    if isinstance(block, dict):
+        return block
+    if isinstance(block, Volume):
+        b = block.to_bspline()
+        spec: dict[str, Any] = {"type": "bspline_volume", "degree": list(b["degree"]),
+                                "knots": {"u": b["knots_u"].tolist(), "v": b["knots_v"].tolist(),
+                                          "w": b["knots_w"].tolist()},
+                                "control_points": arrays.add(b["control_points"], f"{name}.control_points"),
+                                "periodic": list(b["periodic"])}
+        if b["weights"] is not None:
+            spec["weights"] = b["weights"].tolist()
+        return spec
+    raise _error("wrong_type", f"{name}: a Volume or a volume spec dict, got {type(block).__name__}")
 
 
 def _scattered_sites(spec: dict[str, Any], arrays: _Arrays, param: Any, params: Any, base: Any) -> None:

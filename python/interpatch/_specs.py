@@ -15,14 +15,15 @@ from typing import Any, Callable, Optional, Sequence, Union, cast
 import numpy as np
 import numpy.typing as npt
 
-from ._args import _approximation, _Arrays, _curve, _error, _options, _point, _real, _reals, _scattered_sites, _surface_spec
+from ._args import (_approximation, _Arrays, _curve, _error, _options, _point, _real, _reals, _scattered_sites,
+                    _surface_spec, _volume_spec)
 from ._core import Curve, Surface, Volume
 from ._core import build as _build
 
 __all__ = ["build", "interpolate_surface", "bilinear", "ruled", "coons", "curve_network", "hermite_patch",
            "interpolate_volume", "trilinear", "coons_volume", "hermite_volume", "interpolate_curve", "bspline_curve",
            "hermite_curve", "line", "approximate_surface", "approximate_volume", "approximate_curve", "loft",
-           "loft_volume"]
+           "loft_volume", "blocks"]
 
 _Path = Union[str, PathLike[str]]
 _CurveLike = Union[Curve, npt.ArrayLike]
@@ -469,6 +470,40 @@ def loft_volume(sections: Sequence[Any], degree: Optional[int] = None, param: Un
     if param is not None and not isinstance(param, str):
         param = _reals(param, "param")
     return cast(Volume, _build(_options(spec, degree=degree, param=param, periodic=periodic), ".", a.table))
+
+
+def blocks(blocks: Sequence[Any], names: Optional[Sequence[str]] = None,
+           sampling: Optional[Sequence[Optional[dict[str, Any]]]] = None,
+           patches: Optional[dict[str, Sequence[str]]] = None, tolerance: Optional[float] = None) -> Volume:
+    """Volumes meshed together (docs/spec-format.md, type blocks): `blocks` are Volume
+    objects or volume spec dicts; `names` and `sampling` give each its name and its
+    sampling (a dict per block, or None); `patches` groups outer faces ("NAME_w0") into
+    named patches. The faces they share are found by geometry; write() the merged
+    mesh to .vtu, .msh or CASE/constant/polyMesh.
+
+    Examples
+    --------
+    >>> a = interpatch.trilinear([[[[0, 0, 0], [0, 0, 1]], [[0, 1, 0], [0, 1, 1]]],
+    ...                           [[[1, 0, 0], [1, 0, 1]], [[1, 1, 0], [1, 1, 1]]]])
+    >>> b = {"type": "trilinear", "p000": [1, 0, 0], "p001": [1, 0, 1], "p010": [1, 1, 0], "p011": [1, 1, 1],
+    ...      "p100": [2, 0, 0], "p101": [2, 0, 1], "p110": [2, 1, 0], "p111": [2, 1, 1]}
+    >>> two = interpatch.blocks([a, b], names=["left", "right"],
+    ...                         sampling=[{"u": {"count": 5}, "v": {"count": 3}}, {"w": {"count": 3}}],
+    ...                         patches={"ends": ["left_u0", "right_u1"]}, tolerance=1e-9)
+    >>> info = two.info()                  # v and w tied across the shared face: 3 x 3 nodes on it
+    >>> info["shared_faces"][0]["faces"], info["mesh"]["points"], info["patches"]["ends"]
+    (['u1', 'u0'], 333, 8)"""
+    a = _Arrays()
+    specs = []
+    for i, block in enumerate(blocks):
+        spec = dict(_volume_spec(block, a, f"blocks[{i}]"))
+        if names is not None:
+            spec["name"] = names[i]
+        if sampling is not None and sampling[i] is not None:
+            spec["sampling"] = sampling[i]
+        specs.append(spec)
+    return cast(Volume, _build(_options({"type": "blocks", "blocks": specs}, patches=patches, tolerance=tolerance),
+                               ".", a.table))
 
 
 def hermite_patch(corners: dict[str, dict[str, npt.ArrayLike]]) -> Surface:

@@ -36,7 +36,7 @@ def _examples(kind):
             b = _built(f)
         except interpatch.Error:
             continue
-        if isinstance(b, kind):
+        if isinstance(b, kind) and b.type != "blocks":  # blocks locate block by block
             out.append(f)
     return out
 
