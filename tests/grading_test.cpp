@@ -152,6 +152,9 @@ TEST(Grading, Refusals) {
   refused({.count = 5, .ratio = 2, .last = 0.1}, errc::invalid_grading, "ratio is given with first or last");
   refused({.count = 5, .first = 3}, errc::invalid_grading, "first 3 is longer than the direction");
   refused({.count = 50, .first = 0.6, .last = 0.6, .max_growth = 100}, errc::invalid_grading, "overlap");
+  // Finer than doubles can place: no parameter step above 0 gives a cell this short.
+  refused({.count = 5, .first = 1e-300, .max_growth = 1e300}, errc::invalid_grading,
+          "first 1e-300 is shorter than rounding allows");
 }
 
 TEST(Grading, SpecSamplingIsReadAndCheckedAsDocumented) {
