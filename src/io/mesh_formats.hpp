@@ -43,6 +43,17 @@ std::vector<std::string> float32_warnings(const std::filesystem::path& path, con
 // Structured grids (mesh_structured.cpp): legacy VTK, VTK XML (.vts) and Plot3D
 // (.xyz), shared by surfaces (nw = 1) and volumes.
 
+// Where each array starts in a VTK XML file's raw appended data, each array after its
+// UInt64 byte count: next(bytes) gives an array's offset and moves past it.
+struct AppendedOffsets {
+  std::uint64_t end = 0;
+  std::uint64_t next(std::uint64_t bytes) {
+    const std::uint64_t at = end;
+    end += 8 + bytes;
+    return at;
+  }
+};
+
 struct Structured {
   std::size_t nu = 1, nv = 1, nw = 1;
   const Vec3* points = nullptr;   // C order: index (i * nv + j) * nw + k

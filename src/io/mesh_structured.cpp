@@ -45,12 +45,7 @@ std::string legacy_vtk_point_data(std::size_t size, bool vectors, bool scalars) 
 std::string vts_head(std::size_t nu, std::size_t nv, std::size_t nw, bool vectors, bool scalars) {
   const std::uint64_t n = std::uint64_t{nu} * nv * nw;
   const std::uint64_t vec_bytes = 24 * n, scal_bytes = 8 * n;
-  std::uint64_t offset = 0;
-  auto next_offset = [&](std::uint64_t bytes) {
-    const std::uint64_t o = offset;
-    offset += 8 + bytes;
-    return o;
-  };
+  AppendedOffsets offsets;
   std::string head;
   Sink s(head);
   auto extent = [&]() { s.text("0 ").uint(nu - 1).text(" 0 ").uint(nv - 1).text(" 0 ").uint(nw - 1); };
@@ -66,17 +61,17 @@ std::string vts_head(std::size_t nu, std::size_t nv, std::size_t nw, bool vector
   s.text(">\n");
   if (vectors) {
     s.text("        <DataArray type=\"Float64\" Name=\"Normals\" NumberOfComponents=\"3\" format=\"appended\" offset=\"")
-        .uint(next_offset(vec_bytes))
+        .uint(offsets.next(vec_bytes))
         .text("\"/>\n");
   }
   if (scalars) {
     s.text("        <DataArray type=\"Float64\" Name=\"jacobian\" NumberOfComponents=\"1\" format=\"appended\" offset=\"")
-        .uint(next_offset(scal_bytes))
+        .uint(offsets.next(scal_bytes))
         .text("\"/>\n");
   }
   s.text("      </PointData>\n      <Points>\n"
          "        <DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" format=\"appended\" offset=\"")
-      .uint(next_offset(vec_bytes))
+      .uint(offsets.next(vec_bytes))
       .text("\"/>\n      </Points>\n    </Piece>\n  </StructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _");
   return head;
 }

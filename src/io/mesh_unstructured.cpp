@@ -26,12 +26,7 @@ std::array<std::uint32_t, 8> right_handed(const std::array<std::uint32_t, 8>& c,
 // count (UInt64): the jacobian (when given), the points, connectivity, offsets, types.
 void write_vtu(std::ostream& os, const mesh::HexMesh& m, bool flipped, const double* jacobian) {
   const std::uint64_t np = m.points.size(), nc = m.cells.size();
-  std::uint64_t offset = 0;
-  auto next = [&](std::uint64_t bytes) {
-    const std::uint64_t o = offset;
-    offset += 8 + bytes;
-    return o;
-  };
+  AppendedOffsets offsets;
   std::string head;
   {
     Sink s(head);
@@ -46,18 +41,18 @@ void write_vtu(std::ostream& os, const mesh::HexMesh& m, bool flipped, const dou
     s.text(">\n");
     if (jacobian)
       s.text("        <DataArray type=\"Float64\" Name=\"jacobian\" format=\"appended\" offset=\"")
-          .uint(next(8 * np))
+          .uint(offsets.next(8 * np))
           .text("\"/>\n");
     s.text("      </PointData>\n      <Points>\n"
            "        <DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" format=\"appended\" offset=\"")
-        .uint(next(24 * np))
+        .uint(offsets.next(24 * np))
         .text("\"/>\n      </Points>\n      <Cells>\n"
               "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"appended\" offset=\"")
-        .uint(next(64 * nc))
+        .uint(offsets.next(64 * nc))
         .text("\"/>\n        <DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"")
-        .uint(next(8 * nc))
+        .uint(offsets.next(8 * nc))
         .text("\"/>\n        <DataArray type=\"UInt8\" Name=\"types\" format=\"appended\" offset=\"")
-        .uint(next(nc))
+        .uint(offsets.next(nc))
         .text("\"/>\n      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _");
   }
   os << head;
