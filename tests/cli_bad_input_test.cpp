@@ -636,6 +636,8 @@ std::vector<Row> rows() {
        errc::wrong_type},
       {"BlocksMeshedWithRes", {{grid_file, two_boxes(1)}}, {"mesh", grid_file, "-o", "out.vtu", "--res", "5x5x5"}, 2,
        R"(--res 5x5x5: a blocks spec takes its counts from each block's "sampling", tied across the faces they share)"},
+      {"BlocksBuilt", {{grid_file, two_boxes(1)}}, {"build", grid_file, "-o", "out.step"}, 3,
+       R"(blocks: a blocks spec has an exact form per block: build each block's spec)", errc::no_exact_form, false},
       {"BlocksEvaluated", {{grid_file, two_boxes(1)}}, {"eval", grid_file, "--grid", "5", "-o", "out.npy"}, 3,
        R"(blocks: 2 volumes, not one: they are meshed together)", errc::wrong_type, false},
       {"ProjectToAnUnknownFormat", {{grid_file, grid}, {"p.csv", "0,0,0\n"}}, {"project", grid_file, "p.csv", "-o", "out.vtk"}, 2,
