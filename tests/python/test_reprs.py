@@ -59,13 +59,15 @@ def test_help_is_a_reference():
 
 def test_the_stubs_declare_what_the_module_has():
     import ast
-    from interpatch import _specs
+    from interpatch import _specs, _volumes
     # The compiled module's classes in _core.pyi; the keyword constructors annotated
-    # where _specs.py defines them (__init__.pyi re-exports both: test_spec_fields.py).
+    # where _specs.py and _volumes.py define them (__init__.pyi re-exports both:
+    # test_spec_fields.py).
     stub = ast.parse(open(os.path.join(os.path.dirname(interpatch.__file__), "_core.pyi")).read())
     declared = {n.name: n for n in stub.body if isinstance(n, (ast.ClassDef, ast.FunctionDef))}
-    specs = ast.parse(open(_specs.__file__).read())
-    declared.update({n.name: n for n in specs.body if isinstance(n, ast.FunctionDef) and n.name in _specs.__all__})
+    for module in (_specs, _volumes):
+        specs = ast.parse(open(module.__file__).read())
+        declared.update({n.name: n for n in specs.body if isinstance(n, ast.FunctionDef) and n.name in _specs.__all__})
     for name in interpatch.__all__:
         if name not in ("__version__", "ERROR_CODES"):
             assert name in declared, f"{name} is not in the stubs"

@@ -32,7 +32,10 @@ import numpy as np
 import pytest
 
 import interpatch
-from interpatch import _core, _specs
+from interpatch import _core, _specs, _volumes
+
+# The modules that define the keyword constructors; _specs exports them all.
+DEFINED_IN = {_specs.__name__, _volumes.__name__}
 
 # Reader types no keyword constructor makes; build() takes them as dicts.
 NO_CONSTRUCTOR = {
@@ -58,16 +61,17 @@ NOT_CONSTRUCTED_KINDS = {"points", "sampling"}
 
 
 def public_functions():
-    """The public functions _specs defines: the keyword constructors and build()."""
+    """The public functions _specs has (defined there or in _volumes): the keyword
+    constructors and build()."""
     return sorted(name for name, f in vars(_specs).items()
-                  if inspect.isfunction(f) and f.__module__ == _specs.__name__ and not name.startswith("_"))
+                  if inspect.isfunction(f) and f.__module__ in DEFINED_IN and not name.startswith("_"))
 
 
 def constructors():
     """The public functions of _specs but build(), which takes any spec as it is."""
     return sorted(name for name in interpatch.__all__
                   if name != "build" and inspect.isfunction(getattr(interpatch, name))
-                  and getattr(interpatch, name).__module__ == _specs.__name__)
+                  and getattr(interpatch, name).__module__ in DEFINED_IN)
 
 
 @dataclass
@@ -103,9 +107,9 @@ def recorded(name: str, f: Any, seen: Examples, built: list, running: list) -> A
 @pytest.fixture(scope="module")
 def examples():
     """Every public function's docstring examples, run with interpatch's functions
-    recording their calls and _specs._build the specs it is handed (then built)."""
+    recording their calls and _core.build the specs it is handed (then built)."""
     seen, built, running = Examples(), [], [None]
-    real_build = _specs._build
+    real_build = _core.build
 
     def recording_build(spec, base_dir, arrays):
         built.append(spec)
@@ -114,12 +118,13 @@ def examples():
     finder = doctest.DocTestFinder(recurse=False)
     runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(_specs, "_build", recording_build)
+        mp.setattr(_core, "build", recording_build)
         for name in _specs.__all__:
             mp.setattr(interpatch, name, recorded(name, getattr(_specs, name), seen, built, running))
         for name in _specs.__all__:
             running[0] = name
-            tests = finder.find(getattr(_specs, name), name, module=_specs, globs={"np": np, "interpatch": interpatch})
+            f = getattr(_specs, name)
+            tests = finder.find(f, name, module=inspect.getmodule(f), globs={"np": np, "interpatch": interpatch})
             report = []
             results = [runner.run(test, out=report.append) for test in tests]
             seen.tests[name] = (sum(r.attempted for r in results), sum(r.failed for r in results), "".join(report))
