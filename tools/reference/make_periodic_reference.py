@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Independent reference values for interpatch's closed (periodic) interpolation, computed with SciPy.
 
-Rerun (the result must be byte-identical to the checked-in file; CTest checks it
+Rerun (the result must agree with the checked-in file, to 1e-12 of the scale as
+same_reference.py says; CTest checks it
 with tests/reference_check.cmake when python3-scipy is installed):
 
     python3 tools/reference/make_periodic_reference.py -o tests/data/periodic_reference.json
