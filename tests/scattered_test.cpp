@@ -18,10 +18,7 @@
 #include "interpatch/io/spec.hpp"
 #include "constructions/scattered/scattered_system.hpp"
 #include "property/promise_harness.hpp"
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
+#include "thread_util.hpp"
 
 namespace interpatch {
 namespace {
@@ -149,20 +146,7 @@ TEST(Scattered, AVoidIsFilledWithinTheDataAroundIt) {
   }
 }
 
-// Runs f with `threads` OpenMP threads, restoring the setting.
-template <class F>
-auto with_threads(int threads, F&& f) {
-#ifdef _OPENMP
-  const int before = omp_get_max_threads();
-  omp_set_dynamic(0);
-  omp_set_num_threads(threads);
-#endif
-  auto r = f();
-#ifdef _OPENMP
-  omp_set_num_threads(before);
-#endif
-  return r;
-}
+using test::with_threads;
 
 TEST(Scattered, TheSameBitsOnOneTwoAndThreeThreads) {
   std::mt19937_64 g(15);
@@ -338,8 +322,8 @@ TEST(Scattered, SpecRefusalsNameTheField) {
   refused([](nlohmann::json& s) { s["domain"] = {{1000, 0}, {0, 800}}; }, errc::non_increasing,
           "domain along u is [1000, 0]: it must increase");
   refused([](nlohmann::json& s) { s["domain"] = {{0, 500}, {0, 800}}; }, errc::out_of_domain, "outside the domain [0, 500]");
-  refused([](nlohmann::json& s) { s.erase("tolerance"); s["smoothing"] = "auto"; }, errc::wrong_type,
-          "/smoothing: scattered points take a number for smoothing");
+  refused([](nlohmann::json& s) { s.erase("tolerance"); s["smoothing"] = "fast"; }, errc::wrong_type,
+          "/smoothing: expected a number or \"auto\", got \"fast\"");
   refused([](nlohmann::json& s) { s["periodic"] = {true, false}; }, errc::wrong_type,
           "/periodic: scattered points have no closed directions");
   refused([](nlohmann::json& s) { s["weights"] = {1, 2}; }, errc::size_mismatch, "/weights: 2 weights for 60 points");

@@ -1,6 +1,7 @@
 #pragma once
-// Test helper: exact forms computed with 1, 2 and 3 OpenMP threads, compared bit for
-// bit (tests/determinism_test.cpp does the same for the other threaded loops).
+// Test helpers: a call with a given number of OpenMP threads; exact forms computed with
+// 1, 2 and 3 threads, compared bit for bit (tests/determinism_test.cpp does the same for
+// the other threaded loops).
 
 #include <gtest/gtest.h>
 
@@ -13,6 +14,21 @@
 #include "interpatch/vec3.hpp"
 
 namespace interpatch::test {
+
+/// f() run with `threads` OpenMP threads (dynamic adjustment off), the setting restored.
+template <class F>
+auto with_threads([[maybe_unused]] int threads, F&& f) {
+#ifdef _OPENMP
+  const int before = omp_get_max_threads();
+  omp_set_dynamic(0);
+  omp_set_num_threads(threads);
+#endif
+  auto r = f();
+#ifdef _OPENMP
+  omp_set_num_threads(before);
+#endif
+  return r;
+}
 
 #ifdef _OPENMP
 /// Expects to_bspline() of each construction to give a control net with the same

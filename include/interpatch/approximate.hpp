@@ -84,6 +84,10 @@ struct ApproximationOptions {
 /// this many, knots placed by the least-squares rule.
 inline constexpr int smoothing_max_control_points = 128;
 
+/// The most control points per direction of a scattered smoothing fit (one per point
+/// present along each direction below it).
+inline constexpr int smoothing_max_scattered = 1024;
+
 using CurveApproximationOptions = ApproximationOptions<1>;
 using SurfaceApproximationOptions = ApproximationOptions<2>;
 using VolumeApproximationOptions = ApproximationOptions<3>;
@@ -128,7 +132,8 @@ struct VolumeApproximation {
 ///   o.tolerance = 0.02;
 ///   auto r = approximate_curve(q, o);  // r.report.max_error <= 0.02, far fewer than 41 control points
 /// @endcode
-/// @throws error wrong_type (not exactly one of control_points, tolerance, smoothing;
+/// @throws error wrong_type (not exactly one of control_points, tolerance, smoothing,
+///   auto_smoothing;
 ///   tolerance ≤ 0; negative smoothing), too_few_points (all points missing, more
 ///   control points than data, fewer than degree + 1), invalid_degree, not_finite
 ///   (an infinite coordinate, a NaN weight), size_mismatch (weights of another
@@ -189,7 +194,7 @@ enum class ScatteredParam {
 };
 
 /// How a scattered approximation is set up. Exactly one of `control_points`,
-/// `tolerance` and `smoothing` is given.
+/// `tolerance`, `smoothing` and `auto_smoothing` is given.
 struct ScatteredApproximationOptions {
   /// Degrees in u and v; unset means 3.
   std::array<std::optional<int>, 2> degree{};
@@ -208,8 +213,12 @@ struct ScatteredApproximationOptions {
   /// `max_control_points`.
   std::optional<double> tolerance;
   /// The fairness weight λ ≥ 0, on a net of about one control point per point present
-  /// (at most smoothing_max_control_points a direction).
+  /// (at most smoothing_max_scattered a direction).
   std::optional<double> smoothing;
+  /// λ chosen by cross-validation on the same net (instead of `smoothing`): the
+  /// points present split into 5 folds by their coordinates, and the λ whose fits
+  /// predict held-out points best (ApproximationReport::lambda) is kept.
+  bool auto_smoothing = false;
   /// The largest net a tolerance may reach, per direction; unset: 4096 a direction and
   /// at most one control point per 4 points present (and never fewer than 64 × 64):
   /// finer nets leave most knot cells without a point, held by the small fairness term
@@ -247,8 +256,9 @@ struct ScatteredApproximation {
 /// The normal equations are assembled in one pass over the points, each touching
 /// (p+1)(q+1) basis functions, into a banded matrix of the control net (no dense
 /// matrix, memory O(N + control points)), and solved by a sparse LDLᵀ decomposition up
-/// to 40 000 control points, by conjugate gradients started from the fit on half the
-/// spans beyond. The result has the same bits on any number of threads.
+/// to 4 096 control points, beyond by conjugate gradients preconditioned by multigrid
+/// (the same fit on nets of halved spans). `auto_smoothing` chooses λ by 5-fold
+/// cross-validation. The result has the same bits on any number of threads.
 ///
 /// Example:
 /// @code
@@ -263,7 +273,8 @@ struct ScatteredApproximation {
 ///   o.tolerance = 0.05;
 ///   auto r = approximate_scattered(q, o);  // z = f(x, y); every point within 0.05
 /// @endcode
-/// @throws error wrong_type (not exactly one of control_points, tolerance, smoothing;
+/// @throws error wrong_type (not exactly one of control_points, tolerance, smoothing,
+///   auto_smoothing;
 ///   tolerance ≤ 0; negative smoothing), too_few_points (fewer points present than
 ///   (p+1)(q+1), fewer control points than p + 1), invalid_degree, not_finite (an
 ///   infinite coordinate or site, a NaN weight), size_mismatch (sites or weights of

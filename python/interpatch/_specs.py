@@ -179,8 +179,9 @@ def approximate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int],
     entry of a masked array, marks it missing (the fairness term fills the hole).
     Exactly one of `control_points` ((nu, nv): least squares with that net),
     `tolerance` (the fewest control points keeping every point within that distance)
-    and `smoothing` (the fairness weight, or "auto" for generalized cross-validation
-    on a grid); optional `weights`, one per point, non-negative. For a grid, `degree`,
+    and `smoothing` (the fairness weight, or "auto": generalized cross-validation on a
+    grid, 5-fold cross-validation for scattered points); optional `weights`, one per
+    point, non-negative. For a grid, `degree`,
     `param` and `periodic` as for interpolate_surface. For scattered points, `param`
     is "plane" (the default: the points' least-squares plane) or "xy" (a height field,
     u = x and v = y), or `params` gives the sites, shape (N, 2), or `base` (a Surface, spec
@@ -219,6 +220,10 @@ def approximate_surface(points: npt.ArrayLike, degree: Union[int, Sequence[int],
     >>> p = s.info()["parameters"]
     >>> p["max_error"] <= 0.3, p["param"], p["points"], np.round(s.point(0.5, 0.5)[:2], 9).tolist()
     (True, 'xy', 5000, [150.0, 100.0])
+    >>> s = interpatch.approximate_surface(survey, param="xy", smoothing="auto")  # λ by cross-validation
+    >>> p = s.info()["parameters"]
+    >>> p["smoothing"], p["lambda"] > 0, p["rms_error"] < 0.1
+    ('auto', True, True)
     >>> s = interpatch.approximate_surface(survey, params=xy / 100, control_points=(12, 10))
     >>> s.info()["parameters"]["param"], s.info()["control_points"]
     ('sites', [12, 10])

@@ -14,14 +14,14 @@ namespace detail {
 
 namespace {
 
-struct Local {
+struct CurveLocal {
   double t, f;  // f = |C(t) − q|²
 };
 
 // The nearest point to q of piece pc: the best of its ends and middle, then Newton's
 // iteration on f = |C − q|² bounded to the piece (Gauss–Newton where f'' <= 0); a step
 // that does not lower f is halved.
-Local descend(const Spline& s, const PieceNets& nets, const Piece& pc, const Vec3& q) {
+CurveLocal descend(const Spline& s, const PieceNets& nets, const Piece& pc, const Vec3& q) {
   const double a = pc.lo[0], b = pc.hi[0];
   double t = a, f = std::numeric_limits<double>::infinity();
   std::array<Vec3, 3> d{};
@@ -71,11 +71,11 @@ CurveSearch::CurveSearch(const BSplineCurve& c) : curve(c), tree({}) {
 CurvePoint CurveSearch::closest(const Vec3& q) const {
   const Vec3 qc = spline.local(q);
   double bound2 = std::numeric_limits<double>::infinity();
-  Local best{0, std::numeric_limits<double>::infinity()};
+  CurveLocal best{0, std::numeric_limits<double>::infinity()};
   const double slack = prune_slack * spline.diagonal;
   tree.nearest(qc, bound2, [&](std::size_t k) {
     if (pieces[k].tight.distance2(qc) >= bound2) return;
-    const Local l = descend(spline, nets, pieces[k], qc);
+    const CurveLocal l = descend(spline, nets, pieces[k], qc);
     if (l.f < best.f) {
       best = l;
       const double b = std::sqrt(l.f) - slack;

@@ -26,7 +26,7 @@ BSplineSurface exact_form(const Surface& s) {
   return b;
 }
 
-struct Local {
+struct SurfaceLocal {
   double u, v, f;  // f = |S(u, v) − q|²
 };
 
@@ -60,7 +60,7 @@ std::array<double, 2> bilinear_seed(const H4* net, int nu, int nv, const Vec3& q
 // f = |S − q|², bounded to the region. Where the Hessian of f is not positive
 // definite, Gauss–Newton's JᵀJ (with a trace-relative shift where that too is
 // singular, as at a pole); a step that does not lower f is halved.
-Local descend(const SurfaceSearch& S, const Piece& pc, const Region& rg, double u, double v, const Vec3& q) {
+SurfaceLocal descend(const SurfaceSearch& S, const Piece& pc, const Region& rg, double u, double v, const Vec3& q) {
   const Spline& s = S.spline;
   const double u0 = rg.u0, u1 = rg.u1, v0 = rg.v0, v1 = rg.v1;
   SurfaceDerivatives d = S.at(pc, u, v);
@@ -254,9 +254,9 @@ void SurfaceSearch::search_bent(const Piece& pc, const Vec3& q, const double& bo
 SurfacePoint SurfaceSearch::closest(const Vec3& q) const {
   const Vec3 qc = spline.local(q);
   double bound2 = std::numeric_limits<double>::infinity();
-  Local best{0, 0, std::numeric_limits<double>::infinity()};
+  SurfaceLocal best{0, 0, std::numeric_limits<double>::infinity()};
   const double slack = prune_slack * spline.diagonal;
-  const auto keep = [&](const Local& l) {
+  const auto keep = [&](const SurfaceLocal& l) {
     if (!(l.f < best.f)) return;
     best = l;
     const double b = std::sqrt(l.f) - slack;
@@ -274,7 +274,7 @@ SurfacePoint SurfaceSearch::closest(const Vec3& q) const {
     }
     const H4* net = &nets.h[pc.net];
     const auto [a, b] = bilinear_seed(net, nets.n[0], nets.n[1], qc);
-    const Local l = descend(*this, pc, whole, pc.lo[0] + a * (pc.hi[0] - pc.lo[0]), pc.lo[1] + b * (pc.hi[1] - pc.lo[1]), qc);
+    const SurfaceLocal l = descend(*this, pc, whole, pc.lo[0] + a * (pc.hi[0] - pc.lo[0]), pc.lo[1] + b * (pc.hi[1] - pc.lo[1]), qc);
     keep(l);
     if (may_bend(pc.tight, pc.convex, qc, std::sqrt(l.f))) search_bent(pc, qc, bound2, keep);
   });

@@ -13,12 +13,12 @@
 namespace interpatch {
 
 using detail::fail;
-using H = std::array<double, 4>;  // homogeneous point (w x, w y, w z, w)
+using Homogeneous = std::array<double, 4>;  // homogeneous point (w x, w y, w z, w)
 
 namespace {
 
-std::vector<H> homogeneous(const std::vector<Vec3>& cp, const std::vector<double>& w) {
-  std::vector<H> h(cp.size());
+std::vector<Homogeneous> homogeneous(const std::vector<Vec3>& cp, const std::vector<double>& w) {
+  std::vector<Homogeneous> h(cp.size());
   for (std::size_t i = 0; i < cp.size(); ++i) {
     const double wi = w.empty() ? 1.0 : w[i];
     h[i] = {cp[i].x * wi, cp[i].y * wi, cp[i].z * wi, wi};
@@ -26,7 +26,7 @@ std::vector<H> homogeneous(const std::vector<Vec3>& cp, const std::vector<double
   return h;
 }
 
-BSplineCurve from_homogeneous(KnotVector k, const std::vector<H>& h, bool rational) {
+BSplineCurve from_homogeneous(KnotVector k, const std::vector<Homogeneous>& h, bool rational) {
   std::vector<Vec3> cp(h.size());
   std::vector<double> w;
   if (rational) w.resize(h.size());
@@ -40,7 +40,7 @@ BSplineCurve from_homogeneous(KnotVector k, const std::vector<H>& h, bool ration
 
 // q ← α q + (1 − α) q1, coordinate by coordinate.
 void mix(Vec3& q, const Vec3& q1, double alpha) { q = alpha * q + (1.0 - alpha) * q1; }
-void mix(H& q, const H& q1, double alpha) {
+void mix(Homogeneous& q, const Homogeneous& q1, double alpha) {
   for (std::size_t c = 0; c < 4; ++c) q[c] = alpha * q[c] + (1.0 - alpha) * q1[c];
 }
 
@@ -90,12 +90,12 @@ Refined<T> refine(const KnotVector& knots, const std::vector<T>& P, const std::v
 }
 
 // The homogeneous point of a curve at t (inside its domain, or wrapped).
-H homogeneous_at(const KnotVector& k, const std::vector<Vec3>& cp, const std::vector<double>& w, double t) {
+Homogeneous homogeneous_at(const KnotVector& k, const std::vector<Vec3>& cp, const std::vector<double>& w, double t) {
   t = k.wrap(t);
   const int p = k.degree(), span = k.find_span(t);
   double N[max_degree + 1];
   k.basis(span, t, N);
-  H h{0, 0, 0, 0};
+  Homogeneous h{0, 0, 0, 0};
   for (int j = 0; j <= p; ++j) {
     const auto idx = static_cast<std::size_t>(k.wrap_index(span - p + j));
     const double c = N[j] * (w.empty() ? 1.0 : w[idx]);
@@ -113,7 +113,7 @@ H homogeneous_at(const KnotVector& k, const std::vector<Vec3>& cp, const std::ve
 // (or cyclic banded) solve.
 BSplineCurve in_space(KnotVector target, const KnotVector& k, const std::vector<Vec3>& cp, const std::vector<double>& w) {
   const auto g = target.greville();
-  std::vector<H> rhs(g.size());
+  std::vector<Homogeneous> rhs(g.size());
   for (std::size_t i = 0; i < g.size(); ++i) rhs[i] = homogeneous_at(k, cp, w, g[i]);
   if (target.periodic()) detail::factor_periodic_collocation(target, g).solve(rhs.data()->data(), 4, 4);
   else detail::factor_collocation(target, g).solve(rhs.data()->data(), 4, 4);
@@ -231,10 +231,10 @@ BSplineCurve BSplineCurve::inserted(double t, int times) const {
   const int k = knots_.find_span(t);
   const int np = knots_.count() - 1;
   const auto P = homogeneous(cp_, w_);
-  std::vector<H> Q(P.size() + static_cast<std::size_t>(times));
+  std::vector<Homogeneous> Q(P.size() + static_cast<std::size_t>(times));
   for (int i = 0; i <= k - p; ++i) Q[static_cast<std::size_t>(i)] = P[static_cast<std::size_t>(i)];
   for (int i = k - s; i <= np; ++i) Q[static_cast<std::size_t>(i + times)] = P[static_cast<std::size_t>(i)];
-  std::vector<H> R(static_cast<std::size_t>(p - s + 1));
+  std::vector<Homogeneous> R(static_cast<std::size_t>(p - s + 1));
   for (int i = 0; i <= p - s; ++i) R[static_cast<std::size_t>(i)] = P[static_cast<std::size_t>(k - p + i)];
   int L = 0;
   for (int j = 1; j <= times; ++j) {

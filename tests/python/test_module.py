@@ -497,9 +497,18 @@ def test_approximate_scattered_points(tmp_path):
     with pytest.raises(interpatch.Error) as e:
         interpatch.approximate_surface(pts, params=np.ones((3000, 3)), control_points=(9, 8))
     assert e.value.code == "size_mismatch"
-    with pytest.raises(interpatch.Error) as e:
-        interpatch.approximate_surface(pts, param="xy", smoothing="auto")
-    assert e.value.code == "wrong_type" and "/smoothing" in str(e.value)
+    # smoothing="auto": λ by cross-validation; with noise of σ = 0.5 added, the fit is
+    # closer to the noise-free field between the points than the noise itself.
+    noisy = pts.copy()
+    noisy[:, 2] += rng.normal(0, 0.5, len(pts))
+    a = interpatch.approximate_surface(noisy, param="xy", smoothing="auto")
+    q = a.info()["parameters"]
+    assert q["smoothing"] == "auto" and q["lambda"] > 0
+    (x0, x1), (y0, y1) = q["domain"]
+    new = rng.uniform((x0, y0), (x1, y1), (500, 2))
+    z = np.array([a.point((x - x0) / (x1 - x0), (y - y0) / (y1 - y0))[2] for x, y in new])
+    truth = 20 * np.sin(new[:, 0] / 60) * np.cos(new[:, 1] / 50)
+    assert np.sqrt(np.mean((z - truth) ** 2)) < 0.25
     with pytest.raises(interpatch.Error) as e:
         interpatch.approximate_surface(pts[:, [0, 0, 2]], param="xy", tolerance=0.1)  # x = y: one line
     assert e.value.code == "singular"

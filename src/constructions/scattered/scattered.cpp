@@ -1,6 +1,6 @@
 // approximate_scattered: the sites (scattered_sites.hpp), the values centred and
-// scaled, a cascade of nets solved coarse to fine (scattered_system.hpp), and the
-// checks every result passes on the finished spline.
+// scaled, the net's normal equations (scattered_system.hpp) solved with multigrid
+// (scattered_multigrid.hpp), and the checks every result passes on the finished spline.
 
 #include <algorithm>
 #include <cmath>
@@ -12,122 +12,13 @@
 #include "base/text.hpp"
 #include "constructions/approximate/approx_check.hpp"
 #include "constructions/approximate/approx_rows.hpp"
-#include "constructions/scattered/scattered_sites.hpp"
-#include "constructions/scattered/scattered_system.hpp"
+#include "constructions/scattered/scattered_fit.hpp"
 #include "interpatch/approximate.hpp"
 #include "interpatch/memory.hpp"
 
 namespace interpatch::detail::scattered {
 
 namespace {
-
-// The largest net solved by a sparse factorization (about 8 s at 200 x 200, its time
-// growing as n^1.5): below it conjugate gradients are no faster where the points are
-// dense, and far slower across voids, where the fairness term alone holds the net.
-constexpr std::size_t direct_limit = 40000;
-
-// The fit in its own frame: unit sites, values centred on the points' mean and scaled
-// into a power of two near their size (sums of squares neither overflow nor vanish).
-struct Problem {
-  int p = 3, q = 3, cols = 3;
-  std::vector<std::array<double, 2>> unit;
-  std::vector<double> value;  // cols per point
-  const Sites* sites = nullptr;
-  Vec3 centre{};
-  double unit_length = 1;
-  double aspect = 1;  // the domain's extent along u over its extent along v
-  // The domain in the fit's frame: [0, range[0]] × [0, range[1]], the longer side 1, so
-  // that J weighs both directions alike (the thin-plate energy of the domain itself).
-  std::array<double, 2> range{1, 1};
-};
-
-Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool xy) {
-  Problem pr;
-  pr.p = p, pr.q = q, pr.cols = xy ? 1 : 3, pr.sites = &s;
-  for (std::size_t k = 0; k < points.size(); ++k)
-    if (s.weight[k] > 0) pr.centre = pr.centre + points[k];
-  pr.centre = pr.centre * (1.0 / static_cast<double>(s.present));
-  double top = 0;
-  for (std::size_t k = 0; k < points.size(); ++k)
-    if (s.weight[k] > 0) top = std::max(top, max_abs(points[k] - pr.centre));
-  pr.unit_length = approximation_unit(top);
-  const double inv = 1 / pr.unit_length;
-  const auto [u0, u1] = s.domain[0];
-  const auto [v0, v1] = s.domain[1];
-  pr.aspect = (u1 - u0) / (v1 - v0);
-  const double side = std::max(u1 - u0, v1 - v0);
-  pr.range = {(u1 - u0) / side, (v1 - v0) / side};
-  pr.unit.assign(points.size(), {0, 0});
-  pr.value.assign(points.size() * static_cast<std::size_t>(pr.cols), 0.0);
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    if (!(s.weight[k] > 0)) continue;
-    pr.unit[k] = {std::clamp((s.uv[k][0] - u0) / side, 0.0, pr.range[0]), std::clamp((s.uv[k][1] - v0) / side, 0.0, pr.range[1])};
-    const Vec3 d = (points[k] - pr.centre) * inv;
-    if (xy) pr.value[k] = d.z;
-    else pr.value[3 * k] = d.x, pr.value[3 * k + 1] = d.y, pr.value[3 * k + 2] = d.z;
-  }
-  return pr;
-}
-
-// A net's values (cols per control point) as a surface over the net's domain (one
-// column: in z).
-BSplineSurface unit_surface(const Net& net, std::span<const double> x, int cols) {
-  PointGrid cp({static_cast<std::size_t>(net.nu), static_cast<std::size_t>(net.nv)});
-  for (std::size_t r = 0; r < net.size(); ++r)
-    cp.values()[r] = cols == 1 ? Vec3{0, 0, x[r]} : Vec3{x[3 * r], x[3 * r + 1], x[3 * r + 2]};
-  return BSplineSurface(net.ku, net.kv, std::move(cp));
-}
-
-struct Level {
-  std::vector<double> x;
-  double lambda = 0;  // in E's units: the weight of J against the mean squared distance
-};
-
-// One net solved: the normal equations assembled, λ (at least the small one that fills
-// voids), and conjugate gradients from the coarser fit's values at this net's Greville
-// abscissae (zero for the first).
-Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoothing, const BSplineSurface* coarser) {
-  require_memory(net.size(), sizeof(double) * static_cast<std::size_t>(std::max(net.p, 2) * (2 * std::max(net.q, 2) + 1) + 8 + 5 * pr.cols),
-                 cat("scattered approximation's net of ", net.nu, " x ", net.nv, " control points"));
-  const Sites& s = *pr.sites;
-  System sys{NetMatrix(net.nu, net.nv, std::max(net.p, 2), std::max(net.q, 2)), std::vector<double>(net.size() * static_cast<std::size_t>(pr.cols), 0.0),
-             pr.cols};
-  add_data_term(net, Samples{pr.unit, s.weight, pr.value, pr.cols}, sys);
-  std::vector<double> fair_diagonal(net.size(), 0.0);
-  add_fairness(net, nullptr, 0, &fair_diagonal);
-  const double fair_mean = std::accumulate(fair_diagonal.begin(), fair_diagonal.end(), 0.0) / static_cast<double>(net.size());
-  const double fill = 1e-5 * (mean_diagonal(sys.a) / s.weight_sum) / fair_mean;
-  Level out;
-  out.lambda = std::max(fill, smoothing.value_or(0.0));
-  add_fairness(net, &sys.a, s.weight_sum * out.lambda);
-
-  // Nets up to direct_limit control points are factored: exact whatever λ and the
-  // points' spacing. Larger ones take conjugate gradients to a residual of 1e-12 of the
-  // right-hand side, the fit to about twelve digits of the data's size; their λ is the
-  // small one of tolerance and control_points (smoothing's nets stay below the limit).
-  out.x.assign(sys.rhs.size(), 0.0);
-  if (net.size() <= direct_limit) {
-    if (!solve_direct(sys.a, sys.rhs, out.x, pr.cols))
-      fail(errc::singular, "scattered approximation with ", net.nu, " x ", net.nv, " control points: the normal ",
-           "equations are not positive definite (points all on one line of the parameter plane)");
-    return out;
-  }
-  if (coarser) {
-    const std::vector<double> gu = net.ku.greville(), gv = net.kv.greville();
-    std::vector<Vec3> at(net.size());
-    coarser->evaluate_into(gu, gv, at);
-    for (std::size_t r = 0; r < net.size(); ++r) {
-      if (pr.cols == 1) out.x[r] = at[r].z;
-      else out.x[3 * r] = at[r].x, out.x[3 * r + 1] = at[r].y, out.x[3 * r + 2] = at[r].z;
-    }
-  }
-  const int cap = 200 + 40 * (net.nu + net.nv);
-  const Solved sol = solve_cg(sys.a, sys.rhs, out.x, pr.cols, 1e-12, cap);
-  if (!(sol.residual <= 1e-9))
-    fail(errc::ill_conditioned, "scattered approximation with ", net.nu, " x ", net.nv, " control points: conjugate gradients ",
-         "left a residual of ", sol.residual, " of the data after ", sol.iterations, " steps");
-  return out;
-}
 
 // Largest distance from the points present to a surface at their sites, and where,
 // the threads in blocks whose results are merged in order (the lowest index wins a tie).
@@ -159,17 +50,13 @@ std::array<int, 2> spans_for(double aspect, double cells) {
   return {round(std::sqrt(cells * aspect)), round(std::sqrt(cells / aspect))};
 }
 
-// The nets a fit of `spans` solves in turn: halved until a net is small enough to be
-// factored, each larger one then started from the one before.
-std::vector<std::array<int, 2>> cascade(std::array<int, 2> spans, int p, int q) {
-  std::vector<std::array<int, 2>> out{spans};
-  const auto size = [&](const std::array<int, 2>& s) { return static_cast<std::size_t>(s[0] + p) * static_cast<std::size_t>(s[1] + q); };
-  while (size(spans) > direct_limit) {
-    spans = {(spans[0] + 1) / 2, (spans[1] + 1) / 2};
-    out.push_back(spans);
-  }
-  std::reverse(out.begin(), out.end());
-  return out;
+// A smoothing fit's net: about one control point per point present, so that λ alone
+// sets how closely the surface follows the data, at most 1024 a direction.
+std::array<int, 2> smoothing_spans(const Problem& pr, const Sites& s) {
+  auto sp = spans_for(pr.aspect, static_cast<double>(s.present));
+  sp[0] = std::min(sp[0], smoothing_max_scattered - pr.p);
+  sp[1] = std::min(sp[1], smoothing_max_scattered - pr.q);
+  return sp;
 }
 
 struct Fitted {
@@ -178,17 +65,21 @@ struct Fitted {
   int fits = 0;
 };
 
-Fitted solve_cascade(const Problem& pr, std::array<int, 2> spans, std::optional<double> smoothing, const progress_callback& progress) {
-  const auto nets = cascade(spans, pr.p, pr.q);
-  std::optional<BSplineSurface> coarser;
-  Fitted f{Net(pr.p, pr.q, pr.p + 1, pr.q + 1, pr.range), {}, 0};
-  for (std::size_t l = 0; l < nets.size(); ++l) {
-    f.net = Net(pr.p, pr.q, nets[l][0] + pr.p, nets[l][1] + pr.q, pr.range);
-    f.level = solve_level(pr, f.net, smoothing, coarser ? &*coarser : nullptr);
-    ++f.fits;
-    if (progress) progress(static_cast<double>(l + 1) / static_cast<double>(nets.size() + 1));
-    if (l + 1 < nets.size()) coarser = unit_surface(f.net, f.level.x, pr.cols);
-  }
+Fitted solve_once(const Problem& pr, std::array<int, 2> spans, std::optional<double> smoothing, const progress_callback& progress,
+                  std::vector<double> start = {}) {
+  Fitted f{Net(pr.p, pr.q, spans[0] + pr.p, spans[1] + pr.q, pr.range), {}, 1};
+  f.level = solve_level(pr, f.net, smoothing, nullptr, std::move(start));
+  if (progress) progress(0.9);
+  return f;
+}
+
+// A smoothing fit, λ given or chosen by cross-validation.
+Fitted solve_smoothing(const Problem& pr, const ScatteredApproximationOptions& o) {
+  const auto spans = smoothing_spans(pr, *pr.sites);
+  if (!o.auto_smoothing) return solve_once(pr, spans, o.smoothing, o.progress);
+  Chosen c = choose_lambda(pr, Net(pr.p, pr.q, spans[0] + pr.p, spans[1] + pr.q, pr.range), o.progress, 0.0, 0.85);
+  Fitted f = solve_once(pr, spans, c.lambda, o.progress, std::move(c.x));
+  f.fits = 1;
   return f;
 }
 
@@ -252,9 +143,10 @@ namespace interpatch {
 ScatteredApproximation approximate_scattered(std::span<const Vec3> points, const ScatteredApproximationOptions& o) {
   using namespace detail::scattered;
   using detail::fail;
-  const int ways = (o.control_points ? 1 : 0) + (o.tolerance ? 1 : 0) + (o.smoothing ? 1 : 0);
+  const int ways = (o.control_points ? 1 : 0) + (o.tolerance ? 1 : 0) + (o.smoothing ? 1 : 0) + (o.auto_smoothing ? 1 : 0);
   if (ways != 1)
-    fail(errc::wrong_type, "scattered approximation takes exactly one of control_points, tolerance and smoothing, got ", ways);
+    fail(errc::wrong_type, "scattered approximation takes exactly one of control_points, tolerance, smoothing and ",
+         "automatic smoothing, got ", ways);
   if (o.tolerance && !(*o.tolerance > 0 && std::isfinite(*o.tolerance)))
     fail(errc::wrong_type, "tolerance ", *o.tolerance, " is not a positive distance");
   if (o.smoothing && !(*o.smoothing >= 0 && std::isfinite(*o.smoothing)))
@@ -278,13 +170,8 @@ ScatteredApproximation approximate_scattered(std::span<const Vec3> points, const
   const Problem pr = frame(points, s, deg[0], deg[1], xy);
   Fitted f = o.tolerance ? solve_tolerance(pr, *o.tolerance, o, o.progress)
              : o.control_points
-                 ? solve_cascade(pr, {(*o.control_points)[0] - deg[0], (*o.control_points)[1] - deg[1]}, std::nullopt, o.progress)
-                 : solve_cascade(pr, [&] {
-                     auto sp = spans_for(pr.aspect, static_cast<double>(s.present));
-                     sp[0] = std::min(sp[0], smoothing_max_control_points - deg[0]);
-                     sp[1] = std::min(sp[1], smoothing_max_control_points - deg[1]);
-                     return sp;
-                   }(), o.smoothing, o.progress);
+                 ? solve_once(pr, {(*o.control_points)[0] - deg[0], (*o.control_points)[1] - deg[1]}, std::nullopt, o.progress)
+                 : solve_smoothing(pr, o);
 
   // The surface in the data's own frame, over the domain.
   const auto [u0, u1] = s.domain[0];

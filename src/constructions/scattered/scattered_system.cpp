@@ -29,6 +29,76 @@ void NetMatrix::add_outer(std::span<const std::array<int, 2>> at, std::span<cons
     }
 }
 
+void NetMatrix::mirror() {
+  const int fw = (2 * hu_ + 1) * (2 * hv_ + 1);
+  full_.assign(rows() * static_cast<std::size_t>(fw), 0.0);
+  const std::size_t nv = static_cast<std::size_t>(nv_);
+  for (int i = 0; i < nu_; ++i)
+    for (int j = 0; j < nv_; ++j) {
+      const std::size_t r = static_cast<std::size_t>(i) * nv + static_cast<std::size_t>(j);
+      double* row = &full_[r * static_cast<std::size_t>(fw)];
+      for (int di = -hu_; di <= hu_; ++di)
+        for (int dj = -hv_; dj <= hv_; ++dj) {
+          if (i + di < 0 || i + di >= nu_ || j + dj < 0 || j + dj >= nv_) continue;
+          const bool upper = di > 0 || (di == 0 && dj >= 0);
+          const std::size_t o = upper ? r : r - static_cast<std::size_t>(-di) * nv - static_cast<std::size_t>(-dj);
+          row[(di + hu_) * (2 * hv_ + 1) + dj + hv_] = a_[o * static_cast<std::size_t>(width_) +
+                                                           static_cast<std::size_t>(upper ? offset(di, dj) : offset(-di, -dj))];
+        }
+    }
+  mirrored_ = true;
+}
+
+namespace {
+
+template <int HU, int HV, int C>
+void full_row(const double* row, const double* xs, std::size_t nv, double* acc) {
+  constexpr int w = 2 * HV + 1;
+  double sum[C] = {};
+  for (int di = 0; di <= 2 * HU; ++di, row += w, xs += nv * C)
+    for (int k = 0; k < w; ++k)
+      for (int m = 0; m < C; ++m) sum[m] += row[k] * xs[k * C + m];
+  for (int m = 0; m < C; ++m) acc[m] = sum[m];
+}
+
+}  // namespace
+
+void NetMatrix::row_product(int i, int j, std::span<const double> x, std::size_t c, double* acc) const {
+  const std::size_t nv = static_cast<std::size_t>(nv_);
+  const std::size_t r = static_cast<std::size_t>(i) * nv + static_cast<std::size_t>(j);
+  for (std::size_t k = 0; k < c; ++k) acc[k] = 0;
+  if (mirrored_ && i >= hu_ && i + hu_ < nu_ && j >= hv_ && j + hv_ < nv_) {
+    // Inside the net: the whole row, one contiguous stretch of x per di; the cubic
+    // nets' shape known at compile time.
+    const std::size_t w = static_cast<std::size_t>(2 * hv_ + 1);
+    const double* row = &full_[r * w * static_cast<std::size_t>(2 * hu_ + 1)];
+    const double* xs = &x[(r - static_cast<std::size_t>(hu_) * nv - static_cast<std::size_t>(hv_)) * c];
+    if (hu_ == 3 && hv_ == 3 && c == 1) return full_row<3, 3, 1>(row, xs, nv, acc);
+    if (hu_ == 3 && hv_ == 3 && c == 3) return full_row<3, 3, 3>(row, xs, nv, acc);
+    for (int di = -hu_; di <= hu_; ++di, row += w, xs += nv * c)
+      for (std::size_t k = 0; k < w; ++k)
+        for (std::size_t m = 0; m < c; ++m) acc[m] += row[k] * xs[k * c + m];
+    return;
+  }
+  for (int di = 0; di <= hu_; ++di) {
+    // The upper half of row r, and row r's entries kept by the rows above it.
+    const int jlo = std::max(di == 0 ? 0 : -hv_, -j), jhi = std::min(hv_, nv_ - 1 - j);
+    if (i + di < nu_)
+      for (int dj = jlo; dj <= jhi; ++dj) {
+        const double a = at(r, offset(di, dj));
+        const std::size_t s = (r + static_cast<std::size_t>(di) * nv + static_cast<std::size_t>(dj)) * c;
+        for (std::size_t k = 0; k < c; ++k) acc[k] += a * x[s + k];
+      }
+    if (i - di < 0) continue;
+    const int klo = std::max(di == 0 ? 1 : -hv_, j - (nv_ - 1)), khi = std::min(hv_, j);
+    for (int dj = klo; dj <= khi; ++dj) {
+      const std::size_t o = r - static_cast<std::size_t>(di) * nv - static_cast<std::size_t>(dj);
+      const double a = at(o, offset(di, dj));
+      for (std::size_t k = 0; k < c; ++k) acc[k] += a * x[o * c + k];
+    }
+  }
+}
+
 void NetMatrix::multiply(std::span<const double> x, std::span<double> y, int cols) const {
   const std::size_t c = static_cast<std::size_t>(cols), nv = static_cast<std::size_t>(nv_);
   const bool parallel = rows() * static_cast<std::size_t>(2 * width_) * c >= parallel_min_work;
@@ -36,29 +106,42 @@ void NetMatrix::multiply(std::span<const double> x, std::span<double> y, int col
   for (int i = 0; i < nu_; ++i)
     for (int j = 0; j < nv_; ++j) {
       const std::size_t r = static_cast<std::size_t>(i) * nv + static_cast<std::size_t>(j);
-      double acc[3] = {0, 0, 0};
-      for (int di = 0; di <= hu_; ++di) {
-        // The upper half of row r, and row r's entries kept by the rows above it.
-        const int jlo = std::max(di == 0 ? 0 : -hv_, -j), jhi = std::min(hv_, nv_ - 1 - j);
-        if (i + di < nu_)
-          for (int dj = jlo; dj <= jhi; ++dj) {
-            const double a = at(r, offset(di, dj));
-            const std::size_t s = (r + static_cast<std::size_t>(di) * nv + static_cast<std::size_t>(dj)) * c;
-            for (std::size_t k = 0; k < c; ++k) acc[k] += a * x[s + k];
-          }
-        if (i - di < 0) continue;
-        const int klo = std::max(di == 0 ? 1 : -hv_, j - (nv_ - 1)), khi = std::min(hv_, j);
-        for (int dj = klo; dj <= khi; ++dj) {
-          const std::size_t o = r - static_cast<std::size_t>(di) * nv - static_cast<std::size_t>(dj);
-          const double a = at(o, offset(di, dj));
-          for (std::size_t k = 0; k < c; ++k) acc[k] += a * x[o * c + k];
-        }
-      }
+      double acc[3];
+      row_product(i, j, x, c, acc);
       for (std::size_t k = 0; k < c; ++k) y[r * c + k] = acc[k];
     }
 }
 
+void NetMatrix::gauss_seidel(std::span<const double> b, std::span<double> x, int cols, bool backward) const {
+  const std::size_t c = static_cast<std::size_t>(cols), nv = static_cast<std::size_t>(nv_);
+  const int su = hu_ + 1, sv = hv_ + 1, colours = su * sv;
+  // Each colour is a parallel region of its own: worth it only for a colour's work.
+  const bool parallel = rows() / static_cast<std::size_t>(colours) * static_cast<std::size_t>(2 * width_) * c >= parallel_min_work;
+  for (int n = 0; n < colours; ++n) {
+    const int colour = backward ? colours - 1 - n : n, ci = colour / sv, cj = colour % sv;
+    const int lines = nu_ > ci ? (nu_ - ci + su - 1) / su : 0;
+#pragma omp parallel for schedule(static) if (parallel)
+    for (int l = 0; l < lines; ++l) {
+      const int i = ci + l * su;
+      for (int j = cj; j < nv_; j += sv) {
+        const std::size_t r = static_cast<std::size_t>(i) * nv + static_cast<std::size_t>(j);
+        const double d = at(r, 0);
+        if (!(d > 0)) continue;
+        double acc[3];
+        row_product(i, j, x, c, acc);
+        for (std::size_t k = 0; k < c; ++k) x[r * c + k] += (b[r * c + k] - acc[k]) / d;
+      }
+    }
+  }
+}
+
+void NetMatrix::assign_sum(const NetMatrix& d, const NetMatrix& f, double s) {
+  mirrored_ = false;
+  for (std::size_t k = 0; k < a_.size(); ++k) a_[k] = d.a_[k] + s * f.a_[k];
+}
+
 void NetMatrix::scale(double s) {
+  mirrored_ = false;
   for (double& v : a_) v *= s;
 }
 
@@ -251,13 +334,19 @@ void dots(std::span<const double> x, std::span<const double> y, int cols, double
 
 }  // namespace
 
-Solved solve_cg(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols, double rel, int max_iter) {
+Solved solve_cg(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols, double rel, int max_iter,
+                const Preconditioner& precondition) {
   const std::size_t c = static_cast<std::size_t>(cols), n = a.rows(), len = n * c;
   std::vector<double> inv(n), r(len), z(len), p(len), ap(len), partial;
   for (std::size_t i = 0; i < n; ++i) inv[i] = a.at(i, 0) > 0 ? 1 / a.at(i, 0) : 1.0;
+  const auto apply = [&] {
+    if (precondition) precondition(r, z, cols);
+    else
+      for (std::size_t i = 0; i < len; ++i) z[i] = r[i] * inv[i / c];
+  };
   a.multiply(x, ap, cols);
   for (std::size_t i = 0; i < len; ++i) r[i] = b[i] - ap[i];
-  for (std::size_t i = 0; i < len; ++i) z[i] = r[i] * inv[i / c];
+  apply();
   p = z;
   double bb[3], rz[3], rr[3], pap[3];
   dots(b, b, cols, bb, partial);
@@ -283,8 +372,8 @@ Solved solve_cg(const NetMatrix& a, std::span<const double> b, std::span<double>
     for (std::size_t i = 0; i < len; ++i) {
       x[i] += alpha[i % c] * p[i];
       r[i] -= alpha[i % c] * ap[i];
-      z[i] = r[i] * inv[i / c];
     }
+    apply();
     double rz_new[3];
     dots(r, z, cols, rz_new, partial);
     for (std::size_t k = 0; k < c; ++k) {
@@ -297,7 +386,13 @@ Solved solve_cg(const NetMatrix& a, std::span<const double> b, std::span<double>
   return out;
 }
 
-bool solve_direct(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols) {
+struct DirectSolver::Factor {
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Upper> ldlt;
+  Eigen::Index n = 0;
+  bool ok = false;
+};
+
+DirectSolver::DirectSolver(const NetMatrix& a) : f_(std::make_unique<Factor>()) {
   const auto n = static_cast<Eigen::Index>(a.rows());
   std::vector<Eigen::Triplet<double>> entries;
   entries.reserve(a.rows() * static_cast<std::size_t>(2 * a.hu() * a.hv() + a.hu() + a.hv() + 1));
@@ -314,14 +409,31 @@ bool solve_direct(const NetMatrix& a, std::span<const double> b, std::span<doubl
     }
   Eigen::SparseMatrix<double> m(n, n);
   m.setFromTriplets(entries.begin(), entries.end());
-  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Upper> ldlt(m);
-  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) return false;
-  Eigen::VectorXd rhs(n);
-  for (int c = 0; c < cols; ++c) {
-    for (Eigen::Index r = 0; r < n; ++r) rhs[r] = b[static_cast<std::size_t>(r) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)];
-    const Eigen::VectorXd sol = ldlt.solve(rhs);
-    for (Eigen::Index r = 0; r < n; ++r) x[static_cast<std::size_t>(r) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)] = sol[r];
+  f_->n = n;
+  f_->ldlt.compute(m);
+  f_->ok = f_->ldlt.info() == Eigen::Success && f_->ldlt.vectorD().minCoeff() > 0;
+}
+
+DirectSolver::~DirectSolver() = default;
+DirectSolver::DirectSolver(DirectSolver&&) noexcept = default;
+DirectSolver& DirectSolver::operator=(DirectSolver&&) noexcept = default;
+
+bool DirectSolver::ok() const { return f_->ok; }
+
+void DirectSolver::solve(std::span<const double> b, std::span<double> x, int cols) const {
+  const std::size_t c = static_cast<std::size_t>(cols);
+  Eigen::VectorXd rhs(f_->n);
+  for (std::size_t k = 0; k < c; ++k) {
+    for (Eigen::Index r = 0; r < f_->n; ++r) rhs[r] = b[static_cast<std::size_t>(r) * c + k];
+    const Eigen::VectorXd sol = f_->ldlt.solve(rhs);
+    for (Eigen::Index r = 0; r < f_->n; ++r) x[static_cast<std::size_t>(r) * c + k] = sol[r];
   }
+}
+
+bool solve_direct(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols) {
+  const DirectSolver d(a);
+  if (!d.ok()) return false;
+  d.solve(b, x, cols);
   return true;
 }
 

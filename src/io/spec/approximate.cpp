@@ -18,6 +18,20 @@ namespace interpatch::io::reader {
 
 namespace {
 
+// "smoothing": the fairness weight λ ≥ 0, or "auto" to have it chosen.
+template <class Options>
+void read_smoothing(const json& way, const std::string& at_way, Options& o) {
+  if (way.is_string()) {
+    if (way.get<std::string>() != "auto")
+      fail(errc::wrong_type, place(at_way), ": expected a number or \"auto\", got \"", interpatch::detail::excerpt(way.get<std::string>()), "\"");
+    o.auto_smoothing = true;
+    return;
+  }
+  const double l = number(way, at_way);
+  if (!(l >= 0)) fail(errc::wrong_type, place(at_way), ": smoothing ", l, " is negative");
+  o.smoothing = l;
+}
+
 // Which of "control_points", "tolerance" and "smoothing" the approximation at `ptr`
 // gives: exactly one.
 std::string approximation_way(const json& obj, std::string_view ptr) {
@@ -77,14 +91,8 @@ ApproximationOptions<D> read_options(const json& obj, std::string_view ptr, cons
     o.control_points = c;
   } else if (given == "tolerance") {
     o.tolerance = positive_tolerance(way, at_way);
-  } else if (way.is_string()) {
-    if (way.get<std::string>() != "auto")
-      fail(errc::wrong_type, place(at_way), ": expected a number or \"auto\", got \"", interpatch::detail::excerpt(way.get<std::string>()), "\"");
-    o.auto_smoothing = true;
   } else {
-    const double l = number(way, at_way);
-    if (!(l >= 0)) fail(errc::wrong_type, place(at_way), ": smoothing ", l, " is negative");
-    o.smoothing = l;
+    read_smoothing(way, at_way, o);
   }
 
   if (const json* w = find_member(obj, "weights")) {
@@ -251,13 +259,8 @@ ScatteredApproximationOptions scattered_options(const json& spec, const PointSto
     o.control_points = net_counts(way, at_way, p);
   } else if (given == "tolerance") {
     o.tolerance = positive_tolerance(way, at_way);
-  } else if (way.is_string()) {
-    fail(errc::wrong_type, place(at_way), ": scattered points take a number for smoothing (the fairness weight λ); ",
-         "\"auto\" is for grids");
   } else {
-    const double l = number(way, at_way);
-    if (!(l >= 0)) fail(errc::wrong_type, place(at_way), ": smoothing ", l, " is negative");
-    o.smoothing = l;
+    read_smoothing(way, at_way, o);
   }
   if (const json* m = find_member(spec, "max_control_points")) {
     if (!o.tolerance) fail(errc::wrong_type, "/max_control_points: it limits a tolerance's refinement; give \"tolerance\"");

@@ -1,0 +1,161 @@
+#include "constructions/scattered/scattered_fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "base/text.hpp"
+#include "constructions/approximate/approx_check.hpp"
+#include "constructions/approximate/approx_rows.hpp"
+#include "constructions/scattered/scattered_multigrid.hpp"
+#include "interpatch/memory.hpp"
+
+namespace interpatch::detail::scattered {
+
+namespace {
+
+// The largest net factored when conjugate gradients stall (about 8 s at 200 x 200, the
+// time growing as n^1.5).
+constexpr std::size_t direct_limit = 40000;
+
+[[noreturn]] void not_definite(const Net& net) {
+  fail(errc::singular, "scattered approximation with ", net.nu, " x ", net.nv, " control points: the normal ",
+       "equations are not positive definite (points all on one line of the parameter plane)");
+}
+
+// The nets below `net` for multigrid, their systems (data and fairness at `scaled`,
+// the weight times the points' weight sum) and the cycle over them and `top`.
+struct Hierarchy {
+  std::vector<System> below;
+  std::optional<Multigrid> mg;
+};
+
+Hierarchy hierarchy_for(const Problem& pr, const Net& net, const NetMatrix& top, std::span<const double> weight, double scaled) {
+  Hierarchy h;
+  const auto spans = hierarchy(std::array<int, 2>{net.nu - net.p, net.nv - net.q}, net.p, net.q, coarsest_net);
+  std::vector<Net> nets;
+  for (const auto& sp : spans) nets.emplace_back(net.p, net.q, sp[0] + net.p, sp[1] + net.q, pr.range);
+  h.below.reserve(nets.size() - 1);
+  std::vector<const NetMatrix*> matrices;
+  for (std::size_t l = 0; l + 1 < nets.size(); ++l) {
+    h.below.push_back(data_system(pr, nets[l], weight));
+    add_fairness(nets[l], &h.below.back().a, scaled);
+    h.below.back().a.mirror();
+    matrices.push_back(&h.below.back().a);
+  }
+  matrices.push_back(&top);
+  h.mg.emplace(std::move(nets), std::move(matrices), pr.cols);
+  return h;
+}
+
+}  // namespace
+
+Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool xy) {
+  Problem pr;
+  pr.p = p, pr.q = q, pr.cols = xy ? 1 : 3, pr.sites = &s, pr.points = points;
+  for (std::size_t k = 0; k < points.size(); ++k)
+    if (s.weight[k] > 0) pr.centre = pr.centre + points[k];
+  pr.centre = pr.centre * (1.0 / static_cast<double>(s.present));
+  double top = 0;
+  for (std::size_t k = 0; k < points.size(); ++k)
+    if (s.weight[k] > 0) top = std::max(top, max_abs(points[k] - pr.centre));
+  pr.unit_length = approximation_unit(top);
+  const double inv = 1 / pr.unit_length;
+  const auto [u0, u1] = s.domain[0];
+  const auto [v0, v1] = s.domain[1];
+  pr.aspect = (u1 - u0) / (v1 - v0);
+  const double side = std::max(u1 - u0, v1 - v0);
+  pr.range = {(u1 - u0) / side, (v1 - v0) / side};
+  pr.unit.assign(points.size(), {0, 0});
+  pr.value.assign(points.size() * static_cast<std::size_t>(pr.cols), 0.0);
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if (!(s.weight[k] > 0)) continue;
+    pr.unit[k] = {std::clamp((s.uv[k][0] - u0) / side, 0.0, pr.range[0]), std::clamp((s.uv[k][1] - v0) / side, 0.0, pr.range[1])};
+    const Vec3 d = (points[k] - pr.centre) * inv;
+    if (xy) pr.value[k] = d.z;
+    else pr.value[3 * k] = d.x, pr.value[3 * k + 1] = d.y, pr.value[3 * k + 2] = d.z;
+  }
+  return pr;
+}
+
+// A net's values (cols per control point) as a surface over the net's domain (one
+// column: in z).
+BSplineSurface unit_surface(const Net& net, std::span<const double> x, int cols) {
+  PointGrid cp({static_cast<std::size_t>(net.nu), static_cast<std::size_t>(net.nv)});
+  for (std::size_t r = 0; r < net.size(); ++r)
+    cp.values()[r] = cols == 1 ? Vec3{0, 0, x[r]} : Vec3{x[3 * r], x[3 * r + 1], x[3 * r + 2]};
+  return BSplineSurface(net.ku, net.kv, std::move(cp));
+}
+
+System data_system(const Problem& pr, const Net& net, std::span<const double> weight) {
+  require_memory(net.size(), NetMatrix::bytes_per_row(std::max(net.p, 2), std::max(net.q, 2)) + sizeof(double) * static_cast<std::size_t>(8 + 5 * pr.cols),
+                 cat("scattered approximation's net of ", net.nu, " x ", net.nv, " control points"));
+  System sys{NetMatrix(net.nu, net.nv, std::max(net.p, 2), std::max(net.q, 2)), std::vector<double>(net.size() * static_cast<std::size_t>(pr.cols), 0.0),
+             pr.cols};
+  add_data_term(net, Samples{pr.unit, weight, pr.value, pr.cols}, sys);
+  return sys;
+}
+
+double fill_lambda(const Net& net, const NetMatrix& data, double weight_sum) {
+  std::vector<double> fair_diagonal(net.size(), 0.0);
+  add_fairness(net, nullptr, 0, &fair_diagonal);
+  const double fair_mean = std::accumulate(fair_diagonal.begin(), fair_diagonal.end(), 0.0) / static_cast<double>(net.size());
+  return 1e-5 * (mean_diagonal(data) / weight_sum) / fair_mean;
+}
+
+// Solves one net's system from the x given: factored when small, otherwise conjugate
+// gradients to a residual of 1e-12 of the right-hand side (the fit to about twelve
+// digits of the data's size), preconditioned by a V-cycle; factored after all when
+// they stall on a net the factorization still takes (ties of points far finer than
+// the knots), an error past it.
+void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const double> weight, double scaled, std::vector<double>& x,
+               double rel) {
+  if (net.size() <= coarsest_net) {
+    if (!solve_direct(sys.a, sys.rhs, x, pr.cols)) not_definite(net);
+    return;
+  }
+  sys.a.mirror();
+  Hierarchy h = hierarchy_for(pr, net, sys.a, weight, scaled);
+  if (!h.mg->factor()) not_definite(h.mg->net(0));
+  Multigrid& mg = *h.mg;
+  // A few dozen steps where the fairness weight holds every cell; hundreds where only
+  // the small fill does and cells hold fewer points than control points.
+  const bool factorable = net.size() <= direct_limit;
+  const int cap = factorable ? 300 : 200 + 40 * (net.nu + net.nv);
+  const Solved sol = solve_cg(sys.a, sys.rhs, x, pr.cols, rel, cap,
+                              [&mg](std::span<const double> r, std::span<double> z, int) { mg.apply(r, z); });
+  if (sol.residual <= rel) return;
+  if (factorable) {
+    if (!solve_direct(sys.a, sys.rhs, x, pr.cols)) not_definite(net);
+    return;
+  }
+  if (!(sol.residual <= std::max(1e-9, 1e3 * rel)))
+    fail(errc::ill_conditioned, "scattered approximation with ", net.nu, " x ", net.nv, " control points: conjugate gradients ",
+         "left a residual of ", sol.residual, " of the data after ", sol.iterations, " steps");
+}
+
+// One net solved: the normal equations assembled, λ (at least the small one that fills
+// voids), from the coarser fit's values at this net's Greville abscissae (zero for the
+// first).
+Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoothing, const BSplineSurface* coarser,
+                  std::vector<double> start) {
+  const Sites& s = *pr.sites;
+  System sys = data_system(pr, net, s.weight);
+  Level out;
+  out.lambda = std::max(fill_lambda(net, sys.a, s.weight_sum), smoothing.value_or(0.0));
+  add_fairness(net, &sys.a, s.weight_sum * out.lambda);
+  if (start.size() == sys.rhs.size()) out.x = std::move(start);
+  else out.x.assign(sys.rhs.size(), 0.0);
+  if (coarser && start.empty() && net.size() > coarsest_net) {
+    const std::vector<double> gu = net.ku.greville(), gv = net.kv.greville();
+    std::vector<Vec3> at(net.size());
+    coarser->evaluate_into(gu, gv, at);
+    for (std::size_t r = 0; r < net.size(); ++r) {
+      if (pr.cols == 1) out.x[r] = at[r].z;
+      else out.x[3 * r] = at[r].x, out.x[3 * r + 1] = at[r].y, out.x[3 * r + 2] = at[r].z;
+    }
+  }
+  solve_net(pr, net, sys, s.weight, s.weight_sum * out.lambda, out.x);
+  return out;
+}
+}  // namespace interpatch::detail::scattered

@@ -1,0 +1,80 @@
+#pragma once
+// A scattered fit's problem in its own frame and one net's solve: the normal equations
+// (scattered_system.hpp) with a fairness weight, solved directly or by conjugate
+// gradients with multigrid (scattered_multigrid.hpp).
+
+#include <array>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "constructions/scattered/scattered_sites.hpp"
+#include "constructions/scattered/scattered_system.hpp"
+#include "interpatch/bspline_surface.hpp"
+
+namespace interpatch::detail::scattered {
+
+// The fit in its own frame: unit sites, values centred on the points' mean and scaled
+// into a power of two near their size (sums of squares neither overflow nor vanish).
+struct Problem {
+  int p = 3, q = 3, cols = 3;
+  std::vector<std::array<double, 2>> unit;
+  std::vector<double> value;  // cols per point
+  const Sites* sites = nullptr;
+  std::span<const Vec3> points;  // as given
+  Vec3 centre{};
+  double unit_length = 1;
+  double aspect = 1;  // the domain's extent along u over its extent along v
+  // The domain in the fit's frame: [0, range[0]] × [0, range[1]], the longer side 1, so
+  // that J weighs both directions alike (the thin-plate energy of the domain itself).
+  std::array<double, 2> range{1, 1};
+};
+
+/// Nets up to this many control points are factored (milliseconds); larger ones go by
+/// conjugate gradients preconditioned by multigrid down to a net this size.
+inline constexpr std::size_t coarsest_net = 4096;
+
+/// The problem of `points` at sites `s` (one column, z, when `xy`).
+Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool xy);
+
+/// A net's values (cols per control point) as a surface over the net's domain (one
+/// column: in z).
+BSplineSurface unit_surface(const Net& net, std::span<const double> x, int cols);
+
+struct Level {
+  std::vector<double> x;
+  double lambda = 0;  // in E's units: the weight of J against the mean squared distance
+};
+
+/// The data term of the points of nonzero `weight` on one net.
+System data_system(const Problem& pr, const Net& net, std::span<const double> weight);
+
+/// The small fairness weight that fills voids and makes the system definite: J's
+/// diagonal on average 1e-5 of the data term's, far below any smoothing asked for.
+double fill_lambda(const Net& net, const NetMatrix& data, double weight_sum);
+
+/// Solves one net's system (data term of `weight`, fairness added at `scaled`, λ times
+/// the weight sum) from the x given, to a residual of `rel` of the right-hand side.
+/// Factored when small, otherwise by conjugate gradients preconditioned by a V-cycle
+/// over nets assembled from the same points and weight; factored after all when they
+/// stall on a net the factorization still takes, an error past it.
+void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const double> weight, double scaled, std::vector<double>& x,
+               double rel = 1e-12);
+
+/// One net solved on every point present: λ at least the fill, started from `start`
+/// (the net's values), or the coarser fit's values at this net's Greville abscissae,
+/// or zero.
+Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoothing, const BSplineSurface* coarser,
+                  std::vector<double> start = {});
+
+/// λ chosen by cross-validation and the last fit of the search (of most points).
+struct Chosen {
+  double lambda = 0;
+  std::vector<double> x;
+};
+
+/// λ for `net` chosen by cross-validation (the points in 5 folds by their
+/// coordinates), reported through `progress` from `from` to `to`.
+Chosen choose_lambda(const Problem& pr, const Net& net, const progress_callback& progress, double from, double to);
+
+}  // namespace interpatch::detail::scattered

@@ -1,0 +1,192 @@
+#include "constructions/scattered/scattered_multigrid.hpp"
+
+#include <algorithm>
+#include <utility>
+
+#include "base/parallel.hpp"
+
+namespace interpatch::detail::scattered {
+
+namespace {
+
+// Fine point i of the coarse spline by blossoming: the coarse polynomial piece on the
+// span holding fine knot i, blossomed at the fine knots i + 1 .. i + p (de Boor's
+// recurrence with a new argument at each level), kept as weights of the p + 1 coarse
+// points.
+void blossom_row(const KnotVector& t, const KnotVector& tau, int i, int& first, double* w) {
+  const int p = t.degree();
+  const int mu = t.find_span(tau[static_cast<std::size_t>(i)]);
+  double c[max_degree + 1][max_degree + 1] = {};
+  for (int a = 0; a <= p; ++a) c[a][a] = 1;  // c[a]: coarse point mu - p + a, as weights
+  for (int r = 1; r <= p; ++r) {
+    const double x = tau[static_cast<std::size_t>(i + r)];
+    for (int j = mu; j >= mu - p + r; --j) {
+      const double lo = t[static_cast<std::size_t>(j)], hi = t[static_cast<std::size_t>(j + p + 1 - r)];
+      const double alpha = (x - lo) / (hi - lo);
+      const int a = j - (mu - p);
+      for (int k = 0; k <= p; ++k) c[a][k] = alpha * c[a][k] + (1 - alpha) * c[a - 1][k];
+    }
+  }
+  first = mu - p;
+  for (int k = 0; k <= p; ++k) w[k] = c[p][k];
+}
+
+}  // namespace
+
+Refinement refinement(const KnotVector& coarse, const KnotVector& fine) {
+  Refinement r;
+  r.p = coarse.degree(), r.fine = fine.count(), r.coarse = coarse.count();
+  const std::size_t width = static_cast<std::size_t>(r.p + 1);
+  r.first.assign(static_cast<std::size_t>(r.fine), 0);
+  r.weight.assign(static_cast<std::size_t>(r.fine) * width, 0.0);
+  const int cs = r.coarse - r.p, fs = r.fine - r.p;
+  const std::vector<double> g = fine.greville();
+  for (int i = 0; i < r.fine; ++i) {
+    double* w = &r.weight[static_cast<std::size_t>(i) * width];
+    int& first = r.first[static_cast<std::size_t>(i)];
+    if (r.fine == r.coarse) {
+      first = std::min(i, r.coarse - r.p - 1);
+      w[i - first] = 1;
+    } else if (fs == 2 * cs) {
+      blossom_row(coarse, fine, i, first, w);
+    } else {
+      const int span = coarse.find_span(g[static_cast<std::size_t>(i)]);
+      coarse.basis(span, g[static_cast<std::size_t>(i)], w);
+      first = span - r.p;
+    }
+  }
+  // The transpose, gathered per coarse point in increasing fine order.
+  r.t_start.assign(static_cast<std::size_t>(r.coarse) + 1, 0);
+  for (int i = 0; i < r.fine; ++i)
+    for (std::size_t a = 0; a < width; ++a)
+      if (r.weight[static_cast<std::size_t>(i) * width + a] != 0)
+        ++r.t_start[static_cast<std::size_t>(r.first[static_cast<std::size_t>(i)]) + a + 1];
+  for (std::size_t a = 0; a < static_cast<std::size_t>(r.coarse); ++a) r.t_start[a + 1] += r.t_start[a];
+  r.t_index.resize(r.t_start.back());
+  r.t_weight.resize(r.t_start.back());
+  std::vector<std::size_t> next(r.t_start.begin(), r.t_start.end() - 1);
+  for (int i = 0; i < r.fine; ++i)
+    for (std::size_t a = 0; a < width; ++a) {
+      const double w = r.weight[static_cast<std::size_t>(i) * width + a];
+      if (w == 0) continue;
+      const std::size_t row = static_cast<std::size_t>(r.first[static_cast<std::size_t>(i)]) + a;
+      r.t_index[next[row]] = i;
+      r.t_weight[next[row]++] = w;
+    }
+  return r;
+}
+
+std::vector<std::array<int, 2>> hierarchy(std::array<int, 2> spans, int p, int q, std::size_t coarsest) {
+  std::vector<std::array<int, 2>> out{spans};
+  const auto size = [&](const std::array<int, 2>& s) { return static_cast<std::size_t>(s[0] + p) * static_cast<std::size_t>(s[1] + q); };
+  while (size(spans) > coarsest && (spans[0] > 4 || spans[1] > 4)) {
+    for (int& s : spans)
+      if (s > 4) s = (s + 1) / 2;
+    out.push_back(spans);
+  }
+  std::reverse(out.begin(), out.end());
+  return out;
+}
+
+void prolong(const std::array<Refinement, 2>& r, std::span<const double> coarse, std::span<double> fine, int cols,
+             std::vector<double>& tmp) {
+  const Refinement &ru = r[0], &rv = r[1];
+  const std::size_t c = static_cast<std::size_t>(cols), wu = static_cast<std::size_t>(ru.p + 1), wv = static_cast<std::size_t>(rv.p + 1);
+  const std::size_t cu = static_cast<std::size_t>(ru.coarse), cv = static_cast<std::size_t>(rv.coarse);
+  const std::size_t fu = static_cast<std::size_t>(ru.fine), fv = static_cast<std::size_t>(rv.fine);
+  tmp.assign(cu * fv * c, 0.0);
+  const bool parallel = fu * fv * c * (wu + wv) >= parallel_min_work;
+#pragma omp parallel for schedule(static) if (parallel)
+  for (long long a = 0; a < static_cast<long long>(cu); ++a)
+    for (std::size_t j = 0; j < fv; ++j) {
+      const std::size_t b0 = static_cast<std::size_t>(rv.first[j]);
+      for (std::size_t b = 0; b < wv; ++b) {
+        const double w = rv.weight[j * wv + b];
+        if (w == 0) continue;
+        const std::size_t from = (static_cast<std::size_t>(a) * cv + b0 + b) * c, to = (static_cast<std::size_t>(a) * fv + j) * c;
+        for (std::size_t k = 0; k < c; ++k) tmp[to + k] += w * coarse[from + k];
+      }
+    }
+#pragma omp parallel for schedule(static) if (parallel)
+  for (long long i = 0; i < static_cast<long long>(fu); ++i) {
+    const std::size_t ii = static_cast<std::size_t>(i), a0 = static_cast<std::size_t>(ru.first[ii]);
+    for (std::size_t a = 0; a < wu; ++a) {
+      const double w = ru.weight[ii * wu + a];
+      if (w == 0) continue;
+      for (std::size_t j = 0; j < fv * c; ++j) fine[ii * fv * c + j] += w * tmp[(a0 + a) * fv * c + j];
+    }
+  }
+}
+
+namespace {
+
+// b_c = Pᵀ r_f, each coarse value gathered from the fine ones in a fixed order.
+void restrict_to(const std::array<Refinement, 2>& r, std::span<const double> fine, std::span<double> coarse, int cols,
+                 std::vector<double>& tmp) {
+  const Refinement &ru = r[0], &rv = r[1];
+  const std::size_t c = static_cast<std::size_t>(cols);
+  const std::size_t cu = static_cast<std::size_t>(ru.coarse), cv = static_cast<std::size_t>(rv.coarse);
+  const std::size_t fu = static_cast<std::size_t>(ru.fine), fv = static_cast<std::size_t>(rv.fine);
+  tmp.assign(fu * cv * c, 0.0);
+  const bool parallel = fu * fv * c * 8 >= parallel_min_work;
+#pragma omp parallel for schedule(static) if (parallel)
+  for (long long i = 0; i < static_cast<long long>(fu); ++i)
+    for (std::size_t b = 0; b < cv; ++b)
+      for (std::size_t e = rv.t_start[b]; e < rv.t_start[b + 1]; ++e) {
+        const double w = rv.t_weight[e];
+        const std::size_t from = (static_cast<std::size_t>(i) * fv + static_cast<std::size_t>(rv.t_index[e])) * c;
+        const std::size_t to = (static_cast<std::size_t>(i) * cv + b) * c;
+        for (std::size_t k = 0; k < c; ++k) tmp[to + k] += w * fine[from + k];
+      }
+#pragma omp parallel for schedule(static) if (parallel)
+  for (long long a = 0; a < static_cast<long long>(cu); ++a) {
+    const std::size_t aa = static_cast<std::size_t>(a);
+    std::fill(coarse.begin() + static_cast<std::ptrdiff_t>(aa * cv * c), coarse.begin() + static_cast<std::ptrdiff_t>((aa + 1) * cv * c), 0.0);
+    for (std::size_t e = ru.t_start[aa]; e < ru.t_start[aa + 1]; ++e) {
+      const double w = ru.t_weight[e];
+      const std::size_t from = static_cast<std::size_t>(ru.t_index[e]) * cv * c;
+      for (std::size_t j = 0; j < cv * c; ++j) coarse[aa * cv * c + j] += w * tmp[from + j];
+    }
+  }
+}
+
+}  // namespace
+
+Multigrid::Multigrid(std::vector<Net> nets, std::vector<const NetMatrix*> matrices, int cols)
+    : nets_(std::move(nets)), a_(std::move(matrices)), cols_(cols) {
+  const std::size_t n = nets_.size();
+  up_.resize(n);
+  for (std::size_t l = 1; l < n; ++l)
+    up_[l] = {refinement(nets_[l - 1].ku, nets_[l].ku), refinement(nets_[l - 1].kv, nets_[l].kv)};
+  r_.resize(n), b_.resize(n), x_.resize(n), tmp_.resize(n);
+  for (std::size_t l = 0; l < n; ++l) {
+    const std::size_t len = nets_[l].size() * static_cast<std::size_t>(cols);
+    r_[l].assign(len, 0.0), b_[l].assign(len, 0.0), x_[l].assign(len, 0.0);
+  }
+}
+
+bool Multigrid::factor() {
+  coarsest_.emplace(*a_.front());
+  return coarsest_->ok();
+}
+
+void Multigrid::cycle(std::size_t level, std::span<const double> b, std::span<double> x) {
+  if (level == 0) {
+    coarsest_->solve(b, x, cols_);
+    return;
+  }
+  const NetMatrix& a = *a_[level];
+  std::fill(x.begin(), x.end(), 0.0);
+  a.gauss_seidel(b, x, cols_, false);
+  std::vector<double>& r = r_[level];
+  a.multiply(x, r, cols_);
+  for (std::size_t k = 0; k < r.size(); ++k) r[k] = b[k] - r[k];
+  restrict_to(up_[level], r, b_[level - 1], cols_, tmp_[level]);
+  cycle(level - 1, b_[level - 1], x_[level - 1]);
+  prolong(up_[level], x_[level - 1], x, cols_, tmp_[level]);
+  a.gauss_seidel(b, x, cols_, true);
+}
+
+void Multigrid::apply(std::span<const double> r, std::span<double> z) { cycle(nets_.size() - 1, r, z); }
+
+}  // namespace interpatch::detail::scattered

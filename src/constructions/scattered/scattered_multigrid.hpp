@@ -1,0 +1,71 @@
+#pragma once
+// Multigrid for the normal equations of a scattered fit: the same functional (data term
+// and fairness with the same weight) assembled on nets of halved spans, a symmetric
+// V-cycle of multicolour Gauss–Seidel between them and a factored coarsest net, used to
+// precondition conjugate gradients. The data term alone is a mass matrix whose
+// oscillating modes Gauss–Seidel damps slowly; the fairness term across voids is a
+// biharmonic one whose smooth modes only the coarse nets reach; together they leave
+// conjugate gradients a few dozen steps where the diagonal needed thousands.
+
+#include <array>
+#include <cstddef>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "constructions/scattered/scattered_system.hpp"
+
+namespace interpatch::detail::scattered {
+
+/// The control points of a spline on one uniform knot vector as those of a spline on a
+/// finer one along one direction: fine point i is Σ_a weight[i·(p+1) + a] times coarse
+/// point first[i] + a. Exact when every coarse knot is a fine knot (knot insertion by
+/// blossoming, the Oslo algorithm); otherwise the coarse spline at the fine Greville
+/// abscissae (Schoenberg's variation-diminishing approximation); the identity when
+/// both are one.
+struct Refinement {
+  int p = 3, fine = 0, coarse = 0;
+  std::vector<int> first;
+  std::vector<double> weight;
+  /// The transpose, row a of the coarse points: (fine index, weight) pairs from
+  /// t_start[a] to t_start[a + 1].
+  std::vector<std::size_t> t_start;
+  std::vector<int> t_index;
+  std::vector<double> t_weight;
+};
+Refinement refinement(const KnotVector& coarse, const KnotVector& fine);
+
+/// The spans of the nets below a fine net of `spans`, coarsest first and the fine one
+/// last: each direction halved (rounded up) while it has more than 4 spans, until the
+/// net has at most `coarsest` control points.
+std::vector<std::array<int, 2>> hierarchy(std::array<int, 2> spans, int p, int q, std::size_t coarsest);
+
+/// A V-cycle over nets whose matrices the caller owns (and may change between
+/// factor() calls, as a search over the fairness weight does).
+class Multigrid {
+ public:
+  /// nets and matrices coarsest first; the matrices outlive this object.
+  Multigrid(std::vector<Net> nets, std::vector<const NetMatrix*> matrices, int cols);
+  /// Factors the coarsest matrix (again). False when it is not positive definite.
+  bool factor();
+  /// z = the V-cycle applied to r: one forward sweep down, the coarsest solved, one
+  /// backward sweep up, so the operator is symmetric positive definite.
+  void apply(std::span<const double> r, std::span<double> z);
+  [[nodiscard]] const Net& net(std::size_t level) const { return nets_[level]; }
+  [[nodiscard]] std::size_t levels() const { return nets_.size(); }
+
+ private:
+  void cycle(std::size_t level, std::span<const double> b, std::span<double> x);
+  std::vector<Net> nets_;
+  std::vector<const NetMatrix*> a_;
+  std::vector<std::array<Refinement, 2>> up_;  // up_[l]: level l - 1 to level l
+  std::vector<std::vector<double>> r_, b_, x_, tmp_;
+  std::optional<DirectSolver> coarsest_;
+  int cols_;
+};
+
+/// Refines a coarse net's values (cols per control point) onto the fine net: x_f += P x_c.
+void prolong(const std::array<Refinement, 2>& r, std::span<const double> coarse, std::span<double> fine, int cols,
+             std::vector<double>& tmp);
+
+}  // namespace interpatch::detail::scattered

@@ -1,0 +1,274 @@
+// Multigrid for scattered fits (src/constructions/scattered/scattered_multigrid.hpp)
+// and "smoothing": "auto" (scattered_auto.cpp): the refinement between nets exact where
+// the knots nest and reproducing lines where they do not, the V-cycle symmetric and
+// positive (what conjugate gradients need of a preconditioner), solves equal to the
+// factorization, and λ chosen by cross-validation predicting points it never saw
+// about as well as the best decade of λ, the same on any thread count and in any order.
+// Splines are evaluated by tests/property/promise_harness.hpp's own Cox–de Boor.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <numeric>
+#include <random>
+
+#include "constructions/scattered/scattered_multigrid.hpp"
+#include "interpatch/approximate.hpp"
+#include "interpatch/io/spec.hpp"
+#include "property/promise_harness.hpp"
+#include "thread_util.hpp"
+
+namespace interpatch {
+namespace {
+
+using namespace detail::scattered;
+using promise::own_basis;
+
+double spline_at(const KnotVector& k, std::span<const double> c, double t) {
+  const promise::Basis b = own_basis(k.values(), k.degree(), t);
+  double s = 0;
+  for (std::size_t a = 0; a < b.N.size(); ++a) s += b.N[a] * c[static_cast<std::size_t>(b.first) + a];
+  return s;
+}
+
+std::vector<double> refine(const Refinement& r, std::span<const double> coarse) {
+  std::vector<double> fine(static_cast<std::size_t>(r.fine), 0.0);
+  const std::size_t w = static_cast<std::size_t>(r.p + 1);
+  for (std::size_t i = 0; i < fine.size(); ++i)
+    for (std::size_t a = 0; a < w; ++a)
+      if (r.weight[i * w + a] != 0) fine[i] += r.weight[i * w + a] * coarse[static_cast<std::size_t>(r.first[i]) + a];
+  return fine;
+}
+
+// Knot insertion changes no point: the coarse spline and its refinement agree
+// everywhere, to rounding (1e-13 of coefficients of size 1, at most p + 1 terms).
+TEST(ScatteredMultigrid, RefinementIsExactWhereTheKnotsNest) {
+  std::mt19937_64 g(31);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (const int p : {1, 2, 3, 5})
+    for (const int spans : {1, 4, 9, 40}) {
+      const KnotVector c = KnotVector::uniform(p, spans + p, 0, 0.8), f = KnotVector::uniform(p, 2 * spans + p, 0, 0.8);
+      const Refinement r = refinement(c, f);
+      std::vector<double> coef(static_cast<std::size_t>(c.count()));
+      for (double& x : coef) x = U(g);
+      const std::vector<double> fine = refine(r, coef);
+      for (int k = 0; k <= 200; ++k) {
+        const double t = 0.8 * k / 200;
+        EXPECT_NEAR(spline_at(c, coef, t), spline_at(f, fine, t), 1e-13) << "p " << p << ", " << spans << " spans, t " << t;
+      }
+    }
+}
+
+// Between nets that do not nest (odd spans halved and rounded up), the coarse spline's
+// values at the fine Greville abscissae: lines are reproduced, so the coarse
+// correction of a smooth error is right to second order.
+TEST(ScatteredMultigrid, RefinementReproducesLinesWhereTheKnotsDoNotNest) {
+  for (const int spans : {3, 7, 25}) {
+    const KnotVector c = KnotVector::uniform(3, (spans + 1) / 2 + 3, 0, 1), f = KnotVector::uniform(3, spans + 3, 0, 1);
+    const Refinement r = refinement(c, f);
+    const std::vector<double> gc = c.greville(), gf = f.greville();
+    std::vector<double> line(gc.size());
+    for (std::size_t i = 0; i < gc.size(); ++i) line[i] = 2 - 3 * gc[i];
+    const std::vector<double> fine = refine(r, line);
+    for (std::size_t i = 0; i < gf.size(); ++i) EXPECT_NEAR(fine[i], 2 - 3 * gf[i], 1e-14) << spans << " spans, point " << i;
+    // The transpose holds the same weights.
+    double from_rows = 0, from_columns = 0;
+    for (double w : r.weight) from_rows += w;
+    for (double w : r.t_weight) from_columns += w;
+    EXPECT_NEAR(from_rows, from_columns, 1e-13);
+  }
+}
+
+struct Fixture {
+  std::vector<Net> nets;
+  std::vector<System> systems;
+  std::vector<std::array<double, 2>> site;
+  std::vector<double> weight, value;
+};
+
+// Random points (with a void) on a net of nu × nv, and the systems of the nets below.
+Fixture fixture(int nu, int nv, std::size_t points, double lambda, int cols, std::uint64_t seed) {
+  Fixture f;
+  std::mt19937_64 g(seed);
+  std::uniform_real_distribution<double> U(0, 1);
+  while (f.site.size() < points) {
+    const std::array<double, 2> s{U(g), 0.8 * U(g)};
+    if (std::hypot(s[0] - 0.6, s[1] - 0.4) < 0.15) continue;  // a void held by the fairness term alone
+    f.site.push_back(s);
+  }
+  f.weight.assign(points, 1.0);
+  f.value.resize(points * static_cast<std::size_t>(cols));
+  for (std::size_t k = 0; k < points; ++k)
+    for (int c = 0; c < cols; ++c)
+      f.value[k * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)] =
+          std::sin(7 * f.site[k][0] + c) * std::cos(5 * f.site[k][1]) + 0.05 * (U(g) - 0.5);
+  for (const auto& sp : hierarchy({nu - 3, nv - 3}, 3, 3, 4096)) {
+    f.nets.emplace_back(3, 3, sp[0] + 3, sp[1] + 3, std::array<double, 2>{1, 0.8});
+    const Net& n = f.nets.back();
+    f.systems.push_back(System{NetMatrix(n.nu, n.nv, 3, 3), std::vector<double>(n.size() * static_cast<std::size_t>(cols), 0.0), cols});
+    add_data_term(n, Samples{f.site, f.weight, f.value, cols}, f.systems.back());
+    add_fairness(n, &f.systems.back().a, static_cast<double>(points) * lambda);
+    f.systems.back().a.mirror();
+  }
+  return f;
+}
+
+Multigrid multigrid(const Fixture& f, int cols) {
+  std::vector<const NetMatrix*> m;
+  for (const System& s : f.systems) m.push_back(&s.a);
+  Multigrid mg(f.nets, m, cols);
+  EXPECT_TRUE(mg.factor());
+  return mg;
+}
+
+// Conjugate gradients need a symmetric positive definite preconditioner: yᵀ M r = rᵀ M y
+// (to rounding of the cycle's sums, 1e-12 of the products) and rᵀ M r > 0.
+TEST(ScatteredMultigrid, TheCycleIsSymmetricAndPositive) {
+  const Fixture f = fixture(150, 120, 40000, 1e-7, 1, 32);
+  ASSERT_GE(f.nets.size(), 3u);
+  Multigrid mg = multigrid(f, 1);
+  std::mt19937_64 g(33);
+  std::normal_distribution<double> N(0, 1);
+  const std::size_t n = f.nets.back().size();
+  for (int trial = 0; trial < 5; ++trial) {
+    std::vector<double> r(n), y(n), mr(n), my(n);
+    for (std::size_t i = 0; i < n; ++i) r[i] = N(g), y[i] = N(g);
+    mg.apply(r, mr);
+    mg.apply(y, my);
+    const double a = std::inner_product(y.begin(), y.end(), mr.begin(), 0.0);
+    const double b = std::inner_product(r.begin(), r.end(), my.begin(), 0.0);
+    const double scale = std::sqrt(std::inner_product(r.begin(), r.end(), mr.begin(), 0.0) * std::inner_product(y.begin(), y.end(), my.begin(), 0.0));
+    EXPECT_GT(std::inner_product(r.begin(), r.end(), mr.begin(), 0.0), 0.0);
+    EXPECT_NEAR(a, b, 1e-12 * scale) << trial;
+  }
+}
+
+// Preconditioned by the cycle, conjugate gradients reach the factorization's solution
+// (to 1e-9 of its size: a residual of 1e-13 times a condition number below 1e4) in a
+// few dozen steps, for one column and for three.
+TEST(ScatteredMultigrid, SolvesEqualTheFactorization) {
+  for (const int cols : {1, 3}) {
+    const Fixture f = fixture(90, 75, 30000, 1e-8, cols, 34 + static_cast<std::uint64_t>(cols));
+    Multigrid mg = multigrid(f, cols);
+    const System& top = f.systems.back();
+    std::vector<double> x(top.rhs.size(), 0.0), direct(top.rhs.size(), 0.0);
+    const Solved s = solve_cg(top.a, top.rhs, x, cols, 1e-13, 200,
+                              [&mg](std::span<const double> r, std::span<double> z, int) { mg.apply(r, z); });
+    EXPECT_LE(s.residual, 1e-13);
+    EXPECT_LE(s.iterations, 80) << cols << " columns";
+    ASSERT_TRUE(solve_direct(top.a, top.rhs, direct, cols));
+    double size = 0, worst = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) size = std::max(size, std::abs(direct[i])), worst = std::max(worst, std::abs(x[i] - direct[i]));
+    EXPECT_LE(worst, 1e-9 * size) << cols << " columns";
+  }
+}
+
+// A smooth field with noise σ = 2 at scattered sites.
+double field(double x, double y) { return 40 * std::sin(x / 170) * std::cos(y / 130) + 0.02 * x + 5 * std::sin((x + y) / 90); }
+
+std::vector<Vec3> noisy_survey(std::mt19937_64& g, std::size_t n, double sigma) {
+  std::uniform_real_distribution<double> ux(0, 1000), uy(0, 800);
+  std::normal_distribution<double> e(0, sigma);
+  std::vector<Vec3> q(n);
+  for (Vec3& p : q) {
+    const double x = ux(g), y = uy(g);
+    p = {x, y, field(x, y) + e(g)};
+  }
+  return q;
+}
+
+// RMS of the fit against the noise-free field at sites the fit never saw.
+double unseen_rms(const ScatteredApproximation& r, std::mt19937_64& g) {
+  const promise::Tensor t = promise::tensor_of(r.surface);
+  std::uniform_real_distribution<double> ux(0, 1000), uy(0, 800);
+  double sq = 0;
+  constexpr int n = 3000;
+  for (int k = 0; k < n; ++k) {
+    const double x = ux(g), y = uy(g);
+    const Vec3 s = t.eval(x, y).s;
+    sq += (s.z - field(x, y)) * (s.z - field(x, y));
+  }
+  return std::sqrt(sq / n);
+}
+
+ScatteredApproximationOptions xy_auto() {
+  ScatteredApproximationOptions o;
+  o.param = ScatteredParam::xy;
+  o.auto_smoothing = true;
+  return o;
+}
+
+// λ chosen by cross-validation predicts the field between the points within 10 % of the
+// best of six decades of λ tried afterwards with the truth known (the search's own
+// spread: its folds are one sample of the noise), and well inside the noise itself.
+TEST(ScatteredMultigrid, AutoSmoothingPredictsUnseenPointsAsTheBestLambda) {
+  for (const std::size_t n : {3000u, 30000u}) {
+    std::mt19937_64 g(40 + n);
+    const auto q = noisy_survey(g, n, 2.0);
+    const auto chosen = approximate_scattered(q, xy_auto());
+    std::mt19937_64 h(41);
+    const double got = unseen_rms(chosen, h);
+    double best = std::numeric_limits<double>::infinity();
+    for (int t = -6; t <= -1; ++t) {
+      ScatteredApproximationOptions o;
+      o.param = ScatteredParam::xy;
+      o.smoothing = std::pow(10.0, t);
+      std::mt19937_64 h2(41);
+      best = std::min(best, unseen_rms(approximate_scattered(q, o), h2));
+    }
+    EXPECT_LE(got, 1.1 * best) << n << " points, λ " << chosen.report.lambda;
+    EXPECT_LT(got, 1.0) << n << " points";  // σ = 2: most of the noise is gone
+    EXPECT_GT(chosen.report.lambda, 0.0);
+  }
+}
+
+// The folds follow the points' coordinates, not their order: shuffled, the same λ
+// (to the rounding of sums taken in another order) and the same surface.
+TEST(ScatteredMultigrid, AutoSmoothingIgnoresTheOrderOfThePoints) {
+  std::mt19937_64 g(42);
+  auto q = noisy_survey(g, 5000, 2.0);
+  const auto a = approximate_scattered(q, xy_auto());
+  std::shuffle(q.begin(), q.end(), g);
+  const auto b = approximate_scattered(q, xy_auto());
+  EXPECT_NEAR(a.report.lambda, b.report.lambda, 1e-6 * a.report.lambda);
+  const auto& ca = a.surface.control_points().values();
+  const auto& cb = b.surface.control_points().values();
+  ASSERT_EQ(ca.size(), cb.size());
+  double worst = 0;
+  for (std::size_t i = 0; i < ca.size(); ++i) worst = std::max(worst, distance(ca[i], cb[i]));
+  EXPECT_LE(worst, 1e-6);  // heights of about 50 m; solves to 1e-12 of the data
+}
+
+using test::with_threads;
+
+// Past the factored nets (about 25 000 points, 160 x 130 control points): the search
+// and the fit give the same bits on one, two and three threads.
+TEST(ScatteredMultigrid, AutoSmoothingGivesTheSameBitsOnAnyThreadCount) {
+  std::mt19937_64 g(43);
+  const auto q = noisy_survey(g, 26000, 2.0);
+  std::vector<ScatteredApproximation> r;
+  for (const int threads : {1, 2, 3}) r.push_back(with_threads(threads, [&] { return approximate_scattered(q, xy_auto()); }));
+  for (std::size_t t = 1; t < r.size(); ++t) {
+    EXPECT_EQ(r[t].report.lambda, r[0].report.lambda);
+    const auto& a = r[0].surface.control_points().values();
+    const auto& b = r[t].surface.control_points().values();
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3))) << t + 1 << " threads";
+  }
+}
+
+// The spec: "smoothing": "auto" on scattered points, the chosen λ in the report.
+TEST(ScatteredMultigrid, AutoSmoothingFromASpec) {
+  std::mt19937_64 g(44);
+  nlohmann::json pts = nlohmann::json::array();
+  for (const Vec3& p : noisy_survey(g, 800, 2.0)) pts.push_back({p.x, p.y, p.z});
+  const nlohmann::json spec = {{"type", "approximate"}, {"param", "xy"}, {"smoothing", "auto"}, {"points", pts}};
+  const io::Construction c = io::build(spec);
+  EXPECT_EQ(c.parameters.at("smoothing"), "auto");
+  EXPECT_GT(c.parameters.at("lambda").get<double>(), 0.0);
+}
+
+}  // namespace
+}  // namespace interpatch
