@@ -1,9 +1,10 @@
 // The promise harness for scattered points (approximate with an (N, 3) list): random
 // smooth sheets in hostile frames, sites from x and y, the least-squares plane or
-// given, voids, missing points and weights; each case built through io::build as a
-// user's spec is, and checked by the harness's own Cox–de Boor at every point's site:
-// a tolerance met at every point present, "xy"'s x(u, v) = u, a finite control net
-// near the data, and info's report in agreement.
+// given, voids, missing points and weights, every way of asking (λ given or "auto");
+// each case built through io::build as a user's spec is, and checked by the harness's
+// own Cox–de Boor at every point's site: a tolerance met at every point present,
+// "xy"'s x(u, v) = u, a finite control net near the data, and info's report in
+// agreement.
 
 #include <gtest/gtest.h>
 
@@ -52,6 +53,8 @@ json make_case(std::mt19937_64& g) {
     if (chance(g, 0.3)) spec["max_control_points"] = pick(g, 8, 80);
   } else if (way == 2) {
     spec["control_points"] = {pick(g, 4, 30), pick(g, 4, 30)};
+  } else if (chance(g, 0.3)) {
+    spec["smoothing"] = "auto";
   } else {
     spec["smoothing"] = std::pow(10.0, uni(g, -9, 3));
   }
@@ -91,6 +94,7 @@ void check_case(const json& spec, io::Construction& c, Findings& f) {
       f.add("point " + std::to_string(k) + " is " + std::to_string(d) + " from the surface, tolerance " +
             std::to_string(spec["tolerance"].get<double>()));
   }
+  if (spec.value("smoothing", json()) == "auto" && !(c.parameters["lambda"].get<double>() > 0)) f.add("\"auto\" reported no λ");
   const double reported = c.parameters["max_error"].get<double>();
   if (!(std::abs(reported - worst) <= 1e-9 * box.diagonal() + slack))
     f.add("info's max_error " + std::to_string(reported) + ", own evaluation " + std::to_string(worst));

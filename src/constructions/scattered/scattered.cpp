@@ -79,7 +79,7 @@ Fitted solve_smoothing(const Problem& pr, const ScatteredApproximationOptions& o
   if (!o.auto_smoothing) return solve_once(pr, spans, o.smoothing, o.progress);
   Chosen c = choose_lambda(pr, Net(pr.p, pr.q, spans[0] + pr.p, spans[1] + pr.q, pr.range), o.progress, 0.0, 0.85);
   Fitted f = solve_once(pr, spans, c.lambda, o.progress, std::move(c.x));
-  f.fits = 1;
+  f.fits = c.fits + 1;
   return f;
 }
 

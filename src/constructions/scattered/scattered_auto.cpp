@@ -168,7 +168,8 @@ Chosen choose_lambda(const Problem& pr, const Net& net, const progress_callback&
   if (fc < e) t = c, e = fc;
   if (fd < e) t = d;
   // The last fit of the first fold, near the one wanted, starts the fit of every point.
-  return {balance * std::pow(10.0, t), std::move(search.folds.front().x)};
+  const int fits = search.evaluations * static_cast<int>(search.folds.size());
+  return {balance * std::pow(10.0, t), std::move(search.folds.front().x), fits};
 }
 
 }  // namespace interpatch::detail::scattered

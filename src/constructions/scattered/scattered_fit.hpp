@@ -71,6 +71,7 @@ Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoot
 struct Chosen {
   double lambda = 0;
   std::vector<double> x;
+  int fits = 0;  ///< of the folds, over every λ tried
 };
 
 /// λ for `net` chosen by cross-validation (the points in 5 folds by their
