@@ -44,6 +44,43 @@ ApproxDistance distances(const BSplineSurface& s, std::span<const std::array<dou
   return e;
 }
 
+// The same as distances() for a fit still in the fit's frame, straight from the net's
+// values and the basis at each site (no surface built, no derivatives): what the
+// tolerance's refinement measures after each fit. The spline it keeps is measured
+// again by distances(), through its own evaluator.
+ApproxDistance net_distances(const Problem& pr, const Net& net, std::span<const double> x) {
+  constexpr std::size_t block = 8192;
+  const std::size_t n = pr.unit.size(), blocks = (n + block - 1) / block, c = static_cast<std::size_t>(pr.cols);
+  const std::size_t nv = static_cast<std::size_t>(net.nv);
+  const std::span<const double> weight = pr.sites->weight;
+  std::vector<ApproxDistance> part(blocks);
+  parallel_for(blocks, n >= parallel_min_work / 64, Share::blocks, [&](std::size_t b) {
+    double bu[max_degree + 1], bv[max_degree + 1];
+    for (std::size_t k = b * block; k < std::min(n, (b + 1) * block); ++k) {
+      if (!(weight[k] > 0)) continue;
+      const int su = net.ku.find_span(pr.unit[k][0]), sv = net.kv.find_span(pr.unit[k][1]);
+      net.ku.basis(su, pr.unit[k][0], bu);
+      net.kv.basis(sv, pr.unit[k][1], bv);
+      double at[3] = {0, 0, 0};
+      for (int a = 0; a <= net.p; ++a) {
+        const std::size_t row = static_cast<std::size_t>(su - net.p + a) * nv + static_cast<std::size_t>(sv - net.q);
+        for (int e = 0; e <= net.q; ++e) {
+          const double w = bu[a] * bv[e];
+          for (std::size_t m = 0; m < c; ++m) at[m] += w * x[(row + static_cast<std::size_t>(e)) * c + m];
+        }
+      }
+      double sq = 0;
+      for (std::size_t m = 0; m < c; ++m) sq += (at[m] - pr.value[k * c + m]) * (at[m] - pr.value[k * c + m]);
+      const double d = std::sqrt(sq);
+      if (!(d <= part[b].max)) part[b] = {std::isnan(d) ? std::numeric_limits<double>::infinity() : d, k};
+    }
+  });
+  ApproxDistance e;
+  for (const ApproxDistance& p : part)
+    if (p.max > e.max) e = p;
+  return e;
+}
+
 // About `cells` knot cells, shaped after the domain (cells near square in its units).
 std::array<int, 2> spans_for(double aspect, double cells) {
   const auto round = [](double x) { return static_cast<int>(std::clamp(std::lround(x), 1L, 1L << 20)); };
@@ -83,14 +120,6 @@ Fitted solve_smoothing(const Problem& pr, const ScatteredApproximationOptions& o
   return f;
 }
 
-// The data in the fit's frame, as points (one column: in z).
-std::vector<Vec3> frame_targets(const Problem& pr) {
-  std::vector<Vec3> t(pr.unit.size());
-  for (std::size_t k = 0; k < t.size(); ++k)
-    t[k] = pr.cols == 1 ? Vec3{0, 0, pr.value[k]} : Vec3{pr.value[3 * k], pr.value[3 * k + 1], pr.value[3 * k + 2]};
-  return t;
-}
-
 // The largest net a tolerance may reach: as asked, or 4096 a direction.
 std::array<int, 2> largest_net(const ScatteredApproximationOptions& o) {
   return o.max_control_points.value_or(std::array<int, 2>{4096, 4096});
@@ -115,7 +144,6 @@ bool within(const std::array<int, 2>& net, const std::array<int, 2>& limit, cons
 Fitted solve_tolerance(const Problem& pr, double tolerance, const ScatteredApproximationOptions& o, const progress_callback& progress) {
   const Sites& s = *pr.sites;
   const double d = tolerance / pr.unit_length;
-  const std::vector<Vec3> target = frame_targets(pr);
   const std::array<int, 2> limit = largest_net(o);
   std::array<int, 2> spans = spans_for(pr.aspect, 1);
   std::optional<BSplineSurface> coarser;
@@ -124,9 +152,9 @@ Fitted solve_tolerance(const Problem& pr, double tolerance, const ScatteredAppro
     f.net = Net(pr.p, pr.q, spans[0] + pr.p, spans[1] + pr.q, pr.range);
     f.level = solve_level(pr, f.net, std::nullopt, coarser ? &*coarser : nullptr);
     ++f.fits;
-    coarser = unit_surface(f.net, f.level.x, pr.cols);
-    const ApproxDistance e = distances(*coarser, pr.unit, target, s.weight, nullptr);
+    const ApproxDistance e = net_distances(pr, f.net, f.level.x);
     if (e.max <= d) return f;
+    coarser = unit_surface(f.net, f.level.x, pr.cols);
     const std::array<int, 2> next{2 * spans[0] + pr.p, 2 * spans[1] + pr.q};
     if (!within(next, limit, o, s)) refuse_tolerance(tolerance, e, pr, f.net, limit, o.max_control_points.has_value());
     spans = {2 * spans[0], 2 * spans[1]};
