@@ -20,18 +20,19 @@ namespace interpatch::detail::scattered {
 
 namespace {
 
-// Largest distance from the points present to a surface at their sites, and where,
-// the threads in blocks whose results are merged in order (the lowest index wins a tie).
-ApproxDistance distances(const BSplineSurface& s, std::span<const std::array<double, 2>> site, std::span<const Vec3> target,
-                         std::span<const double> weight, double* sum_sq) {
+// The largest of distance(k) over the points present, and where, the threads in blocks
+// whose results are merged in order (the lowest index wins a tie); a NaN distance counts
+// as infinite. Adds the squares to *sum_sq when given.
+template <class F>
+ApproxDistance worst_point(std::span<const double> weight, double* sum_sq, F&& distance) {
   constexpr std::size_t block = 8192;
-  const std::size_t n = site.size(), blocks = (n + block - 1) / block;
+  const std::size_t n = weight.size(), blocks = (n + block - 1) / block;
   std::vector<ApproxDistance> part(blocks);
   std::vector<double> sq(blocks, 0.0);
   parallel_for(blocks, n >= parallel_min_work / 64, Share::blocks, [&](std::size_t b) {
     for (std::size_t k = b * block; k < std::min(n, (b + 1) * block); ++k) {
       if (!(weight[k] > 0)) continue;
-      const double d = distance(s.point(site[k][0], site[k][1]), target[k]);
+      const double d = distance(k);
       sq[b] += d * d;
       if (!(d <= part[b].max)) part[b] = {std::isnan(d) ? std::numeric_limits<double>::infinity() : d, k};
     }
@@ -44,41 +45,18 @@ ApproxDistance distances(const BSplineSurface& s, std::span<const std::array<dou
   return e;
 }
 
-// The same as distances() for a fit still in the fit's frame, straight from the net's
-// values and the basis at each site (no surface built, no derivatives): what the
-// tolerance's refinement measures after each fit. The spline it keeps is measured
-// again by distances(), through its own evaluator.
+// Largest distance from the points present to a surface at their sites, through the
+// surface's own evaluator: the check of the spline returned.
+ApproxDistance distances(const BSplineSurface& s, std::span<const std::array<double, 2>> site, std::span<const Vec3> target,
+                         std::span<const double> weight, double* sum_sq) {
+  return worst_point(weight, sum_sq, [&](std::size_t k) { return distance(s.point(site[k][0], site[k][1]), target[k]); });
+}
+
+// The same for a fit still in the fit's frame, from the net's values and the basis at
+// each site (no surface built, no derivatives): what the tolerance's refinement
+// measures after each fit.
 ApproxDistance net_distances(const Problem& pr, const Net& net, std::span<const double> x) {
-  constexpr std::size_t block = 8192;
-  const std::size_t n = pr.unit.size(), blocks = (n + block - 1) / block, c = static_cast<std::size_t>(pr.cols);
-  const std::size_t nv = static_cast<std::size_t>(net.nv);
-  const std::span<const double> weight = pr.sites->weight;
-  std::vector<ApproxDistance> part(blocks);
-  parallel_for(blocks, n >= parallel_min_work / 64, Share::blocks, [&](std::size_t b) {
-    double bu[max_degree + 1], bv[max_degree + 1];
-    for (std::size_t k = b * block; k < std::min(n, (b + 1) * block); ++k) {
-      if (!(weight[k] > 0)) continue;
-      const int su = net.ku.find_span(pr.unit[k][0]), sv = net.kv.find_span(pr.unit[k][1]);
-      net.ku.basis(su, pr.unit[k][0], bu);
-      net.kv.basis(sv, pr.unit[k][1], bv);
-      double at[3] = {0, 0, 0};
-      for (int a = 0; a <= net.p; ++a) {
-        const std::size_t row = static_cast<std::size_t>(su - net.p + a) * nv + static_cast<std::size_t>(sv - net.q);
-        for (int e = 0; e <= net.q; ++e) {
-          const double w = bu[a] * bv[e];
-          for (std::size_t m = 0; m < c; ++m) at[m] += w * x[(row + static_cast<std::size_t>(e)) * c + m];
-        }
-      }
-      double sq = 0;
-      for (std::size_t m = 0; m < c; ++m) sq += (at[m] - pr.value[k * c + m]) * (at[m] - pr.value[k * c + m]);
-      const double d = std::sqrt(sq);
-      if (!(d <= part[b].max)) part[b] = {std::isnan(d) ? std::numeric_limits<double>::infinity() : d, k};
-    }
-  });
-  ApproxDistance e;
-  for (const ApproxDistance& p : part)
-    if (p.max > e.max) e = p;
-  return e;
+  return worst_point(pr.sites->weight, nullptr, [&](std::size_t k) { return distance_at(pr, net, x, k); });
 }
 
 // About `cells` knot cells, shaped after the domain (cells near square in its units).

@@ -81,13 +81,9 @@ struct Search {
       const Solved sol = solve_cg(sum.back(), f.data.back().rhs, f.x, pr.cols, 1e-10, 400,
                                   [&m](std::span<const double> r, std::span<double> z, int) { m.apply(r, z); });
       if (!(sol.residual <= 1e-4)) return std::numeric_limits<double>::infinity();
-      const BSplineSurface s = unit_surface(nets.back(), f.x, pr.cols);
-      const std::size_t c = static_cast<std::size_t>(pr.cols);
       for (std::size_t k = 0; k < fold_of.size(); ++k) {
         if (fold_of[k] != f.index) continue;
-        const Vec3 at = s.point(pr.unit[k][0], pr.unit[k][1]);
-        const Vec3 want = c == 1 ? Vec3{at.x, at.y, pr.value[k]} : Vec3{pr.value[3 * k], pr.value[3 * k + 1], pr.value[3 * k + 2]};
-        const double d = distance(at, want);
+        const double d = distance_at(pr, nets.back(), f.x, k);
         total += pr.sites->weight[k] * d * d;
       }
     }

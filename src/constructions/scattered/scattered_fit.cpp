@@ -108,8 +108,7 @@ double fill_lambda(const Net& net, const NetMatrix& data, double weight_sum) {
 // digits of the data's size), preconditioned by a V-cycle; factored after all when
 // they stall on a net the factorization still takes (ties of points far finer than
 // the knots), an error past it.
-void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const double> weight, double scaled, std::vector<double>& x,
-               double rel) {
+void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const double> weight, double scaled, std::vector<double>& x) {
   if (net.size() <= coarsest_net) {
     if (!solve_direct(sys.a, sys.rhs, x, pr.cols)) not_definite(net);
     return;
@@ -122,14 +121,14 @@ void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const d
   // the small fill does and cells hold fewer points than control points.
   const bool factorable = net.size() <= direct_limit;
   const int cap = factorable ? 300 : 200 + 40 * (net.nu + net.nv);
-  const Solved sol = solve_cg(sys.a, sys.rhs, x, pr.cols, rel, cap,
+  const Solved sol = solve_cg(sys.a, sys.rhs, x, pr.cols, 1e-12, cap,
                               [&mg](std::span<const double> r, std::span<double> z, int) { mg.apply(r, z); });
-  if (sol.residual <= rel) return;
+  if (sol.residual <= 1e-12) return;
   if (factorable) {
     if (!solve_direct(sys.a, sys.rhs, x, pr.cols)) not_definite(net);
     return;
   }
-  if (!(sol.residual <= std::max(1e-9, 1e3 * rel)))
+  if (!(sol.residual <= 1e-9))
     fail(errc::ill_conditioned, "scattered approximation with ", net.nu, " x ", net.nv, " control points: conjugate gradients ",
          "left a residual of ", sol.residual, " of the data after ", sol.iterations, " steps");
 }
@@ -144,9 +143,10 @@ Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoot
   Level out;
   out.lambda = std::max(fill_lambda(net, sys.a, s.weight_sum), smoothing.value_or(0.0));
   add_fairness(net, &sys.a, s.weight_sum * out.lambda);
-  if (start.size() == sys.rhs.size()) out.x = std::move(start);
+  const bool started = start.size() == sys.rhs.size();
+  if (started) out.x = std::move(start);
   else out.x.assign(sys.rhs.size(), 0.0);
-  if (coarser && start.empty() && net.size() > coarsest_net) {
+  if (coarser && !started && net.size() > coarsest_net) {
     const std::vector<double> gu = net.ku.greville(), gv = net.kv.greville();
     std::vector<Vec3> at(net.size());
     coarser->evaluate_into(gu, gv, at);
@@ -158,4 +158,24 @@ Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoot
   solve_net(pr, net, sys, s.weight, s.weight_sum * out.lambda, out.x);
   return out;
 }
+
+double distance_at(const Problem& pr, const Net& net, std::span<const double> x, std::size_t k) {
+  const std::size_t c = static_cast<std::size_t>(pr.cols), nv = static_cast<std::size_t>(net.nv);
+  double bu[max_degree + 1], bv[max_degree + 1];
+  const int su = net.ku.find_span(pr.unit[k][0]), sv = net.kv.find_span(pr.unit[k][1]);
+  net.ku.basis(su, pr.unit[k][0], bu);
+  net.kv.basis(sv, pr.unit[k][1], bv);
+  double at[3] = {0, 0, 0};
+  for (int a = 0; a <= net.p; ++a) {
+    const std::size_t row = static_cast<std::size_t>(su - net.p + a) * nv + static_cast<std::size_t>(sv - net.q);
+    for (int e = 0; e <= net.q; ++e) {
+      const double w = bu[a] * bv[e];
+      for (std::size_t m = 0; m < c; ++m) at[m] += w * x[(row + static_cast<std::size_t>(e)) * c + m];
+    }
+  }
+  double sq = 0;
+  for (std::size_t m = 0; m < c; ++m) sq += (at[m] - pr.value[k * c + m]) * (at[m] - pr.value[k * c + m]);
+  return std::sqrt(sq);
+}
+
 }  // namespace interpatch::detail::scattered

@@ -54,12 +54,15 @@ System data_system(const Problem& pr, const Net& net, std::span<const double> we
 double fill_lambda(const Net& net, const NetMatrix& data, double weight_sum);
 
 /// Solves one net's system (data term of `weight`, fairness added at `scaled`, λ times
-/// the weight sum) from the x given, to a residual of `rel` of the right-hand side.
+/// the weight sum) from the x given, to a residual of 1e-12 of the right-hand side.
 /// Factored when small, otherwise by conjugate gradients preconditioned by a V-cycle
 /// over nets assembled from the same points and weight; factored after all when they
 /// stall on a net the factorization still takes, an error past it.
-void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const double> weight, double scaled, std::vector<double>& x,
-               double rel = 1e-12);
+void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const double> weight, double scaled, std::vector<double>& x);
+
+/// The distance of point k from the fit whose net holds `x` (cols per control point),
+/// at the point's site, in the fit's frame: the basis there times the net's values.
+double distance_at(const Problem& pr, const Net& net, std::span<const double> x, std::size_t k);
 
 /// One net solved on every point present: λ at least the fill, started from `start`
 /// (the net's values), or the coarser fit's values at this net's Greville abscissae,

@@ -88,6 +88,9 @@ std::vector<std::array<int, 2>> hierarchy(std::array<int, 2> spans, int p, int q
   return out;
 }
 
+namespace {
+
+// x_f += P x_c: a coarse net's values (cols per control point) refined onto the fine net.
 void prolong(const std::array<Refinement, 2>& r, std::span<const double> coarse, std::span<double> fine, int cols,
              std::vector<double>& tmp) {
   const Refinement &ru = r[0], &rv = r[1];
@@ -117,8 +120,6 @@ void prolong(const std::array<Refinement, 2>& r, std::span<const double> coarse,
     }
   }
 }
-
-namespace {
 
 // b_c = Pᵀ r_f, each coarse value gathered from the fine ones in a fixed order.
 void restrict_to(const std::array<Refinement, 2>& r, std::span<const double> fine, std::span<double> coarse, int cols,

@@ -64,8 +64,4 @@ class Multigrid {
   int cols_;
 };
 
-/// Refines a coarse net's values (cols per control point) onto the fine net: x_f += P x_c.
-void prolong(const std::array<Refinement, 2>& r, std::span<const double> coarse, std::span<double> fine, int cols,
-             std::vector<double>& tmp);
-
 }  // namespace interpatch::detail::scattered
