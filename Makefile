@@ -28,7 +28,6 @@ BUILD_DEBS := cmake ninja-build g++ python3 libcli11-dev nlohmann-json3-dev libe
 #   python3-venv python3-pip python3-setuptools python3-wheel
 #                                    `pip install .` into a virtual environment, then the suite against it
 #   libocct-*-dev                    OpenCASCADE reads back the STEP and IGES files
-#   clang libclang-rt-14-dev libomp-14-dev   libFuzzer (with its OpenMP) runs the fuzz targets
 #   chromium chromium-driver python3-selenium   the viewer pages opened in a real browser (make test,
 #                                    make pictures, make bench-viewer)
 #   libopenmpi-dev openmpi-bin       MPI: eval and build split between processes (mpirun; docs/mpi.md) and their tests
@@ -36,9 +35,12 @@ TEST_DEBS := libgtest-dev libgmock-dev pkg-config python3-numpy python3-scipy py
         python3-pytest python3-hypothesis python3-matplotlib \
         python3-venv python3-pip python3-setuptools python3-wheel \
         libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
-        libocct-foundation-dev clang libclang-rt-14-dev libomp-14-dev \
+        libocct-foundation-dev \
         chromium chromium-driver python3-selenium libopenmpi-dev openmpi-bin openfoam \
         python3-meshio python3-gmsh
+# Fuzzing: `make fuzz` and `make test-fuzz` add these to the test list.
+#   clang libclang-rt-14-dev libomp-14-dev   libFuzzer (with its OpenMP) runs the fuzz targets
+FUZZ_DEBS := clang libclang-rt-14-dev libomp-14-dev
 # The benchmarks: `make bench` adds these.
 #   libbenchmark-dev                 Google Benchmark (bench/interpatch_bench)
 #   libocct-*-dev libsisl-dev        OpenCASCADE and SISL race interpatch (bench/compare);
@@ -53,7 +55,7 @@ BENCH_DEBS := libbenchmark-dev libocct-data-exchange-dev libocct-modeling-algori
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
-.PHONY: all deps test-deps bench-deps viewer-deps build install demo test test-release test-asan test-fuzz \
+.PHONY: all deps test-deps bench-deps fuzz-deps viewer-deps build install demo test test-release test-asan test-fuzz \
         fuzz fuzz-build promise bench clean pictures bench-viewer
 # Prerequisites run in the order written, so that a target's packages are installed
 # before its configure looks for them (cmake parallelizes the builds themselves).
@@ -79,6 +81,8 @@ test-deps:
 	$(call install_missing,$(BUILD_DEBS) $(TEST_DEBS))
 bench-deps:
 	$(call install_missing,$(BUILD_DEBS) $(BENCH_DEBS))
+fuzz-deps:
+	$(call install_missing,$(BUILD_DEBS) $(TEST_DEBS) $(FUZZ_DEBS))
 
 # three.js for the viewer page, as viewer/package-lock.json pins it (the build embeds
 # it and stops without it). Again whenever the lock file changes. `npm ci` where npm
@@ -114,6 +118,13 @@ demo: viewer-deps
 # OMP_WAIT_POLICY=PASSIVE: JOBS tests at once, each with a thread per core, leave
 # OpenMP's spinning threads waiting on cores another test holds (one scattered-points
 # test: 32 s spinning, 8 s passive, on 2 loaded cores).
+#
+# make test runs each test once, in the build where it tells most: the Release build
+# (test-release) runs the property tests with every random case, the C++ examples,
+# the Python suite against `pip install .`, the installed and source-tree consumers,
+# MPI, and the outside programs that read the files (OpenCASCADE, VTK, OpenFOAM,
+# Chromium); the sanitizer build (test-asan) runs the unit tests, the property tests
+# on a fifth of the cases, the fuzz targets' checked-in inputs and MPI again.
 test-release: test-deps build
 	ctest --preset release -j $(JOBS) || { python3 tools/failed_tests.py build/release; exit 1; }
 
@@ -122,20 +133,21 @@ test-release: test-deps build
 # stays at -O2: tests compare networks with fixtures made at -O3, and -O1 rounds a knot
 # differently enough to change a merge. Its promise tests run a fifth of the random
 # cases (INTERPATCH_PROMISE_CASES=0.2): it looks for memory and undefined-behaviour
-# errors, and the Release run tries every case. The C++ examples and the browser
-# checks of the viewer pages run in the Release build only.
+# errors, and the Release run tries every case.
 test-asan: test-deps viewer-deps
 	cmake --preset asan
 	cmake --build --preset asan -j $(JOBS)
 	ctest --preset asan -j $(JOBS) || { python3 tools/failed_tests.py build/asan; exit 1; }
 
 # The parsers under libFuzzer (clang, ASan + UBSan): every checked-in seed and
-# regression input once, then FUZZ_TEST_SECONDS of fuzzing per target. `make fuzz`
-# fuzzes longer; new corpus entries and crashes stay in build/fuzz/fuzz-work/.
+# regression input once, then FUZZ_TEST_SECONDS of fuzzing per target (test-fuzz) or
+# FUZZ_SECONDS (fuzz); new corpus entries and crashes stay in build/fuzz/fuzz-work/.
+# Not part of make test, which replays the checked-in inputs in the sanitizer build
+# (g++) and so spares the clang build of the whole library.
 FUZZ_TEST_SECONDS ?= 20
 FUZZ_SECONDS ?= 600
 
-fuzz-build: test-deps viewer-deps
+fuzz-build: fuzz-deps viewer-deps
 	cmake --preset fuzz
 	cmake --build --preset fuzz -j $(JOBS)
 
@@ -151,9 +163,9 @@ fuzz: fuzz-build
 PROMISE_CASES ?= 50
 
 promise: test-deps build
-	INTERPATCH_PROMISE_CASES=$(PROMISE_CASES) ./build/release/tests/interpatch_tests --gtest_filter='Promise*'
+	INTERPATCH_PROMISE_CASES=$(PROMISE_CASES) ./build/release/tests/interpatch_property_tests --gtest_filter='Promise*'
 
-test: test-release test-asan test-fuzz
+test: test-release test-asan
 
 # Benchmarks (never part of `make test`): the console table, then the JSON record
 # and its Markdown tables (docs/BENCHMARKS.md). Repetitions tame a shared machine;
