@@ -140,6 +140,23 @@ Fitted solve_tolerance(const Problem& pr, double tolerance, const ScatteredAppro
   }
 }
 
+// The fit and the frame that maps it back. Its problem (a site and a value per point)
+// is gone when it returns, before the result's sites are made.
+struct Solution {
+  Fitted f;
+  double unit_length = 1;
+  Vec3 centre{};
+};
+
+Solution solve(std::span<const Vec3> points, const Sites& s, int p, int q, const ScatteredApproximationOptions& o) {
+  const Problem pr = frame(points, s, p, q, o.param == ScatteredParam::xy);
+  Fitted f = o.tolerance ? solve_tolerance(pr, *o.tolerance, o, o.progress)
+             : o.control_points
+                 ? solve_once(pr, {(*o.control_points)[0] - p, (*o.control_points)[1] - q}, std::nullopt, o.progress)
+                 : solve_smoothing(pr, o);
+  return {std::move(f), pr.unit_length, pr.centre};
+}
+
 }  // namespace
 
 }  // namespace interpatch::detail::scattered
@@ -173,11 +190,7 @@ ScatteredApproximation approximate_scattered(std::span<const Vec3> points, const
 
   const Sites s = scattered_sites(points, o, deg[0], deg[1]);
   const bool xy = o.param == ScatteredParam::xy;
-  const Problem pr = frame(points, s, deg[0], deg[1], xy);
-  Fitted f = o.tolerance ? solve_tolerance(pr, *o.tolerance, o, o.progress)
-             : o.control_points
-                 ? solve_once(pr, {(*o.control_points)[0] - deg[0], (*o.control_points)[1] - deg[1]}, std::nullopt, o.progress)
-                 : solve_smoothing(pr, o);
+  const auto [f, unit_length, centre] = solve(points, s, deg[0], deg[1], o);
 
   // The surface in the data's own frame, over the domain.
   const auto [u0, u1] = s.domain[0];
@@ -189,17 +202,19 @@ ScatteredApproximation approximate_scattered(std::span<const Vec3> points, const
   for (std::size_t i = 0; i < gu.size(); ++i)
     for (std::size_t j = 0; j < gv.size(); ++j) {
       const std::size_t r = i * gv.size() + j;
-      net(i, j) = xy ? Vec3{gu[i], gv[j], x[r] * pr.unit_length + pr.centre.z}
-                     : Vec3{x[3 * r], x[3 * r + 1], x[3 * r + 2]} * pr.unit_length + pr.centre;
+      net(i, j) = xy ? Vec3{gu[i], gv[j], x[r] * unit_length + centre.z}
+                     : Vec3{x[3 * r], x[3 * r + 1], x[3 * r + 2]} * unit_length + centre;
     }
   const detail::ApproxData data{{points.size()}, points, s.weight};
   detail::check_approx_net(std::span<const Vec3>(net.data(), net.size()), {gu.size(), gv.size()}, data,
                            "scattered approximation");
 
-  ScatteredApproximation r{BSplineSurface(std::move(ku), std::move(kv), std::move(net)), s.uv, s.domain, s.origin,
+  ScatteredApproximation r{BSplineSurface(std::move(ku), std::move(kv), std::move(net)), {}, s.domain, s.origin,
                            s.axis_u, s.axis_v, {}};
+  r.sites.reserve(points.size());
+  for (std::size_t k = 0; k < points.size(); ++k) r.sites.push_back(s.uv(k));
   double sum_sq = 0;
-  const detail::ApproxDistance e = distances(r.surface, s.uv, points, s.weight, &sum_sq);
+  const detail::ApproxDistance e = distances(r.surface, r.sites, points, s.weight, &sum_sq);
   ApproximationReport& rep = r.report;
   rep.max_error = e.max;
   rep.max_error_at = {e.worst};

@@ -70,7 +70,8 @@ Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool x
   pr.value.assign(points.size() * static_cast<std::size_t>(pr.cols), 0.0);
   for (std::size_t k = 0; k < points.size(); ++k) {
     if (!(s.weight[k] > 0)) continue;
-    pr.unit[k] = {std::clamp((s.uv[k][0] - u0) / side, 0.0, pr.range[0]), std::clamp((s.uv[k][1] - v0) / side, 0.0, pr.range[1])};
+    const auto uv = s.uv(k);
+    pr.unit[k] = {std::clamp((uv[0] - u0) / side, 0.0, pr.range[0]), std::clamp((uv[1] - v0) / side, 0.0, pr.range[1])};
     const Vec3 d = (points[k] - pr.centre) * inv;
     if (xy) pr.value[k] = d.z;
     else pr.value[3 * k] = d.x, pr.value[3 * k + 1] = d.y, pr.value[3 * k + 2] = d.z;

@@ -12,8 +12,6 @@ namespace interpatch::detail::scattered {
 
 namespace {
 
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-
 // Which points count, with their weights; an infinite coordinate or a bad weight refused.
 void take_points(Sites& s, std::span<const Vec3> points, const ScatteredApproximationOptions& o) {
   const std::size_t n = points.size();
@@ -74,38 +72,49 @@ void plane_axes(Sites& s, std::span<const Vec3> points) {
 // Refuses sites that all lie on one line (nothing fixes the surface across it): the
 // smaller principal spread of the sites is below 1e-9 of the larger.
 void check_spread(const Sites& s, const char* what) {
+  const std::size_t n = s.weight.size();
   double mu = 0, mv = 0;
-  for (std::size_t k = 0; k < s.uv.size(); ++k)
-    if (s.weight[k] > 0) mu += s.uv[k][0], mv += s.uv[k][1];
+  for (std::size_t k = 0; k < n; ++k)
+    if (s.weight[k] > 0) {
+      const auto uv = s.uv(k);
+      mu += uv[0], mv += uv[1];
+    }
   mu /= static_cast<double>(s.present), mv /= static_cast<double>(s.present);
   // In a unit of the sites' own size: squares of 1e200 would overflow.
   double top = 0;
-  for (std::size_t k = 0; k < s.uv.size(); ++k)
-    if (s.weight[k] > 0) top = std::max({top, std::abs(s.uv[k][0] - mu), std::abs(s.uv[k][1] - mv)});
+  for (std::size_t k = 0; k < n; ++k)
+    if (s.weight[k] > 0) {
+      const auto uv = s.uv(k);
+      top = std::max({top, std::abs(uv[0] - mu), std::abs(uv[1] - mv)});
+    }
   const double unit = top > 0 ? top : 1.0;
   double suu = 0, suv = 0, svv = 0;
-  for (std::size_t k = 0; k < s.uv.size(); ++k)
+  for (std::size_t k = 0; k < n; ++k)
     if (s.weight[k] > 0) {
-      const double du = (s.uv[k][0] - mu) / unit, dv = (s.uv[k][1] - mv) / unit;
+      const auto uv = s.uv(k);
+      const double du = (uv[0] - mu) / unit, dv = (uv[1] - mv) / unit;
       suu += du * du, suv += du * dv, svv += dv * dv;
     }
   const double half = (suu + svv) / 2, gap = std::sqrt((suu - svv) * (suu - svv) / 4 + suv * suv);
   const double large = half + gap, small = std::max(half - gap, 0.0);
-  const double n = static_cast<double>(s.present);
+  const double present = static_cast<double>(s.present);
   if (!(std::sqrt(small) > 1e-9 * std::sqrt(large)))
     fail(errc::singular, "the ", s.present, " points present", what, " all lie on one line (their spread across it is ",
-         unit * std::sqrt(small / n), ", along it ", unit * std::sqrt(large / n), "): a surface needs points that span a plane");
+         unit * std::sqrt(small / present), ", along it ", unit * std::sqrt(large / present),
+         "): a surface needs points that span a plane");
 }
 
 void set_domain(Sites& s, const ScatteredApproximationOptions& o) {
   std::array<std::array<double, 2>, 2> box{{{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()},
                                             {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()}}};
-  for (std::size_t k = 0; k < s.uv.size(); ++k)
-    if (s.weight[k] > 0)
+  for (std::size_t k = 0; k < s.weight.size(); ++k)
+    if (s.weight[k] > 0) {
+      const auto uv = s.uv(k);
       for (int a = 0; a < 2; ++a) {
-        box[a][0] = std::min(box[a][0], s.uv[k][a]);
-        box[a][1] = std::max(box[a][1], s.uv[k][a]);
+        box[a][0] = std::min(box[a][0], uv[a]);
+        box[a][1] = std::max(box[a][1], uv[a]);
       }
+    }
   if (!o.domain) {
     s.domain = box;
     return;
@@ -116,12 +125,14 @@ void set_domain(Sites& s, const ScatteredApproximationOptions& o) {
     if (!(std::isfinite(d0) && std::isfinite(d1) && d0 < d1))
       fail(errc::non_increasing, "domain along ", a == 0 ? "u" : "v", " is [", d0, ", ", d1, "]: it must increase");
   }
-  for (std::size_t k = 0; k < s.uv.size(); ++k)
-    if (s.weight[k] > 0)
+  for (std::size_t k = 0; k < s.weight.size(); ++k)
+    if (s.weight[k] > 0) {
+      const auto uv = s.uv(k);
       for (int a = 0; a < 2; ++a)
-        if (s.uv[k][a] < s.domain[a][0] || s.uv[k][a] > s.domain[a][1])
-          fail(errc::out_of_domain, "point [", k, "] sits at ", a == 0 ? "u" : "v", " = ", s.uv[k][a], ", outside the domain [",
+        if (uv[a] < s.domain[a][0] || uv[a] > s.domain[a][1])
+          fail(errc::out_of_domain, "point [", k, "] sits at ", a == 0 ? "u" : "v", " = ", uv[a], ", outside the domain [",
                s.domain[a][0], ", ", s.domain[a][1], "]");
+    }
 }
 
 }  // namespace
@@ -133,29 +144,23 @@ Sites scattered_sites(std::span<const Vec3> points, const ScatteredApproximation
   if (s.present < need)
     fail(errc::too_few_points, s.present, " of ", points.size(), " points are present (not missing, weight above 0): a degree (",
          p, ", ", q, ") surface needs at least ", need);
-  s.uv.assign(points.size(), {nan, nan});
+  s.param = o.param;
+  s.points = points;
   const char* what = "";
   switch (o.param) {
     case ScatteredParam::xy:
-      for (std::size_t k = 0; k < points.size(); ++k)
-        if (s.weight[k] > 0) s.uv[k] = {points[k].x, points[k].y};
       what = " in x and y";
       break;
     case ScatteredParam::plane:
       plane_axes(s, points);
-      for (std::size_t k = 0; k < points.size(); ++k)
-        if (s.weight[k] > 0) {
-          const Vec3 d = points[k] - s.origin;
-          s.uv[k] = {dot(d, s.axis_u), dot(d, s.axis_v)};
-        }
       break;
     case ScatteredParam::sites:
       for (std::size_t k = 0; k < points.size(); ++k) {
         const auto& t = o.sites[k];
         if (!std::isfinite(t[0]) || !std::isfinite(t[1]))
           fail(errc::not_finite, "site [", k, "] is (", t[0], ", ", t[1], ")");
-        if (s.weight[k] > 0) s.uv[k] = t;
       }
+      s.given = o.sites;
       what = " at their sites";
       break;
   }
