@@ -60,21 +60,17 @@ Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool x
   for (std::size_t k = 0; k < points.size(); ++k)
     if (s.weight[k] > 0) top = std::max(top, max_abs(points[k] - pr.centre));
   pr.unit_length = approximation_unit(top);
-  const double inv = 1 / pr.unit_length;
+  pr.scale = 1 / pr.unit_length;
   const auto [u0, u1] = s.domain[0];
   const auto [v0, v1] = s.domain[1];
   pr.aspect = (u1 - u0) / (v1 - v0);
   const double side = std::max(u1 - u0, v1 - v0);
   pr.range = {(u1 - u0) / side, (v1 - v0) / side};
   pr.unit.assign(points.size(), {0, 0});
-  pr.value.assign(points.size() * static_cast<std::size_t>(pr.cols), 0.0);
   for (std::size_t k = 0; k < points.size(); ++k) {
     if (!(s.weight[k] > 0)) continue;
     const auto uv = s.uv(k);
     pr.unit[k] = {std::clamp((uv[0] - u0) / side, 0.0, pr.range[0]), std::clamp((uv[1] - v0) / side, 0.0, pr.range[1])};
-    const Vec3 d = (points[k] - pr.centre) * inv;
-    if (xy) pr.value[k] = d.z;
-    else pr.value[3 * k] = d.x, pr.value[3 * k + 1] = d.y, pr.value[3 * k + 2] = d.z;
   }
   return pr;
 }
@@ -93,7 +89,7 @@ System data_system(const Problem& pr, const Net& net, std::span<const double> we
                  cat("scattered approximation's net of ", net.nu, " x ", net.nv, " control points"));
   System sys{NetMatrix(net.nu, net.nv, std::max(net.p, 2), std::max(net.q, 2)), std::vector<double>(net.size() * static_cast<std::size_t>(pr.cols), 0.0),
              pr.cols};
-  add_data_term(net, Samples{pr.unit, weight, pr.value, pr.cols}, sys);
+  add_data_term(net, pr.samples(weight), sys);
   return sys;
 }
 
@@ -175,7 +171,10 @@ double distance_at(const Problem& pr, const Net& net, std::span<const double> x,
     }
   }
   double sq = 0;
-  for (std::size_t m = 0; m < c; ++m) sq += (at[m] - pr.value[k * c + m]) * (at[m] - pr.value[k * c + m]);
+  for (std::size_t m = 0; m < c; ++m) {
+    const double v = pr.value(k, static_cast<int>(m));
+    sq += (at[m] - v) * (at[m] - v);
+  }
   return std::sqrt(sq);
 }
 

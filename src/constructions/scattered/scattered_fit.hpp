@@ -19,15 +19,23 @@ namespace interpatch::detail::scattered {
 struct Problem {
   int p = 3, q = 3, cols = 3;
   std::vector<std::array<double, 2>> unit;
-  std::vector<double> value;  // cols per point
   const Sites* sites = nullptr;
   std::span<const Vec3> points;  // as given
   Vec3 centre{};
   double unit_length = 1;
+  double scale = 1;  // 1 / unit_length
   double aspect = 1;  // the domain's extent along u over its extent along v
   // The domain in the fit's frame: [0, range[0]] × [0, range[1]], the longer side 1, so
   // that J weighs both directions alike (the thin-plate energy of the domain itself).
   std::array<double, 2> range{1, 1};
+
+  /// The points of nonzero `weight`, their values (cols per point) made from the
+  /// points as they are read.
+  [[nodiscard]] Samples samples(std::span<const double> weight) const {
+    return Samples{unit, weight, {}, cols, points, centre, scale};
+  }
+  /// Column c of point k's value.
+  [[nodiscard]] double value(std::size_t k, int c) const { return samples({}).value_at(k, c); }
 };
 
 /// Nets up to this many control points are factored (milliseconds); larger ones go by

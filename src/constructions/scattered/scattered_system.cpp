@@ -205,13 +205,15 @@ void add_cell(const Net& net, const Samples& s, const Cells& cells, std::size_t 
     net.ku.basis(span_u, s.site[k][0], nu_b);
     net.kv.basis(span_v, s.site[k][1], nv_b);
     const double w = s.weight[k];
+    double value[3];
+    for (int c = 0; c < cols; ++c) value[c] = s.value_at(k, c);
     for (int al = 0; al <= p; ++al)
       for (int be = 0; be <= q; ++be) basis[al * (q + 1) + be] = nu_b[al] * nv_b[be];
     std::size_t e = 0;
     for (int l = 0; l < m; ++l) {
       const double wb = w * basis[l];
       for (int l2 = l; l2 < m; ++l2) local[e++] += wb * basis[l2];
-      for (int c = 0; c < cols; ++c) local[pairs + static_cast<std::size_t>(l * cols + c)] += wb * s.value[k * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)];
+      for (int c = 0; c < cols; ++c) local[pairs + static_cast<std::size_t>(l * cols + c)] += wb * value[c];
     }
   }
   const std::size_t nv = static_cast<std::size_t>(net.nv), base = a * nv + b;
