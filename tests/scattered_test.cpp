@@ -15,6 +15,7 @@
 #include <random>
 
 #include "interpatch/approximate.hpp"
+#include "interpatch/io/json_out.hpp"
 #include "interpatch/io/spec.hpp"
 #include "constructions/scattered/scattered_system.hpp"
 #include "property/promise_harness.hpp"
@@ -293,6 +294,27 @@ TEST(Scattered, Refusals) {
     EXPECT_NE(std::string(e.what()).find("point ["), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("control points"), std::string::npos) << e.what();
   }
+}
+
+// A point of weight 0 takes no part and has no site: info measures the data error at
+// the other points' sites, where the fit's own report measured it, and the point, far
+// off the surface, is not the worst one.
+TEST(Scattered, InfoLeavesOutThePointsOfWeightZero) {
+  std::mt19937_64 g(21);
+  auto q = survey(g, 80);
+  q[5].z += 1000;
+  nlohmann::json pts = nlohmann::json::array();
+  for (const Vec3& p : q) pts.push_back({p.x, p.y, p.z});
+  std::vector<double> w(q.size(), 1.0);
+  w[5] = 0;
+  const nlohmann::json spec = {{"type", "approximate"}, {"param", "xy"}, {"tolerance", 0.5}, {"points", pts}, {"weights", w}};
+  const io::Construction c = io::build(spec);
+  const nlohmann::ordered_json info = io::info_json(c);
+  const auto& e = info["max_data_error"];
+  ASSERT_TRUE(e.is_object()) << info.dump();
+  EXPECT_NE(e["at"], "/points/5");
+  EXPECT_LE(e["absolute"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(e["absolute"].get<double>(), c.parameters["max_error"].get<double>()) << info.dump();
 }
 
 // The spec's own refusals for scattered points, each with its code and its place.

@@ -170,7 +170,7 @@ void scattered_data_error(const Surface& s, const DataSet& d, DataError& e, std:
   for (std::size_t k = 0; k < us.size(); ++k) {
     const Vec3& q = d.points[k];
     if (progress && ++done % 65536 == 0) progress(static_cast<double>(done) / static_cast<double>(total));
-    if (!is_finite(q)) continue;  // a missing point
+    if (!is_finite(q) || std::isnan(us[k])) continue;  // a missing point, or one of weight 0: no site
     const Vec3 p = s.point(us[k], vs[k]);
     const double dist = distance(p, q);
     if (!std::isfinite(dist)) result_not_finite(p, cat(d.pointer, "/", k), {us[k], vs[k]});
