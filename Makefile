@@ -124,15 +124,15 @@ demo: viewer-deps
 # the Python suite against `pip install .`, the installed and source-tree consumers,
 # MPI, and the outside programs that read the files (OpenCASCADE, VTK, OpenFOAM,
 # Chromium); the sanitizer build (test-asan) runs the unit tests, the property tests
-# on a fifth of the cases, the fuzz targets' checked-in inputs and MPI again.
+# on a tenth of the cases, the fuzz targets' checked-in inputs and MPI again.
 test-release: test-deps build
 	ctest --preset release -j $(JOBS) || { python3 tools/failed_tests.py build/release; exit 1; }
 
 # The sanitizer build with line tables alone (-g1, CMakePresets.json): three quarters of
 # the compile time of -g, and the reports still name every function, file and line. It
 # stays at -O2: tests compare networks with fixtures made at -O3, and -O1 rounds a knot
-# differently enough to change a merge. Its promise tests run a fifth of the random
-# cases (INTERPATCH_PROMISE_CASES=0.2): it looks for memory and undefined-behaviour
+# differently enough to change a merge. Its promise tests run a tenth of the random
+# cases (INTERPATCH_PROMISE_CASES=0.1): it looks for memory and undefined-behaviour
 # errors, and the Release run tries every case.
 test-asan: test-deps viewer-deps
 	cmake --preset asan

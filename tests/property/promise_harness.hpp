@@ -54,7 +54,7 @@ inline constexpr double eps = std::numeric_limits<double>::epsilon();
 /// `base` cases times INTERPATCH_PROMISE_CASES (1 when unset or not a positive
 /// number), at least one: long runs multiply it (make promise); the sanitizer run,
 /// which looks for memory and undefined-behaviour errors rather than for inputs the
-/// Release run has not tried, takes a fifth (CMakePresets.json, test preset asan).
+/// Release run has not tried, takes a tenth (CMakePresets.json, test preset asan).
 inline std::size_t case_count(std::size_t base) {
   const char* m = std::getenv("INTERPATCH_PROMISE_CASES");
   double k = m ? std::strtod(m, nullptr) : 1.0;
