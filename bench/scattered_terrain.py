@@ -33,7 +33,7 @@ interpatch is skipped, with the reason, while it does not take (N, 3) points.
 
 Needs Debian's python3-numpy python3-scipy python3-matplotlib (the DEM) and gmt.
   /usr/bin/python3 bench/scattered_terrain.py [--points 20000] [--noise 2] [--seed 1]
-      [--rounds 3] [--only griddata,rbf,...] [--json out.json]
+      [--rounds 3] [--only griddata,rbf,...] [--ways tolerance,auto,...] [--json out.json]
       [--interpatch build/release/interpatch]   (module: PYTHONPATH, else python/ beside it)
 """
 import argparse
@@ -302,9 +302,13 @@ def methods(data, args, work):
             ("bispline", "scipy SmoothBivariateSpline", run_bispline),
             ("gmt", "gmt blockmean+surface", run_gmt)]
     for name, kwargs in interpatch_options(data, args).items():
+        if name not in args.ways:
+            continue
         rows.append(("interpatch-py", f"interpatch py {name}",
                      lambda d, a, w, k=kwargs: run_module(d, a, w, k)))
     for name in ("tolerance", "auto", "net"):
+        if name not in args.ways:
+            continue
         rows.append(("interpatch-cli", f"interpatch cli {name}",
                      lambda d, a, w, n=name: run_cli(d, a, w, n)))
     rows.append(("io-floor", "pure I/O floor (cat)", run_io_floor))
@@ -417,10 +421,13 @@ def parse_args():
     ap.add_argument("--smoothing", type=float, default=3e-13,
                     help="interpatch's fairness weight, picked by hand (no unit; 3e-13 gave the best held-out RMS "
                          "of 1e-12, 3e-13 and 1e-13 at 10^5 points; \"auto\" is a row of its own)")
+    ap.add_argument("--ways", default="tolerance,smoothing,auto,net",
+                    help="interpatch's ways to ask for the fit, comma-separated (the command has no smoothing row)")
     ap.add_argument("--bispline-max", type=int, default=50000)
     ap.add_argument("--dir", type=Path, help="keep the files here (default: a temporary folder)")
     args = ap.parse_args()
     args.only = set(args.only.split(","))
+    args.ways = set(args.ways.split(","))
     unknown = args.only - set(GROUPS) - {"interpatch"}
     if unknown:
         ap.error(f"unknown --only {','.join(sorted(unknown))}; known: {','.join(GROUPS)}")
