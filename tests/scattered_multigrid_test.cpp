@@ -81,6 +81,25 @@ TEST(ScatteredMultigrid, RefinementReproducesLinesWhereTheKnotsDoNotNest) {
   }
 }
 
+// The span from the knots' spacing is find_span's, at every knot, beside each (the
+// next double either way), between them, and past both ends.
+TEST(ScatteredMultigrid, SpansFromTheSpacingAreTheSearchedOnes) {
+  std::mt19937_64 g(40);
+  std::uniform_real_distribution<double> U(-0.1, 1.1);
+  for (const int degree : {1, 2, 3, 5})
+    for (const int count : {degree + 1, degree + 2, 7, 64, 259, 1027})
+      for (const double range : {1.0, 0.8, 0.3}) {
+        const Net net(degree, degree, count, count, {range, range});
+        std::vector<double> ts;
+        for (int i = 0; i <= count + degree; ++i) {
+          const double k = net.ku[static_cast<std::size_t>(i)];
+          ts.insert(ts.end(), {k, std::nextafter(k, -1.0), std::nextafter(k, 2.0)});
+        }
+        for (int i = 0; i < 200; ++i) ts.push_back(U(g) * range);
+        for (const double t : ts) ASSERT_EQ(net.span_u(t), net.ku.find_span(t)) << degree << " " << count << " " << range << " t " << t;
+      }
+}
+
 struct Fixture {
   std::vector<Net> nets;
   std::vector<System> systems;

@@ -159,7 +159,7 @@ Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoot
 double distance_at(const Problem& pr, const Net& net, std::span<const double> x, std::size_t k) {
   const std::size_t c = static_cast<std::size_t>(pr.cols), nv = static_cast<std::size_t>(net.nv);
   double bu[max_degree + 1], bv[max_degree + 1];
-  const int su = net.ku.find_span(pr.unit[k][0]), sv = net.kv.find_span(pr.unit[k][1]);
+  const int su = net.span_u(pr.unit[k][0]), sv = net.span_v(pr.unit[k][1]);
   net.ku.basis(su, pr.unit[k][0], bu);
   net.kv.basis(sv, pr.unit[k][1], bv);
   double at[3] = {0, 0, 0};

@@ -14,6 +14,19 @@ namespace interpatch::detail::scattered {
 Net::Net(int p_, int q_, int nu_, int nv_, std::array<double, 2> range)
     : p(p_), q(q_), nu(nu_), nv(nv_), ku(KnotVector::uniform(p_, nu_, 0, range[0])), kv(KnotVector::uniform(q_, nv_, 0, range[1])) {}
 
+int Net::uniform_span(const KnotVector& k, double t) {
+  const int p = k.degree(), n = k.count() - 1;
+  const double a = k[static_cast<std::size_t>(p)], b = k[static_cast<std::size_t>(n + 1)];
+  if (!(t > a)) return p;
+  if (t >= b) return n;
+  // The guess from the spacing, then moved onto the knots as rounded: the span
+  // find_span gives, u[s] <= t < u[s + 1].
+  int s = std::clamp(p + static_cast<int>((t - a) / (b - a) * (n + 1 - p)), p, n);
+  while (s > p && t < k[static_cast<std::size_t>(s)]) --s;
+  while (s < n && t >= k[static_cast<std::size_t>(s + 1)]) ++s;
+  return s;
+}
+
 NetMatrix::NetMatrix(int nu, int nv, int hu, int hv)
     : nu_(nu), nv_(nv), hu_(hu), hv_(hv), width_(hv + 1 + hu * (2 * hv + 1)), a_(rows() * static_cast<std::size_t>(width_), 0.0) {}
 
@@ -172,8 +185,8 @@ Cells sort_by_cell(const Net& net, const Samples& s) {
       cell[kk] = ~std::uint32_t{0};
       continue;
     }
-    const auto a = static_cast<std::size_t>(net.ku.find_span(s.site[kk][0]) - net.p);
-    const auto b = static_cast<std::size_t>(net.kv.find_span(s.site[kk][1]) - net.q);
+    const auto a = static_cast<std::size_t>(net.span_u(s.site[kk][0]) - net.p);
+    const auto b = static_cast<std::size_t>(net.span_v(s.site[kk][1]) - net.q);
     cell[kk] = static_cast<std::uint32_t>(a * sv + b);
   }
   Cells c;
