@@ -124,7 +124,9 @@ demo: viewer-deps
 # the Python suite against `pip install .`, the installed and source-tree consumers,
 # MPI, and the outside programs that read the files (OpenCASCADE, VTK, OpenFOAM,
 # Chromium); the sanitizer build (test-asan) runs the unit tests, the property tests
-# on a tenth of the cases, the fuzz targets' checked-in inputs and MPI again.
+# on a tenth of the cases, the fuzz targets' checked-in inputs and MPI again (its
+# cases' variants left out). There the libraries and the command carry both
+# sanitizers, the tests' own code AddressSanitizer alone (tests/CMakeLists.txt says why).
 test-release: test-deps build
 	ctest --preset release -j $(JOBS) || { python3 tools/failed_tests.py build/release; exit 1; }
 

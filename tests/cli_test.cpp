@@ -450,6 +450,33 @@ TEST_F(CliTest, ViewDecimatesRatherThanRefuses) {
   }
 }
 
+// What `info` says of a checked-in example: a blocks example shares its faces within its
+// tolerance and inverts no cell; an approximation passes within its tolerance, or as
+// near as its λ lets it; a network drawn freehand (its curves re-expressed) passes its
+// curves within 1e-7 of the diagonal; every other construction interpolates to rounding.
+void expect_example_info(const json& j, const std::string& name) {
+  if (j["type"] == "blocks") {
+    EXPECT_FALSE(j["shared_faces"].empty()) << name;
+    for (const auto& f : j["shared_faces"]) EXPECT_LE(f["gap"].get<double>(), j["tolerance"].get<double>()) << name;
+    EXPECT_EQ(j["mesh"]["inverted_cells"], 0) << name;
+    return;
+  }
+  bool reexpressed = false;
+  if (j["parameters"].contains("network_curves"))
+    for (const auto& c : j["parameters"]["network_curves"]) reexpressed |= c["reexpressed"].get<bool>();
+  if (j["parameters"].contains("tolerance")) {
+    EXPECT_LE(j["max_data_error"]["absolute"].get<double>(), j["parameters"]["tolerance"].get<double>()) << name;
+  } else if (j["parameters"].contains("smoothing")) {
+    // info measures what the fit reported: two evaluations of one spline, to rounding
+    // of the data's size.
+    EXPECT_NEAR(j["max_data_error"]["absolute"].get<double>(), j["parameters"]["max_error"].get<double>(),
+                1e-9 * (1 + j["parameters"]["max_error"].get<double>())) << name;
+    EXPECT_GT(j["parameters"]["lambda"].get<double>(), 0.0) << name;
+  } else if (!j["max_data_error"].is_null()) {
+    EXPECT_LT(j["max_data_error"]["relative"].get<double>(), reexpressed ? 1e-7 : 1e-12) << name;
+  }
+}
+
 TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
   const Result r = run({"demo", "-o", "out"});
   ASSERT_EQ(r.status, 0) << r.err;
@@ -522,9 +549,13 @@ TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
     EXPECT_EQ(read_file(at("out") / (name + ".spec.json")), read_file(fs::path(INTERPATCH_EXAMPLES) / (name + ".json")))
         << name;
   }
-  // Every checked-in example is in the demo.
-  for (const std::string& name : checked_in)
+  // Every checked-in example is in the demo, and builds as its description says (the
+  // demo writes what `info` prints for it).
+  EXPECT_GE(checked_in.size(), 3u);
+  for (const std::string& name : checked_in) {
     EXPECT_TRUE(std::ranges::find(shown, name) != shown.end()) << name << " is not in the demo";
+    expect_example_info(json::parse(read_file(at("out") / (name + ".info.json"))), name);
+  }
   // The network drawn freehand: sorted, turned and re-expressed, within 1e-7 of the
   // diagonal of the curves given, and without a warning.
   const json drawn = json::parse(read_file(at("out") / "network_drawn.info.json"));
@@ -546,41 +577,6 @@ TEST_F(CliTest, DemoWritesEveryExampleAndSaysWhere) {
   // A demo directory whose parent is missing is refused, not created.
   expect_one_line_error(run({"demo", "-o", "no/such/dir"}), 4, {"no/such"});
   EXPECT_FALSE(fs::exists(at("no")));
-}
-
-TEST_F(CliTest, CheckedInExamplesBuild) {
-  std::size_t count = 0;
-  for (const auto& e : fs::directory_iterator(INTERPATCH_EXAMPLES)) {
-    if (e.path().extension() != ".json") continue;
-    ++count;
-    const Result r = run({"info", e.path().string()});
-    ASSERT_EQ(r.status, 0) << e.path() << ": " << r.err;
-    const json j = json::parse(r.out);
-    if (j["type"] == "blocks") {  // its faces shared within its tolerance, its cells none inverted
-      EXPECT_FALSE(j["shared_faces"].empty()) << e.path();
-      for (const auto& f : j["shared_faces"]) EXPECT_LE(f["gap"].get<double>(), j["tolerance"].get<double>()) << e.path();
-      EXPECT_EQ(j["mesh"]["inverted_cells"], 0) << e.path();
-      continue;
-    }
-    // A network whose curves were re-expressed (drawn freehand) passes them within
-    // 1e-7 of the diagonal; every other construction interpolates to rounding.
-    bool reexpressed = false;
-    if (j["parameters"].contains("network_curves"))
-      for (const auto& c : j["parameters"]["network_curves"]) reexpressed |= c["reexpressed"].get<bool>();
-    if (j["parameters"].contains("tolerance")) {
-      // An approximation passes near its data: within its tolerance.
-      EXPECT_LE(j["max_data_error"]["absolute"].get<double>(), j["parameters"]["tolerance"].get<double>()) << e.path();
-    } else if (j["parameters"].contains("smoothing")) {
-      // A smoothing passes as near as its λ lets it: info measures what the fit reported
-      // (two evaluations of one spline, to rounding of the data's size).
-      EXPECT_NEAR(j["max_data_error"]["absolute"].get<double>(), j["parameters"]["max_error"].get<double>(),
-                  1e-9 * (1 + j["parameters"]["max_error"].get<double>())) << e.path();
-      EXPECT_GT(j["parameters"]["lambda"].get<double>(), 0.0) << e.path();
-    } else if (!j["max_data_error"].is_null()) {
-      EXPECT_LT(j["max_data_error"]["relative"].get<double>(), reexpressed ? 1e-7 : 1e-12) << e.path();
-    }
-  }
-  EXPECT_GE(count, 3u);
 }
 
 // --- closed (periodic) shapes ------------------------------------------------------------
