@@ -167,7 +167,19 @@ PROMISE_CASES ?= 50
 promise: test-deps build
 	INTERPATCH_PROMISE_CASES=$(PROMISE_CASES) ./build/release/tests/interpatch_property_tests --gtest_filter='Promise*'
 
-test: test-release test-asan
+# make test: the Release tests leave a core idle a seventh of their time (waiting on
+# launchers, browsers and other processes), so the sanitizer build compiles beside them
+# at the lowest priority (nice 19: a test that wants a core has it), its output in
+# build/asan/build.log; then the sanitizer run. (ninja itself, not cmake --build: killed,
+# it stops the compilers it started.) It runs what test-release, then test-asan run.
+test: test-deps build viewer-deps
+	cmake --preset asan
+	@echo "make test: the sanitizer build compiles beside the Release tests; its log: build/asan/build.log"
+	@nice -n 19 ninja -C build/asan -j $(JOBS) > build/asan/build.log 2>&1 & build=$$!; \
+	ctest --preset release -j $(JOBS) || { python3 tools/failed_tests.py build/release; kill $$build; wait $$build; exit 1; }; \
+	wait $$build || { tail -n 80 build/asan/build.log; echo "make test: the sanitizer build failed (build/asan/build.log)"; exit 1; }; \
+	tail -n 2 build/asan/build.log
+	ctest --preset asan -j $(JOBS) || { python3 tools/failed_tests.py build/asan; exit 1; }
 
 # Benchmarks (never part of `make test`): the console table, then the JSON record
 # and its Markdown tables (docs/BENCHMARKS.md). Repetitions tame a shared machine;
