@@ -131,9 +131,10 @@ test-release: test-deps build
 	ctest --preset release -j $(JOBS) || { python3 tools/failed_tests.py build/release; exit 1; }
 
 # The sanitizer build with line tables alone (-g1, CMakePresets.json): three quarters of
-# the compile time of -g, and the reports still name every function, file and line. It
-# stays at -O2: tests compare networks with fixtures made at -O3, and -O1 rounds a knot
-# differently enough to change a merge. Its promise tests run a tenth of the random
+# the compile time of -g, and the reports still name every function, file and line. The
+# core stays at -O2: tests compare networks with fixtures made at -O3, and -O1 rounds a
+# knot differently enough to change a merge. io and the command, which parse and write
+# what the core computes, take -O1 (INTERPATCH_IO_COMPILE_OPTIONS). Its promise tests run a tenth of the random
 # cases (INTERPATCH_PROMISE_CASES=0.1): it looks for memory and undefined-behaviour
 # errors, and the Release run tries every case.
 test-asan: test-deps viewer-deps
