@@ -127,20 +127,23 @@ demo: viewer-deps
 # on a tenth of the cases, the fuzz targets' checked-in inputs and MPI again (its
 # cases' variants left out). There the libraries and the command carry both
 # sanitizers, the tests' own code AddressSanitizer alone (tests/CMakeLists.txt says why).
+# A test run: on failure, the failed tests' last lines, then $(2) (make test stops the
+# sanitizer build compiling beside the Release run).
+ctest_run = ctest --preset $(1) -j $(JOBS) || { python3 tools/failed_tests.py build/$(1); $(2) exit 1; }
 test-release: test-deps build
-	ctest --preset release -j $(JOBS) || { python3 tools/failed_tests.py build/release; exit 1; }
+	$(call ctest_run,release)
 
 # The sanitizer build with line tables alone (-g1, CMakePresets.json): three quarters of
 # the compile time of -g, and the reports still name every function, file and line. The
 # core stays at -O2: tests compare networks with fixtures made at -O3, and -O1 rounds a
 # knot differently enough to change a merge. io and the command, which parse and write
-# what the core computes, take -O1 (INTERPATCH_IO_COMPILE_OPTIONS). Its promise tests run a tenth of the random
-# cases (INTERPATCH_PROMISE_CASES=0.1): it looks for memory and undefined-behaviour
-# errors, and the Release run tries every case.
+# what the core computes, take -O1 (INTERPATCH_IO_COMPILE_OPTIONS). Its promise tests
+# run a tenth of the random cases (INTERPATCH_PROMISE_CASES=0.1): it looks for memory
+# and undefined-behaviour errors, and the Release run tries every case.
 test-asan: test-deps viewer-deps
 	cmake --preset asan
 	cmake --build --preset asan -j $(JOBS)
-	ctest --preset asan -j $(JOBS) || { python3 tools/failed_tests.py build/asan; exit 1; }
+	$(call ctest_run,asan)
 
 # The parsers under libFuzzer (clang, ASan + UBSan): every checked-in seed and
 # regression input once, then FUZZ_TEST_SECONDS of fuzzing per target (test-fuzz) or
@@ -177,10 +180,10 @@ test: test-deps build viewer-deps
 	cmake --preset asan
 	@echo "make test: the sanitizer build compiles beside the Release tests; its log: build/asan/build.log"
 	@nice -n 19 ninja -C build/asan -j $(JOBS) > build/asan/build.log 2>&1 & build=$$!; \
-	ctest --preset release -j $(JOBS) || { python3 tools/failed_tests.py build/release; kill $$build; wait $$build; exit 1; }; \
+	$(call ctest_run,release,kill $$build; wait $$build;); \
 	wait $$build || { tail -n 80 build/asan/build.log; echo "make test: the sanitizer build failed (build/asan/build.log)"; exit 1; }; \
 	tail -n 2 build/asan/build.log
-	ctest --preset asan -j $(JOBS) || { python3 tools/failed_tests.py build/asan; exit 1; }
+	$(call ctest_run,asan)
 
 # Benchmarks (never part of `make test`): the console table, then the JSON record
 # and its Markdown tables (docs/BENCHMARKS.md). Repetitions tame a shared machine;
