@@ -14,7 +14,9 @@
 #include <numeric>
 #include <random>
 
+#include "constructions/scattered/scattered_fit.hpp"
 #include "constructions/scattered/scattered_multigrid.hpp"
+#include "constructions/scattered/scattered_smoother.hpp"
 #include "interpatch/approximate.hpp"
 #include "interpatch/io/spec.hpp"
 #include "property/promise_harness.hpp"
@@ -107,7 +109,8 @@ struct Fixture {
   std::vector<double> weight, value;
 };
 
-// Random points (with a void) on a net of nu × nv, and the systems of the nets below.
+// Random points (with a void) on a net of nu × nv, and the systems of the nets below;
+// λ below 0: the fill weight of the finest net, what `control_points` fits use.
 Fixture fixture(int nu, int nv, std::size_t points, double lambda, int cols, std::uint64_t seed) {
   Fixture f;
   std::mt19937_64 g(seed);
@@ -123,6 +126,12 @@ Fixture fixture(int nu, int nv, std::size_t points, double lambda, int cols, std
     for (int c = 0; c < cols; ++c)
       f.value[k * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)] =
           std::sin(7 * f.site[k][0] + c) * std::cos(5 * f.site[k][1]) + 0.05 * (U(g) - 0.5);
+  if (lambda < 0) {
+    const Net n(3, 3, nu, nv, {1, 0.8});
+    System fine{NetMatrix(nu, nv, 3, 3), std::vector<double>(n.size() * static_cast<std::size_t>(cols), 0.0), cols};
+    add_data_term(n, Samples{f.site, f.weight, f.value, cols}, fine);
+    lambda = fill_lambda(n, fine.a, static_cast<double>(points));
+  }
   for (const auto& sp : hierarchy({nu - 3, nv - 3}, 3, 3, 4096)) {
     f.nets.emplace_back(3, 3, sp[0] + 3, sp[1] + 3, std::array<double, 2>{1, 0.8});
     const Net& n = f.nets.back();
@@ -182,6 +191,84 @@ TEST(ScatteredMultigrid, SolvesEqualTheFactorization) {
     for (std::size_t i = 0; i < x.size(); ++i) size = std::max(size, std::abs(direct[i])), worst = std::max(worst, std::abs(x[i] - direct[i]));
     EXPECT_LE(worst, 1e-9 * size) << cols << " columns";
   }
+}
+
+// With only the fill weight and about four points a knot cell, the normal equations
+// have near-null modes a few control points wide (clusters of points the basis hardly
+// tells apart, the edges' B-splines that barely reach a point). Strips solved whole
+// keep conjugate gradients to a few dozen steps: 13 on this net, where Gauss–Seidel
+// point by point took 244 on the same kind of net.
+TEST(ScatteredMultigrid, FourPointsACellWithOnlyTheFillTakeFewSteps) {
+  const Fixture f = fixture(100, 100, 36000, -1, 1, 37);
+  Multigrid mg = multigrid(f, 1);
+  const System& top = f.systems.back();
+  std::vector<double> x(top.rhs.size(), 0.0);
+  const Solved s = solve_cg(top.a, top.rhs, x, 1, 1e-12, 300, [&mg](std::span<const double> r, std::span<double> z, int) { mg.apply(r, z); });
+  EXPECT_LE(s.residual, 1e-12);
+  EXPECT_LE(s.iterations, 30);
+}
+
+// A strip as wide as the net is the whole net: with four rows (one strip along u) or
+// four columns (one along v, solved last), a sweep from zero gives the factorization's
+// solution, to 1e-9 of its size (two factorizations' rounding times a condition number
+// of this small, well-filled net below 1e6).
+TEST(ScatteredMultigrid, AStripAsWideAsTheNetSolvesIt) {
+  for (const auto& [nu, nv] : {std::array<int, 2>{4, 40}, std::array<int, 2>{40, 4}})
+    for (const int cols : {1, 3}) {
+      std::mt19937_64 g(static_cast<std::uint64_t>(nu * 10 + cols));
+      std::uniform_real_distribution<double> U(0, 1);
+      const Net n(3, 3, nu, nv);
+      std::vector<std::array<double, 2>> site(3000);
+      std::vector<double> weight(site.size(), 1.0), value(site.size() * static_cast<std::size_t>(cols));
+      for (auto& st : site) st = {U(g), U(g)};
+      for (double& v : value) v = U(g);
+      System sys{NetMatrix(nu, nv, 3, 3), std::vector<double>(n.size() * static_cast<std::size_t>(cols), 0.0), cols};
+      add_data_term(n, Samples{site, weight, value, cols}, sys);
+      add_fairness(n, &sys.a, 1e-6 * static_cast<double>(site.size()));
+      sys.a.mirror();
+      std::vector<double> x(sys.rhs.size(), 0.0), direct(sys.rhs.size(), 0.0);
+      const StripSmoother smoother(sys.a);
+      smoother.sweep(sys.a, sys.rhs, x, cols, false);
+      ASSERT_TRUE(solve_direct(sys.a, sys.rhs, direct, cols));
+      double size = 0, worst = 0;
+      for (std::size_t i = 0; i < x.size(); ++i) size = std::max(size, std::abs(direct[i])), worst = std::max(worst, std::abs(x[i] - direct[i]));
+      EXPECT_LE(worst, 1e-9 * size) << nu << " x " << nv << ", " << cols << " columns";
+    }
+}
+
+// A net's matrix kept with one fairness weight and taken with another is the matrix
+// assembled with the other, to rounding (1e-13 of the largest entry: two sums of a
+// few dozen terms each), and a net not kept is not there.
+TEST(ScatteredMultigrid, KeptMatricesTakeTheNewFairnessWeight) {
+  std::mt19937_64 g(38);
+  std::uniform_real_distribution<double> U(0, 1);
+  const Net n(3, 3, 30, 25), other(3, 3, 25, 30);
+  std::vector<std::array<double, 2>> site(4000);
+  std::vector<double> weight(site.size(), 1.0), value(site.size());
+  for (auto& st : site) st = {U(g), U(g)};
+  for (double& v : value) v = U(g);
+  const auto assembled = [&](double scaled) {
+    System sys{NetMatrix(n.nu, n.nv, 3, 3), std::vector<double>(n.size(), 0.0), 1};
+    add_data_term(n, Samples{site, weight, value, 1}, sys);
+    add_fairness(n, &sys.a, scaled);
+    return std::move(sys.a);
+  };
+  KeptMatrices kept;
+  kept.keep(n, assembled(0.5), 0.5);
+  EXPECT_FALSE(kept.take(other, 3.0).has_value());
+  const std::optional<NetMatrix> got = kept.take(n, 3.0);
+  ASSERT_TRUE(got.has_value());
+  const NetMatrix want = assembled(3.0);
+  double top = 0, worst = 0;
+  for (std::size_t r = 0; r < want.rows(); ++r)
+    for (int di = 0; di <= 3; ++di)
+      for (int dj = di == 0 ? 0 : -3; dj <= 3; ++dj) {
+        const int k = want.offset(di, dj);
+        top = std::max(top, std::abs(want.at(r, k)));
+        worst = std::max(worst, std::abs(want.at(r, k) - got->at(r, k)));
+      }
+  EXPECT_LE(worst, 1e-13 * top);
+  EXPECT_FALSE(kept.take(n, 3.0).has_value());  // taken out
 }
 
 // A smooth field with noise σ = 2 at scattered sites.

@@ -126,9 +126,10 @@ Fitted solve_tolerance(const Problem& pr, double tolerance, const ScatteredAppro
   std::array<int, 2> spans = spans_for(pr.aspect, 1);
   std::optional<BSplineSurface> coarser;
   Fitted f{Net(pr.p, pr.q, pr.p + 1, pr.q + 1, pr.range), {}, 0};
+  KeptMatrices kept;  // each net's matrix, the next nets' multigrid levels
   for (;;) {
     f.net = Net(pr.p, pr.q, spans[0] + pr.p, spans[1] + pr.q, pr.range);
-    f.level = solve_level(pr, f.net, std::nullopt, coarser ? &*coarser : nullptr);
+    f.level = solve_level(pr, f.net, std::nullopt, coarser ? &*coarser : nullptr, {}, &kept);
     ++f.fits;
     const ApproxDistance e = net_distances(pr, f.net, f.level.x);
     if (e.max <= d) return f;

@@ -14,37 +14,51 @@ namespace interpatch::detail::scattered {
 
 namespace {
 
-// The largest net factored when conjugate gradients stall (about 8 s at 200 x 200, the
-// time growing as n^1.5).
-constexpr std::size_t direct_limit = 40000;
+// The largest net factored when conjugate gradients would take many steps: 78 400
+// control points took 6.4 s and 305 MB, against 28 s of conjugate gradients; the time
+// grows as n^1.5. Factored only when the memory (up to direct_bytes a control point)
+// is there.
+constexpr std::size_t direct_limit = 100000;
+constexpr std::size_t direct_bytes = 8192;
+// Conjugate gradients' steps between two looks at their rate, from which the steps to
+// the end are told, and the most steps worth taking when the factorization is the other
+// way.
+constexpr int probe_steps = 40;
+constexpr int slow_steps = 150;
 
 [[noreturn]] void not_definite(const Net& net) {
   fail(errc::singular, "scattered approximation with ", net.nu, " x ", net.nv, " control points: the normal ",
        "equations are not positive definite (points all on one line of the parameter plane)");
 }
 
-// The nets below `net` for multigrid, their systems (data and fairness at `scaled`,
-// the weight times the points' weight sum) and the cycle over them and `top`.
+// The nets below `net` for multigrid, their matrices (data and fairness at `scaled`,
+// the weight times the points' weight sum; taken from `kept` where there) and the
+// cycle over them and `top`.
 struct Hierarchy {
-  std::vector<System> below;
+  std::vector<Net> nets;
+  std::vector<NetMatrix> below;
   std::optional<Multigrid> mg;
 };
 
-Hierarchy hierarchy_for(const Problem& pr, const Net& net, const NetMatrix& top, std::span<const double> weight, double scaled) {
+Hierarchy hierarchy_for(const Problem& pr, const Net& net, const NetMatrix& top, std::span<const double> weight, double scaled,
+                        KeptMatrices* kept) {
   Hierarchy h;
   const auto spans = hierarchy(std::array<int, 2>{net.nu - net.p, net.nv - net.q}, net.p, net.q, coarsest_net);
-  std::vector<Net> nets;
-  for (const auto& sp : spans) nets.emplace_back(net.p, net.q, sp[0] + net.p, sp[1] + net.q, pr.range);
-  h.below.reserve(nets.size() - 1);
+  for (const auto& sp : spans) h.nets.emplace_back(net.p, net.q, sp[0] + net.p, sp[1] + net.q, pr.range);
+  h.below.reserve(h.nets.size() - 1);
   std::vector<const NetMatrix*> matrices;
-  for (std::size_t l = 0; l + 1 < nets.size(); ++l) {
-    h.below.push_back(data_system(pr, nets[l], weight));
-    add_fairness(nets[l], &h.below.back().a, scaled);
-    h.below.back().a.mirror();
-    matrices.push_back(&h.below.back().a);
+  for (std::size_t l = 0; l + 1 < h.nets.size(); ++l) {
+    std::optional<NetMatrix> a = kept ? kept->take(h.nets[l], scaled) : std::nullopt;
+    if (!a) {
+      a.emplace(std::move(data_system(pr, h.nets[l], weight).a));
+      add_fairness(h.nets[l], &*a, scaled);
+    }
+    h.below.push_back(std::move(*a));
+    h.below.back().mirror();
+    matrices.push_back(&h.below.back());
   }
   matrices.push_back(&top);
-  h.mg.emplace(std::move(nets), std::move(matrices), pr.cols);
+  h.mg.emplace(h.nets, std::move(matrices), pr.cols);
   return h;
 }
 
@@ -85,9 +99,10 @@ BSplineSurface unit_surface(const Net& net, std::span<const double> x, int cols)
 }
 
 System data_system(const Problem& pr, const Net& net, std::span<const double> weight) {
-  require_memory(net.size(), NetMatrix::bytes_per_row(std::max(net.p, 2), std::max(net.q, 2)) + sizeof(double) * static_cast<std::size_t>(8 + 5 * pr.cols),
+  const int hu = std::max(net.p, 2), hv = std::max(net.q, 2);
+  require_memory(net.size(), NetMatrix::bytes_per_row(hu, hv) + StripSmoother::bytes_per_row(hu, hv) + sizeof(double) * static_cast<std::size_t>(8 + 5 * pr.cols),
                  cat("scattered approximation's net of ", net.nu, " x ", net.nv, " control points"));
-  System sys{NetMatrix(net.nu, net.nv, std::max(net.p, 2), std::max(net.q, 2)), std::vector<double>(net.size() * static_cast<std::size_t>(pr.cols), 0.0),
+  System sys{NetMatrix(net.nu, net.nv, hu, hv), std::vector<double>(net.size() * static_cast<std::size_t>(pr.cols), 0.0),
              pr.cols};
   add_data_term(net, pr.samples(weight), sys);
   return sys;
@@ -102,24 +117,52 @@ double fill_lambda(const Net& net, const NetMatrix& data, double weight_sum) {
 
 // Solves one net's system from the x given: factored when small, otherwise conjugate
 // gradients to a residual of 1e-12 of the right-hand side (the fit to about twelve
-// digits of the data's size), preconditioned by a V-cycle; factored after all when
-// they stall on a net the factorization still takes (ties of points far finer than
-// the knots), an error past it.
-void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const double> weight, double scaled, std::vector<double>& x) {
+// digits of the data's size), preconditioned by a V-cycle. Where cells hold a few
+// points or more they take one or two dozen steps; where they hold about one or fewer
+// (only the small fill between the points), hundreds: a net the factorization takes is
+// then factored as soon as the first steps show the rate, a larger one runs on and is
+// refused if it stalls.
+std::optional<NetMatrix> KeptMatrices::take(const Net& net, double scaled) {
+  for (auto e = kept_.begin(); e != kept_.end(); ++e) {
+    if (e->nu != net.nu || e->nv != net.nv) continue;
+    NetMatrix a = std::move(e->a);
+    if (scaled != e->scaled) add_fairness(net, &a, scaled - e->scaled);
+    kept_.erase(e);
+    return a;
+  }
+  return std::nullopt;
+}
+
+void KeptMatrices::keep(const Net& net, NetMatrix a, double scaled) {
+  a.drop_mirror();
+  kept_.push_back(Entry{net.nu, net.nv, scaled, std::move(a)});
+}
+
+void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const double> weight, double scaled, std::vector<double>& x,
+               KeptMatrices* kept) {
   if (net.size() <= coarsest_net) {
     if (!solve_direct(sys.a, sys.rhs, x, pr.cols)) not_definite(net);
     return;
   }
-  sys.a.mirror();
-  Hierarchy h = hierarchy_for(pr, net, sys.a, weight, scaled);
-  if (!h.mg->factor()) not_definite(h.mg->net(0));
-  Multigrid& mg = *h.mg;
-  // A few dozen steps where the fairness weight holds every cell; hundreds where only
-  // the small fill does and cells hold fewer points than control points.
-  const bool factorable = net.size() <= direct_limit;
-  const int cap = factorable ? 300 : 200 + 40 * (net.nu + net.nv);
-  const Solved sol = solve_cg(sys.a, sys.rhs, x, pr.cols, 1e-12, cap,
-                              [&mg](std::span<const double> r, std::span<double> z, int) { mg.apply(r, z); });
+  const bool factorable = net.size() <= direct_limit && available_memory() / direct_bytes >= net.size();
+  Solved sol;
+  {
+    sys.a.mirror();
+    Hierarchy h = hierarchy_for(pr, net, sys.a, weight, scaled, kept);
+    if (!h.mg->factor()) not_definite(h.mg->net(0));
+    Multigrid& mg = *h.mg;
+    double before = 0;  // the residual probe_steps ago
+    const KeepGoing keep_going = [&](int steps, double residual) {
+      if (!factorable || steps % probe_steps != 0) return true;
+      const double rate = std::log(residual / before) / probe_steps;  // per step, below 0 while converging
+      before = residual;
+      return steps == 0 || (rate < 0 && steps + std::log(1e-12 / residual) / rate <= slow_steps);
+    };
+    sol = solve_cg(sys.a, sys.rhs, x, pr.cols, 1e-12, factorable ? 4 * slow_steps : 200 + 40 * (net.nu + net.nv),
+                   [&mg](std::span<const double> r, std::span<double> z, int) { mg.apply(r, z); }, keep_going);
+    if (kept)
+      for (std::size_t l = 0; l < h.below.size(); ++l) kept->keep(h.nets[l], std::move(h.below[l]), scaled);
+  }
   if (sol.residual <= 1e-12) return;
   if (factorable) {
     if (!solve_direct(sys.a, sys.rhs, x, pr.cols)) not_definite(net);
@@ -134,7 +177,7 @@ void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const d
 // voids), from the coarser fit's values at this net's Greville abscissae (zero for the
 // first).
 Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoothing, const BSplineSurface* coarser,
-                  std::vector<double> start) {
+                  std::vector<double> start, KeptMatrices* kept) {
   const Sites& s = *pr.sites;
   System sys = data_system(pr, net, s.weight);
   Level out;
@@ -152,7 +195,8 @@ Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoot
       else out.x[3 * r] = at[r].x, out.x[3 * r + 1] = at[r].y, out.x[3 * r + 2] = at[r].z;
     }
   }
-  solve_net(pr, net, sys, s.weight, s.weight_sum * out.lambda, out.x);
+  solve_net(pr, net, sys, s.weight, s.weight_sum * out.lambda, out.x, kept);
+  if (kept) kept->keep(net, std::move(sys.a), s.weight_sum * out.lambda);
   return out;
 }
 

@@ -61,12 +61,34 @@ System data_system(const Problem& pr, const Net& net, std::span<const double> we
 /// diagonal on average 1e-5 of the data term's, far below any smoothing asked for.
 double fill_lambda(const Net& net, const NetMatrix& data, double weight_sum);
 
+/// The matrices of nets already solved on the same points and weights, each with the
+/// fairness weight summed into it: a finer net's multigrid takes them for its coarse
+/// nets, the weight moved by adding the difference times the fairness term, where a
+/// pass over the points would assemble them again (the tolerance's refinement solves
+/// every net of a finer one's hierarchy before it).
+class KeptMatrices {
+ public:
+  /// The matrix of a nu × nv net moved out, summed with fairness at `scaled`, if kept.
+  std::optional<NetMatrix> take(const Net& net, double scaled);
+  void keep(const Net& net, NetMatrix a, double scaled);
+
+ private:
+  struct Entry {
+    int nu = 0, nv = 0;
+    double scaled = 0;
+    NetMatrix a;
+  };
+  std::vector<Entry> kept_;
+};
+
 /// Solves one net's system (data term of `weight`, fairness added at `scaled`, λ times
 /// the weight sum) from the x given, to a residual of 1e-12 of the right-hand side.
 /// Factored when small, otherwise by conjugate gradients preconditioned by a V-cycle
-/// over nets assembled from the same points and weight; factored after all when they
-/// stall on a net the factorization still takes, an error past it.
-void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const double> weight, double scaled, std::vector<double>& x);
+/// over nets assembled from the same points and weight (or taken from `kept`, where
+/// they are left afterwards); factored after all when they stall on a net the
+/// factorization still takes, an error past it.
+void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const double> weight, double scaled, std::vector<double>& x,
+               KeptMatrices* kept = nullptr);
 
 /// The distance of point k from the fit whose net holds `x` (cols per control point),
 /// at the point's site, in the fit's frame: the basis there times the net's values.
@@ -74,9 +96,9 @@ double distance_at(const Problem& pr, const Net& net, std::span<const double> x,
 
 /// One net solved on every point present: λ at least the fill, started from `start`
 /// (the net's values), or the coarser fit's values at this net's Greville abscissae,
-/// or zero.
+/// or zero. Its matrices are left in `kept` when given.
 Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoothing, const BSplineSurface* coarser,
-                  std::vector<double> start = {});
+                  std::vector<double> start = {}, KeptMatrices* kept = nullptr);
 
 /// λ chosen by cross-validation and the last fit of the search (of most points).
 struct Chosen {

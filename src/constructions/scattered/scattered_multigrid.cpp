@@ -168,6 +168,9 @@ Multigrid::Multigrid(std::vector<Net> nets, std::vector<const NetMatrix*> matric
 
 bool Multigrid::factor() {
   coarsest_.emplace(*a_.front());
+  smoothers_.clear();
+  smoothers_.reserve(a_.size());
+  for (std::size_t l = 1; l < a_.size(); ++l) smoothers_.emplace_back(*a_[l]);
   return coarsest_->ok();
 }
 
@@ -178,14 +181,15 @@ void Multigrid::cycle(std::size_t level, std::span<const double> b, std::span<do
   }
   const NetMatrix& a = *a_[level];
   std::fill(x.begin(), x.end(), 0.0);
-  a.gauss_seidel(b, x, cols_, false);
+  const StripSmoother& smoother = smoothers_[level - 1];
+  smoother.sweep(a, b, x, cols_, false);
   std::vector<double>& r = r_[level];
   a.multiply(x, r, cols_);
   for (std::size_t k = 0; k < r.size(); ++k) r[k] = b[k] - r[k];
   restrict_to(up_[level], r, b_[level - 1], cols_, tmp_[level]);
   cycle(level - 1, b_[level - 1], x_[level - 1]);
   prolong(up_[level], x_[level - 1], x, cols_, tmp_[level]);
-  a.gauss_seidel(b, x, cols_, true);
+  smoother.sweep(a, b, x, cols_, true);
 }
 
 void Multigrid::apply(std::span<const double> r, std::span<double> z) { cycle(nets_.size() - 1, r, z); }

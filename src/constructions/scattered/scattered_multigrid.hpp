@@ -1,11 +1,10 @@
 #pragma once
 // Multigrid for the normal equations of a scattered fit: the same functional (data term
 // and fairness with the same weight) assembled on nets of halved spans, a symmetric
-// V-cycle of multicolour Gauss–Seidel between them and a factored coarsest net, used to
-// precondition conjugate gradients. The data term alone is a mass matrix whose
-// oscillating modes Gauss–Seidel damps slowly; the fairness term across voids is a
-// biharmonic one whose smooth modes only the coarse nets reach; together they leave
-// conjugate gradients a few dozen steps where the diagonal needed thousands.
+// V-cycle of strip Gauss–Seidel (scattered_smoother.hpp) between them and a factored
+// coarsest net, used to precondition conjugate gradients. The data term alone is a mass
+// matrix whose oscillating modes a point smoother damps slowly; the fairness term across
+// voids is a biharmonic one whose smooth modes only the coarse nets reach.
 
 #include <array>
 #include <cstddef>
@@ -13,6 +12,7 @@
 #include <span>
 #include <vector>
 
+#include "constructions/scattered/scattered_smoother.hpp"
 #include "constructions/scattered/scattered_system.hpp"
 
 namespace interpatch::detail::scattered {
@@ -46,10 +46,12 @@ class Multigrid {
  public:
   /// nets and matrices coarsest first; the matrices outlive this object.
   Multigrid(std::vector<Net> nets, std::vector<const NetMatrix*> matrices, int cols);
-  /// Factors the coarsest matrix (again). False when it is not positive definite.
+  /// Factors the coarsest matrix and the finer ones' smoothers (again). False when the
+  /// coarsest is not positive definite.
   bool factor();
-  /// z = the V-cycle applied to r: one forward sweep down, the coarsest solved, one
-  /// backward sweep up, so the operator is symmetric positive definite.
+  /// z = the V-cycle applied to r: one forward sweep of the strip smoother down, the
+  /// coarsest solved, one backward sweep up, so the operator is symmetric positive
+  /// definite.
   void apply(std::span<const double> r, std::span<double> z);
   [[nodiscard]] const Net& net(std::size_t level) const { return nets_[level]; }
   [[nodiscard]] std::size_t levels() const { return nets_.size(); }
@@ -61,6 +63,7 @@ class Multigrid {
   std::vector<std::array<Refinement, 2>> up_;  // up_[l]: level l - 1 to level l
   std::vector<std::vector<double>> r_, b_, x_, tmp_;
   std::optional<DirectSolver> coarsest_;
+  std::vector<StripSmoother> smoothers_;  // smoothers_[l - 1]: level l's
   int cols_;
 };
 

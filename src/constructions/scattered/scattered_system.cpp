@@ -125,29 +125,6 @@ void NetMatrix::multiply(std::span<const double> x, std::span<double> y, int col
     }
 }
 
-void NetMatrix::gauss_seidel(std::span<const double> b, std::span<double> x, int cols, bool backward) const {
-  const std::size_t c = static_cast<std::size_t>(cols), nv = static_cast<std::size_t>(nv_);
-  const int su = hu_ + 1, sv = hv_ + 1, colours = su * sv;
-  // Each colour is a parallel region of its own: worth it only for a colour's work.
-  const bool parallel = rows() / static_cast<std::size_t>(colours) * static_cast<std::size_t>(2 * width_) * c >= parallel_min_work;
-  for (int n = 0; n < colours; ++n) {
-    const int colour = backward ? colours - 1 - n : n, ci = colour / sv, cj = colour % sv;
-    const int lines = nu_ > ci ? (nu_ - ci + su - 1) / su : 0;
-#pragma omp parallel for schedule(static) if (parallel)
-    for (int l = 0; l < lines; ++l) {
-      const int i = ci + l * su;
-      for (int j = cj; j < nv_; j += sv) {
-        const std::size_t r = static_cast<std::size_t>(i) * nv + static_cast<std::size_t>(j);
-        const double d = at(r, 0);
-        if (!(d > 0)) continue;
-        double acc[3];
-        row_product(i, j, x, c, acc);
-        for (std::size_t k = 0; k < c; ++k) x[r * c + k] += (b[r * c + k] - acc[k]) / d;
-      }
-    }
-  }
-}
-
 void NetMatrix::assign_sum(const NetMatrix& d, const NetMatrix& f, double s) {
   mirrored_ = false;
   for (std::size_t k = 0; k < a_.size(); ++k) a_[k] = d.a_[k] + s * f.a_[k];
@@ -350,7 +327,7 @@ void dots(std::span<const double> x, std::span<const double> y, int cols, double
 }  // namespace
 
 Solved solve_cg(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols, double rel, int max_iter,
-                const Preconditioner& precondition) {
+                const Preconditioner& precondition, const KeepGoing& keep_going) {
   const std::size_t c = static_cast<std::size_t>(cols), n = a.rows(), len = n * c;
   std::vector<double> inv(n), r(len), z(len), p(len), ap(len), partial;
   for (std::size_t i = 0; i < n; ++i) inv[i] = a.at(i, 0) > 0 ? 1 / a.at(i, 0) : 1.0;
@@ -379,7 +356,8 @@ Solved solve_cg(const NetMatrix& a, std::span<const double> b, std::span<double>
     return w;
   };
   out.residual = worst();
-  for (; out.iterations < max_iter && out.residual > rel; ++out.iterations) {
+  const auto go_on = [&] { return out.iterations < max_iter && out.residual > rel && (!keep_going || keep_going(out.iterations, out.residual)); };
+  for (; go_on(); ++out.iterations) {
     a.multiply(p, ap, cols);
     dots(p, ap, cols, pap, partial);
     double alpha[3] = {0, 0, 0};

@@ -49,16 +49,19 @@ class NetMatrix {
     return a_[row * static_cast<std::size_t>(width_) + static_cast<std::size_t>(k)];
   }
   [[nodiscard]] double at(std::size_t row, int k) const { return a_[row * static_cast<std::size_t>(width_) + static_cast<std::size_t>(k)]; }
+  /// The entry coupling row (i, j), index `row`, with (i + di, j + dj), either half
+  /// (|di| <= hu, |dj| <= hv, both inside the net).
+  [[nodiscard]] double entry(std::size_t row, int di, int dj) const {
+    if (di > 0 || (di == 0 && dj >= 0)) return at(row, offset(di, dj));
+    const auto back = static_cast<std::ptrdiff_t>(-di) * nv_ - dj;
+    return at(static_cast<std::size_t>(static_cast<std::ptrdiff_t>(row) - back), offset(-di, -dj));
+  }
   /// Adds s·v vᵀ for v with entries `coef` at the control points `at` (each (i, j)).
   void add_outer(std::span<const std::array<int, 2>> at, std::span<const double> coef, double s);
   /// y = A x for `cols` interleaved columns (x[r·cols + c]); rows shared by the threads.
   void multiply(std::span<const double> x, std::span<double> y, int cols) const;
-  /// One sweep of Gauss–Seidel on A x = b, in place: the rows in (hu+1)(hv+1) colours
-  /// (i mod (hu+1), j mod (hv+1)), no two rows of a colour coupled, so a colour's rows
-  /// are updated by the threads at once and the result is the same on any number of
-  /// them. `backward` runs the colours in reverse: a forward sweep then a backward one
-  /// is symmetric.
-  void gauss_seidel(std::span<const double> b, std::span<double> x, int cols, bool backward) const;
+  /// Row (i, j) of A times x, column by column, into acc.
+  void row_product(int i, int j, std::span<const double> x, std::size_t cols, double* acc) const;
   /// This matrix set to d + s·f (all three of one net and one pattern).
   void assign_sum(const NetMatrix& d, const NetMatrix& f, double s);
   /// Scales every entry by s.
@@ -67,14 +70,17 @@ class NetMatrix {
   /// products and sweeps read one contiguous row instead of entries spread over the
   /// rows above (about 5 times faster). Any change to an entry drops the copy.
   void mirror();
+  /// Frees the copy (a matrix kept for later, its products not needed until then).
+  void drop_mirror() {
+    mirrored_ = false;
+    std::vector<double>().swap(full_);
+  }
   /// Bytes a control point takes with its row mirrored.
   static std::size_t bytes_per_row(int hu, int hv) {
     return sizeof(double) * static_cast<std::size_t>(hv + 1 + hu * (2 * hv + 1) + (2 * hu + 1) * (2 * hv + 1));
   }
 
  private:
-  // Row (i, j) of A times x, column by column, into acc.
-  void row_product(int i, int j, std::span<const double> x, std::size_t cols, double* acc) const;
   int nu_, nv_, hu_, hv_, width_;
   std::vector<double> a_;
   std::vector<double> full_;  // (2hu+1)(2hv+1) a row, (di, dj) row-major from (-hu, -hv)
@@ -132,12 +138,16 @@ struct Solved {
 /// z ≈ A⁻¹ r for `cols` interleaved columns: a symmetric positive definite operator.
 using Preconditioner = std::function<void(std::span<const double> r, std::span<double> z, int cols)>;
 
+/// Whether conjugate gradients should go on, asked after each step with the steps
+/// taken and the residual reached (and once before the first).
+using KeepGoing = std::function<bool(int iterations, double residual)>;
+
 /// Solves A x = b by conjugate gradients, preconditioned by `precondition` (the
 /// diagonal when empty), from the x given, each column to a residual of `rel` of its
-/// right-hand side or `max_iter` steps. Every sum runs in blocks of fixed size: the
-/// same bits on any number of threads.
+/// right-hand side, `max_iter` steps, or until `keep_going` says no. Every sum runs in
+/// blocks of fixed size: the same bits on any number of threads.
 Solved solve_cg(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols, double rel, int max_iter,
-                const Preconditioner& precondition = {});
+                const Preconditioner& precondition = {}, const KeepGoing& keep_going = {});
 
 /// A sparse LDLᵀ decomposition of A (Eigen's, fill-reducing ordering), factored once
 /// and solved for any number of right-hand sides: exact to rounding whatever the

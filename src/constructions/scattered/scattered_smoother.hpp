@@ -1,0 +1,52 @@
+#pragma once
+// The smoother of the scattered multigrid: block Gauss–Seidel over strips of control
+// points, each strip solved exactly. With only the small fill weight, the normal
+// equations of points scattered a few to a knot cell have near-null modes a few control
+// points wide (clusters a handful of points hardly tell apart, the clamped edges' B-splines
+// that barely reach any point). Point Gauss–Seidel damps them by a hair a sweep and the
+// coarse nets cannot hold them; a strip solved whole removes them. Strips along u, then
+// strips along v.
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "constructions/scattered/scattered_system.hpp"
+
+namespace interpatch::detail::scattered {
+
+/// Strips of control points max(hu, hv) + 1 wide across the whole net, along each
+/// direction, every strip's matrix factored as a band (LLᵀ).
+class StripSmoother {
+ public:
+  /// Factors the strips of `a`, its entries as they are now.
+  explicit StripSmoother(const NetMatrix& a);
+  /// One sweep of block Gauss–Seidel on a x = b, in place: the strips along u, then
+  /// those along v, each in two colours of strips that share no entry of the matrix
+  /// (a colour's strips solved by the threads at once; the same bits on any number of
+  /// them). `backward` runs everything in reverse order: a forward sweep then a
+  /// backward one is symmetric. A strip whose matrix did not factor (not positive
+  /// definite to rounding) is left out.
+  void sweep(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols, bool backward) const;
+  /// The bytes a control point's share of the factors takes.
+  static std::size_t bytes_per_row(int hu, int hv);
+
+ private:
+  struct Strip {
+    int dir = 0;  // 0: rows i in [first, first + width), every j; 1: columns j likewise
+    int index = 0, first = 0, width = 0;  // index: its place along the direction (the colour's parity)
+    int band = 0;   // half bandwidth of the strip's matrix in its own order
+    std::size_t size = 0, at = 0;  // unknowns, offset of its factor in factor_
+    bool ok = false;
+  };
+  // Control point (i, j) of a strip's unknown k: along the strip, then across it.
+  [[nodiscard]] std::size_t row_of(const Strip& s, std::size_t k) const;
+  void factor(const NetMatrix& a, Strip& s);
+  void solve(const Strip& s, const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols,
+             std::vector<double>& r) const;
+  int nu_, nv_;
+  std::vector<Strip> strips_;  // along u, then along v, each by first
+  std::vector<double> factor_;  // per strip, row k: L[k][k - band .. k - 1], then 1 / L[k][k]
+};
+
+}  // namespace interpatch::detail::scattered
