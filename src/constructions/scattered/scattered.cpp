@@ -20,18 +20,19 @@ namespace interpatch::detail::scattered {
 
 namespace {
 
-// The largest of distance(k) over the points present, and where, the threads in blocks
-// whose results are merged in order (the lowest index wins a tie); a NaN distance counts
-// as infinite. Adds the squares to *sum_sq when given.
+// The largest of distance(k) over n points (those of weight above 0 when `weight` is
+// given), and where, the threads in blocks whose results are merged in order (the lowest
+// index wins a tie); a NaN distance counts as infinite. Adds the squares to *sum_sq
+// when given.
 template <class F>
-ApproxDistance worst_point(std::span<const double> weight, double* sum_sq, F&& distance) {
+ApproxDistance worst_point(std::size_t n, std::span<const double> weight, double* sum_sq, F&& distance) {
   constexpr std::size_t block = 8192;
-  const std::size_t n = weight.size(), blocks = (n + block - 1) / block;
+  const std::size_t blocks = (n + block - 1) / block;
   std::vector<ApproxDistance> part(blocks);
   std::vector<double> sq(blocks, 0.0);
   parallel_for(blocks, n >= parallel_min_work / 64, Share::blocks, [&](std::size_t b) {
     for (std::size_t k = b * block; k < std::min(n, (b + 1) * block); ++k) {
-      if (!(weight[k] > 0)) continue;
+      if (!weight.empty() && !(weight[k] > 0)) continue;
       const double d = distance(k);
       sq[b] += d * d;
       if (!(d <= part[b].max)) part[b] = {std::isnan(d) ? std::numeric_limits<double>::infinity() : d, k};
@@ -49,14 +50,23 @@ ApproxDistance worst_point(std::span<const double> weight, double* sum_sq, F&& d
 // surface's own evaluator: the check of the spline returned.
 ApproxDistance distances(const BSplineSurface& s, std::span<const std::array<double, 2>> site, std::span<const Vec3> target,
                          std::span<const double> weight, double* sum_sq) {
-  return worst_point(weight, sum_sq, [&](std::size_t k) { return distance(s.point(site[k][0], site[k][1]), target[k]); });
+  return worst_point(weight.size(), weight, sum_sq, [&](std::size_t k) { return distance(s.point(site[k][0], site[k][1]), target[k]); });
 }
 
 // The same for a fit still in the fit's frame, from the net's values and the basis at
 // each site (no surface built, no derivatives): what the tolerance's refinement
-// measures after each fit.
+// measures after each fit. The worst point is named by its index in the problem's order.
 ApproxDistance net_distances(const Problem& pr, const Net& net, std::span<const double> x) {
-  return worst_point(pr.sites->weight, nullptr, [&](std::size_t k) { return distance_at(pr, net, x, k); });
+  return worst_point(pr.size(), pr.weight, nullptr, [&](std::size_t k) { return distance_at(pr, net, x, k); });
+}
+
+// The same over the input, in its order: the worst point as the user numbers it.
+ApproxDistance input_distances(const Problem& pr, const Net& net, std::span<const double> x) {
+  return worst_point(pr.points.size(), pr.sites->weight, nullptr, [&](std::size_t k) {
+    double v[3];
+    pr.input_value(k, v);
+    return distance_of(net, x, pr.cols, pr.input_unit(k), v);
+  });
 }
 
 // About `cells` knot cells, shaped after the domain (cells near square in its units).
@@ -110,8 +120,9 @@ bool within(const std::array<int, 2>& net, const std::array<int, 2>& limit, cons
   return total <= std::max(static_cast<double>(s.present) / 4, 4096.0);
 }
 
-[[noreturn]] void refuse_tolerance(double tolerance, const ApproxDistance& e, const Problem& pr, const Net& net,
+[[noreturn]] void refuse_tolerance(double tolerance, const Problem& pr, const Net& net, std::span<const double> x,
                                    const std::array<int, 2>& limit, bool given) {
+  const ApproxDistance e = input_distances(pr, net, x);
   fail(errc::tolerance_not_met, "tolerance ", tolerance, " not met: point [", e.worst, "] is ", e.max * pr.unit_length,
        " from the approximation with ", net.nu, " x ", net.nv, " control points, and doubling the knots would pass the ",
        "largest net allowed (", limit[0], " x ", limit[1], given ? " control points, max_control_points" :
@@ -135,7 +146,7 @@ Fitted solve_tolerance(const Problem& pr, double tolerance, const ScatteredAppro
     if (e.max <= d) return f;
     coarser = unit_surface(f.net, f.level.x, pr.cols);
     const std::array<int, 2> next{2 * spans[0] + pr.p, 2 * spans[1] + pr.q};
-    if (!within(next, limit, o, s)) refuse_tolerance(tolerance, e, pr, f.net, limit, o.max_control_points.has_value());
+    if (!within(next, limit, o, s)) refuse_tolerance(tolerance, pr, f.net, f.level.x, limit, o.max_control_points.has_value());
     spans = {2 * spans[0], 2 * spans[1]};
     if (progress) progress(std::min(0.9, 0.1 * f.fits));
   }
@@ -150,7 +161,7 @@ struct Solution {
 };
 
 Solution solve(std::span<const Vec3> points, const Sites& s, int p, int q, const ScatteredApproximationOptions& o) {
-  const Problem pr = frame(points, s, p, q, o.param == ScatteredParam::xy);
+  const Problem pr = frame(points, s, p, q, o.param == ScatteredParam::xy, o.auto_smoothing && !o.tolerance && !o.control_points);
   Fitted f = o.tolerance ? solve_tolerance(pr, *o.tolerance, o, o.progress)
              : o.control_points
                  ? solve_once(pr, {(*o.control_points)[0] - p, (*o.control_points)[1] - q}, std::nullopt, o.progress)

@@ -32,21 +32,6 @@ std::uint64_t mix(std::uint64_t h, std::uint64_t v) {
   return h ^ (h >> 29);
 }
 
-// The fold of each point present (fold_count for a missing one), from the bits of its
-// coordinates as given: anything computed from them (the centre, the plane) is summed in
-// the points' order and would move the folds when the points are shuffled.
-std::vector<std::uint8_t> folds_of(const Problem& pr) {
-  const Sites& s = *pr.sites;
-  std::vector<std::uint8_t> f(pr.points.size(), static_cast<std::uint8_t>(fold_count));
-  for (std::size_t k = 0; k < f.size(); ++k) {
-    if (!(s.weight[k] > 0)) continue;
-    std::uint64_t h = 0;
-    for (const double c : {pr.points[k].x, pr.points[k].y, pr.points[k].z}) h = mix(h, std::bit_cast<std::uint64_t>(c + 0.0));
-    f[k] = static_cast<std::uint8_t>(h % fold_count);
-  }
-  return f;
-}
-
 // One fold's training fit: its data terms on every net, its weight sum, its solution.
 struct Fold {
   int index = 0;
@@ -61,7 +46,6 @@ struct Search {
   std::vector<Net> nets;
   std::vector<NetMatrix> fair, sum;
   std::vector<Fold> folds;
-  std::vector<std::uint8_t> fold_of;
   std::optional<Multigrid> mg;
   int evaluations = 0;
 
@@ -81,10 +65,10 @@ struct Search {
       const Solved sol = solve_cg(sum.back(), f.data.back().rhs, f.x, pr.cols, 1e-10, 400,
                                   [&m](std::span<const double> r, std::span<double> z, int) { m.apply(r, z); });
       if (!(sol.residual <= 1e-4)) return std::numeric_limits<double>::infinity();
-      for (std::size_t k = 0; k < fold_of.size(); ++k) {
-        if (fold_of[k] != f.index) continue;
+      for (std::size_t k = 0; k < pr.size(); ++k) {
+        if (pr.fold[k] != f.index) continue;
         const double d = distance_at(pr, nets.back(), f.x, k);
-        total += pr.sites->weight[k] * d * d;
+        total += pr.samples().weight_at(k) * d * d;
       }
     }
     ++evaluations;
@@ -94,16 +78,22 @@ struct Search {
 
 }  // namespace
 
+std::uint8_t fold_of(const Vec3& point) {
+  std::uint64_t h = 0;
+  for (const double c : {point.x, point.y, point.z}) h = mix(h, std::bit_cast<std::uint64_t>(c + 0.0));
+  return static_cast<std::uint8_t>(h % fold_count);
+}
+
 Chosen choose_lambda(const Problem& pr, const Net& net, const progress_callback& progress, double from, double to) {
   const Sites& s = *pr.sites;
-  Search search{pr, {}, {}, {}, {}, folds_of(pr), std::nullopt, 0};
+  Search search{pr, {}, {}, {}, {}, std::nullopt, 0};
   for (const auto& sp : hierarchy(std::array<int, 2>{net.nu - net.p, net.nv - net.q}, net.p, net.q, coarsest_net))
     search.nets.emplace_back(net.p, net.q, sp[0] + net.p, sp[1] + net.q, pr.range);
   const int evaluated = s.present < all_folds_below ? fold_count : 1;
   std::size_t rows = 0;
   for (const Net& n : search.nets) rows += n.size();
   const int hu = std::max(net.p, 2), hv = std::max(net.q, 2);
-  require_memory(rows, NetMatrix::bytes_per_row(hu, hv) * static_cast<std::size_t>(evaluated + 2),
+  require_memory(rows, NetMatrix::bytes_per_row(hu, hv) * static_cast<std::size_t>(evaluated + 2) + StripSmoother::bytes_per_row(hu, hv),
                  cat("cross-validation of ", evaluated, " folds on a net of ", net.nu, " x ", net.nv, " control points"));
   for (const Net& n : search.nets) {
     search.fair.emplace_back(n.nu, n.nv, hu, hv);
@@ -113,9 +103,8 @@ Chosen choose_lambda(const Problem& pr, const Net& net, const progress_callback&
   for (int f = 0; f < evaluated; ++f) {
     Fold fold;
     fold.index = f;
-    fold.weight = s.weight;
-    for (std::size_t k = 0; k < fold.weight.size(); ++k)
-      if (search.fold_of[k] == f) fold.weight[k] = 0;
+    fold.weight.resize(pr.size());
+    for (std::size_t k = 0; k < fold.weight.size(); ++k) fold.weight[k] = pr.fold[k] == f ? 0.0 : pr.samples().weight_at(k);
     fold.weight_sum = std::accumulate(fold.weight.begin(), fold.weight.end(), 0.0);
     for (const Net& n : search.nets) fold.data.push_back(data_system(pr, n, fold.weight));
     fold.x.assign(net.size() * static_cast<std::size_t>(pr.cols), 0.0);

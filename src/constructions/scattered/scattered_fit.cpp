@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "base/text.hpp"
@@ -64,7 +65,57 @@ Hierarchy hierarchy_for(const Problem& pr, const Net& net, const NetMatrix& top,
 
 }  // namespace
 
-Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool xy) {
+namespace {
+
+// Interleaves the bits of two 10-bit cell indices: the cell's place on a Z-curve.
+std::uint32_t z_order(std::uint32_t i, std::uint32_t j) {
+  std::uint32_t key = 0;
+  for (int b = 0; b < 10; ++b) key |= ((i >> b) & 1U) << (2 * b + 1) | ((j >> b) & 1U) << (2 * b);
+  return key;
+}
+
+// The points present in the order of their cells on a 1024 × 1024 grid over the domain
+// along a Z-curve, the order given within a cell (two stable counting sorts of 10 bits).
+template <class UnitAt>
+std::vector<std::uint32_t> z_sorted(const Sites& s, const UnitAt& unit_at, std::array<double, 2> range) {
+  const std::size_t n = s.weight.size();
+  std::vector<std::uint32_t> key(n), order, next;
+  order.reserve(s.present);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!(s.weight[k] > 0)) continue;
+    const auto cell = [](double t, double r) { return static_cast<std::uint32_t>(std::clamp(t / r * 1024, 0.0, 1023.0)); };
+    const std::array<double, 2> u = unit_at(k);
+    key[k] = z_order(cell(u[0], range[0]), cell(u[1], range[1]));
+    order.push_back(static_cast<std::uint32_t>(k));
+  }
+  next.resize(order.size());
+  for (const int shift : {0, 10}) {
+    std::vector<std::size_t> start(1025, 0);
+    for (const std::uint32_t k : order) ++start[((key[k] >> shift) & 1023U) + 1];
+    for (std::size_t b = 0; b < 1024; ++b) start[b + 1] += start[b];
+    for (const std::uint32_t k : order) next[start[(key[k] >> shift) & 1023U]++] = k;
+    order.swap(next);
+  }
+  return order;
+}
+
+}  // namespace
+
+std::array<double, 2> Problem::input_unit(std::size_t k) const {
+  const auto uv = sites->uv(k);
+  return {std::clamp((uv[0] - lower[0]) / side, 0.0, range[0]), std::clamp((uv[1] - lower[1]) / side, 0.0, range[1])};
+}
+
+void Problem::input_value(std::size_t k, double* v) const {
+  for (int m = 0; m < cols; ++m) {
+    const int a = cols == 1 ? 2 : m;
+    v[m] = (points[k][a] - centre[a]) * scale;
+  }
+}
+
+Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool xy, bool folds) {
+  if (points.size() > std::numeric_limits<std::uint32_t>::max())
+    fail(errc::too_large, "scattered approximation of ", points.size(), " points: at most ", std::numeric_limits<std::uint32_t>::max());
   Problem pr;
   pr.p = p, pr.q = q, pr.cols = xy ? 1 : 3, pr.sites = &s, pr.points = points;
   for (std::size_t k = 0; k < points.size(); ++k)
@@ -78,13 +129,26 @@ Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool x
   const auto [u0, u1] = s.domain[0];
   const auto [v0, v1] = s.domain[1];
   pr.aspect = (u1 - u0) / (v1 - v0);
-  const double side = std::max(u1 - u0, v1 - v0);
-  pr.range = {(u1 - u0) / side, (v1 - v0) / side};
-  pr.unit.assign(points.size(), {0, 0});
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    if (!(s.weight[k] > 0)) continue;
-    const auto uv = s.uv(k);
-    pr.unit[k] = {std::clamp((uv[0] - u0) / side, 0.0, pr.range[0]), std::clamp((uv[1] - v0) / side, 0.0, pr.range[1])};
+  pr.side = std::max(u1 - u0, v1 - v0);
+  pr.lower = {u0, v0};
+  pr.range = {(u1 - u0) / pr.side, (v1 - v0) / pr.side};
+  const std::vector<std::uint32_t> order = z_sorted(s, [&pr](std::size_t k) { return pr.input_unit(k); }, pr.range);
+  const std::size_t n = order.size(), c = static_cast<std::size_t>(pr.cols);
+  pr.unit.resize(n);
+  pr.value.resize(n * c);
+  bool unit_weights = true;
+  for (std::size_t i = 0; i < n; ++i) {
+    pr.unit[i] = pr.input_unit(order[i]);
+    pr.input_value(order[i], &pr.value[i * c]);
+    unit_weights = unit_weights && s.weight[order[i]] == 1;
+  }
+  if (!unit_weights) {
+    pr.weight.resize(n);
+    for (std::size_t i = 0; i < n; ++i) pr.weight[i] = s.weight[order[i]];
+  }
+  if (folds) {
+    pr.fold.resize(n);
+    for (std::size_t i = 0; i < n; ++i) pr.fold[i] = fold_of(points[order[i]]);
   }
   return pr;
 }
@@ -179,7 +243,7 @@ void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const d
 Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoothing, const BSplineSurface* coarser,
                   std::vector<double> start, KeptMatrices* kept) {
   const Sites& s = *pr.sites;
-  System sys = data_system(pr, net, s.weight);
+  System sys = data_system(pr, net, pr.weight);
   Level out;
   out.lambda = std::max(fill_lambda(net, sys.a, s.weight_sum), smoothing.value_or(0.0));
   add_fairness(net, &sys.a, s.weight_sum * out.lambda);
@@ -195,17 +259,17 @@ Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoot
       else out.x[3 * r] = at[r].x, out.x[3 * r + 1] = at[r].y, out.x[3 * r + 2] = at[r].z;
     }
   }
-  solve_net(pr, net, sys, s.weight, s.weight_sum * out.lambda, out.x, kept);
+  solve_net(pr, net, sys, pr.weight, s.weight_sum * out.lambda, out.x, kept);
   if (kept) kept->keep(net, std::move(sys.a), s.weight_sum * out.lambda);
   return out;
 }
 
-double distance_at(const Problem& pr, const Net& net, std::span<const double> x, std::size_t k) {
-  const std::size_t c = static_cast<std::size_t>(pr.cols), nv = static_cast<std::size_t>(net.nv);
+double distance_of(const Net& net, std::span<const double> x, int cols, std::array<double, 2> site, const double* value) {
+  const std::size_t c = static_cast<std::size_t>(cols), nv = static_cast<std::size_t>(net.nv);
   double bu[max_degree + 1], bv[max_degree + 1];
-  const int su = net.span_u(pr.unit[k][0]), sv = net.span_v(pr.unit[k][1]);
-  net.ku.basis(su, pr.unit[k][0], bu);
-  net.kv.basis(sv, pr.unit[k][1], bv);
+  const int su = net.span_u(site[0]), sv = net.span_v(site[1]);
+  net.ku.basis(su, site[0], bu);
+  net.kv.basis(sv, site[1], bv);
   double at[3] = {0, 0, 0};
   for (int a = 0; a <= net.p; ++a) {
     const std::size_t row = static_cast<std::size_t>(su - net.p + a) * nv + static_cast<std::size_t>(sv - net.q);
@@ -215,10 +279,7 @@ double distance_at(const Problem& pr, const Net& net, std::span<const double> x,
     }
   }
   double sq = 0;
-  for (std::size_t m = 0; m < c; ++m) {
-    const double v = pr.value(k, static_cast<int>(m));
-    sq += (at[m] - v) * (at[m] - v);
-  }
+  for (std::size_t m = 0; m < c; ++m) sq += (at[m] - value[m]) * (at[m] - value[m]);
   return std::sqrt(sq);
 }
 

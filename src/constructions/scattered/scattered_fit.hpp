@@ -4,6 +4,7 @@
 // gradients with multigrid (scattered_multigrid.hpp).
 
 #include <array>
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <vector>
@@ -14,11 +15,17 @@
 
 namespace interpatch::detail::scattered {
 
-// The fit in its own frame: unit sites, values centred on the points' mean and scaled
-// into a power of two near their size (sums of squares neither overflow nor vanish).
+// The fit in its own frame: the points present, their unit sites, their values centred
+// on the points' mean and scaled into a power of two near their size (sums of squares
+// neither overflow nor vanish), in the order of a Z-curve over the domain, so that each
+// knot cell's points lie near one another in memory on any net (in the order given,
+// a pass over a million points waits on memory for most of its time).
 struct Problem {
   int p = 3, q = 3, cols = 3;
   std::vector<std::array<double, 2>> unit;
+  std::vector<double> value;  // cols per point
+  std::vector<double> weight;  // empty when every weight is 1
+  std::vector<std::uint8_t> fold;  // for cross-validation (when asked): fold_of(the point)
   const Sites* sites = nullptr;
   std::span<const Vec3> points;  // as given
   Vec3 centre{};
@@ -28,22 +35,32 @@ struct Problem {
   // The domain in the fit's frame: [0, range[0]] × [0, range[1]], the longer side 1, so
   // that J weighs both directions alike (the thin-plate energy of the domain itself).
   std::array<double, 2> range{1, 1};
+  std::array<double, 2> lower{0, 0};  // the domain's lower corner
+  double side = 1;  // its longer side
 
-  /// The points of nonzero `weight`, their values (cols per point) made from the
-  /// points as they are read.
-  [[nodiscard]] Samples samples(std::span<const double> weight) const {
-    return Samples{unit, weight, {}, cols, points, centre, scale};
-  }
+  [[nodiscard]] std::size_t size() const { return unit.size(); }
+  /// Input point k's unit site and its value (cols numbers into v), present or not.
+  [[nodiscard]] std::array<double, 2> input_unit(std::size_t k) const;
+  void input_value(std::size_t k, double* v) const;
+  /// The points with weights `weight` (the problem's own when empty).
+  [[nodiscard]] Samples samples(std::span<const double> w) const { return Samples{unit, w, value, cols}; }
+  [[nodiscard]] Samples samples() const { return samples(weight); }
   /// Column c of point k's value.
-  [[nodiscard]] double value(std::size_t k, int c) const { return samples({}).value_at(k, c); }
+  [[nodiscard]] double value_at(std::size_t k, int c) const { return samples().value_at(k, c); }
 };
 
 /// Nets up to this many control points are factored (milliseconds); larger ones go by
 /// conjugate gradients preconditioned by multigrid down to a net this size.
 inline constexpr std::size_t coarsest_net = 4096;
 
-/// The problem of `points` at sites `s` (one column, z, when `xy`).
-Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool xy);
+/// The problem of `points` at sites `s` (one column, z, when `xy`), with each point's
+/// fold when `folds`.
+Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool xy, bool folds = false);
+
+/// A point's fold of the cross-validation, from the bits of its coordinates as given:
+/// anything computed from them (the centre, the plane) is summed in the points' order
+/// and would move the folds when the points are shuffled.
+std::uint8_t fold_of(const Vec3& point);
 
 /// A net's values (cols per control point) as a surface over the net's domain (one
 /// column: in z).
@@ -90,9 +107,13 @@ class KeptMatrices {
 void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const double> weight, double scaled, std::vector<double>& x,
                KeptMatrices* kept = nullptr);
 
-/// The distance of point k from the fit whose net holds `x` (cols per control point),
-/// at the point's site, in the fit's frame: the basis there times the net's values.
-double distance_at(const Problem& pr, const Net& net, std::span<const double> x, std::size_t k);
+/// The distance of a value (cols numbers) from the fit whose net holds `x` (cols per
+/// control point) at a unit site, in the fit's frame: the basis there times the net's values.
+double distance_of(const Net& net, std::span<const double> x, int cols, std::array<double, 2> site, const double* value);
+/// The same for the problem's point k.
+inline double distance_at(const Problem& pr, const Net& net, std::span<const double> x, std::size_t k) {
+  return distance_of(net, x, pr.cols, pr.unit[k], &pr.value[k * static_cast<std::size_t>(pr.cols)]);
+}
 
 /// One net solved on every point present: λ at least the fill, started from `start`
 /// (the net's values), or the coarser fit's values at this net's Greville abscissae,

@@ -153,28 +153,22 @@ struct Cells {
 Cells sort_by_cell(const Net& net, const Samples& s) {
   const std::size_t su = static_cast<std::size_t>(net.nu - net.p), sv = static_cast<std::size_t>(net.nv - net.q);
   const std::size_t n = s.site.size();
-  std::vector<std::uint32_t> cell(n);
-  const auto count = static_cast<long long>(n);
-#pragma omp parallel for schedule(static) if (n >= parallel_min_work / 8)
-  for (long long k = 0; k < count; ++k) {
-    const auto kk = static_cast<std::size_t>(k);
-    if (!(s.weight[kk] > 0)) {
-      cell[kk] = ~std::uint32_t{0};
-      continue;
-    }
-    const auto a = static_cast<std::size_t>(net.span_u(s.site[kk][0]) - net.p);
-    const auto b = static_cast<std::size_t>(net.span_v(s.site[kk][1]) - net.q);
-    cell[kk] = static_cast<std::uint32_t>(a * sv + b);
-  }
+  // Each point's cell found twice, to count and to place, rather than kept (4 bytes a
+  // point at the peak of a large fit's memory).
+  const auto cell_of = [&](std::size_t k) {
+    const auto a = static_cast<std::size_t>(net.span_u(s.site[k][0]) - net.p);
+    const auto b = static_cast<std::size_t>(net.span_v(s.site[k][1]) - net.q);
+    return a * sv + b;
+  };
   Cells c;
   c.start.assign(su * sv + 1, 0);
-  for (std::uint32_t x : cell)
-    if (x != ~std::uint32_t{0}) ++c.start[x + 1];
+  for (std::size_t k = 0; k < n; ++k)
+    if (s.weight_at(k) > 0) ++c.start[cell_of(k) + 1];
   std::partial_sum(c.start.begin(), c.start.end(), c.start.begin());
   c.order.resize(c.start.back());
   std::vector<std::size_t> next(c.start.begin(), c.start.end() - 1);
   for (std::size_t k = 0; k < n; ++k)
-    if (cell[k] != ~std::uint32_t{0}) c.order[next[cell[k]]++] = static_cast<std::uint32_t>(k);
+    if (s.weight_at(k) > 0) c.order[next[cell_of(k)]++] = static_cast<std::uint32_t>(k);
   return c;
 }
 
@@ -194,7 +188,7 @@ void add_cell(const Net& net, const Samples& s, const Cells& cells, std::size_t 
     const std::size_t k = cells.order[x];
     net.ku.basis(span_u, s.site[k][0], nu_b);
     net.kv.basis(span_v, s.site[k][1], nv_b);
-    const double w = s.weight[k];
+    const double w = s.weight_at(k);
     double value[3];
     for (int c = 0; c < cols; ++c) value[c] = s.value_at(k, c);
     for (int al = 0; al <= p; ++al)

@@ -95,24 +95,16 @@ struct System {
   int cols = 1;
 };
 
-/// The points a fit takes: unit sites, weights (0: not present), and the values fitted
-/// (cols per point, interleaved): given in `value`, or, when it is empty, the points
-/// in the fit's frame, (p − centre) · scale (z alone when cols is 1), made as they are
-/// read rather than stored (a million points' values are 8 to 24 MB).
+/// The points a fit takes: unit sites, weights (0: left out; all 1 when empty), and the
+/// values fitted (cols per point, interleaved).
 struct Samples {
   std::span<const std::array<double, 2>> site;  ///< in the net's domain
   std::span<const double> weight;
   std::span<const double> value;
   int cols = 1;
-  std::span<const Vec3> points{};
-  Vec3 centre{};
-  double scale = 1;
 
-  [[nodiscard]] double value_at(std::size_t k, int c) const {
-    if (!value.empty()) return value[k * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)];
-    const int a = cols == 1 ? 2 : c;
-    return (points[k][a] - centre[a]) * scale;
-  }
+  [[nodiscard]] double weight_at(std::size_t k) const { return weight.empty() ? 1.0 : weight[k]; }
+  [[nodiscard]] double value_at(std::size_t k, int c) const { return value[k * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)]; }
 };
 
 /// The normal equations of the data term, Σ w_k B(s_k) B(s_k)ᵀ and Σ w_k B(s_k) Q_k,
