@@ -84,14 +84,12 @@ void StripSmoother::factor(const NetMatrix& a, Strip& s) {
 void StripSmoother::solve(const Strip& s, const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols,
                           std::vector<double>& r) const {
   const auto c = static_cast<std::size_t>(cols), band = static_cast<std::size_t>(s.band), stride = band + 1;
-  const auto nv = static_cast<std::size_t>(nv_);
   const double* f = &factor_[s.at];
-  for (std::size_t k = 0; k < s.size; ++k) {
-    const std::size_t row = row_of(s, k);
+  for_each_row(s, [&](std::size_t k, int i, int j, std::size_t row) {
     double acc[3];
-    a.row_product(static_cast<int>(row / nv), static_cast<int>(row % nv), x, c, acc);
+    a.row_product(i, j, x, c, acc);
     for (std::size_t m = 0; m < c; ++m) r[k * c + m] = b[row * c + m] - acc[m];
-  }
+  });
   // L y = r, then Lᵀ z = y, in place.
   for (std::size_t k = 0; k < s.size; ++k) {
     const double* lk = f + k * stride;
@@ -111,10 +109,9 @@ void StripSmoother::solve(const Strip& s, const NetMatrix& a, std::span<const do
       for (std::size_t i = i0; i < k; ++i) r[i * c + m] -= lk[band - (k - i)] * z;
     }
   }
-  for (std::size_t k = 0; k < s.size; ++k) {
-    const std::size_t row = row_of(s, k);
+  for_each_row(s, [&](std::size_t k, int, int, std::size_t row) {
     for (std::size_t m = 0; m < c; ++m) x[row * c + m] += r[k * c + m];
-  }
+  });
 }
 
 void StripSmoother::sweep(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols, bool backward) const {

@@ -41,6 +41,17 @@ class StripSmoother {
   };
   // Control point (i, j) of a strip's unknown k: along the strip, then across it.
   [[nodiscard]] std::size_t row_of(const Strip& s, std::size_t k) const;
+  // f(k, i, j, row) for a strip's unknowns in order, without dividing for each.
+  template <class F>
+  void for_each_row(const Strip& s, F&& f) const {
+    const int along = s.dir == 0 ? nv_ : nu_;
+    std::size_t k = 0;
+    for (int t = 0; t < along; ++t)
+      for (int w = 0; w < s.width; ++w, ++k) {
+        const int i = s.dir == 0 ? s.first + w : t, j = s.dir == 0 ? t : s.first + w;
+        f(k, i, j, static_cast<std::size_t>(i) * static_cast<std::size_t>(nv_) + static_cast<std::size_t>(j));
+      }
+  }
   void factor(const NetMatrix& a, Strip& s);
   void solve(const Strip& s, const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols,
              std::vector<double>& r) const;
