@@ -236,6 +236,39 @@ TEST(ScatteredMultigrid, AStripAsWideAsTheNetSolvesIt) {
     }
 }
 
+// Mirrored, a matrix keeps only its whole rows: its entries read the same bits, its
+// products agree with the upper half's to rounding (1e-14 of their largest size, 49: sums of 49
+// terms in another order), and going back to the upper half loses nothing.
+TEST(ScatteredMultigrid, AMirroredMatrixReadsAsItsUpperHalf) {
+  std::mt19937_64 g(39);
+  std::uniform_real_distribution<double> U(-1, 1);
+  NetMatrix m(12, 15, 3, 3);
+  for (std::size_t r = 0; r < m.rows(); ++r)
+    for (int di = 0; di <= 3; ++di)
+      for (int dj = di == 0 ? 0 : -3; dj <= 3; ++dj) {
+        const int i = static_cast<int>(r) / 15 + di, j = static_cast<int>(r) % 15 + dj;
+        if (i < 12 && j >= 0 && j < 15) m.at(r, m.offset(di, dj)) = U(g);
+      }
+  std::vector<double> upper, x(m.rows()), y0(m.rows()), y1(m.rows());
+  for (std::size_t r = 0; r < m.rows(); ++r)
+    for (int k = 0; k < 25; ++k) upper.push_back(m.at(r, k));
+  for (double& v : x) v = U(g);
+  m.multiply(x, y0, 1);
+  m.mirror();
+  m.multiply(x, y1, 1);
+  const NetMatrix& read = m;
+  std::size_t e = 0, moved = 0;
+  for (std::size_t r = 0; r < m.rows(); ++r)
+    for (int k = 0; k < 25; ++k) moved += read.at(r, k) != upper[e++];
+  EXPECT_EQ(moved, 0u);
+  for (std::size_t r = 0; r < m.rows(); ++r) EXPECT_NEAR(y0[r], y1[r], 1e-14 * 49) << r;
+  m.unmirror();
+  e = 0, moved = 0;
+  for (std::size_t r = 0; r < m.rows(); ++r)
+    for (int k = 0; k < 25; ++k) moved += m.at(r, k) != upper[e++];
+  EXPECT_EQ(moved, 0u);
+}
+
 // A net's matrix kept with one fairness weight and taken with another is the matrix
 // assembled with the other, to rounding (1e-13 of the largest entry: two sums of a
 // few dozen terms each), and a net not kept is not there.

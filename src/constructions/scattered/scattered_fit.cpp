@@ -198,7 +198,7 @@ std::optional<NetMatrix> KeptMatrices::take(const Net& net, double scaled) {
 }
 
 void KeptMatrices::keep(const Net& net, NetMatrix a, double scaled) {
-  a.drop_mirror();
+  a.unmirror();
   kept_.push_back(Entry{net.nu, net.nv, scaled, std::move(a)});
 }
 

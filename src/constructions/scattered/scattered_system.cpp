@@ -28,7 +28,11 @@ int Net::uniform_span(const KnotVector& k, double t) {
 }
 
 NetMatrix::NetMatrix(int nu, int nv, int hu, int hv)
-    : nu_(nu), nv_(nv), hu_(hu), hv_(hv), width_(hv + 1 + hu * (2 * hv + 1)), a_(rows() * static_cast<std::size_t>(width_), 0.0) {}
+    : nu_(nu), nv_(nv), hu_(hu), hv_(hv), width_(hv + 1 + hu * (2 * hv + 1)), a_(rows() * static_cast<std::size_t>(width_), 0.0) {
+  in_full_.resize(static_cast<std::size_t>(width_));
+  for (int di = 0; di <= hu_; ++di)
+    for (int dj = di == 0 ? 0 : -hv_; dj <= hv_; ++dj) in_full_[static_cast<std::size_t>(offset(di, dj))] = (di + hu_) * (2 * hv_ + 1) + dj + hv_;
+}
 
 void NetMatrix::add_outer(std::span<const std::array<int, 2>> at, std::span<const double> coef, double s) {
   for (std::size_t x = 0; x < at.size(); ++x)
@@ -43,6 +47,7 @@ void NetMatrix::add_outer(std::span<const std::array<int, 2>> at, std::span<cons
 }
 
 void NetMatrix::mirror() {
+  if (mirrored_) return;
   const int fw = (2 * hu_ + 1) * (2 * hv_ + 1);
   full_.assign(rows() * static_cast<std::size_t>(fw), 0.0);
   const std::size_t nv = static_cast<std::size_t>(nv_);
@@ -59,7 +64,18 @@ void NetMatrix::mirror() {
                                                            static_cast<std::size_t>(upper ? offset(di, dj) : offset(-di, -dj))];
         }
     }
+  std::vector<double>().swap(a_);
   mirrored_ = true;
+}
+
+void NetMatrix::unmirror() {
+  if (!mirrored_) return;
+  const std::size_t w = static_cast<std::size_t>(width_), fw = full_width();
+  a_.assign(rows() * w, 0.0);
+  for (std::size_t r = 0; r < rows(); ++r)
+    for (std::size_t k = 0; k < w; ++k) a_[r * w + k] = full_[r * fw + static_cast<std::size_t>(in_full_[k])];
+  std::vector<double>().swap(full_);
+  mirrored_ = false;
 }
 
 namespace {
@@ -126,12 +142,18 @@ void NetMatrix::multiply(std::span<const double> x, std::span<double> y, int col
 }
 
 void NetMatrix::assign_sum(const NetMatrix& d, const NetMatrix& f, double s) {
-  mirrored_ = false;
-  for (std::size_t k = 0; k < a_.size(); ++k) a_[k] = d.a_[k] + s * f.a_[k];
+  if (mirrored_) {
+    std::vector<double>().swap(full_);
+    a_.resize(rows() * static_cast<std::size_t>(width_));
+    mirrored_ = false;
+  }
+  const std::size_t w = static_cast<std::size_t>(width_);
+  for (std::size_t r = 0; r < rows(); ++r)
+    for (std::size_t k = 0; k < w; ++k) a_[r * w + k] = d.at(r, static_cast<int>(k)) + s * f.at(r, static_cast<int>(k));
 }
 
 void NetMatrix::scale(double s) {
-  mirrored_ = false;
+  unmirror();
   for (double& v : a_) v *= s;
 }
 

@@ -45,10 +45,13 @@ class NetMatrix {
   /// Index of offset (di, dj) in a row (di ≥ 0; dj ≥ 0 when di = 0).
   [[nodiscard]] int offset(int di, int dj) const { return di == 0 ? dj : hv_ + 1 + (di - 1) * (2 * hv_ + 1) + dj + hv_; }
   [[nodiscard]] double& at(std::size_t row, int k) {
-    mirrored_ = false;
+    if (mirrored_) unmirror();
     return a_[row * static_cast<std::size_t>(width_) + static_cast<std::size_t>(k)];
   }
-  [[nodiscard]] double at(std::size_t row, int k) const { return a_[row * static_cast<std::size_t>(width_) + static_cast<std::size_t>(k)]; }
+  [[nodiscard]] double at(std::size_t row, int k) const {
+    if (mirrored_) return full_[row * full_width() + static_cast<std::size_t>(in_full_[static_cast<std::size_t>(k)])];
+    return a_[row * static_cast<std::size_t>(width_) + static_cast<std::size_t>(k)];
+  }
   /// The entry coupling row (i, j), index `row`, with (i + di, j + dj), either half
   /// (|di| <= hu, |dj| <= hv, both inside the net).
   [[nodiscard]] double entry(std::size_t row, int di, int dj) const {
@@ -66,24 +69,24 @@ class NetMatrix {
   void assign_sum(const NetMatrix& d, const NetMatrix& f, double s);
   /// Scales every entry by s.
   void scale(double s);
-  /// Keeps a copy of every row whole, the lower half mirrored from the upper, so that
-  /// products and sweeps read one contiguous row instead of entries spread over the
-  /// rows above (about 5 times faster). Any change to an entry drops the copy.
+  /// Keeps every row whole, the lower half mirrored from the upper, so that products
+  /// and sweeps read one contiguous row instead of entries spread over the rows above
+  /// (about 5 times faster); the upper half alone is then let go. Changing an entry
+  /// goes back to the upper half.
   void mirror();
-  /// Frees the copy (a matrix kept for later, its products not needed until then).
-  void drop_mirror() {
-    mirrored_ = false;
-    std::vector<double>().swap(full_);
-  }
-  /// Bytes a control point takes with its row mirrored.
+  /// Back to the upper half alone, the smaller form (a matrix kept for later).
+  void unmirror();
+  /// Bytes a control point takes while its row is mirrored (both forms at once).
   static std::size_t bytes_per_row(int hu, int hv) {
     return sizeof(double) * static_cast<std::size_t>(hv + 1 + hu * (2 * hv + 1) + (2 * hu + 1) * (2 * hv + 1));
   }
 
  private:
+  [[nodiscard]] std::size_t full_width() const { return static_cast<std::size_t>((2 * hu_ + 1) * (2 * hv_ + 1)); }
   int nu_, nv_, hu_, hv_, width_;
-  std::vector<double> a_;
-  std::vector<double> full_;  // (2hu+1)(2hv+1) a row, (di, dj) row-major from (-hu, -hv)
+  std::vector<double> a_;  // the upper half, `width_` a row; empty while mirrored
+  std::vector<double> full_;  // (2hu+1)(2hv+1) a row, (di, dj) row-major from (-hu, -hv); empty unless mirrored
+  std::vector<int> in_full_;  // upper offset k's place in a whole row
   bool mirrored_ = false;
 };
 
