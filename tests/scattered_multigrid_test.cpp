@@ -269,6 +269,18 @@ TEST(ScatteredMultigrid, AMirroredMatrixReadsAsItsUpperHalf) {
   EXPECT_EQ(moved, 0u);
 }
 
+// Points are indexed in 32 bits: one more than they reach is refused, by name and count.
+TEST(ScatteredMultigrid, MorePointsThan32BitIndicesAreRefused) {
+  EXPECT_NO_THROW(require_indexable(std::size_t{4294967295}));
+  try {
+    require_indexable(std::size_t{4294967296});
+    ADD_FAILURE() << "no error";
+  } catch (const error& e) {
+    EXPECT_EQ(e.code(), errc::too_large);
+    EXPECT_STREQ(e.what(), "scattered approximation of 4294967296 points: at most 4294967295 (points are indexed in 32 bits)");
+  }
+}
+
 // A net's matrix kept with one fairness weight and taken with another is the matrix
 // assembled with the other, to rounding (1e-13 of the largest entry: two sums of a
 // few dozen terms each), and a net not kept is not there.

@@ -113,9 +113,14 @@ void Problem::input_value(std::size_t k, double* v) const {
   }
 }
 
+void require_indexable(std::size_t points) {
+  if (points > std::numeric_limits<std::uint32_t>::max())
+    fail(errc::too_large, "scattered approximation of ", points, " points: at most ", std::numeric_limits<std::uint32_t>::max(),
+         " (points are indexed in 32 bits)");
+}
+
 Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool xy, bool folds) {
-  if (points.size() > std::numeric_limits<std::uint32_t>::max())
-    fail(errc::too_large, "scattered approximation of ", points.size(), " points: at most ", std::numeric_limits<std::uint32_t>::max());
+  require_indexable(points.size());
   Problem pr;
   pr.p = p, pr.q = q, pr.cols = xy ? 1 : 3, pr.sites = &s, pr.points = points;
   for (std::size_t k = 0; k < points.size(); ++k)

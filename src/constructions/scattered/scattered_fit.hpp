@@ -53,6 +53,10 @@ struct Problem {
 /// conjugate gradients preconditioned by multigrid down to a net this size.
 inline constexpr std::size_t coarsest_net = 4096;
 
+/// Refuses (too_large) more points than 32-bit indices reach: the sorts by cell index
+/// the points in 32 bits.
+void require_indexable(std::size_t points);
+
 /// The problem of `points` at sites `s` (one column, z, when `xy`), with each point's
 /// fold when `folds`.
 Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool xy, bool folds = false);
