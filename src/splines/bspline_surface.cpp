@@ -115,7 +115,32 @@ BSplineSurface::BSplineSurface(KnotVector knots_u, KnotVector knots_v, PointGrid
       }
 }
 
-Vec3 BSplineSurface::point(double u, double v) const { return derivative(u, v, 0, 0); }
+Vec3 BSplineSurface::point(double u, double v) const {
+  // derivative(u, v, 0, 0) without its tables of derivatives (twice as fast, which a check
+  // of every point of a large fit feels), the same sums in the same order.
+  check_parameter(ku_, u, "u");
+  check_parameter(kv_, v, "v");
+  u = ku_.periodic() ? ku_.wrap(u) : std::clamp(u, ku_.front(), ku_.back());
+  v = kv_.periodic() ? kv_.wrap(v) : std::clamp(v, kv_.front(), kv_.back());
+  const int p = degree_u(), q = degree_v();
+  const int su = ku_.find_span(u), sv = kv_.find_span(v);
+  double Nu[W], Nv[W];
+  ku_.basis(su, u, Nu);
+  kv_.basis(sv, v, Nv);
+  Vec3 a{};
+  double wsum = 0;
+  for (int i = 0; i <= p; ++i) {
+    if (Nu[i] == 0.0) continue;
+    const auto ii = static_cast<std::size_t>(ku_.wrap_index(su - p + i));
+    for (int j = 0; j <= q; ++j) {
+      const auto jj = static_cast<std::size_t>(kv_.wrap_index(sv - q + j));
+      const double c = Nu[i] * Nv[j] * (w_.empty() ? 1.0 : w_(ii, jj));
+      a += c * cp_(ii, jj);
+      wsum += c;
+    }
+  }
+  return rational() ? a / wsum : a;
+}
 
 Vec3 BSplineSurface::derivative(double u, double v, int du, int dv) const {
   check_parameter(ku_, u, "u");
