@@ -102,6 +102,76 @@ TEST(ScatteredMultigrid, SpansFromTheSpacingAreTheSearchedOnes) {
       }
 }
 
+// On spans whose knots are evenly spaced the net's basis skips the knots' divisions:
+// it agrees with the recurrence on the knots (an independent one here) to the knots'
+// rounding, on every span of every shape. A knot is rounded by up to an ulp of itself,
+// which moves t's place in its span by that over the spacing, about 1e-16 times the
+// spans over the range; the basis functions' slopes in that place are below 2 (1e-15
+// times the control points bounds it).
+TEST(ScatteredMultigrid, TheNetsBasisIsTheKnotsBasis) {
+  std::mt19937_64 g(41);
+  std::uniform_real_distribution<double> U(0, 1);
+  for (const int degree : {1, 2, 3, 4, 7})
+    for (const int count : {degree + 1, degree + 3, 2 * degree + 2, 19, 260})
+      for (const double range : {1.0, 0.8}) {
+        const Net net(degree, degree, count, count, {range, range});
+        for (int k = 0; k < 300; ++k) {
+          const double t = k < 2 ? k * range : U(g) * range;
+          const int span = net.span_u(t);
+          double n[max_degree + 1];
+          net.basis_u(span, t, n);
+          const promise::Basis b = own_basis(net.ku.values(), degree, t);
+          ASSERT_EQ(b.first, span - degree);
+          for (int a = 0; a <= degree; ++a)
+            EXPECT_NEAR(n[a], b.N[static_cast<std::size_t>(a)], 1e-15 * count) << degree << " " << count << " t " << t;
+        }
+      }
+}
+
+// A coarse net's data term restricted from a finer one's equals the one summed over the
+// points, entry by entry, for weights of all sizes (some zero), 1 and 3 columns, and
+// degrees whose matrices reach further than the data (degree 1 keeps the fairness's
+// reach of 2): to 1e-12 of the largest entry (sums of a few hundred terms of one sign
+// for the matrix, reordered).
+TEST(ScatteredMultigrid, RestrictedDataTermsEqualTheAssembledOnes) {
+  std::mt19937_64 g(42);
+  std::uniform_real_distribution<double> U(0, 1);
+  for (const int degree : {1, 2, 3})
+    for (const int cols : {1, 3})
+      for (const std::array<int, 2> spans : {std::array<int, 2>{1, 1}, {3, 5}, {12, 9}}) {
+        std::vector<std::array<double, 2>> site(3000);
+        std::vector<double> weight(site.size()), value(site.size() * static_cast<std::size_t>(cols));
+        for (auto& st : site) st = {U(g), 0.7 * U(g)};
+        for (double& w : weight) w = U(g) < 0.1 ? 0.0 : 0.1 + 3 * U(g);
+        for (double& v : value) v = U(g) - 0.5;
+        const auto system_on = [&](const Net& n) {
+          const int h = std::max(degree, 2);
+          System sys{NetMatrix(n.nu, n.nv, h, h), std::vector<double>(n.size() * static_cast<std::size_t>(cols), 0.0), cols};
+          add_data_term(n, Samples{site, weight, value, cols}, sys);
+          return sys;
+        };
+        const Net coarse(degree, degree, spans[0] + degree, spans[1] + degree, {1, 0.7});
+        const Net fine(degree, degree, 2 * spans[0] + degree, 2 * spans[1] + degree, {1, 0.7});
+        const System direct = system_on(coarse);
+        const System restricted = restrict_system(system_on(fine), {refinement(coarse.ku, fine.ku), refinement(coarse.kv, fine.kv)});
+        double size = 0, rhs_size = 0;
+        for (std::size_t r = 0; r < coarse.size(); ++r) size = std::max(size, std::abs(direct.a.at(r, 0)));
+        for (const double b : direct.rhs) rhs_size = std::max(rhs_size, std::abs(b));
+        const int h = direct.a.hu();
+        for (std::size_t r = 0; r < coarse.size(); ++r) {
+          const int i = static_cast<int>(r) / coarse.nv, j = static_cast<int>(r) % coarse.nv;
+          for (int di = -h; di <= h; ++di)
+            for (int dj = -h; dj <= h; ++dj) {
+              if (i + di < 0 || i + di >= coarse.nu || j + dj < 0 || j + dj >= coarse.nv) continue;
+              ASSERT_NEAR(restricted.a.entry(r, di, dj), direct.a.entry(r, di, dj), 1e-12 * size)
+                  << "degree " << degree << ", " << spans[0] << " x " << spans[1] << " spans, row " << r << " (" << di << ", " << dj << ")";
+            }
+        }
+        for (std::size_t k = 0; k < direct.rhs.size(); ++k)
+          ASSERT_NEAR(restricted.rhs[k], direct.rhs[k], 1e-12 * rhs_size) << "degree " << degree << ", value " << k;
+      }
+}
+
 struct Fixture {
   std::vector<Net> nets;
   std::vector<System> systems;
@@ -228,7 +298,8 @@ TEST(ScatteredMultigrid, AStripAsWideAsTheNetSolvesIt) {
       sys.a.mirror();
       std::vector<double> x(sys.rhs.size(), 0.0), direct(sys.rhs.size(), 0.0);
       const StripSmoother smoother(sys.a);
-      smoother.sweep(sys.a, sys.rhs, x, cols, false);
+      std::vector<double> work;
+      smoother.sweep(sys.a, sys.rhs, x, cols, false, work, true);
       ASSERT_TRUE(solve_direct(sys.a, sys.rhs, direct, cols));
       double size = 0, worst = 0;
       for (std::size_t i = 0; i < x.size(); ++i) size = std::max(size, std::abs(direct[i])), worst = std::max(worst, std::abs(x[i] - direct[i]));

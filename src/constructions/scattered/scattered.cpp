@@ -13,6 +13,7 @@
 #include "constructions/approximate/approx_check.hpp"
 #include "constructions/approximate/approx_rows.hpp"
 #include "constructions/scattered/scattered_fit.hpp"
+#include "constructions/scattered/scattered_multigrid.hpp"
 #include "interpatch/approximate.hpp"
 #include "interpatch/memory.hpp"
 
@@ -130,6 +131,58 @@ bool within(const std::array<int, 2>& net, const std::array<int, 2>& limit, cons
        "with values farther apart than twice the tolerance, or a tolerance below the rounding of the coordinates");
 }
 
+// The data terms of the doubling sequence's first nets, up to the last whose cells
+// hold 32 points or more on average: that one assembled from the points, each coarser
+// one restricted from the next finer (a pass over the points for all of them, where
+// each took one; restricting costs a few numbers a control point). Empty when the
+// first net is already that fine.
+std::vector<std::optional<System>> restricted_terms(const Problem& pr, std::array<int, 2> spans, const std::array<int, 2>& limit,
+                                                    const ScatteredApproximationOptions& o) {
+  const Sites& s = *pr.sites;
+  std::vector<Net> nets;
+  for (;;) {
+    nets.emplace_back(pr.p, pr.q, spans[0] + pr.p, spans[1] + pr.q, pr.range);
+    const std::array<int, 2> next{2 * spans[0] + pr.p, 2 * spans[1] + pr.q};
+    const double cells = 4.0 * spans[0] * spans[1];
+    if (!within(next, limit, o, s) || cells * 32 > static_cast<double>(s.present)) break;
+    spans = {2 * spans[0], 2 * spans[1]};
+  }
+  std::vector<std::optional<System>> out(nets.size());
+  if (nets.size() < 2) return {};
+  out.back() = data_system(pr, nets.back(), pr.weight);
+  for (std::size_t l = nets.size() - 1; l-- > 0;)
+    out[l] = restrict_system(*out[l + 1], {refinement(nets[l].ku, nets[l + 1].ku), refinement(nets[l].kv, nets[l + 1].kv)});
+  return out;
+}
+
+// Σ w |z|² and Σ w over the points present, in the fit's frame.
+struct Squares {
+  double values = 0, weights = 0;
+};
+
+Squares squares_of(const Problem& pr) {
+  Squares out;
+  for (std::size_t k = 0; k < pr.size(); ++k) {
+    const double w = pr.weight.empty() ? 1.0 : pr.weight[k];
+    for (int c = 0; c < pr.cols; ++c) out.values += w * pr.value_at(k, c) * pr.value_at(k, c);
+    out.weights += w;
+  }
+  return out;
+}
+
+// Whether a fit surely misses tolerance d, told from its normal equations without a pass
+// over the points: the largest distance is at least the root mean square one, and
+// Σ w |S − z|² = Σ w |z|² − 2 xᵀb + xᵀDx with xᵀDx = xᵀAx − s xᵀFx (A = D + s F). Only
+// when that passes d² Σ w by more than the rounding of its sums could move it (1e-9 of
+// their sizes, a million terms' worst case): a coarse net, far from the tolerance,
+// then skips its pass.
+bool surely_missed(const Problem& pr, const Squares& sq, const Fitted& f, double d) {
+  const double fair = f.level.lambda * pr.sites->weight_sum * fairness_energy(f.net, f.level.x, pr.cols);
+  const double sum = sq.values - 2 * f.level.x_b + f.level.x_a_x - fair;
+  const double rounding = 1e-9 * (sq.values + 2 * std::abs(f.level.x_b) + std::abs(f.level.x_a_x) + fair);
+  return sum - rounding > d * d * sq.weights;
+}
+
 Fitted solve_tolerance(const Problem& pr, double tolerance, const ScatteredApproximationOptions& o, const progress_callback& progress) {
   const Sites& s = *pr.sites;
   const double d = tolerance / pr.unit_length;
@@ -138,12 +191,14 @@ Fitted solve_tolerance(const Problem& pr, double tolerance, const ScatteredAppro
   std::optional<BSplineSurface> coarser;
   Fitted f{Net(pr.p, pr.q, pr.p + 1, pr.q + 1, pr.range), {}, 0};
   KeptMatrices kept;  // each net's matrix, the next nets' multigrid levels
-  for (;;) {
+  std::vector<std::optional<System>> terms = restricted_terms(pr, spans, limit, o);
+  const Squares squares = squares_of(pr);
+  for (std::size_t k = 0;; ++k) {
     f.net = Net(pr.p, pr.q, spans[0] + pr.p, spans[1] + pr.q, pr.range);
-    f.level = solve_level(pr, f.net, std::nullopt, coarser ? &*coarser : nullptr, {}, &kept);
+    f.level = solve_level(pr, f.net, std::nullopt, coarser ? &*coarser : nullptr, {}, &kept,
+                          k < terms.size() ? std::move(terms[k]) : std::nullopt);
     ++f.fits;
-    const ApproxDistance e = net_distances(pr, f.net, f.level.x);
-    if (e.max <= d) return f;
+    if (!surely_missed(pr, squares, f, d) && net_distances(pr, f.net, f.level.x).max <= d) return f;
     coarser = unit_surface(f.net, f.level.x, pr.cols);
     const std::array<int, 2> next{2 * spans[0] + pr.p, 2 * spans[1] + pr.q};
     if (!within(next, limit, o, s)) refuse_tolerance(tolerance, pr, f.net, f.level.x, limit, o.max_control_points.has_value());

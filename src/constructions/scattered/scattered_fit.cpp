@@ -246,9 +246,9 @@ void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const d
 // voids), from the coarser fit's values at this net's Greville abscissae (zero for the
 // first).
 Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoothing, const BSplineSurface* coarser,
-                  std::vector<double> start, KeptMatrices* kept) {
+                  std::vector<double> start, KeptMatrices* kept, std::optional<System> data) {
   const Sites& s = *pr.sites;
-  System sys = data_system(pr, net, pr.weight);
+  System sys = data ? std::move(*data) : data_system(pr, net, pr.weight);
   Level out;
   out.lambda = std::max(fill_lambda(net, sys.a, s.weight_sum), smoothing.value_or(0.0));
   add_fairness(net, &sys.a, s.weight_sum * out.lambda);
@@ -265,27 +265,43 @@ Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoot
     }
   }
   solve_net(pr, net, sys, pr.weight, s.weight_sum * out.lambda, out.x, kept);
-  if (kept) kept->keep(net, std::move(sys.a), s.weight_sum * out.lambda);
+  if (kept) {
+    std::vector<double> ax(out.x.size());
+    sys.a.multiply(out.x, ax, pr.cols);
+    for (std::size_t k = 0; k < ax.size(); ++k) out.x_a_x += out.x[k] * ax[k], out.x_b += out.x[k] * sys.rhs[k];
+    kept->keep(net, std::move(sys.a), s.weight_sum * out.lambda);
+  }
   return out;
 }
 
-double distance_of(const Net& net, std::span<const double> x, int cols, std::array<double, 2> site, const double* value) {
-  const std::size_t c = static_cast<std::size_t>(cols), nv = static_cast<std::size_t>(net.nv);
+namespace {
+
+// The spline's value at a site minus the value given, C columns: the sums in registers
+// (a runtime column count kept them in memory, each step waiting on the last).
+template <int C>
+double distance_in(const Net& net, std::span<const double> x, std::array<double, 2> site, const double* value) {
+  const std::size_t nv = static_cast<std::size_t>(net.nv);
   double bu[max_degree + 1], bv[max_degree + 1];
   const int su = net.span_u(site[0]), sv = net.span_v(site[1]);
-  net.ku.basis(su, site[0], bu);
-  net.kv.basis(sv, site[1], bv);
-  double at[3] = {0, 0, 0};
+  net.basis_u(su, site[0], bu);
+  net.basis_v(sv, site[1], bv);
+  double at[C] = {};
   for (int a = 0; a <= net.p; ++a) {
-    const std::size_t row = static_cast<std::size_t>(su - net.p + a) * nv + static_cast<std::size_t>(sv - net.q);
-    for (int e = 0; e <= net.q; ++e) {
-      const double w = bu[a] * bv[e];
-      for (std::size_t m = 0; m < c; ++m) at[m] += w * x[(row + static_cast<std::size_t>(e)) * c + m];
-    }
+    const double* row = &x[(static_cast<std::size_t>(su - net.p + a) * nv + static_cast<std::size_t>(sv - net.q)) * C];
+    double part[C] = {};
+    for (int e = 0; e <= net.q; ++e)
+      for (int m = 0; m < C; ++m) part[m] += bv[e] * row[e * C + m];
+    for (int m = 0; m < C; ++m) at[m] += bu[a] * part[m];
   }
   double sq = 0;
-  for (std::size_t m = 0; m < c; ++m) sq += (at[m] - value[m]) * (at[m] - value[m]);
+  for (int m = 0; m < C; ++m) sq += (at[m] - value[m]) * (at[m] - value[m]);
   return std::sqrt(sq);
+}
+
+}  // namespace
+
+double distance_of(const Net& net, std::span<const double> x, int cols, std::array<double, 2> site, const double* value) {
+  return cols == 1 ? distance_in<1>(net, x, site, value) : distance_in<3>(net, x, site, value);
 }
 
 }  // namespace interpatch::detail::scattered

@@ -73,6 +73,7 @@ BSplineSurface unit_surface(const Net& net, std::span<const double> x, int cols)
 struct Level {
   std::vector<double> x;
   double lambda = 0;  // in E's units: the weight of J against the mean squared distance
+  double x_a_x = 0, x_b = 0;  // xᵀ A x and xᵀ b of the system solved (kept fits only)
 };
 
 /// The data term of the points of nonzero `weight` on one net.
@@ -121,9 +122,10 @@ inline double distance_at(const Problem& pr, const Net& net, std::span<const dou
 
 /// One net solved on every point present: λ at least the fill, started from `start`
 /// (the net's values), or the coarser fit's values at this net's Greville abscissae,
-/// or zero. Its matrices are left in `kept` when given.
+/// or zero. Its matrices are left in `kept` when given; its data term is `data` when
+/// given (made already), otherwise assembled.
 Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoothing, const BSplineSurface* coarser,
-                  std::vector<double> start = {}, KeptMatrices* kept = nullptr);
+                  std::vector<double> start = {}, KeptMatrices* kept = nullptr, std::optional<System> data = std::nullopt);
 
 /// λ chosen by cross-validation and the last fit of the search (of most points).
 struct Chosen {

@@ -153,6 +153,90 @@ void restrict_to(const std::array<Refinement, 2>& r, std::span<const double> fin
 
 }  // namespace
 
+System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
+  const NetMatrix& a = fine.a;
+  const Refinement &ru = r[0], &rv = r[1];
+  const int hu = a.hu(), hv = a.hv(), wu = 2 * hu + 1, wv = 2 * hv + 1;
+  const auto c = static_cast<std::size_t>(fine.cols), band = static_cast<std::size_t>(wu * wv);
+  const auto fu = static_cast<std::size_t>(ru.fine), fv = static_cast<std::size_t>(rv.fine);
+  const auto cu = static_cast<std::size_t>(ru.coarse), cv = static_cast<std::size_t>(rv.coarse);
+  const auto pu = static_cast<std::size_t>(ru.p + 1), pv = static_cast<std::size_t>(rv.p + 1);
+  // Along v: t[(i, b)][(di, db)] = Σ_j Σ_j' Pv[j][b] A[(i, j)][(i + di, j')] Pv[j'][b + db], both
+  // halves, each fine row i summed by one thread in a fixed order.
+  std::vector<double> t(fu * cv * band, 0.0), tb(fu * cv * c, 0.0);
+  const bool parallel = fu * fv * band * pv * pv >= parallel_min_work;
+#pragma omp parallel for schedule(static) if (parallel)
+  for (long long ii = 0; ii < static_cast<long long>(fu); ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    for (std::size_t j = 0; j < fv; ++j) {
+      const std::size_t row = i * fv + j;
+      for (std::size_t e = 0; e < pv; ++e) {
+        const double w = rv.weight[j * pv + e];
+        const std::size_t b = static_cast<std::size_t>(rv.first[j]) + e;
+        for (std::size_t m = 0; m < c && w != 0; ++m) tb[(i * cv + b) * c + m] += w * fine.rhs[row * c + m];
+      }
+      for (int di = -hu; di <= hu; ++di) {
+        if (static_cast<long long>(i) + di < 0 || static_cast<long long>(i) + di >= static_cast<long long>(fu)) continue;
+        for (int dj = -hv; dj <= hv; ++dj) {
+          const long long j2 = static_cast<long long>(j) + dj;
+          if (j2 < 0 || j2 >= static_cast<long long>(fv)) continue;
+          const double v = a.entry(row, di, dj);
+          if (v == 0) continue;
+          for (std::size_t e = 0; e < pv; ++e) {
+            const double w = rv.weight[j * pv + e] * v;
+            if (w == 0) continue;
+            const int b = rv.first[j] + static_cast<int>(e);
+            for (std::size_t e2 = 0; e2 < pv; ++e2) {
+              const int db = rv.first[static_cast<std::size_t>(j2)] + static_cast<int>(e2) - b;
+              if (db < -hv || db > hv) continue;  // coarse functions apart: zero (the header says why)
+              t[((i * cv + static_cast<std::size_t>(b)) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(di + hu)) * static_cast<std::size_t>(wv) +
+                static_cast<std::size_t>(db + hv)] += w * rv.weight[static_cast<std::size_t>(j2) * pv + e2];
+            }
+          }
+        }
+      }
+    }
+  }
+  // Along u, each coarse row a from the fine rows i that refine it (the transpose), in
+  // their order.
+  System out{NetMatrix(ru.coarse, rv.coarse, hu, hv), std::vector<double>(cu * cv * c, 0.0), fine.cols};
+  std::vector<double> full(cu * cv * band, 0.0);
+#pragma omp parallel for schedule(static) if (parallel)
+  for (long long aa = 0; aa < static_cast<long long>(cu); ++aa) {
+    const auto ca = static_cast<std::size_t>(aa);
+    for (std::size_t x = ru.t_start[ca]; x < ru.t_start[ca + 1]; ++x) {
+      const auto i = static_cast<std::size_t>(ru.t_index[x]);
+      const double w = ru.t_weight[x];
+      for (std::size_t b = 0; b < cv; ++b) {
+        for (std::size_t m = 0; m < c; ++m) out.rhs[(ca * cv + b) * c + m] += w * tb[(i * cv + b) * c + m];
+        for (int di = -hu; di <= hu; ++di) {
+          const long long i2 = static_cast<long long>(i) + di;
+          if (i2 < 0 || i2 >= static_cast<long long>(fu)) continue;
+          const double* from = &t[((i * cv + b) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(di + hu)) * static_cast<std::size_t>(wv)];
+          for (std::size_t e2 = 0; e2 < pu; ++e2) {
+            const double w2 = w * ru.weight[static_cast<std::size_t>(i2) * pu + e2];
+            const int da = ru.first[static_cast<std::size_t>(i2)] + static_cast<int>(e2) - static_cast<int>(ca);
+            if (w2 == 0 || da < -hu || da > hu) continue;
+            double* to = &full[((ca * cv + b) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(da + hu)) * static_cast<std::size_t>(wv)];
+            for (std::size_t k = 0; k < static_cast<std::size_t>(wv); ++k) to[k] += w2 * from[k];
+          }
+        }
+      }
+    }
+  }
+  // The upper half kept, where the neighbour is inside the net.
+  for (std::size_t ca = 0; ca < cu; ++ca)
+    for (std::size_t b = 0; b < cv; ++b)
+      for (int da = 0; da <= hu; ++da)
+        for (int db = da == 0 ? 0 : -hv; db <= hv; ++db) {
+          const long long b2 = static_cast<long long>(b) + db;
+          if (ca + static_cast<std::size_t>(da) >= cu || b2 < 0 || b2 >= static_cast<long long>(cv)) continue;
+          out.a.at(ca * cv + b, out.a.offset(da, db)) =
+              full[((ca * cv + b) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(da + hu)) * static_cast<std::size_t>(wv) + static_cast<std::size_t>(db + hv)];
+        }
+  return out;
+}
+
 Multigrid::Multigrid(std::vector<Net> nets, std::vector<const NetMatrix*> matrices, int cols)
     : nets_(std::move(nets)), a_(std::move(matrices)), cols_(cols) {
   const std::size_t n = nets_.size();
@@ -182,14 +266,14 @@ void Multigrid::cycle(std::size_t level, std::span<const double> b, std::span<do
   const NetMatrix& a = *a_[level];
   std::fill(x.begin(), x.end(), 0.0);
   const StripSmoother& smoother = smoothers_[level - 1];
-  smoother.sweep(a, b, x, cols_, false);
+  smoother.sweep(a, b, x, cols_, false, tmp_[level], true);
   std::vector<double>& r = r_[level];
   a.multiply(x, r, cols_);
   for (std::size_t k = 0; k < r.size(); ++k) r[k] = b[k] - r[k];
   restrict_to(up_[level], r, b_[level - 1], cols_, tmp_[level]);
   cycle(level - 1, b_[level - 1], x_[level - 1]);
   prolong(up_[level], x_[level - 1], x, cols_, tmp_[level]);
-  smoother.sweep(a, b, x, cols_, true);
+  smoother.sweep(a, b, x, cols_, true, tmp_[level]);
 }
 
 void Multigrid::apply(std::span<const double> r, std::span<double> z) { cycle(nets_.size() - 1, r, z); }

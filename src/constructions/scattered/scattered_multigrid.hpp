@@ -35,6 +35,14 @@ struct Refinement {
 };
 Refinement refinement(const KnotVector& coarse, const KnotVector& fine);
 
+/// The data term of a coarser net from a finer one's: Pᵀ A P and Pᵀ b for the
+/// refinement P of `r`, in time proportional to the fine net rather than to the points.
+/// Exact when every coarse knot is a fine knot: each coarse basis function is then a
+/// combination of fine ones (P's columns), and so are the sums over the points. Coarse
+/// functions whose supports do not meet get nothing: no fine functions refining them
+/// meet either.
+System restrict_system(const System& fine, const std::array<Refinement, 2>& r);
+
 /// The spans of the nets below a fine net of `spans`, coarsest first and the fine one
 /// last: each direction halved (rounded up) while it has more than 4 spans, until the
 /// net has at most `coarsest` control points.

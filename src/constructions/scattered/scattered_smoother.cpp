@@ -81,23 +81,45 @@ void StripSmoother::factor(const NetMatrix& a, Strip& s) {
   s.ok = true;
 }
 
-void StripSmoother::solve(const Strip& s, const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols,
-                          std::vector<double>& r) const {
-  const auto c = static_cast<std::size_t>(cols), band = static_cast<std::size_t>(s.band), stride = band + 1;
+void StripSmoother::residuals(int dir, int colour, const NetMatrix& a, std::span<const double> b, std::span<const double> x,
+                              std::size_t c, std::span<double> r) const {
+  const int w = strip_width(a);
+  // One net row i a task. Along u, the rows of the colour's strips; along v, every row:
+  // reading the matrix in stretches of w rows with gaps as long took a third longer than
+  // reading it whole.
+  const std::size_t work = a.rows() * static_cast<std::size_t>((2 * a.hu() + 1) * (2 * a.hv() + 1)) * c;
+#pragma omp parallel for schedule(static) if (work >= parallel_min_work)
+  for (int i = 0; i < nu_; ++i) {
+    if (dir == 0 && (i / w) % 2 != colour) continue;
+    for (int j = 0; j < nv_; ++j) {
+      double acc[3];
+      const std::size_t row = static_cast<std::size_t>(i) * static_cast<std::size_t>(nv_) + static_cast<std::size_t>(j);
+      a.row_product(i, j, x, c, acc);
+      for (std::size_t m = 0; m < c; ++m) r[row * c + m] = b[row * c + m] - acc[m];
+    }
+  }
+}
+
+void StripSmoother::solve(const Strip& s, std::span<const double> all, std::span<double> x, std::size_t c,
+                          std::vector<double>& scratch) const {
+  const auto band = static_cast<std::size_t>(s.band), stride = band + 1;
   const double* f = &factor_[s.at];
-  for_each_row(s, [&](std::size_t k, int i, int j, std::size_t row) {
-    double acc[3];
-    a.row_product(i, j, x, c, acc);
-    for (std::size_t m = 0; m < c; ++m) r[k * c + m] = b[row * c + m] - acc[m];
+  double* r = scratch.data();
+  for_each_row(s, [&](std::size_t k, int, int, std::size_t row) {
+    for (std::size_t m = 0; m < c; ++m) r[k * c + m] = all[row * c + m];
   });
-  // L y = r, then Lᵀ z = y, in place.
+  // L y = r, then Lᵀ z = y, in place; the forward sums in four interleaved parts so that
+  // they do not wait on one adder.
   for (std::size_t k = 0; k < s.size; ++k) {
     const double* lk = f + k * stride;
     const std::size_t i0 = k > band ? k - band : 0;
     for (std::size_t m = 0; m < c; ++m) {
-      double sum = r[k * c + m];
-      for (std::size_t i = i0; i < k; ++i) sum -= lk[band - (k - i)] * r[i * c + m];
-      r[k * c + m] = sum * lk[band];
+      double part[4] = {r[k * c + m], 0, 0, 0};
+      std::size_t i = i0;
+      for (; i + 4 <= k; i += 4)
+        for (std::size_t e = 0; e < 4; ++e) part[e] -= lk[band - (k - i - e)] * r[(i + e) * c + m];
+      for (; i < k; ++i) part[0] -= lk[band - (k - i)] * r[i * c + m];
+      r[k * c + m] = ((part[0] + part[1]) + (part[2] + part[3])) * lk[band];
     }
   }
   for (std::size_t k = s.size; k-- > 0;) {
@@ -114,23 +136,26 @@ void StripSmoother::solve(const Strip& s, const NetMatrix& a, std::span<const do
   });
 }
 
-void StripSmoother::sweep(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols, bool backward) const {
+void StripSmoother::sweep(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols, bool backward,
+                          std::vector<double>& work, bool from_zero) const {
   const std::size_t c = static_cast<std::size_t>(cols);
+  work.resize(a.rows() * c);
+  // A colour's band solves: about half the net's rows, each the band twice.
+  const std::size_t solves = a.rows() * bytes_per_row(a.hu(), a.hv()) / sizeof(double) * c;
   std::size_t largest = 0;
   for (const Strip& s : strips_) largest = std::max(largest, s.size);
-  // A colour's work: about half the net's rows, each a row of the matrix and the band.
-  const std::size_t work = a.rows() / 2 * (static_cast<std::size_t>((2 * a.hu() + 1) * (2 * a.hv() + 1)) + bytes_per_row(a.hu(), a.hv()) / sizeof(double)) * c;
-  const bool parallel = work >= parallel_min_work;
-  std::vector<std::vector<double>> scratch(parallel ? max_threads() : 1, std::vector<double>(largest * c));
+  std::vector<std::vector<double>> scratch(solves >= parallel_min_work ? max_threads() : 1, std::vector<double>(largest * c));
   for (int n = 0; n < 4; ++n) {
     const int step = backward ? 3 - n : n, dir = step / 2, colour = step % 2;
     std::vector<const Strip*> these;
     for (const Strip& s : strips_)
       if (s.dir == dir && s.ok && s.index % 2 == colour) these.push_back(&s);
+    if (!(n == 0 && from_zero)) residuals(dir, colour, a, b, x, c, work);
+    const std::span<const double> r = n == 0 && from_zero ? b : std::span<const double>(work);
     const auto count = static_cast<long long>(these.size());
-#pragma omp parallel for schedule(dynamic, 1) if (parallel)
+#pragma omp parallel for schedule(dynamic, 1) if (solves >= parallel_min_work)
     for (long long k = 0; k < count; ++k)
-      solve(*these[static_cast<std::size_t>(k)], a, b, x, cols, scratch[static_cast<std::size_t>(thread_index())]);
+      solve(*these[static_cast<std::size_t>(k)], r, x, c, scratch[static_cast<std::size_t>(thread_index())]);
   }
 }
 

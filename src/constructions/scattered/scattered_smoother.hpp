@@ -27,7 +27,10 @@ class StripSmoother {
   /// them). `backward` runs everything in reverse order: a forward sweep then a
   /// backward one is symmetric. A strip whose matrix did not factor (not positive
   /// definite to rounding) is left out.
-  void sweep(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols, bool backward) const;
+  /// `work` holds the strips' residuals (resized to the net's values); `from_zero` says x
+  /// is zero, so the first colour's residuals are b itself.
+  void sweep(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols, bool backward,
+             std::vector<double>& work, bool from_zero = false) const;
   /// The bytes a control point's share of the factors takes.
   static std::size_t bytes_per_row(int hu, int hv);
 
@@ -53,8 +56,13 @@ class StripSmoother {
       }
   }
   void factor(const NetMatrix& a, Strip& s);
-  void solve(const Strip& s, const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols,
-             std::vector<double>& r) const;
+  // r = b - A x at (at least) the control points of one direction's strips of one
+  // colour, the matrix's rows read in memory order whatever the direction.
+  void residuals(int dir, int colour, const NetMatrix& a, std::span<const double> b, std::span<const double> x, std::size_t c,
+                 std::span<double> r) const;
+  // The strip's correction for the residual r, added to x (its unknowns gathered into
+  // `scratch` in the strip's order).
+  void solve(const Strip& s, std::span<const double> r, std::span<double> x, std::size_t c, std::vector<double>& scratch) const;
   int nu_, nv_;
   std::vector<Strip> strips_;  // along u, then along v, each by first
   std::vector<double> factor_;  // per strip, row k: L[k][k - band .. k - 1], then 1 / L[k][k]

@@ -12,16 +12,40 @@
 namespace interpatch::detail::scattered {
 
 Net::Net(int p_, int q_, int nu_, int nv_, std::array<double, 2> range)
-    : p(p_), q(q_), nu(nu_), nv(nv_), ku(KnotVector::uniform(p_, nu_, 0, range[0])), kv(KnotVector::uniform(q_, nv_, 0, range[1])) {}
+    : p(p_), q(q_), nu(nu_), nv(nv_), ku(KnotVector::uniform(p_, nu_, 0, range[0])), kv(KnotVector::uniform(q_, nv_, 0, range[1])),
+      inv_h{(nu_ - p_) / range[0], (nv_ - q_) / range[1]} {}
 
-int Net::uniform_span(const KnotVector& k, double t) {
+void Net::uniform_basis(const KnotVector& k, double inv_h, int span, double t, double* n) {
+  // The Cox–de Boor recurrence (The NURBS Book's A2.2) on the knots span + 1 - p ..
+  // span + p, which lie between the clamped ends' p + 1 fold knots.
+  const int p = k.degree();
+  if (span < 2 * p - 1 || span + p > k.count()) return k.basis(span, t, n);
+  static constexpr auto inv = [] {
+    std::array<double, max_degree + 1> out{};
+    for (int j = 1; j <= max_degree; ++j) out[static_cast<std::size_t>(j)] = 1.0 / j;
+    return out;
+  }();
+  const double s = (t - k[static_cast<std::size_t>(span)]) * inv_h;  // in the span's spacings
+  n[0] = 1;
+  for (int j = 1; j <= p; ++j) {
+    double saved = 0;
+    for (int r = 0; r < j; ++r) {
+      const double temp = n[r] * inv[static_cast<std::size_t>(j)];  // over right(r + 1) + left(j - r) = j spacings
+      n[r] = saved + (r + 1 - s) * temp;
+      saved = (s + j - r - 1) * temp;
+    }
+    n[j] = saved;
+  }
+}
+
+int Net::uniform_span(const KnotVector& k, double inv_h, double t) {
   const int p = k.degree(), n = k.count() - 1;
   const double a = k[static_cast<std::size_t>(p)], b = k[static_cast<std::size_t>(n + 1)];
   if (!(t > a)) return p;
   if (t >= b) return n;
   // The guess from the spacing, then moved onto the knots as rounded: the span
   // find_span gives, u[s] <= t < u[s + 1].
-  int s = std::clamp(p + static_cast<int>((t - a) / (b - a) * (n + 1 - p)), p, n);
+  int s = std::clamp(p + static_cast<int>((t - a) * inv_h), p, n);
   while (s > p && t < k[static_cast<std::size_t>(s)]) --s;
   while (s < n && t >= k[static_cast<std::size_t>(s + 1)]) ++s;
   return s;
@@ -80,14 +104,20 @@ void NetMatrix::unmirror() {
 
 namespace {
 
+// One sum per di, added together at the end: 2HU + 1 independent chains of additions
+// instead of one, which bounded the product by the adder's latency (3 times slower).
 template <int HU, int HV, int C>
 void full_row(const double* row, const double* xs, std::size_t nv, double* acc) {
-  constexpr int w = 2 * HV + 1;
-  double sum[C] = {};
-  for (int di = 0; di <= 2 * HU; ++di, row += w, xs += nv * C)
+  constexpr int w = 2 * HV + 1, h = 2 * HU + 1;
+  double sum[h][C] = {};
+  for (int di = 0; di < h; ++di, row += w, xs += nv * C)
     for (int k = 0; k < w; ++k)
-      for (int m = 0; m < C; ++m) sum[m] += row[k] * xs[k * C + m];
-  for (int m = 0; m < C; ++m) acc[m] = sum[m];
+      for (int m = 0; m < C; ++m) sum[di][m] += row[k] * xs[k * C + m];
+  for (int m = 0; m < C; ++m) {
+    double total = sum[0][m];
+    for (int di = 1; di < h; ++di) total += sum[di][m];
+    acc[m] = total;
+  }
 }
 
 }  // namespace
@@ -174,7 +204,7 @@ struct Cells {
 
 Cells sort_by_cell(const Net& net, const Samples& s) {
   const std::size_t su = static_cast<std::size_t>(net.nu - net.p), sv = static_cast<std::size_t>(net.nv - net.q);
-  const std::size_t n = s.site.size();
+  const std::size_t n = s.site.size(), cells = su * sv;
   // Each point's cell found twice, to count and to place, rather than kept (4 bytes a
   // point at the peak of a large fit's memory).
   const auto cell_of = [&](std::size_t k) {
@@ -182,34 +212,53 @@ Cells sort_by_cell(const Net& net, const Samples& s) {
     const auto b = static_cast<std::size_t>(net.span_v(s.site[k][1]) - net.q);
     return a * sv + b;
   };
+  // The points in one contiguous block a thread, each block's count of each cell, then
+  // where its points of each cell go: a stable sort, whatever the blocks.
+  const bool parallel = n >= parallel_min_work / 16;
+  const std::size_t blocks = parallel ? max_threads() : 1;
+  std::vector<std::vector<std::uint32_t>> at(blocks, std::vector<std::uint32_t>(cells, 0));
+  const auto range = [&](std::size_t b) { return std::array<std::size_t, 2>{n * b / blocks, n * (b + 1) / blocks}; };
+  parallel_for(blocks, parallel, Share::blocks, [&](std::size_t b) {
+    const auto [lo, hi] = range(b);
+    for (std::size_t k = lo; k < hi; ++k)
+      if (s.weight_at(k) > 0) ++at[b][cell_of(k)];
+  });
   Cells c;
-  c.start.assign(su * sv + 1, 0);
-  for (std::size_t k = 0; k < n; ++k)
-    if (s.weight_at(k) > 0) ++c.start[cell_of(k) + 1];
-  std::partial_sum(c.start.begin(), c.start.end(), c.start.begin());
+  c.start.assign(cells + 1, 0);
+  for (std::size_t cell = 0; cell < cells; ++cell) {
+    std::size_t next = c.start[cell];
+    for (std::size_t b = 0; b < blocks; ++b) {
+      const std::uint32_t count = at[b][cell];
+      at[b][cell] = static_cast<std::uint32_t>(next);
+      next += count;
+    }
+    c.start[cell + 1] = next;
+  }
   c.order.resize(c.start.back());
-  std::vector<std::size_t> next(c.start.begin(), c.start.end() - 1);
-  for (std::size_t k = 0; k < n; ++k)
-    if (s.weight_at(k) > 0) c.order[next[cell_of(k)]++] = static_cast<std::uint32_t>(k);
+  parallel_for(blocks, parallel, Share::blocks, [&](std::size_t b) {
+    const auto [lo, hi] = range(b);
+    for (std::size_t k = lo; k < hi; ++k)
+      if (s.weight_at(k) > 0) c.order[at[b][cell_of(k)]++] = static_cast<std::uint32_t>(k);
+  });
   return c;
 }
 
-// One cell's points added to the system: the (p+1)(q+1) basis functions of each point,
-// their products summed over the cell's points first, then added to the matrix once.
-void add_cell(const Net& net, const Samples& s, const Cells& cells, std::size_t a, std::size_t b, System& sys,
-              std::vector<double>& local) {
-  const int p = net.p, q = net.q, m = (p + 1) * (q + 1), cols = s.cols;
-  const std::size_t sv = static_cast<std::size_t>(net.nv - net.q), cell = a * sv + b;
-  const std::size_t first = cells.start[cell], last = cells.start[cell + 1];
-  if (first == last) return;
+// The sums of one cell's points x in [first, last) of its order: the (p+1)(q+1) basis
+// functions' products, then their products with the values, into `local`. P, Q and C
+// fixed at compile time for the common shapes (0: as the net and samples say), so that
+// the products' loops unroll (half a cubic pass's time).
+template <int P, int Q, int C>
+void cell_sums_of(const Net& net, const Samples& s, const Cells& cells, std::size_t a, std::size_t b, std::size_t first,
+                  std::size_t last, std::span<double> local) {
+  const int p = P ? P : net.p, q = Q ? Q : net.q, m = (p + 1) * (q + 1), cols = C ? C : s.cols;
   const std::size_t pairs = static_cast<std::size_t>(m * (m + 1) / 2);
-  std::fill(local.begin(), local.end(), 0.0);  // sized before the region: nothing allocates on the threads
+  std::fill(local.begin(), local.end(), 0.0);
   double nu_b[max_degree + 1], nv_b[max_degree + 1], basis[(max_degree + 1) * (max_degree + 1)];
   const int span_u = static_cast<int>(a) + p, span_v = static_cast<int>(b) + q;
   for (std::size_t x = first; x < last; ++x) {
     const std::size_t k = cells.order[x];
-    net.ku.basis(span_u, s.site[k][0], nu_b);
-    net.kv.basis(span_v, s.site[k][1], nv_b);
+    net.basis_u(span_u, s.site[k][0], nu_b);
+    net.basis_v(span_v, s.site[k][1], nv_b);
     const double w = s.weight_at(k);
     double value[3];
     for (int c = 0; c < cols; ++c) value[c] = s.value_at(k, c);
@@ -222,6 +271,19 @@ void add_cell(const Net& net, const Samples& s, const Cells& cells, std::size_t 
       for (int c = 0; c < cols; ++c) local[pairs + static_cast<std::size_t>(l * cols + c)] += wb * value[c];
     }
   }
+}
+
+void cell_sums(const Net& net, const Samples& s, const Cells& cells, std::size_t a, std::size_t b, std::size_t first,
+               std::size_t last, std::span<double> local) {
+  if (net.p == 3 && net.q == 3 && s.cols == 1) return cell_sums_of<3, 3, 1>(net, s, cells, a, b, first, last, local);
+  if (net.p == 3 && net.q == 3 && s.cols == 3) return cell_sums_of<3, 3, 3>(net, s, cells, a, b, first, last, local);
+  cell_sums_of<0, 0, 0>(net, s, cells, a, b, first, last, local);
+}
+
+// A cell's sums added to the system, once.
+void add_sums(const Net& net, std::size_t a, std::size_t b, std::span<const double> local, int cols, System& sys) {
+  const int q = net.q, m = (net.p + 1) * (q + 1);
+  const std::size_t pairs = static_cast<std::size_t>(m * (m + 1) / 2);
   const std::size_t nv = static_cast<std::size_t>(net.nv), base = a * nv + b;
   std::size_t e = 0;
   for (int l = 0; l < m; ++l) {
@@ -233,6 +295,11 @@ void add_cell(const Net& net, const Samples& s, const Cells& cells, std::size_t 
   }
 }
 
+// Cells holding more than this many points are summed in blocks of it by all the threads
+// at once (a coarse net's few cells would otherwise keep one thread busy each), the
+// blocks' sums then added in order: the same bits on any number of threads.
+constexpr std::size_t cell_block = 2048;
+
 }  // namespace
 
 void add_data_term(const Net& net, const Samples& s, System& sys) {
@@ -240,18 +307,44 @@ void add_data_term(const Net& net, const Samples& s, System& sys) {
   const std::size_t su = static_cast<std::size_t>(net.nu - net.p), sv = static_cast<std::size_t>(net.nv - net.q);
   const std::size_t pu = static_cast<std::size_t>(net.p + 1), pv = static_cast<std::size_t>(net.q + 1);
   const bool parallel = cells.order.size() * pu * pv * pu * pv >= parallel_min_work;
-  const std::size_t threads = parallel ? max_threads() : 1;
-  const std::size_t m = pu * pv;
-  std::vector<std::vector<double>> local(threads, std::vector<double>(m * (m + 1) / 2 + m * static_cast<std::size_t>(s.cols)));
+  const std::size_t m = pu * pv, len = m * (m + 1) / 2 + m * static_cast<std::size_t>(s.cols);
+  const auto count_of = [&](std::size_t cell) { return cells.start[cell + 1] - cells.start[cell]; };
+  // The large cells' blocks, (cell, first point) each, their sums side by side.
+  std::vector<std::array<std::size_t, 2>> blocks;
+  for (std::size_t cell = 0; cell < su * sv; ++cell)
+    if (count_of(cell) > cell_block)
+      for (std::size_t x = cells.start[cell]; x < cells.start[cell + 1]; x += cell_block) blocks.push_back({cell, x});
+  if (!blocks.empty()) {
+    std::vector<double> sums(blocks.size() * len);
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
+    for (long long k = 0; k < static_cast<long long>(blocks.size()); ++k) {
+      const auto [cell, x] = blocks[static_cast<std::size_t>(k)];
+      cell_sums(net, s, cells, cell / sv, cell % sv, x, std::min(x + cell_block, cells.start[cell + 1]),
+                std::span<double>(sums).subspan(static_cast<std::size_t>(k) * len, len));
+    }
+    for (std::size_t k = 0; k < blocks.size(); ++k) {
+      const std::size_t cell = blocks[k][0];
+      if (k > 0 && blocks[k - 1][0] == cell)
+        for (std::size_t e = 0; e < len; ++e) sums[k * len + e] += sums[(k - 1) * len + e];
+      if (k + 1 == blocks.size() || blocks[k + 1][0] != cell)
+        add_sums(net, cell / sv, cell % sv, std::span<const double>(sums).subspan(k * len, len), s.cols, sys);
+    }
+  }
+  std::vector<std::vector<double>> local(parallel ? max_threads() : 1, std::vector<double>(len));
   // Cells of one colour (a mod (p+1), b mod (q+1)) touch disjoint blocks of control points.
   for (std::size_t ca = 0; ca < pu; ++ca)
     for (std::size_t cb = 0; cb < pv; ++cb) {
       const std::size_t na = su > ca ? (su - ca + pu - 1) / pu : 0, nb = sv > cb ? (sv - cb + pv - 1) / pv : 0;
       const auto count = static_cast<long long>(na * nb);
-#pragma omp parallel for schedule(dynamic, 16) if (parallel)
+      const long long chunk = std::max(1LL, count / 64);
+#pragma omp parallel for schedule(dynamic, chunk) if (parallel)
       for (long long x = 0; x < count; ++x) {
-        const std::size_t xa = static_cast<std::size_t>(x) / nb, xb = static_cast<std::size_t>(x) % nb;
-        add_cell(net, s, cells, ca + xa * pu, cb + xb * pv, sys, local[static_cast<std::size_t>(thread_index())]);
+        const std::size_t a = ca + static_cast<std::size_t>(x) / nb * pu, b = cb + static_cast<std::size_t>(x) % nb * pv;
+        const std::size_t cell = a * sv + b, n = count_of(cell);
+        if (n == 0 || n > cell_block) continue;
+        std::vector<double>& sums = local[static_cast<std::size_t>(thread_index())];
+        cell_sums(net, s, cells, a, b, cells.start[cell], cells.start[cell + 1], sums);
+        add_sums(net, a, b, sums, s.cols, sys);
       }
     }
 }
@@ -271,16 +364,15 @@ std::vector<double> greville_widths(const std::vector<double>& g) {
 
 }  // namespace
 
-void add_fairness(const Net& net, NetMatrix* a, double s, std::vector<double>* diagonal) {
+namespace {
+
+// add(control points, coefficients, weight) for each term of the thin-plate energy:
+// second divided differences over the Greville abscissae along u and along v, and the
+// twist, each weighted by the area it stands for.
+template <class Add>
+void fairness_terms(const Net& net, Add&& add) {
   const std::vector<double> gu = net.ku.greville(), gv = net.kv.greville();
   const std::vector<double> wu = greville_widths(gu), wv = greville_widths(gv);
-  const std::size_t nv = static_cast<std::size_t>(net.nv);
-  auto add = [&](std::span<const std::array<int, 2>> at, std::span<const double> coef, double weight) {
-    if (a) a->add_outer(at, coef, s * weight);
-    if (diagonal)
-      for (std::size_t x = 0; x < at.size(); ++x)
-        (*diagonal)[static_cast<std::size_t>(at[x][0]) * nv + static_cast<std::size_t>(at[x][1])] += weight * coef[x] * coef[x];
-  };
   // Second divided difference over three abscissae, weighted by the length it stands for.
   auto second = [](const std::vector<double>& g, int i, double out[3]) {
     const double h0 = g[static_cast<std::size_t>(i)] - g[static_cast<std::size_t>(i - 1)];
@@ -294,7 +386,7 @@ void add_fairness(const Net& net, NetMatrix* a, double s, std::vector<double>* d
     const double len = (gu[static_cast<std::size_t>(i + 1)] - gu[static_cast<std::size_t>(i - 1)]) / 2;
     for (int j = 0; j < net.nv; ++j) {
       const std::array<int, 2> at[3] = {{i - 1, j}, {i, j}, {i + 1, j}};
-      add(at, c, len * wv[static_cast<std::size_t>(j)]);
+      add(std::span<const std::array<int, 2>>(at), std::span<const double>(c), len * wv[static_cast<std::size_t>(j)]);
     }
   }
   for (int j = 1; j + 1 < net.nv; ++j) {
@@ -303,7 +395,7 @@ void add_fairness(const Net& net, NetMatrix* a, double s, std::vector<double>* d
     const double len = (gv[static_cast<std::size_t>(j + 1)] - gv[static_cast<std::size_t>(j - 1)]) / 2;
     for (int i = 0; i < net.nu; ++i) {
       const std::array<int, 2> at[3] = {{i, j - 1}, {i, j}, {i, j + 1}};
-      add(at, c, len * wu[static_cast<std::size_t>(i)]);
+      add(std::span<const std::array<int, 2>>(at), std::span<const double>(c), len * wu[static_cast<std::size_t>(i)]);
     }
   }
   for (int i = 0; i + 1 < net.nu; ++i)
@@ -313,8 +405,34 @@ void add_fairness(const Net& net, NetMatrix* a, double s, std::vector<double>* d
       const double f = 1 / (hu * hv);
       const std::array<int, 2> at[4] = {{i, j}, {i, j + 1}, {i + 1, j}, {i + 1, j + 1}};
       const double c[4] = {f, -f, -f, f};
-      add(at, c, 2 * hu * hv);
+      add(std::span<const std::array<int, 2>>(at), std::span<const double>(c), 2 * hu * hv);
     }
+}
+
+}  // namespace
+
+void add_fairness(const Net& net, NetMatrix* a, double s, std::vector<double>* diagonal) {
+  const std::size_t nv = static_cast<std::size_t>(net.nv);
+  fairness_terms(net, [&](std::span<const std::array<int, 2>> at, std::span<const double> coef, double weight) {
+    if (a) a->add_outer(at, coef, s * weight);
+    if (diagonal)
+      for (std::size_t x = 0; x < at.size(); ++x)
+        (*diagonal)[static_cast<std::size_t>(at[x][0]) * nv + static_cast<std::size_t>(at[x][1])] += weight * coef[x] * coef[x];
+  });
+}
+
+double fairness_energy(const Net& net, std::span<const double> x, int cols) {
+  const std::size_t nv = static_cast<std::size_t>(net.nv), c = static_cast<std::size_t>(cols);
+  double sum = 0;
+  fairness_terms(net, [&](std::span<const std::array<int, 2>> at, std::span<const double> coef, double weight) {
+    for (std::size_t m = 0; m < c; ++m) {
+      double d = 0;
+      for (std::size_t k = 0; k < at.size(); ++k)
+        d += coef[k] * x[(static_cast<std::size_t>(at[k][0]) * nv + static_cast<std::size_t>(at[k][1])) * c + m];
+      sum += weight * d * d;
+    }
+  });
+  return sum;
 }
 
 namespace {
