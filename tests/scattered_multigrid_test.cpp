@@ -172,6 +172,53 @@ TEST(ScatteredMultigrid, RestrictedDataTermsEqualTheAssembledOnes) {
       }
 }
 
+// What lets a tolerance skip a net's pass over the points: Σ w |S − z|² from the
+// normal equations, Σ w |z|² − 2 xᵀb + xᵀAx − s xᵀFx (A = D + s F), for any x. Checked
+// against the sum over the points with an independent evaluation of S, for weights of
+// all sizes (some zero) and 1 and 3 columns; and xᵀFx against the assembled F. To
+// 1e-11 of the terms' sizes: sums of a few thousand products, reordered.
+TEST(ScatteredMultigrid, TheNormalEquationsTellTheSumOfSquares) {
+  std::mt19937_64 g(43);
+  std::uniform_real_distribution<double> U(0, 1);
+  for (const int cols : {1, 3}) {
+    const Net n(3, 3, 14, 11, {1, 0.6});
+    std::vector<std::array<double, 2>> site(2500);
+    std::vector<double> weight(site.size()), value(site.size() * static_cast<std::size_t>(cols));
+    for (auto& st : site) st = {U(g), 0.6 * U(g)};
+    for (double& w : weight) w = U(g) < 0.1 ? 0.0 : 2 * U(g);
+    for (double& v : value) v = U(g) - 0.5;
+    const double s = 0.37;
+    System sys{NetMatrix(n.nu, n.nv, 3, 3), std::vector<double>(n.size() * static_cast<std::size_t>(cols), 0.0), cols};
+    add_data_term(n, Samples{site, weight, value, cols}, sys);
+    add_fairness(n, &sys.a, s);
+    NetMatrix f(n.nu, n.nv, 3, 3);
+    add_fairness(n, &f, 1);
+    std::vector<double> x(sys.rhs.size()), ax(x.size()), fx(x.size());
+    for (double& v : x) v = U(g) - 0.5;
+    sys.a.multiply(x, ax, cols);
+    f.multiply(x, fx, cols);
+    double zz = 0, xb = 0, xax = 0, xfx = 0, direct = 0;
+    for (std::size_t k = 0; k < x.size(); ++k) xb += x[k] * sys.rhs[k], xax += x[k] * ax[k], xfx += x[k] * fx[k];
+    for (std::size_t k = 0; k < site.size(); ++k) {
+      const promise::Basis bu = own_basis(n.ku.values(), 3, site[k][0]), bv = own_basis(n.kv.values(), 3, site[k][1]);
+      for (int m = 0; m < cols; ++m) {
+        double at = 0;
+        for (std::size_t a = 0; a < 4; ++a)
+          for (std::size_t b = 0; b < 4; ++b)
+            at += bu.N[a] * bv.N[b] *
+                  x[((static_cast<std::size_t>(bu.first) + a) * static_cast<std::size_t>(n.nv) + static_cast<std::size_t>(bv.first) + b) *
+                        static_cast<std::size_t>(cols) + static_cast<std::size_t>(m)];
+        const double z = value[k * static_cast<std::size_t>(cols) + static_cast<std::size_t>(m)];
+        zz += weight[k] * z * z;
+        direct += weight[k] * (at - z) * (at - z);
+      }
+    }
+    const double energy = fairness_energy(n, x, cols);
+    EXPECT_NEAR(energy, xfx, 1e-11 * xfx) << cols << " columns";
+    EXPECT_NEAR(zz - 2 * xb + xax - s * energy, direct, 1e-11 * (zz + 2 * std::abs(xb) + xax + s * xfx)) << cols << " columns";
+  }
+}
+
 struct Fixture {
   std::vector<Net> nets;
   std::vector<System> systems;
