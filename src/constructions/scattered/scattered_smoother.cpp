@@ -20,7 +20,7 @@ std::size_t StripSmoother::bytes_per_row(int hu, int hv) {
   // A strip of width w along one direction has half bandwidth h w + w - 1 across the
   // other's reach h: w (h + 1) numbers a row (the band and the inverse diagonal).
   const std::size_t w = static_cast<std::size_t>(std::max(hu, hv) + 1);
-  return sizeof(double) * w * (static_cast<std::size_t>(hu) + static_cast<std::size_t>(hv) + 2);
+  return sizeof(float) * w * (static_cast<std::size_t>(hu) + static_cast<std::size_t>(hv) + 2);
 }
 
 StripSmoother::StripSmoother(const NetMatrix& a) : nu_(a.nu()), nv_(a.nv()) {
@@ -39,13 +39,16 @@ StripSmoother::StripSmoother(const NetMatrix& a) : nu_(a.nu()), nv_(a.nv()) {
       strips_.push_back(s);
     }
   }
-  factor_.assign(at, 0.0);
+  factor_.assign(at, 0.0f);
   const auto count = static_cast<long long>(strips_.size());
   // Each row of a band b costs about b² / 2 multiply-adds to factor.
   const auto band = static_cast<std::size_t>(std::max(a.hu(), a.hv()) * w + w);
   const bool parallel = a.rows() * band * band >= parallel_min_work;
+  std::size_t largest = 0;
+  for (const Strip& s : strips_) largest = std::max(largest, s.size * static_cast<std::size_t>(s.band + 1));
+  std::vector<std::vector<double>> scratch(parallel ? max_threads() : 1, std::vector<double>(largest));
 #pragma omp parallel for schedule(dynamic, 1) if (parallel)
-  for (long long k = 0; k < count; ++k) factor(a, strips_[static_cast<std::size_t>(k)]);
+  for (long long k = 0; k < count; ++k) factor(a, strips_[static_cast<std::size_t>(k)], scratch[static_cast<std::size_t>(thread_index())]);
 }
 
 std::size_t StripSmoother::row_of(const Strip& s, std::size_t k) const {
@@ -54,10 +57,11 @@ std::size_t StripSmoother::row_of(const Strip& s, std::size_t k) const {
   return s.dir == 0 ? across * static_cast<std::size_t>(nv_) + along : along * static_cast<std::size_t>(nv_) + across;
 }
 
-void StripSmoother::factor(const NetMatrix& a, Strip& s) {
-  // Band Cholesky by rows: L[k][j] = (A[k][j] - Σ_i L[k][i] L[j][i]) / L[j][j].
+void StripSmoother::factor(const NetMatrix& a, Strip& s, std::vector<double>& scratch) {
+  // Band Cholesky by rows: L[k][j] = (A[k][j] - Σ_i L[k][i] L[j][i]) / L[j][j], in
+  // double, then kept in single precision.
   const auto band = static_cast<std::size_t>(s.band), stride = band + 1;
-  double* f = &factor_[s.at];
+  double* f = scratch.data();
   for (std::size_t k = 0; k < s.size; ++k) {
     const std::size_t j0 = k > band ? k - band : 0;
     double* lk = f + k * stride;  // lk[band - (k - j)] = L[k][j]
@@ -78,6 +82,7 @@ void StripSmoother::factor(const NetMatrix& a, Strip& s) {
       }
     }
   }
+  std::copy(f, f + s.size * stride, factor_.begin() + static_cast<std::ptrdiff_t>(s.at));
   s.ok = true;
 }
 
@@ -103,7 +108,7 @@ void StripSmoother::residuals(int dir, int colour, const NetMatrix& a, std::span
 void StripSmoother::solve(const Strip& s, std::span<const double> all, std::span<double> x, std::size_t c,
                           std::vector<double>& scratch) const {
   const auto band = static_cast<std::size_t>(s.band), stride = band + 1;
-  const double* f = &factor_[s.at];
+  const float* f = &factor_[s.at];
   double* r = scratch.data();
   for_each_row(s, [&](std::size_t k, int, int, std::size_t row) {
     for (std::size_t m = 0; m < c; ++m) r[k * c + m] = all[row * c + m];
@@ -111,7 +116,7 @@ void StripSmoother::solve(const Strip& s, std::span<const double> all, std::span
   // L y = r, then Lᵀ z = y, in place; the forward sums in four interleaved parts so that
   // they do not wait on one adder.
   for (std::size_t k = 0; k < s.size; ++k) {
-    const double* lk = f + k * stride;
+    const float* lk = f + k * stride;
     const std::size_t i0 = k > band ? k - band : 0;
     for (std::size_t m = 0; m < c; ++m) {
       double part[4] = {r[k * c + m], 0, 0, 0};
@@ -123,7 +128,7 @@ void StripSmoother::solve(const Strip& s, std::span<const double> all, std::span
     }
   }
   for (std::size_t k = s.size; k-- > 0;) {
-    const double* lk = f + k * stride;
+    const float* lk = f + k * stride;
     const std::size_t i0 = k > band ? k - band : 0;
     for (std::size_t m = 0; m < c; ++m) {
       const double z = r[k * c + m] * lk[band];

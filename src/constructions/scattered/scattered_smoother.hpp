@@ -55,7 +55,7 @@ class StripSmoother {
         f(k, i, j, static_cast<std::size_t>(i) * static_cast<std::size_t>(nv_) + static_cast<std::size_t>(j));
       }
   }
-  void factor(const NetMatrix& a, Strip& s);
+  void factor(const NetMatrix& a, Strip& s, std::vector<double>& scratch);
   // r = b - A x at (at least) the control points of one direction's strips of one
   // colour, the matrix's rows read in memory order whatever the direction.
   void residuals(int dir, int colour, const NetMatrix& a, std::span<const double> b, std::span<const double> x, std::size_t c,
@@ -65,7 +65,10 @@ class StripSmoother {
   void solve(const Strip& s, std::span<const double> r, std::span<double> x, std::size_t c, std::vector<double>& scratch) const;
   int nu_, nv_;
   std::vector<Strip> strips_;  // along u, then along v, each by first
-  std::vector<double> factor_;  // per strip, row k: L[k][k - band .. k - 1], then 1 / L[k][k]
+  // Per strip, row k: L[k][k - band .. k - 1], then 1 / L[k][k]. In single precision:
+  // the sweeps read it from memory (two passes a row per sweep) at half the cost, and a
+  // smoother needs no more than its seven digits.
+  std::vector<float> factor_;
 };
 
 }  // namespace interpatch::detail::scattered
