@@ -13,6 +13,7 @@
 #include <cstring>
 #include <numeric>
 #include <random>
+#include <string>
 
 #include "constructions/scattered/scattered_fit.hpp"
 #include "constructions/scattered/scattered_multigrid.hpp"
@@ -361,37 +362,55 @@ TEST(ScatteredMultigrid, AStripAsWideAsTheNetSolvesIt) {
     }
 }
 
-// Mirrored, a matrix keeps only its whole rows: its entries read the same bits, its
-// products agree with the upper half's to rounding (1e-14 of their largest size, 49: sums of 49
-// terms in another order), and going back to the upper half loses nothing.
-TEST(ScatteredMultigrid, AMirroredMatrixReadsAsItsUpperHalf) {
+// A matrix's products equal the sums over its entries (taken one by one, from either
+// half) to rounding, 1e-14 of their largest size times 49 terms, for 1 and 3 columns:
+// cubic nets from the upper half alone, other reaches from whole rows once mirrored;
+// mirroring (or not, for cubics) and going back change no entry.
+TEST(ScatteredMultigrid, ProductsReadEitherHalfAsTheEntries) {
   std::mt19937_64 g(39);
   std::uniform_real_distribution<double> U(-1, 1);
-  NetMatrix m(12, 15, 3, 3);
-  for (std::size_t r = 0; r < m.rows(); ++r)
-    for (int di = 0; di <= 3; ++di)
-      for (int dj = di == 0 ? 0 : -3; dj <= 3; ++dj) {
-        const int i = static_cast<int>(r) / 15 + di, j = static_cast<int>(r) % 15 + dj;
-        if (i < 12 && j >= 0 && j < 15) m.at(r, m.offset(di, dj)) = U(g);
+  for (const auto& [hu, hv] : {std::array<int, 2>{3, 3}, {2, 2}, {3, 2}})
+    for (const int cols : {1, 3}) {
+      const int nu = 12, nv = 15;
+      NetMatrix m(nu, nv, hu, hv);
+      for (std::size_t r = 0; r < m.rows(); ++r)
+        for (int di = 0; di <= hu; ++di)
+          for (int dj = di == 0 ? 0 : -hv; dj <= hv; ++dj) {
+            const int i = static_cast<int>(r) / nv + di, j = static_cast<int>(r) % nv + dj;
+            if (i < nu && j >= 0 && j < nv) m.at(r, m.offset(di, dj)) = U(g);
+          }
+      const auto c = static_cast<std::size_t>(cols);
+      std::vector<double> upper, x(m.rows() * c), want(x.size(), 0.0), got(x.size());
+      const int width = hv + 1 + hu * (2 * hv + 1);
+      for (std::size_t r = 0; r < m.rows(); ++r)
+        for (int k = 0; k < width; ++k) upper.push_back(m.at(r, k));
+      for (double& v : x) v = U(g);
+      for (std::size_t r = 0; r < m.rows(); ++r) {
+        const int i = static_cast<int>(r) / nv, j = static_cast<int>(r) % nv;
+        for (int di = -hu; di <= hu; ++di)
+          for (int dj = -hv; dj <= hv; ++dj) {
+            if (i + di < 0 || i + di >= nu || j + dj < 0 || j + dj >= nv) continue;
+            const std::size_t o = static_cast<std::size_t>((i + di) * nv + j + dj);
+            for (std::size_t k = 0; k < c; ++k) want[r * c + k] += m.entry(r, di, dj) * x[o * c + k];
+          }
       }
-  std::vector<double> upper, x(m.rows()), y0(m.rows()), y1(m.rows());
-  for (std::size_t r = 0; r < m.rows(); ++r)
-    for (int k = 0; k < 25; ++k) upper.push_back(m.at(r, k));
-  for (double& v : x) v = U(g);
-  m.multiply(x, y0, 1);
-  m.mirror();
-  m.multiply(x, y1, 1);
-  const NetMatrix& read = m;
-  std::size_t e = 0, moved = 0;
-  for (std::size_t r = 0; r < m.rows(); ++r)
-    for (int k = 0; k < 25; ++k) moved += read.at(r, k) != upper[e++];
-  EXPECT_EQ(moved, 0u);
-  for (std::size_t r = 0; r < m.rows(); ++r) EXPECT_NEAR(y0[r], y1[r], 1e-14 * 49) << r;
-  m.unmirror();
-  e = 0, moved = 0;
-  for (std::size_t r = 0; r < m.rows(); ++r)
-    for (int k = 0; k < 25; ++k) moved += m.at(r, k) != upper[e++];
-  EXPECT_EQ(moved, 0u);
+      const auto same_entries = [&] {
+        std::size_t e = 0, moved = 0;
+        const NetMatrix& read = m;
+        for (std::size_t r = 0; r < m.rows(); ++r)
+          for (int k = 0; k < width; ++k) moved += read.at(r, k) != upper[e++];
+        return moved;
+      };
+      for (const char* form : {"as assembled", "mirrored"}) {
+        if (std::string(form) == "mirrored") m.mirror();
+        m.multiply(x, got, cols);
+        for (std::size_t k = 0; k < got.size(); ++k)
+          ASSERT_NEAR(got[k], want[k], 1e-14 * 49) << hu << " x " << hv << ", " << cols << " columns, " << form << ", value " << k;
+        EXPECT_EQ(same_entries(), 0u) << form;
+      }
+      m.unmirror();
+      EXPECT_EQ(same_entries(), 0u) << "back to the upper half";
+    }
 }
 
 // Points are indexed in 32 bits: one more than they reach is refused, by name and count.
