@@ -23,10 +23,6 @@ std::vector<double> greville_widths(const std::vector<double>& g) {
   return w;
 }
 
-}  // namespace
-
-namespace {
-
 // add(control points, coefficients, weight) for each term of the thin-plate energy:
 // second divided differences over the Greville abscissae along u and along v, and the
 // twist, each weighted by the area it stands for.

@@ -198,7 +198,7 @@ System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
     }
   }
   // Along u, each coarse row a from the fine rows i that refine it (the transpose), in
-  // their order.
+  // their order; only the offsets da >= 0 the upper half keeps.
   System out{NetMatrix(ru.coarse, rv.coarse, hu, hv), std::vector<double>(cu * cv * c, 0.0), fine.cols};
   std::vector<double> full(cu * cv * band, 0.0);
 #pragma omp parallel for schedule(static) if (parallel)
@@ -216,7 +216,7 @@ System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
           for (std::size_t e2 = 0; e2 < pu; ++e2) {
             const double w2 = w * ru.weight[static_cast<std::size_t>(i2) * pu + e2];
             const int da = ru.first[static_cast<std::size_t>(i2)] + static_cast<int>(e2) - static_cast<int>(ca);
-            if (w2 == 0 || da < -hu || da > hu) continue;
+            if (w2 == 0 || da < 0 || da > hu) continue;  // the upper half is all that is kept
             double* to = &full[((ca * cv + b) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(da + hu)) * static_cast<std::size_t>(wv)];
             for (std::size_t k = 0; k < static_cast<std::size_t>(wv); ++k) to[k] += w2 * from[k];
           }

@@ -146,7 +146,7 @@ void StripSmoother::sweep(const NetMatrix& a, std::span<const double> b, std::sp
   const std::size_t c = static_cast<std::size_t>(cols);
   work.resize(a.rows() * c);
   // A colour's band solves: about half the net's rows, each the band twice.
-  const std::size_t solves = a.rows() * bytes_per_row(a.hu(), a.hv()) / sizeof(double) * c;
+  const std::size_t solves = a.rows() * bytes_per_row(a.hu(), a.hv()) / sizeof(float) * c;
   std::size_t largest = 0;
   for (const Strip& s : strips_) largest = std::max(largest, s.size);
   std::vector<std::vector<double>> scratch(solves >= parallel_min_work ? max_threads() : 1, std::vector<double>(largest * c));

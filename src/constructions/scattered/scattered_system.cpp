@@ -71,9 +71,7 @@ void NetMatrix::add_outer(std::span<const std::array<int, 2>> at, std::span<cons
 }
 
 void NetMatrix::mirror() {
-  // Cubic nets' products read the upper half as fast (upper_row): memory, not the
-  // adder, bounds them, and the lower entries come from rows just read.
-  if (mirrored_ || (hu_ == 3 && hv_ == 3)) return;
+  if (mirrored_ || stays_upper(hu_, hv_)) return;
   const int fw = (2 * hu_ + 1) * (2 * hv_ + 1);
   full_.assign(rows() * static_cast<std::size_t>(fw), 0.0);
   const std::size_t nv = static_cast<std::size_t>(nv_);
@@ -103,26 +101,6 @@ void NetMatrix::unmirror() {
   std::vector<double>().swap(full_);
   mirrored_ = false;
 }
-
-namespace {
-
-// One sum per di, added together at the end: 2HU + 1 independent chains of additions
-// instead of one, which bounded the product by the adder's latency (3 times slower).
-template <int HU, int HV, int C>
-void full_row(const double* row, const double* xs, std::size_t nv, double* acc) {
-  constexpr int w = 2 * HV + 1, h = 2 * HU + 1;
-  double sum[h][C] = {};
-  for (int di = 0; di < h; ++di, row += w, xs += nv * C)
-    for (int k = 0; k < w; ++k)
-      for (int m = 0; m < C; ++m) sum[di][m] += row[k] * xs[k * C + m];
-  for (int m = 0; m < C; ++m) {
-    double total = sum[0][m];
-    for (int di = 1; di < h; ++di) total += sum[di][m];
-    acc[m] = total;
-  }
-}
-
-}  // namespace
 
 namespace {
 
@@ -165,19 +143,16 @@ void NetMatrix::row_product(int i, int j, std::span<const double> x, std::size_t
   const std::size_t r = static_cast<std::size_t>(i) * nv + static_cast<std::size_t>(j);
   for (std::size_t k = 0; k < c; ++k) acc[k] = 0;
   if (mirrored_ && i >= hu_ && i + hu_ < nu_ && j >= hv_ && j + hv_ < nv_) {
-    // Inside the net: the whole row, one contiguous stretch of x per di; the cubic
-    // nets' shape known at compile time.
+    // Inside the net: the whole row, one contiguous stretch of x per di.
     const std::size_t w = static_cast<std::size_t>(2 * hv_ + 1);
     const double* row = &full_[r * w * static_cast<std::size_t>(2 * hu_ + 1)];
     const double* xs = &x[(r - static_cast<std::size_t>(hu_) * nv - static_cast<std::size_t>(hv_)) * c];
-    if (hu_ == 3 && hv_ == 3 && c == 1) return full_row<3, 3, 1>(row, xs, nv, acc);
-    if (hu_ == 3 && hv_ == 3 && c == 3) return full_row<3, 3, 3>(row, xs, nv, acc);
     for (int di = -hu_; di <= hu_; ++di, row += w, xs += nv * c)
       for (std::size_t k = 0; k < w; ++k)
         for (std::size_t m = 0; m < c; ++m) acc[m] += row[k] * xs[k * c + m];
     return;
   }
-  if (!mirrored_ && hu_ == 3 && hv_ == 3 && i >= hu_ && i + hu_ < nu_ && j >= hv_ && j + hv_ < nv_) {
+  if (!mirrored_ && stays_upper(hu_, hv_) && i >= hu_ && i + hu_ < nu_ && j >= hv_ && j + hv_ < nv_) {
     const auto w = static_cast<std::size_t>(width_);
     if (c == 1) return upper_row<3, 3, 1>(a_.data(), w, r, x.data(), nv, acc);
     if (c == 3) return upper_row<3, 3, 3>(a_.data(), w, r, x.data(), nv, acc);

@@ -84,12 +84,17 @@ class NetMatrix {
   void mirror();
   /// Back to the upper half alone, the smaller form (a matrix kept for later).
   void unmirror();
-  /// Bytes a control point takes while its row is mirrored (both forms at once).
+  /// Bytes a control point takes at most: the upper half, and while mirroring both forms
+  /// at once (never for cubic nets, which stay in the upper half).
   static std::size_t bytes_per_row(int hu, int hv) {
-    return sizeof(double) * static_cast<std::size_t>(hv + 1 + hu * (2 * hv + 1) + (2 * hu + 1) * (2 * hv + 1));
+    const int upper = hv + 1 + hu * (2 * hv + 1);
+    return sizeof(double) * static_cast<std::size_t>(upper + (stays_upper(hu, hv) ? 0 : (2 * hu + 1) * (2 * hv + 1)));
   }
 
  private:
+  // Cubic nets' products read the upper half as fast as whole rows (upper_row): memory,
+  // not the adder, bounds them, and the lower entries come from rows just read.
+  static bool stays_upper(int hu, int hv) { return hu == 3 && hv == 3; }
   [[nodiscard]] std::size_t full_width() const { return static_cast<std::size_t>((2 * hu_ + 1) * (2 * hv_ + 1)); }
   int nu_, nv_, hu_, hv_, width_;
   std::vector<double> a_;  // the upper half, `width_` a row; empty while mirrored
