@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -196,6 +197,43 @@ TEST(Scattered, ConjugateGradientsGiveTheSameBitsOnAnyThreadCount) {
   }
   for (std::size_t t = 1; t < out.size(); ++t)
     EXPECT_EQ(0, std::memcmp(out[t].data(), out[0].data(), out[0].size() * sizeof(double))) << t + 1 << " threads";
+}
+
+// Points missing (NaN) or of weight 0 take no part: the fit is the same, to the bit, as
+// that of the other points alone, which keeps no weights at all. For each way of
+// placing the sites, on a factored net and on one past them (conjugate gradients over
+// multigrid), the points read from the input through the fit's own order.
+TEST(Scattered, PointsLeftOutAreAsIfAbsent) {
+  std::mt19937_64 g(23);
+  const auto all = survey(g, 9000, 0.05);
+  std::vector<Vec3> with = all, without;
+  std::vector<std::array<double, 2>> sites_with, sites_without;
+  std::vector<double> weights(all.size(), 1.0);
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    const bool nan = k % 97 == 3, zero = k % 89 == 5;
+    if (nan) with[k].y = std::numeric_limits<double>::quiet_NaN();
+    if (zero) weights[k] = 0;
+    const std::array<double, 2> site{all[k].x / 1000 + 0.1 * all[k].y / 800, all[k].y / 800};
+    sites_with.push_back(site);
+    if (nan || zero) continue;
+    without.push_back(all[k]);
+    sites_without.push_back(site);
+  }
+  for (const ScatteredParam param : {ScatteredParam::xy, ScatteredParam::plane, ScatteredParam::sites})
+    for (const int n : {12, 75}) {
+      ScatteredApproximationOptions a, b;
+      a.param = b.param = param;
+      a.control_points = b.control_points = std::array<int, 2>{n, n};
+      a.weights = weights;
+      if (param == ScatteredParam::sites) a.sites = sites_with, b.sites = sites_without;
+      const auto r = approximate_scattered(with, a), s = approximate_scattered(without, b);
+      const auto& x = r.surface.control_points().values();
+      const auto& y = s.surface.control_points().values();
+      ASSERT_EQ(x.size(), y.size());
+      EXPECT_EQ(0, std::memcmp(x.data(), y.data(), x.size() * sizeof(Vec3))) << static_cast<int>(param) << ", " << n << " x " << n;
+      EXPECT_EQ(r.report.missing, all.size() / 97 + 1);
+      EXPECT_EQ(s.report.missing, 0U);
+    }
 }
 
 // A sheet tilted in space, its points in random order and far from the origin: the

@@ -51,14 +51,17 @@ ApproxDistance worst_point(std::size_t n, std::span<const double> weight, double
 // surface's own evaluator: the check of the spline returned.
 ApproxDistance distances(const BSplineSurface& s, std::span<const std::array<double, 2>> site, std::span<const Vec3> target,
                          std::span<const double> weight, double* sum_sq) {
-  return worst_point(weight.size(), weight, sum_sq, [&](std::size_t k) { return distance(s.point(site[k][0], site[k][1]), target[k]); });
+  return worst_point(target.size(), weight, sum_sq, [&](std::size_t k) { return distance(s.point(site[k][0], site[k][1]), target[k]); });
 }
 
 // The same for a fit still in the fit's frame, from the net's values and the basis at
 // each site (no surface built, no derivatives): what the tolerance's refinement
 // measures after each fit. The worst point is named by its index in the problem's order.
 ApproxDistance net_distances(const Problem& pr, const Net& net, std::span<const double> x) {
-  return worst_point(pr.size(), pr.weight, nullptr, [&](std::size_t k) { return distance_at(pr, net, x, k); });
+  return worst_point(pr.size(), pr.weight, nullptr, [&](std::size_t k) {
+    pr.prefetch(k + 16);
+    return distance_at(pr, net, x, k);
+  });
 }
 
 // The same over the input, in its order: the worst point as the user numbers it.
@@ -164,9 +167,13 @@ struct Squares {
 
 Squares squares_of(const Problem& pr) {
   Squares out;
-  for (std::size_t k = 0; k < pr.size(); ++k) {
-    const double w = pr.weight.empty() ? 1.0 : pr.weight[k];
-    for (int c = 0; c < pr.cols; ++c) out.values += w * pr.value_at(k, c) * pr.value_at(k, c);
+  const Sites& s = *pr.sites;
+  for (std::size_t k = 0; k < s.size(); ++k) {  // in the input's order: no gathers
+    if (!s.counts(k)) continue;
+    const double w = s.weight_at(k);
+    double v[3];
+    pr.input_value(k, v);
+    for (int c = 0; c < pr.cols; ++c) out.values += w * v[c] * v[c];
     out.weights += w;
   }
   return out;

@@ -78,11 +78,11 @@ std::uint32_t z_order(std::uint32_t i, std::uint32_t j) {
 // along a Z-curve, the order given within a cell (two stable counting sorts of 10 bits).
 template <class UnitAt>
 std::vector<std::uint32_t> z_sorted(const Sites& s, const UnitAt& unit_at, std::array<double, 2> range) {
-  const std::size_t n = s.weight.size();
+  const std::size_t n = s.size();
   std::vector<std::uint32_t> key(n), order, next;
   order.reserve(s.present);
   for (std::size_t k = 0; k < n; ++k) {
-    if (!(s.weight[k] > 0)) continue;
+    if (!s.counts(k)) continue;
     const auto cell = [](double t, double r) { return static_cast<std::uint32_t>(std::clamp(t / r * 1024, 0.0, 1023.0)); };
     const std::array<double, 2> u = unit_at(k);
     key[k] = z_order(cell(u[0], range[0]), cell(u[1], range[1]));
@@ -101,18 +101,6 @@ std::vector<std::uint32_t> z_sorted(const Sites& s, const UnitAt& unit_at, std::
 
 }  // namespace
 
-std::array<double, 2> Problem::input_unit(std::size_t k) const {
-  const auto uv = sites->uv(k);
-  return {std::clamp((uv[0] - lower[0]) / side, 0.0, range[0]), std::clamp((uv[1] - lower[1]) / side, 0.0, range[1])};
-}
-
-void Problem::input_value(std::size_t k, double* v) const {
-  for (int m = 0; m < cols; ++m) {
-    const int a = cols == 1 ? 2 : m;
-    v[m] = (points[k][a] - centre[a]) * scale;
-  }
-}
-
 void require_indexable(std::size_t points) {
   if (points > std::numeric_limits<std::uint32_t>::max())
     fail(errc::too_large, "scattered approximation of ", points, " points: at most ", std::numeric_limits<std::uint32_t>::max(),
@@ -124,11 +112,11 @@ Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool x
   Problem pr;
   pr.p = p, pr.q = q, pr.cols = xy ? 1 : 3, pr.sites = &s, pr.points = points;
   for (std::size_t k = 0; k < points.size(); ++k)
-    if (s.weight[k] > 0) pr.centre = pr.centre + points[k];
+    if (s.counts(k)) pr.centre = pr.centre + points[k];
   pr.centre = pr.centre * (1.0 / static_cast<double>(s.present));
   double top = 0;
   for (std::size_t k = 0; k < points.size(); ++k)
-    if (s.weight[k] > 0) top = std::max(top, max_abs(points[k] - pr.centre));
+    if (s.counts(k)) top = std::max(top, max_abs(points[k] - pr.centre));
   pr.unit_length = approximation_unit(top);
   pr.scale = 1 / pr.unit_length;
   const auto [u0, u1] = s.domain[0];
@@ -137,23 +125,17 @@ Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool x
   pr.side = std::max(u1 - u0, v1 - v0);
   pr.lower = {u0, v0};
   pr.range = {(u1 - u0) / pr.side, (v1 - v0) / pr.side};
-  const std::vector<std::uint32_t> order = z_sorted(s, [&pr](std::size_t k) { return pr.input_unit(k); }, pr.range);
-  const std::size_t n = order.size(), c = static_cast<std::size_t>(pr.cols);
-  pr.unit.resize(n);
-  pr.value.resize(n * c);
+  pr.order = z_sorted(s, [&pr](std::size_t k) { return pr.input_unit(k); }, pr.range);
+  const std::size_t n = pr.order.size();
   bool unit_weights = true;
-  for (std::size_t i = 0; i < n; ++i) {
-    pr.unit[i] = pr.input_unit(order[i]);
-    pr.input_value(order[i], &pr.value[i * c]);
-    unit_weights = unit_weights && s.weight[order[i]] == 1;
-  }
+  for (std::size_t i = 0; i < n && unit_weights; ++i) unit_weights = s.weight_at(pr.order[i]) == 1;
   if (!unit_weights) {
     pr.weight.resize(n);
-    for (std::size_t i = 0; i < n; ++i) pr.weight[i] = s.weight[order[i]];
+    for (std::size_t i = 0; i < n; ++i) pr.weight[i] = s.weight[pr.order[i]];
   }
   if (folds) {
     pr.fold.resize(n);
-    for (std::size_t i = 0; i < n; ++i) pr.fold[i] = fold_of(points[order[i]]);
+    for (std::size_t i = 0; i < n; ++i) pr.fold[i] = fold_of(points[pr.order[i]]);
   }
   return pr;
 }

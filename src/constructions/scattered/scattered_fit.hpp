@@ -15,38 +15,22 @@
 
 namespace interpatch::detail::scattered {
 
-// The fit in its own frame: the points present, their unit sites, their values centred
-// on the points' mean and scaled into a power of two near their size (sums of squares
-// neither overflow nor vanish), in the order of a Z-curve over the domain, so that each
-// knot cell's points lie near one another in memory on any net (in the order given,
-// a pass over a million points waits on memory for most of its time).
-struct Problem {
-  int p = 3, q = 3, cols = 3;
-  std::vector<std::array<double, 2>> unit;
-  std::vector<double> value;  // cols per point
-  std::vector<double> weight;  // empty when every weight is 1
+// The fit in its own frame: the points present (FitPoints: their unit sites, their
+// values centred on the points' mean and scaled into a power of two near their size, so
+// that sums of squares neither overflow nor vanish) in the order of a Z-curve over the
+// domain, so that each knot cell's points lie near one another in that order on any net
+// (in the order given, a pass over a million points waits on memory for most of its
+// time).
+struct Problem : FitPoints {
+  int p = 3, q = 3;
+  std::vector<double> weight;  // in `order`; empty when every weight is 1
   std::vector<std::uint8_t> fold;  // for cross-validation (when asked): fold_of(the point)
-  const Sites* sites = nullptr;
   std::span<const Vec3> points;  // as given
-  Vec3 centre{};
-  double unit_length = 1;
-  double scale = 1;  // 1 / unit_length
+  double unit_length = 1;  // 1 / scale
   double aspect = 1;  // the domain's extent along u over its extent along v
-  // The domain in the fit's frame: [0, range[0]] × [0, range[1]], the longer side 1, so
-  // that J weighs both directions alike (the thin-plate energy of the domain itself).
-  std::array<double, 2> range{1, 1};
-  std::array<double, 2> lower{0, 0};  // the domain's lower corner
-  double side = 1;  // its longer side
-
-  [[nodiscard]] std::size_t size() const { return unit.size(); }
-  /// Input point k's unit site and its value (cols numbers into v), present or not.
-  [[nodiscard]] std::array<double, 2> input_unit(std::size_t k) const;
-  void input_value(std::size_t k, double* v) const;
   /// The points with weights `weight` (the problem's own when empty).
-  [[nodiscard]] Samples samples(std::span<const double> w) const { return Samples{unit, w, value, cols}; }
+  [[nodiscard]] Samples samples(std::span<const double> w) const { return Samples{{}, w, {}, cols, this}; }
   [[nodiscard]] Samples samples() const { return samples(weight); }
-  /// Column c of point k's value.
-  [[nodiscard]] double value_at(std::size_t k, int c) const { return samples().value_at(k, c); }
 };
 
 /// Nets up to this many control points are factored (milliseconds); larger ones go by
@@ -117,7 +101,9 @@ void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const d
 double distance_of(const Net& net, std::span<const double> x, int cols, std::array<double, 2> site, const double* value);
 /// The same for the problem's point k.
 inline double distance_at(const Problem& pr, const Net& net, std::span<const double> x, std::size_t k) {
-  return distance_of(net, x, pr.cols, pr.unit[k], &pr.value[k * static_cast<std::size_t>(pr.cols)]);
+  double v[3];
+  pr.value(k, v);
+  return distance_of(net, x, pr.cols, pr.unit(k), v);
 }
 
 /// One net solved on every point present: λ at least the fill, started from `start`

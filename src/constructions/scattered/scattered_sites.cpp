@@ -19,7 +19,7 @@ void take_points(Sites& s, std::span<const Vec3> points, const ScatteredApproxim
     fail(errc::size_mismatch, o.weights.size(), " weights for ", n, " points");
   if (o.param == ScatteredParam::sites && o.sites.size() != n)
     fail(errc::size_mismatch, o.sites.size(), " sites for ", n, " points: give one (u, v) per point");
-  s.weight.assign(n, 0.0);
+  bool unit = true;  // every point present with weight 1: no weights kept
   for (std::size_t k = 0; k < n; ++k) {
     const Vec3& q = points[k];
     const bool missing = std::isnan(q.x) || std::isnan(q.y) || std::isnan(q.z);
@@ -30,10 +30,16 @@ void take_points(Sites& s, std::span<const Vec3> points, const ScatteredApproxim
     if (w < 0) fail(errc::invalid_weight, "weight [", k, "] is ", w, ": weights are non-negative");
     if (!std::isfinite(w)) fail(errc::not_finite, "weight [", k, "] is ", w);
     if (missing) ++s.missing;
+    unit = unit && !missing && w == 1;
     if (missing || w == 0) continue;
-    s.weight[k] = w;
     s.weight_sum += w;
     ++s.present;
+  }
+  if (unit) return;
+  s.weight.assign(n, 0.0);
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec3& q = points[k];
+    if (!std::isnan(q.x) && !std::isnan(q.y) && !std::isnan(q.z)) s.weight[k] = o.weights.empty() ? 1.0 : o.weights[k];
   }
 }
 
@@ -43,16 +49,16 @@ void take_points(Sites& s, std::span<const Vec3> points, const ScatteredApproxim
 void plane_axes(Sites& s, std::span<const Vec3> points) {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (std::size_t k = 0; k < points.size(); ++k)
-    if (s.weight[k] > 0) mean += Eigen::Vector3d(points[k].x, points[k].y, points[k].z);
+    if (s.counts(k)) mean += Eigen::Vector3d(points[k].x, points[k].y, points[k].z);
   mean /= static_cast<double>(s.present);
   // The spread in a unit of the points' own size: squares of 1e200 would overflow.
   double top = 0;
   for (std::size_t k = 0; k < points.size(); ++k)
-    if (s.weight[k] > 0) top = std::max(top, (Eigen::Vector3d(points[k].x, points[k].y, points[k].z) - mean).cwiseAbs().maxCoeff());
+    if (s.counts(k)) top = std::max(top, (Eigen::Vector3d(points[k].x, points[k].y, points[k].z) - mean).cwiseAbs().maxCoeff());
   const double unit = top > 0 ? top : 1.0;
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   for (std::size_t k = 0; k < points.size(); ++k)
-    if (s.weight[k] > 0) {
+    if (s.counts(k)) {
       const Eigen::Vector3d d = (Eigen::Vector3d(points[k].x, points[k].y, points[k].z) - mean) / unit;
       cov += d * d.transpose();
     }
@@ -72,10 +78,10 @@ void plane_axes(Sites& s, std::span<const Vec3> points) {
 // Refuses sites that all lie on one line (nothing fixes the surface across it): the
 // smaller principal spread of the sites is below 1e-9 of the larger.
 void check_spread(const Sites& s, const char* what) {
-  const std::size_t n = s.weight.size();
+  const std::size_t n = s.size();
   double mu = 0, mv = 0;
   for (std::size_t k = 0; k < n; ++k)
-    if (s.weight[k] > 0) {
+    if (s.counts(k)) {
       const auto uv = s.uv(k);
       mu += uv[0], mv += uv[1];
     }
@@ -83,14 +89,14 @@ void check_spread(const Sites& s, const char* what) {
   // In a unit of the sites' own size: squares of 1e200 would overflow.
   double top = 0;
   for (std::size_t k = 0; k < n; ++k)
-    if (s.weight[k] > 0) {
+    if (s.counts(k)) {
       const auto uv = s.uv(k);
       top = std::max({top, std::abs(uv[0] - mu), std::abs(uv[1] - mv)});
     }
   const double unit = top > 0 ? top : 1.0;
   double suu = 0, suv = 0, svv = 0;
   for (std::size_t k = 0; k < n; ++k)
-    if (s.weight[k] > 0) {
+    if (s.counts(k)) {
       const auto uv = s.uv(k);
       const double du = (uv[0] - mu) / unit, dv = (uv[1] - mv) / unit;
       suu += du * du, suv += du * dv, svv += dv * dv;
@@ -107,8 +113,8 @@ void check_spread(const Sites& s, const char* what) {
 void set_domain(Sites& s, const ScatteredApproximationOptions& o) {
   std::array<std::array<double, 2>, 2> box{{{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()},
                                             {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()}}};
-  for (std::size_t k = 0; k < s.weight.size(); ++k)
-    if (s.weight[k] > 0) {
+  for (std::size_t k = 0; k < s.size(); ++k)
+    if (s.counts(k)) {
       const auto uv = s.uv(k);
       for (int a = 0; a < 2; ++a) {
         box[a][0] = std::min(box[a][0], uv[a]);
@@ -125,8 +131,8 @@ void set_domain(Sites& s, const ScatteredApproximationOptions& o) {
     if (!(std::isfinite(d0) && std::isfinite(d1) && d0 < d1))
       fail(errc::non_increasing, "domain along ", a == 0 ? "u" : "v", " is [", d0, ", ", d1, "]: it must increase");
   }
-  for (std::size_t k = 0; k < s.weight.size(); ++k)
-    if (s.weight[k] > 0) {
+  for (std::size_t k = 0; k < s.size(); ++k)
+    if (s.counts(k)) {
       const auto uv = s.uv(k);
       for (int a = 0; a < 2; ++a)
         if (uv[a] < s.domain[a][0] || uv[a] > s.domain[a][1])
@@ -139,13 +145,13 @@ void set_domain(Sites& s, const ScatteredApproximationOptions& o) {
 
 Sites scattered_sites(std::span<const Vec3> points, const ScatteredApproximationOptions& o, int p, int q) {
   Sites s;
+  s.points = points;
   take_points(s, points, o);
   const std::size_t need = static_cast<std::size_t>((p + 1) * (q + 1));
   if (s.present < need)
     fail(errc::too_few_points, s.present, " of ", points.size(), " points are present (not missing, weight above 0): a degree (",
          p, ", ", q, ") surface needs at least ", need);
   s.param = o.param;
-  s.points = points;
   const char* what = "";
   switch (o.param) {
     case ScatteredParam::xy:

@@ -213,6 +213,10 @@ double mean_diagonal(const NetMatrix& m) {
 
 namespace {
 
+// How many points ahead a pass asks for the input (Samples::prefetch): a cell's sums
+// take about as long per point as memory takes to answer.
+constexpr std::size_t ahead = 8;
+
 // The cell (knot span) of each point present, in u-major order, and the points of each
 // cell in the order given (a counting sort).
 struct Cells {
@@ -222,12 +226,13 @@ struct Cells {
 
 Cells sort_by_cell(const Net& net, const Samples& s) {
   const std::size_t su = static_cast<std::size_t>(net.nu - net.p), sv = static_cast<std::size_t>(net.nv - net.q);
-  const std::size_t n = s.site.size(), cells = su * sv;
+  const std::size_t n = s.size(), cells = su * sv;
   // Each point's cell found twice, to count and to place, rather than kept (4 bytes a
   // point at the peak of a large fit's memory).
   const auto cell_of = [&](std::size_t k) {
-    const auto a = static_cast<std::size_t>(net.span_u(s.site[k][0]) - net.p);
-    const auto b = static_cast<std::size_t>(net.span_v(s.site[k][1]) - net.q);
+    const std::array<double, 2> t = s.site_at(k);
+    const auto a = static_cast<std::size_t>(net.span_u(t[0]) - net.p);
+    const auto b = static_cast<std::size_t>(net.span_v(t[1]) - net.q);
     return a * sv + b;
   };
   // The points in one contiguous block a thread, each block's count of each cell, then
@@ -238,8 +243,10 @@ Cells sort_by_cell(const Net& net, const Samples& s) {
   const auto range = [&](std::size_t b) { return std::array<std::size_t, 2>{n * b / blocks, n * (b + 1) / blocks}; };
   parallel_for(blocks, parallel, Share::blocks, [&](std::size_t b) {
     const auto [lo, hi] = range(b);
-    for (std::size_t k = lo; k < hi; ++k)
+    for (std::size_t k = lo; k < hi; ++k) {
+      s.prefetch(k + 2 * ahead);
       if (s.weight_at(k) > 0) ++at[b][cell_of(k)];
+    }
   });
   Cells c;
   c.start.assign(cells + 1, 0);
@@ -255,8 +262,10 @@ Cells sort_by_cell(const Net& net, const Samples& s) {
   c.order.resize(c.start.back());
   parallel_for(blocks, parallel, Share::blocks, [&](std::size_t b) {
     const auto [lo, hi] = range(b);
-    for (std::size_t k = lo; k < hi; ++k)
+    for (std::size_t k = lo; k < hi; ++k) {
+      s.prefetch(k + 2 * ahead);
       if (s.weight_at(k) > 0) c.order[at[b][cell_of(k)]++] = static_cast<std::uint32_t>(k);
+    }
   });
   return c;
 }
@@ -275,11 +284,13 @@ void cell_sums_of(const Net& net, const Samples& s, const Cells& cells, std::siz
   const int span_u = static_cast<int>(a) + p, span_v = static_cast<int>(b) + q;
   for (std::size_t x = first; x < last; ++x) {
     const std::size_t k = cells.order[x];
-    net.basis_u(span_u, s.site[k][0], nu_b);
-    net.basis_v(span_v, s.site[k][1], nv_b);
+    if (x + ahead < last) s.prefetch(cells.order[x + ahead]);
+    const std::array<double, 2> t = s.site_at(k);
+    net.basis_u(span_u, t[0], nu_b);
+    net.basis_v(span_v, t[1], nv_b);
     const double w = s.weight_at(k);
     double value[3];
-    for (int c = 0; c < cols; ++c) value[c] = s.value_at(k, c);
+    s.values_at(k, value);
     for (int al = 0; al <= p; ++al)
       for (int be = 0; be <= q; ++be) basis[al * (q + 1) + be] = nu_b[al] * nv_b[be];
     std::size_t e = 0;

@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include "constructions/scattered/scattered_sites.hpp"
 #include "interpatch/knot_vector.hpp"
 #include "interpatch/vec3.hpp"
 
@@ -112,15 +113,27 @@ struct System {
 };
 
 /// The points a fit takes: unit sites, weights (0: left out; all 1 when empty), and the
-/// values fitted (cols per point, interleaved).
+/// values fitted (cols per point, interleaved); or, when `points` is given, its points
+/// in their order, read from the input on each use.
 struct Samples {
   std::span<const std::array<double, 2>> site;  ///< in the net's domain
   std::span<const double> weight;
   std::span<const double> value;
   int cols = 1;
+  const FitPoints* points = nullptr;
 
+  [[nodiscard]] std::size_t size() const { return points ? points->size() : site.size(); }
   [[nodiscard]] double weight_at(std::size_t k) const { return weight.empty() ? 1.0 : weight[k]; }
-  [[nodiscard]] double value_at(std::size_t k, int c) const { return value[k * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)]; }
+  [[nodiscard]] std::array<double, 2> site_at(std::size_t k) const { return points ? points->unit(k) : site[k]; }
+  /// FitPoints::prefetch, when the points are read from the input.
+  [[gnu::always_inline]] void prefetch(std::size_t k) const {
+    if (points) points->prefetch(k);
+  }
+  /// Point k's cols values into v.
+  void values_at(std::size_t k, double* v) const {
+    if (points) return points->value(k, v);
+    for (int c = 0; c < cols; ++c) v[c] = value[k * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)];
+  }
 };
 
 /// The normal equations of the data term, Σ w_k B(s_k) B(s_k)ᵀ and Σ w_k B(s_k) Q_k,
