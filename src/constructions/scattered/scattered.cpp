@@ -152,11 +152,13 @@ std::vector<std::optional<System>> restricted_terms(const Problem& pr, std::arra
     if (!within(next, limit, o, s) || cells * 64 > static_cast<double>(s.present)) break;
     spans = {2 * spans[0], 2 * spans[1]};
   }
-  std::vector<std::optional<System>> out(nets.size());
   if (nets.size() < 2) return {};
-  out.back() = data_system(pr, nets.back(), pr.weight);
-  for (std::size_t l = nets.size() - 1; l-- > 0;)
-    out[l] = restrict_system(*out[l + 1], {refinement(nets[l].ku, nets[l + 1].ku), refinement(nets[l].kv, nets[l + 1].kv)});
+  System top = data_system(pr, nets.back(), pr.weight);
+  std::vector<System> below = restrict_down(top, nets.back(), std::span<const Net>(nets).first(nets.size() - 1),
+                                            [&](const Net& n) { return data_system(pr, n, pr.weight); });  // doubling: they nest
+  std::vector<std::optional<System>> out;
+  for (System& t : below) out.emplace_back(std::move(t));
+  out.emplace_back(std::move(top));
   return out;
 }
 

@@ -5,7 +5,8 @@
 // above, one fold of about 20 % is plenty and five would cost five times as much.
 // λ is searched over decades of the balance between the two terms, then refined by
 // golden sections in log λ; each fit starts from the one before, the multigrid's
-// matrices are the data and fairness terms assembled once and summed for each λ.
+// matrices are the data and fairness terms made once (the coarser data terms restricted
+// from the finer where the knots nest) and summed for each λ.
 
 #include <bit>
 #include <cmath>
@@ -106,7 +107,12 @@ Chosen choose_lambda(const Problem& pr, const Net& net, const progress_callback&
     fold.weight.resize(pr.size());
     for (std::size_t k = 0; k < fold.weight.size(); ++k) fold.weight[k] = pr.fold[k] == f ? 0.0 : pr.samples().weight_at(k);
     fold.weight_sum = std::accumulate(fold.weight.begin(), fold.weight.end(), 0.0);
-    for (const Net& n : search.nets) fold.data.push_back(data_system(pr, n, fold.weight));
+    // The finest net's data term from the points, the coarser ones' restricted from it
+    // where the knots nest.
+    System top = data_system(pr, search.nets.back(), fold.weight);
+    fold.data = restrict_down(top, search.nets.back(), std::span<const Net>(search.nets).first(search.nets.size() - 1),
+                              [&](const Net& n) { return data_system(pr, n, fold.weight); });
+    fold.data.push_back(std::move(top));
     fold.x.assign(net.size() * static_cast<std::size_t>(pr.cols), 0.0);
     search.folds.push_back(std::move(fold));
   }

@@ -184,6 +184,10 @@ std::optional<NetMatrix> KeptMatrices::take(const Net& net, double scaled) {
   return std::nullopt;
 }
 
+bool KeptMatrices::has(const Net& net) const {
+  return std::any_of(kept_.begin(), kept_.end(), [&](const Entry& e) { return e.nu == net.nu && e.nv == net.nv; });
+}
+
 void KeptMatrices::keep(const Net& net, NetMatrix a, double scaled) {
   a.unmirror();
   kept_.push_back(Entry{net.nu, net.nv, scaled, std::move(a)});
@@ -224,6 +228,30 @@ void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const d
          "left a residual of ", sol.residual, " of the data after ", sol.iterations, " steps");
 }
 
+namespace {
+
+// The data terms of the nets of `net`'s multigrid that `kept` lacks, each restricted
+// from the next finer one's (from `data`, the net's own, for the first) where the knots
+// nest, otherwise assembled (restrict_down), summed with the fairness at `scaled` and
+// kept. A pass over the points costs about as much on every net; a restriction, a few
+// hundred numbers a fine control point.
+void restrict_hierarchy(const Problem& pr, const Net& net, const System& data, double scaled, KeptMatrices& kept) {
+  const auto spans = hierarchy(std::array<int, 2>{net.nu - net.p, net.nv - net.q}, net.p, net.q, coarsest_net);
+  std::vector<Net> below;  // coarsest first
+  for (std::size_t l = spans.size() - 1; l-- > 0;) {
+    Net coarse(net.p, net.q, spans[l][0] + net.p, spans[l][1] + net.q, pr.range);
+    if (kept.has(coarse)) break;  // and the nets below it, kept with it
+    below.insert(below.begin(), std::move(coarse));
+  }
+  std::vector<System> terms = restrict_down(data, net, below, [&](const Net& n) { return data_system(pr, n, pr.weight); });
+  for (std::size_t l = 0; l < below.size(); ++l) {
+    add_fairness(below[l], &terms[l].a, scaled);
+    kept.keep(below[l], std::move(terms[l].a), scaled);
+  }
+}
+
+}  // namespace
+
 // One net solved: the normal equations assembled, λ (at least the small one that fills
 // voids), from the coarser fit's values at this net's Greville abscissae (zero for the
 // first).
@@ -233,6 +261,8 @@ Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoot
   System sys = data ? std::move(*data) : data_system(pr, net, pr.weight);
   Level out;
   out.lambda = std::max(fill_lambda(net, sys.a, s.weight_sum), smoothing.value_or(0.0));
+  KeptMatrices own;
+  if (net.size() > coarsest_net) restrict_hierarchy(pr, net, sys, s.weight_sum * out.lambda, kept ? *kept : own);
   add_fairness(net, &sys.a, s.weight_sum * out.lambda);
   const bool started = start.size() == sys.rhs.size();
   if (started) out.x = std::move(start);
@@ -246,7 +276,7 @@ Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoot
       else out.x[3 * r] = at[r].x, out.x[3 * r + 1] = at[r].y, out.x[3 * r + 2] = at[r].z;
     }
   }
-  solve_net(pr, net, sys, pr.weight, s.weight_sum * out.lambda, out.x, kept);
+  solve_net(pr, net, sys, pr.weight, s.weight_sum * out.lambda, out.x, kept ? kept : &own);
   if (kept) {
     std::vector<double> ax(out.x.size());
     sys.a.multiply(out.x, ax, pr.cols);

@@ -77,6 +77,7 @@ class KeptMatrices {
   /// The matrix of a nu × nv net moved out, summed with fairness at `scaled`, if kept.
   std::optional<NetMatrix> take(const Net& net, double scaled);
   void keep(const Net& net, NetMatrix a, double scaled);
+  [[nodiscard]] bool has(const Net& net) const;
 
  private:
   struct Entry {
@@ -109,7 +110,9 @@ inline double distance_at(const Problem& pr, const Net& net, std::span<const dou
 /// One net solved on every point present: λ at least the fill, started from `start`
 /// (the net's values), or the coarser fit's values at this net's Greville abscissae,
 /// or zero. Its matrices are left in `kept` when given; its data term is `data` when
-/// given (made already), otherwise assembled.
+/// given (made already), otherwise assembled. The nets of its multigrid that `kept`
+/// lacks are restricted from its data term (Pᵀ D P, restrict_system), not assembled
+/// from the points.
 Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoothing, const BSplineSurface* coarser,
                   std::vector<double> start = {}, KeptMatrices* kept = nullptr, std::optional<System> data = std::nullopt);
 

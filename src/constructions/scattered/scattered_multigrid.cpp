@@ -76,6 +76,27 @@ Refinement refinement(const KnotVector& coarse, const KnotVector& fine) {
   return r;
 }
 
+bool nests(const KnotVector& coarse, const KnotVector& fine) {
+  const int cs = coarse.count() - coarse.degree(), fs = fine.count() - fine.degree();
+  return coarse.degree() == fine.degree() && (fs == cs || fs == 2 * cs);
+}
+
+std::vector<System> restrict_down(const System& top, const Net& top_net, std::span<const Net> nets,
+                                  const std::function<System(const Net&)>& assemble) {
+  std::vector<System> out;  // finest first while made
+  out.reserve(nets.size());
+  for (std::size_t l = nets.size(); l-- > 0;) {
+    const Net& fine = l + 1 < nets.size() ? nets[l + 1] : top_net;
+    const Net& coarse = nets[l];
+    if (nests(coarse.ku, fine.ku) && nests(coarse.kv, fine.kv))
+      out.push_back(restrict_system(out.empty() ? top : out.back(), {refinement(coarse.ku, fine.ku), refinement(coarse.kv, fine.kv)}));
+    else
+      out.push_back(assemble(coarse));
+  }
+  std::reverse(out.begin(), out.end());
+  return out;
+}
+
 std::vector<std::array<int, 2>> hierarchy(std::array<int, 2> spans, int p, int q, std::size_t coarsest) {
   std::vector<std::array<int, 2>> out{spans};
   const auto size = [&](const std::array<int, 2>& s) { return static_cast<std::size_t>(s[0] + p) * static_cast<std::size_t>(s[1] + q); };
@@ -162,37 +183,47 @@ System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
   const auto cu = static_cast<std::size_t>(ru.coarse), cv = static_cast<std::size_t>(rv.coarse);
   const auto pu = static_cast<std::size_t>(ru.p + 1), pv = static_cast<std::size_t>(rv.p + 1);
   // Along v: t[(i, b)][(di, db)] = Σ_j Σ_j' Pv[j][b] A[(i, j)][(i + di, j')] Pv[j'][b + db], both
-  // halves, each fine row i summed by one thread in a fixed order.
+  // halves, each fine row i summed by one thread in a fixed order: first z = the row's
+  // entries times Pv (the coarse functions b' that (i, j)'s neighbours refine, from zlo
+  // on), then Pv[j][b] z into t (about half the products of both at once).
   std::vector<double> t(fu * cv * band, 0.0), tb(fu * cv * c, 0.0);
-  const bool parallel = fu * fv * band * pv * pv >= parallel_min_work;
+  const bool parallel = fu * fv * band * pv >= parallel_min_work;
 #pragma omp parallel for schedule(static) if (parallel)
   for (long long ii = 0; ii < static_cast<long long>(fu); ++ii) {
     const auto i = static_cast<std::size_t>(ii);
+    std::vector<double> z(static_cast<std::size_t>(2 * hv) + pv + 1);
     for (std::size_t j = 0; j < fv; ++j) {
       const std::size_t row = i * fv + j;
+      const double* wj = &rv.weight[j * pv];
+      const int fj = rv.first[j];
       for (std::size_t e = 0; e < pv; ++e) {
-        const double w = rv.weight[j * pv + e];
-        const std::size_t b = static_cast<std::size_t>(rv.first[j]) + e;
-        for (std::size_t m = 0; m < c && w != 0; ++m) tb[(i * cv + b) * c + m] += w * fine.rhs[row * c + m];
+        const std::size_t b = static_cast<std::size_t>(fj) + e;
+        for (std::size_t m = 0; m < c && wj[e] != 0; ++m) tb[(i * cv + b) * c + m] += wj[e] * fine.rhs[row * c + m];
       }
+      const int jlo = std::max(-hv, -static_cast<int>(j)), jhi = std::min(hv, static_cast<int>(fv - 1 - j));
+      const int zlo = rv.first[static_cast<std::size_t>(static_cast<int>(j) + jlo)];
+      const int zhi = rv.first[static_cast<std::size_t>(static_cast<int>(j) + jhi)] + static_cast<int>(pv) - 1;
       for (int di = -hu; di <= hu; ++di) {
         if (static_cast<long long>(i) + di < 0 || static_cast<long long>(i) + di >= static_cast<long long>(fu)) continue;
-        for (int dj = -hv; dj <= hv; ++dj) {
-          const long long j2 = static_cast<long long>(j) + dj;
-          if (j2 < 0 || j2 >= static_cast<long long>(fv)) continue;
+        std::fill(z.begin(), z.begin() + (zhi - zlo + 1), 0.0);
+        bool any = false;
+        for (int dj = jlo; dj <= jhi; ++dj) {
           const double v = a.entry(row, di, dj);
           if (v == 0) continue;
-          for (std::size_t e = 0; e < pv; ++e) {
-            const double w = rv.weight[j * pv + e] * v;
-            if (w == 0) continue;
-            const int b = rv.first[j] + static_cast<int>(e);
-            for (std::size_t e2 = 0; e2 < pv; ++e2) {
-              const int db = rv.first[static_cast<std::size_t>(j2)] + static_cast<int>(e2) - b;
-              if (db < -hv || db > hv) continue;  // coarse functions apart: zero (the header says why)
-              t[((i * cv + static_cast<std::size_t>(b)) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(di + hu)) * static_cast<std::size_t>(wv) +
-                static_cast<std::size_t>(db + hv)] += w * rv.weight[static_cast<std::size_t>(j2) * pv + e2];
-            }
-          }
+          any = true;
+          const auto j2 = static_cast<std::size_t>(static_cast<int>(j) + dj);
+          double* to = &z[static_cast<std::size_t>(rv.first[j2] - zlo)];
+          for (std::size_t e2 = 0; e2 < pv; ++e2) to[e2] += v * rv.weight[j2 * pv + e2];
+        }
+        if (!any) continue;
+        for (std::size_t e = 0; e < pv; ++e) {
+          if (wj[e] == 0) continue;
+          const int b = fj + static_cast<int>(e);
+          // Coarse functions more than hv apart: zero (the header says why).
+          const int lo = std::max(zlo, b - hv), hi = std::min(zhi, b + hv);
+          double* to = &t[((i * cv + static_cast<std::size_t>(b)) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(di + hu)) * static_cast<std::size_t>(wv) +
+                          static_cast<std::size_t>(hv - b)];
+          for (int bb = lo; bb <= hi; ++bb) to[bb] += wj[e] * z[static_cast<std::size_t>(bb - zlo)];
         }
       }
     }

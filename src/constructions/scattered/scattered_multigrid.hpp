@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <span>
 #include <vector>
@@ -42,6 +43,18 @@ Refinement refinement(const KnotVector& coarse, const KnotVector& fine);
 /// functions whose supports do not meet get nothing: no fine functions refining them
 /// meet either.
 System restrict_system(const System& fine, const std::array<Refinement, 2>& r);
+
+/// Whether every knot of `coarse` is a knot of `fine` (uniform knots on one interval:
+/// the same spans, or twice as many), so that restrict_system is exact.
+bool nests(const KnotVector& coarse, const KnotVector& fine);
+
+/// The data terms of `nets` (coarsest first, each coarser than the next, the last
+/// coarser than `top_net`, whose data term is `top`): each restricted from the next
+/// finer one's where their knots nest in both directions, otherwise `assemble`d (from
+/// the points). Elsewhere Pᵀ D P of the cycle's prolongation couples coarse functions
+/// further apart than the matrix reaches.
+std::vector<System> restrict_down(const System& top, const Net& top_net, std::span<const Net> nets,
+                                  const std::function<System(const Net&)>& assemble);
 
 /// The spans of the nets below a fine net of `spans`, coarsest first and the fine one
 /// last: each direction halved (rounded up) while it has more than 4 spans, until the
