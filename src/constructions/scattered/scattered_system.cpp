@@ -227,14 +227,9 @@ struct Cells {
 Cells sort_by_cell(const Net& net, const Samples& s) {
   const std::size_t su = static_cast<std::size_t>(net.nu - net.p), sv = static_cast<std::size_t>(net.nv - net.q);
   const std::size_t n = s.size(), cells = su * sv;
-  // Each point's cell found twice, to count and to place, rather than kept (4 bytes a
-  // point at the peak of a large fit's memory).
-  const auto cell_of = [&](std::size_t k) {
-    const std::array<double, 2> t = s.site_at(k);
-    const auto a = static_cast<std::size_t>(net.span_u(t[0]) - net.p);
-    const auto b = static_cast<std::size_t>(net.span_v(t[1]) - net.q);
-    return a * sv + b;
-  };
+  // Each point's cell, found once (its site read from the input and mapped) and kept
+  // for the placing: 4 bytes a point while the net is assembled, below a fit's peak.
+  std::vector<std::uint32_t> cell(n);
   // The points in one contiguous block a thread, each block's count of each cell, then
   // where its points of each cell go: a stable sort, whatever the blocks.
   const bool parallel = n >= parallel_min_work / 16;
@@ -245,27 +240,29 @@ Cells sort_by_cell(const Net& net, const Samples& s) {
     const auto [lo, hi] = range(b);
     for (std::size_t k = lo; k < hi; ++k) {
       s.prefetch(k + 2 * ahead);
-      if (s.weight_at(k) > 0) ++at[b][cell_of(k)];
+      if (!(s.weight_at(k) > 0)) continue;
+      const std::array<double, 2> t = s.site_at(k);
+      const auto a = static_cast<std::size_t>(net.span_u(t[0]) - net.p), c = static_cast<std::size_t>(net.span_v(t[1]) - net.q);
+      cell[k] = static_cast<std::uint32_t>(a * sv + c);
+      ++at[b][cell[k]];
     }
   });
   Cells c;
   c.start.assign(cells + 1, 0);
-  for (std::size_t cell = 0; cell < cells; ++cell) {
-    std::size_t next = c.start[cell];
+  for (std::size_t x = 0; x < cells; ++x) {
+    std::size_t next = c.start[x];
     for (std::size_t b = 0; b < blocks; ++b) {
-      const std::uint32_t count = at[b][cell];
-      at[b][cell] = static_cast<std::uint32_t>(next);
+      const std::uint32_t count = at[b][x];
+      at[b][x] = static_cast<std::uint32_t>(next);
       next += count;
     }
-    c.start[cell + 1] = next;
+    c.start[x + 1] = next;
   }
   c.order.resize(c.start.back());
   parallel_for(blocks, parallel, Share::blocks, [&](std::size_t b) {
     const auto [lo, hi] = range(b);
-    for (std::size_t k = lo; k < hi; ++k) {
-      s.prefetch(k + 2 * ahead);
-      if (s.weight_at(k) > 0) c.order[at[b][cell_of(k)]++] = static_cast<std::uint32_t>(k);
-    }
+    for (std::size_t k = lo; k < hi; ++k)
+      if (s.weight_at(k) > 0) c.order[at[b][cell[k]]++] = static_cast<std::uint32_t>(k);
   });
   return c;
 }
