@@ -4,8 +4,8 @@
 // equations of points scattered a few to a knot cell have near-null modes a few control
 // points wide (clusters a handful of points hardly tell apart, the clamped edges' B-splines
 // that barely reach any point). Point Gauss–Seidel damps them by a hair a sweep and the
-// coarse nets cannot hold them; a strip solved whole removes them. Strips along u, then
-// strips along v.
+// coarse nets cannot hold them; a strip solved whole removes them. Strips along v, then
+// strips along u.
 
 #include <cstddef>
 #include <span>
@@ -19,10 +19,11 @@ namespace interpatch::detail::scattered {
 /// direction, every strip's matrix factored as a band (LLᵀ).
 class StripSmoother {
  public:
-  /// Factors the strips of `a`, its entries as they are now.
-  explicit StripSmoother(const NetMatrix& a);
-  /// One sweep of block Gauss–Seidel on a x = b, in place: the strips along u, then
-  /// those along v, each in two colours of strips that share no entry of the matrix
+  /// Factors the strips of `a`, its entries as they are now: along both directions, or
+  /// along u alone when not `both`.
+  explicit StripSmoother(const NetMatrix& a, bool both = true);
+  /// One sweep of block Gauss–Seidel on a x = b, in place: the strips along v (if
+  /// any), then those along u, each in two colours of strips that share no entry of the matrix
   /// (a colour's strips solved by the threads at once; the same bits on any number of
   /// them). `backward` runs everything in reverse order: a forward sweep then a
   /// backward one is symmetric. A strip whose matrix did not factor (not positive
@@ -64,6 +65,7 @@ class StripSmoother {
   // `scratch` in the strip's order).
   void solve(const Strip& s, std::span<const double> r, std::span<double> x, std::size_t c, std::vector<double>& scratch) const;
   int nu_, nv_;
+  int directions_ = 2;
   std::vector<Strip> strips_;  // along u, then along v, each by first
   // Per strip, row k: L[k][k - band .. k - 1], then 1 / L[k][k]. In single precision:
   // the sweeps read it from memory (two passes a row per sweep) at half the cost, and a
