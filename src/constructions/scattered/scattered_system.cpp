@@ -367,6 +367,13 @@ void add_data_term(const Net& net, const Samples& s, System& sys) {
       for (long long x = 0; x < count; ++x) {
         const std::size_t a = ca + static_cast<std::size_t>(x) / nb * pu, b = cb + static_cast<std::size_t>(x) % nb * pv;
         const std::size_t cell = a * sv + b, n = count_of(cell);
+        if (x + 1 < count) {
+          // The next cell's first points asked for now: cells of a few points each would
+          // otherwise wait on memory at every point (within a cell, cell_sums_of asks
+          // ahead itself).
+          const std::size_t next = (ca + static_cast<std::size_t>(x + 1) / nb * pu) * sv + cb + static_cast<std::size_t>(x + 1) % nb * pv;
+          for (std::size_t y = cells.start[next]; y < std::min(cells.start[next + 1], cells.start[next] + ahead); ++y) s.prefetch(cells.order[y]);
+        }
         if (n == 0 || n > cell_block) continue;
         std::vector<double>& sums = local[static_cast<std::size_t>(thread_index())];
         cell_sums(net, s, cells, a, b, cells.start[cell], cells.start[cell + 1], sums);
