@@ -18,9 +18,9 @@ namespace interpatch::detail::scattered {
 // The fit in its own frame: the points present (FitPoints: their unit sites, their
 // values centred on the points' mean and scaled into a power of two near their size, so
 // that sums of squares neither overflow nor vanish) in the order of a Z-curve over the
-// domain, so that each knot cell's points lie near one another in that order on any net
-// (in the order given, a pass over a million points waits on memory for most of its
-// time).
+// domain, so that each knot cell's points come one after another on any net: the net's
+// values and matrix rows a pass touches stay in cache, while the points themselves are
+// asked for from the input ahead of their use (FitPoints::prefetch).
 struct Problem : FitPoints {
   int p = 3, q = 3;
   std::vector<double> weight;  // in `order`; empty when every weight is 1
