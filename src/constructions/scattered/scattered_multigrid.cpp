@@ -277,7 +277,10 @@ Multigrid::Multigrid(std::vector<Net> nets, std::vector<const NetMatrix*> matric
   r_.resize(n), b_.resize(n), x_.resize(n), tmp_.resize(n);
   for (std::size_t l = 0; l < n; ++l) {
     const std::size_t len = nets_[l].size() * static_cast<std::size_t>(cols);
-    r_[l].assign(len, 0.0), b_[l].assign(len, 0.0), x_[l].assign(len, 0.0);
+    // r: a finer net's residual; b, x: a coarser net's problem and solution (the finest's
+    // are the caller's).
+    if (l > 0) r_[l].assign(len, 0.0);
+    if (l + 1 < n) b_[l].assign(len, 0.0), x_[l].assign(len, 0.0);
   }
 }
 

@@ -410,8 +410,11 @@ void dots(std::span<const double> x, std::span<const double> y, int cols, double
 Solved solve_cg(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols, double rel, int max_iter,
                 const Preconditioner& precondition, const KeepGoing& keep_going) {
   const std::size_t c = static_cast<std::size_t>(cols), n = a.rows(), len = n * c;
-  std::vector<double> inv(n), r(len), z(len), p(len), ap(len), partial;
-  for (std::size_t i = 0; i < n; ++i) inv[i] = a.at(i, 0) > 0 ? 1 / a.at(i, 0) : 1.0;
+  std::vector<double> inv, r(len), z(len), p(len), ap(len), partial;
+  if (!precondition) {
+    inv.resize(n);
+    for (std::size_t i = 0; i < n; ++i) inv[i] = a.at(i, 0) > 0 ? 1 / a.at(i, 0) : 1.0;
+  }
   const auto apply = [&] {
     if (precondition) precondition(r, z, cols);
     else
