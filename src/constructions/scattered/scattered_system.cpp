@@ -363,15 +363,19 @@ void add_data_term(const Net& net, const Samples& s, System& sys) {
       const std::size_t na = su > ca ? (su - ca + pu - 1) / pu : 0, nb = sv > cb ? (sv - cb + pv - 1) / pv : 0;
       const auto count = static_cast<long long>(na * nb);
       const long long chunk = std::max(1LL, count / 64);
+      const auto at = [&](long long x) {  // the colour's x-th cell: (a, b)
+        return std::array<std::size_t, 2>{ca + static_cast<std::size_t>(x) / nb * pu, cb + static_cast<std::size_t>(x) % nb * pv};
+      };
 #pragma omp parallel for schedule(dynamic, chunk) if (parallel)
       for (long long x = 0; x < count; ++x) {
-        const std::size_t a = ca + static_cast<std::size_t>(x) / nb * pu, b = cb + static_cast<std::size_t>(x) % nb * pv;
+        const auto [a, b] = at(x);
         const std::size_t cell = a * sv + b, n = count_of(cell);
         if (x + 1 < count) {
           // The next cell's first points asked for now: cells of a few points each would
           // otherwise wait on memory at every point (within a cell, cell_sums_of asks
           // ahead itself).
-          const std::size_t next = (ca + static_cast<std::size_t>(x + 1) / nb * pu) * sv + cb + static_cast<std::size_t>(x + 1) % nb * pv;
+          const auto [a1, b1] = at(x + 1);
+          const std::size_t next = a1 * sv + b1;
           for (std::size_t y = cells.start[next]; y < std::min(cells.start[next + 1], cells.start[next] + ahead); ++y) s.prefetch(cells.order[y]);
         }
         if (n == 0 || n > cell_block) continue;
