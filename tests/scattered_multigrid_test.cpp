@@ -64,48 +64,31 @@ TEST(ScatteredMultigrid, RefinementIsExactWhereTheKnotsNest) {
     }
 }
 
-// Between nets that do not nest (odd spans halved and rounded up), the coarse spline's
-// values at the fine Greville abscissae: lines are reproduced, so the coarse
-// correction of a smooth error is right to second order.
-TEST(ScatteredMultigrid, RefinementReproducesLinesWhereTheKnotsDoNotNest) {
-  for (const int spans : {3, 7, 25}) {
-    const KnotVector c = KnotVector::uniform(3, (spans + 1) / 2 + 3, 0, 1), f = KnotVector::uniform(3, spans + 3, 0, 1);
-    const Refinement r = refinement(c, f);
-    const std::vector<double> gc = c.greville(), gf = f.greville();
-    std::vector<double> line(gc.size());
-    for (std::size_t i = 0; i < gc.size(); ++i) line[i] = 2 - 3 * gc[i];
-    const std::vector<double> fine = refine(r, line);
-    for (std::size_t i = 0; i < gf.size(); ++i) EXPECT_NEAR(fine[i], 2 - 3 * gf[i], 1e-14) << spans << " spans, point " << i;
-    // The transpose holds the same weights.
-    double from_rows = 0, from_columns = 0;
-    for (double w : r.weight) from_rows += w;
-    for (double w : r.t_weight) from_columns += w;
-    EXPECT_NEAR(from_rows, from_columns, 1e-13);
-  }
-}
-
 // The span from the knots' spacing is find_span's, at every knot, beside each (the
-// next double either way), between them, and past both ends.
+// next double either way), between them, and past both ends; on uniform nets and on
+// the nets below them, whose knots are not all evenly spaced.
 TEST(ScatteredMultigrid, SpansFromTheSpacingAreTheSearchedOnes) {
   std::mt19937_64 g(40);
   std::uniform_real_distribution<double> U(-0.1, 1.1);
   for (const int degree : {1, 2, 3, 5})
     for (const int count : {degree + 1, degree + 2, 7, 64, 259, 1027})
       for (const double range : {1.0, 0.8, 0.3}) {
-        const Net net(degree, degree, count, count, {range, range});
+       for (const Net& net : hierarchy(Net(degree, degree, count, count, {range, range}), 16)) {
         std::vector<double> ts;
-        for (int i = 0; i <= count + degree; ++i) {
+        for (int i = 0; i <= net.nu + degree; ++i) {
           const double k = net.ku[static_cast<std::size_t>(i)];
           ts.insert(ts.end(), {k, std::nextafter(k, -1.0), std::nextafter(k, 2.0)});
         }
         for (int i = 0; i < 200; ++i) ts.push_back(U(g) * range);
         for (const double t : ts) ASSERT_EQ(net.span_u(t), net.ku.find_span(t)) << degree << " " << count << " " << range << " t " << t;
+       }
       }
 }
 
 // On spans whose knots are evenly spaced the net's basis skips the knots' divisions:
 // it agrees with the recurrence on the knots (an independent one here) to the knots'
-// rounding, on every span of every shape. A knot is rounded by up to an ulp of itself,
+// rounding, on every span of every shape, and on the nets below (not all evenly
+// spaced). A knot is rounded by up to an ulp of itself,
 // which moves t's place in its span by that over the spacing, about 1e-16 times the
 // spans over the range; the basis functions' slopes in that place are below 2 (1e-15
 // times the control points bounds it).
@@ -115,7 +98,7 @@ TEST(ScatteredMultigrid, TheNetsBasisIsTheKnotsBasis) {
   for (const int degree : {1, 2, 3, 4, 7})
     for (const int count : {degree + 1, degree + 3, 2 * degree + 2, 19, 260})
       for (const double range : {1.0, 0.8}) {
-        const Net net(degree, degree, count, count, {range, range});
+       for (const Net& net : hierarchy(Net(degree, degree, count, count, {range, range}), 16))
         for (int k = 0; k < 300; ++k) {
           const double t = k < 2 ? k * range : U(g) * range;
           const int span = net.span_u(t);
@@ -250,9 +233,8 @@ Fixture fixture(int nu, int nv, std::size_t points, double lambda, int cols, std
     add_data_term(n, Samples{f.site, f.weight, f.value, cols}, fine);
     lambda = fill_lambda(n, fine.a, static_cast<double>(points));
   }
-  for (const auto& sp : hierarchy({nu - 3, nv - 3}, 3, 3, 4096)) {
-    f.nets.emplace_back(3, 3, sp[0] + 3, sp[1] + 3, std::array<double, 2>{1, 0.8});
-    const Net& n = f.nets.back();
+  f.nets = hierarchy(Net(3, 3, nu, nv, {1, 0.8}), 4096);
+  for (const Net& n : f.nets) {
     f.systems.push_back(System{NetMatrix(n.nu, n.nv, 3, 3), std::vector<double>(n.size() * static_cast<std::size_t>(cols), 0.0), cols});
     add_data_term(n, Samples{f.site, f.weight, f.value, cols}, f.systems.back());
     add_fairness(n, &f.systems.back().a, static_cast<double>(points) * lambda);

@@ -154,8 +154,7 @@ std::vector<std::optional<System>> restricted_terms(const Problem& pr, std::arra
   }
   if (nets.size() < 2) return {};
   System top = data_system(pr, nets.back(), pr.weight);
-  std::vector<System> below = restrict_down(top, nets.back(), std::span<const Net>(nets).first(nets.size() - 1),
-                                            [&](const Net& n) { return data_system(pr, n, pr.weight); });  // doubling: they nest
+  std::vector<System> below = restrict_down(top, nets.back(), std::span<const Net>(nets).first(nets.size() - 1));  // doubling: they nest
   std::vector<std::optional<System>> out;
   for (System& t : below) out.emplace_back(std::move(t));
   out.emplace_back(std::move(top));

@@ -6,7 +6,7 @@
 // λ is searched over decades of the balance between the two terms, then refined by
 // golden sections in log λ; each fit starts from the one before, the multigrid's
 // matrices are the data and fairness terms made once (the coarser data terms restricted
-// from the finer where the knots nest) and summed for each λ.
+// from the finer) and summed for each λ.
 
 #include <bit>
 #include <cmath>
@@ -88,8 +88,7 @@ std::uint8_t fold_of(const Vec3& point) {
 Chosen choose_lambda(const Problem& pr, const Net& net, const progress_callback& progress, double from, double to) {
   const Sites& s = *pr.sites;
   Search search{pr, {}, {}, {}, {}, std::nullopt, 0};
-  for (const auto& sp : hierarchy(std::array<int, 2>{net.nu - net.p, net.nv - net.q}, net.p, net.q, coarsest_net))
-    search.nets.emplace_back(net.p, net.q, sp[0] + net.p, sp[1] + net.q, pr.range);
+  search.nets = hierarchy(net, coarsest_net);
   const int evaluated = s.present < all_folds_below ? fold_count : 1;
   std::size_t rows = 0;
   for (const Net& n : search.nets) rows += n.size();
@@ -107,11 +106,9 @@ Chosen choose_lambda(const Problem& pr, const Net& net, const progress_callback&
     fold.weight.resize(pr.size());
     for (std::size_t k = 0; k < fold.weight.size(); ++k) fold.weight[k] = pr.fold[k] == f ? 0.0 : pr.samples().weight_at(k);
     fold.weight_sum = std::accumulate(fold.weight.begin(), fold.weight.end(), 0.0);
-    // The finest net's data term from the points, the coarser ones' restricted from it
-    // where the knots nest.
+    // The finest net's data term from the points, the coarser ones' restricted from it.
     System top = data_system(pr, search.nets.back(), fold.weight);
-    fold.data = restrict_down(top, search.nets.back(), std::span<const Net>(search.nets).first(search.nets.size() - 1),
-                              [&](const Net& n) { return data_system(pr, n, fold.weight); });
+    fold.data = restrict_down(top, search.nets.back(), std::span<const Net>(search.nets).first(search.nets.size() - 1));
     fold.data.push_back(std::move(top));
     fold.x.assign(net.size() * static_cast<std::size_t>(pr.cols), 0.0);
     search.folds.push_back(std::move(fold));

@@ -33,33 +33,28 @@ constexpr int slow_steps = 150;
 }
 
 // The nets below `net` for multigrid, their matrices (data and fairness at `scaled`,
-// the weight times the points' weight sum; taken from `kept` where there) and the
-// cycle over them and `top`.
+// the weight times the points' weight sum) moved out of `kept`, and the cycle over them
+// and `top`.
 struct Hierarchy {
   std::vector<Net> nets;
   std::vector<NetMatrix> below;
   std::optional<Multigrid> mg;
 };
 
-Hierarchy hierarchy_for(const Problem& pr, const Net& net, const NetMatrix& top, std::span<const double> weight, double scaled,
-                        KeptMatrices* kept) {
+Hierarchy hierarchy_for(const Net& net, const NetMatrix& top, double scaled, KeptMatrices& kept, int cols) {
   Hierarchy h;
-  const auto spans = hierarchy(std::array<int, 2>{net.nu - net.p, net.nv - net.q}, net.p, net.q, coarsest_net);
-  for (const auto& sp : spans) h.nets.emplace_back(net.p, net.q, sp[0] + net.p, sp[1] + net.q, pr.range);
+  h.nets = hierarchy(net, coarsest_net);
   h.below.reserve(h.nets.size() - 1);
   std::vector<const NetMatrix*> matrices;
   for (std::size_t l = 0; l + 1 < h.nets.size(); ++l) {
-    std::optional<NetMatrix> a = kept ? kept->take(h.nets[l], scaled) : std::nullopt;
-    if (!a) {
-      a.emplace(std::move(data_system(pr, h.nets[l], weight).a));
-      add_fairness(h.nets[l], &*a, scaled);
-    }
+    std::optional<NetMatrix> a = kept.take(h.nets[l], scaled);
+    if (!a) fail(errc::internal, "scattered multigrid: no matrix for the coarse net of ", h.nets[l].nu, " x ", h.nets[l].nv, " control points");
     h.below.push_back(std::move(*a));
     h.below.back().mirror();
     matrices.push_back(&h.below.back());
   }
   matrices.push_back(&top);
-  h.mg.emplace(h.nets, std::move(matrices), pr.cols);
+  h.mg.emplace(h.nets, std::move(matrices), cols);
   return h;
 }
 
@@ -175,7 +170,7 @@ double fill_lambda(const Net& net, const NetMatrix& data, double weight_sum) {
 // refused if it stalls.
 std::optional<NetMatrix> KeptMatrices::take(const Net& net, double scaled) {
   for (auto e = kept_.begin(); e != kept_.end(); ++e) {
-    if (e->nu != net.nu || e->nv != net.nv) continue;
+    if (!e->net.same_knots(net)) continue;
     NetMatrix a = std::move(e->a);
     if (scaled != e->scaled) add_fairness(net, &a, scaled - e->scaled);
     kept_.erase(e);
@@ -185,16 +180,15 @@ std::optional<NetMatrix> KeptMatrices::take(const Net& net, double scaled) {
 }
 
 bool KeptMatrices::has(const Net& net) const {
-  return std::any_of(kept_.begin(), kept_.end(), [&](const Entry& e) { return e.nu == net.nu && e.nv == net.nv; });
+  return std::any_of(kept_.begin(), kept_.end(), [&](const Entry& e) { return e.net.same_knots(net); });
 }
 
 void KeptMatrices::keep(const Net& net, NetMatrix a, double scaled) {
   a.unmirror();
-  kept_.push_back(Entry{net.nu, net.nv, scaled, std::move(a)});
+  kept_.push_back(Entry{net, scaled, std::move(a)});
 }
 
-void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const double> weight, double scaled, std::vector<double>& x,
-               KeptMatrices* kept) {
+void solve_net(const Problem& pr, const Net& net, System& sys, double scaled, std::vector<double>& x, KeptMatrices& kept) {
   if (net.size() <= coarsest_net) {
     if (!solve_direct(sys.a, sys.rhs, x, pr.cols)) not_definite(net);
     return;
@@ -203,7 +197,7 @@ void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const d
   Solved sol;
   {
     sys.a.mirror();
-    Hierarchy h = hierarchy_for(pr, net, sys.a, weight, scaled, kept);
+    Hierarchy h = hierarchy_for(net, sys.a, scaled, kept, pr.cols);
     if (!h.mg->factor()) not_definite(h.mg->net(0));
     Multigrid& mg = *h.mg;
     double before = 0;  // the residual probe_steps ago
@@ -215,8 +209,7 @@ void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const d
     };
     sol = solve_cg(sys.a, sys.rhs, x, pr.cols, 1e-12, factorable ? 4 * slow_steps : 200 + 40 * (net.nu + net.nv),
                    [&mg](std::span<const double> r, std::span<double> z, int) { mg.apply(r, z); }, keep_going);
-    if (kept)
-      for (std::size_t l = 0; l < h.below.size(); ++l) kept->keep(h.nets[l], std::move(h.below[l]), scaled);
+    for (std::size_t l = 0; l < h.below.size(); ++l) kept.keep(h.nets[l], std::move(h.below[l]), scaled);
   }
   if (sol.residual <= 1e-12) return;
   if (factorable) {
@@ -231,19 +224,16 @@ void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const d
 namespace {
 
 // The data terms of the nets of `net`'s multigrid that `kept` lacks, each restricted
-// from the next finer one's (from `data`, the net's own, for the first) where the knots
-// nest, otherwise assembled (restrict_down), summed with the fairness at `scaled` and
-// kept. A pass over the points costs about as much on every net; a restriction, a few
-// hundred numbers a fine control point.
-void restrict_hierarchy(const Problem& pr, const Net& net, const System& data, double scaled, KeptMatrices& kept) {
-  const auto spans = hierarchy(std::array<int, 2>{net.nu - net.p, net.nv - net.q}, net.p, net.q, coarsest_net);
-  std::vector<Net> below;  // coarsest first
-  for (std::size_t l = spans.size() - 1; l-- > 0;) {
-    Net coarse(net.p, net.q, spans[l][0] + net.p, spans[l][1] + net.q, pr.range);
-    if (kept.has(coarse)) break;  // and the nets below it, kept with it
-    below.insert(below.begin(), std::move(coarse));
-  }
-  std::vector<System> terms = restrict_down(data, net, below, [&](const Net& n) { return data_system(pr, n, pr.weight); });
+// from the next finer one's (from `data`, the net's own, for the first), summed with the
+// fairness at `scaled` and kept. A pass over the points costs about as much on every
+// net; a restriction, a few hundred numbers a fine control point.
+void restrict_hierarchy(const Net& net, const System& data, double scaled, KeptMatrices& kept) {
+  std::vector<Net> below = hierarchy(net, coarsest_net);  // coarsest first
+  below.pop_back();
+  std::size_t first = below.size();
+  while (first > 0 && !kept.has(below[first - 1])) --first;  // the nets below a kept one are kept with it
+  below.erase(below.begin(), below.begin() + static_cast<std::ptrdiff_t>(first));
+  std::vector<System> terms = restrict_down(data, net, below);
   for (std::size_t l = 0; l < below.size(); ++l) {
     add_fairness(below[l], &terms[l].a, scaled);
     kept.keep(below[l], std::move(terms[l].a), scaled);
@@ -262,7 +252,7 @@ Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoot
   Level out;
   out.lambda = std::max(fill_lambda(net, sys.a, s.weight_sum), smoothing.value_or(0.0));
   KeptMatrices own;
-  if (net.size() > coarsest_net) restrict_hierarchy(pr, net, sys, s.weight_sum * out.lambda, kept ? *kept : own);
+  if (net.size() > coarsest_net) restrict_hierarchy(net, sys, s.weight_sum * out.lambda, kept ? *kept : own);
   add_fairness(net, &sys.a, s.weight_sum * out.lambda);
   const bool started = start.size() == sys.rhs.size();
   if (started) out.x = std::move(start);
@@ -276,7 +266,7 @@ Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoot
       else out.x[3 * r] = at[r].x, out.x[3 * r + 1] = at[r].y, out.x[3 * r + 2] = at[r].z;
     }
   }
-  solve_net(pr, net, sys, pr.weight, s.weight_sum * out.lambda, out.x, kept ? kept : &own);
+  solve_net(pr, net, sys, s.weight_sum * out.lambda, out.x, kept ? *kept : own);
   if (kept) {
     std::vector<double> ax(out.x.size());
     sys.a.multiply(out.x, ax, pr.cols);

@@ -74,28 +74,27 @@ double fill_lambda(const Net& net, const NetMatrix& data, double weight_sum);
 /// every net of a finer one's hierarchy before it).
 class KeptMatrices {
  public:
-  /// The matrix of a nu × nv net moved out, summed with fairness at `scaled`, if kept.
+  /// The matrix of a net of the same knots moved out, summed with fairness at `scaled`, if kept.
   std::optional<NetMatrix> take(const Net& net, double scaled);
   void keep(const Net& net, NetMatrix a, double scaled);
   [[nodiscard]] bool has(const Net& net) const;
 
  private:
   struct Entry {
-    int nu = 0, nv = 0;
+    Net net;
     double scaled = 0;
     NetMatrix a;
   };
   std::vector<Entry> kept_;
 };
 
-/// Solves one net's system (data term of `weight`, fairness added at `scaled`, λ times
-/// the weight sum) from the x given, to a residual of 1e-12 of the right-hand side.
-/// Factored when small, otherwise by conjugate gradients preconditioned by a V-cycle
-/// over nets assembled from the same points and weight (or taken from `kept`, where
-/// they are left afterwards); factored after all when they stall on a net the
-/// factorization still takes, an error past it.
-void solve_net(const Problem& pr, const Net& net, System& sys, std::span<const double> weight, double scaled, std::vector<double>& x,
-               KeptMatrices* kept = nullptr);
+/// Solves one net's system (fairness added at `scaled`, λ times the weight sum) from
+/// the x given, to a residual of 1e-12 of the right-hand side. Factored when small,
+/// otherwise by conjugate gradients preconditioned by a V-cycle over the coarser nets
+/// of its hierarchy, whose matrices `kept` holds (restricted from this one's) and keeps
+/// afterwards; factored after all when they stall on a net the factorization still
+/// takes, an error past it.
+void solve_net(const Problem& pr, const Net& net, System& sys, double scaled, std::vector<double>& x, KeptMatrices& kept);
 
 /// The distance of a value (cols numbers) from the fit whose net holds `x` (cols per
 /// control point) at a unit site, in the fit's frame: the basis there times the net's values.

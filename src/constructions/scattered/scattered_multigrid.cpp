@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "base/parallel.hpp"
+#include "base/text.hpp"
 
 namespace interpatch::detail::scattered {
 
@@ -34,25 +35,22 @@ void blossom_row(const KnotVector& t, const KnotVector& tau, int i, int& first, 
 }  // namespace
 
 Refinement refinement(const KnotVector& coarse, const KnotVector& fine) {
+  if (!nests(coarse, fine))
+    fail(errc::internal, "scattered multigrid: a coarse net's knots (", coarse.count(), " control points) are not knots of the finer net's (",
+         fine.count(), ")");
   Refinement r;
   r.p = coarse.degree(), r.fine = fine.count(), r.coarse = coarse.count();
   const std::size_t width = static_cast<std::size_t>(r.p + 1);
   r.first.assign(static_cast<std::size_t>(r.fine), 0);
   r.weight.assign(static_cast<std::size_t>(r.fine) * width, 0.0);
-  const int cs = r.coarse - r.p, fs = r.fine - r.p;
-  const std::vector<double> g = fine.greville();
   for (int i = 0; i < r.fine; ++i) {
     double* w = &r.weight[static_cast<std::size_t>(i) * width];
     int& first = r.first[static_cast<std::size_t>(i)];
     if (r.fine == r.coarse) {
       first = std::min(i, r.coarse - r.p - 1);
       w[i - first] = 1;
-    } else if (fs == 2 * cs) {
-      blossom_row(coarse, fine, i, first, w);
     } else {
-      const int span = coarse.find_span(g[static_cast<std::size_t>(i)]);
-      coarse.basis(span, g[static_cast<std::size_t>(i)], w);
-      first = span - r.p;
+      blossom_row(coarse, fine, i, first, w);
     }
   }
   // The transpose, gathered per coarse point in increasing fine order.
@@ -77,34 +75,24 @@ Refinement refinement(const KnotVector& coarse, const KnotVector& fine) {
 }
 
 bool nests(const KnotVector& coarse, const KnotVector& fine) {
-  const int cs = coarse.count() - coarse.degree(), fs = fine.count() - fine.degree();
-  return coarse.degree() == fine.degree() && (fs == cs || fs == 2 * cs);
+  return coarse.degree() == fine.degree() &&
+         std::includes(fine.values().begin(), fine.values().end(), coarse.values().begin(), coarse.values().end());
 }
 
-std::vector<System> restrict_down(const System& top, const Net& top_net, std::span<const Net> nets,
-                                  const std::function<System(const Net&)>& assemble) {
+std::vector<System> restrict_down(const System& top, const Net& top_net, std::span<const Net> nets) {
   std::vector<System> out;  // finest first while made
   out.reserve(nets.size());
   for (std::size_t l = nets.size(); l-- > 0;) {
     const Net& fine = l + 1 < nets.size() ? nets[l + 1] : top_net;
-    const Net& coarse = nets[l];
-    if (nests(coarse.ku, fine.ku) && nests(coarse.kv, fine.kv))
-      out.push_back(restrict_system(out.empty() ? top : out.back(), {refinement(coarse.ku, fine.ku), refinement(coarse.kv, fine.kv)}));
-    else
-      out.push_back(assemble(coarse));
+    out.push_back(restrict_system(out.empty() ? top : out.back(), {refinement(nets[l].ku, fine.ku), refinement(nets[l].kv, fine.kv)}));
   }
   std::reverse(out.begin(), out.end());
   return out;
 }
 
-std::vector<std::array<int, 2>> hierarchy(std::array<int, 2> spans, int p, int q, std::size_t coarsest) {
-  std::vector<std::array<int, 2>> out{spans};
-  const auto size = [&](const std::array<int, 2>& s) { return static_cast<std::size_t>(s[0] + p) * static_cast<std::size_t>(s[1] + q); };
-  while (size(spans) > coarsest && (spans[0] > 4 || spans[1] > 4)) {
-    for (int& s : spans)
-      if (s > 4) s = (s + 1) / 2;
-    out.push_back(spans);
-  }
+std::vector<Net> hierarchy(const Net& top, std::size_t coarsest) {
+  std::vector<Net> out{top};
+  while (out.back().size() > coarsest && (out.back().nu - top.p > 4 || out.back().nv - top.q > 4)) out.push_back(Net::coarser(out.back()));
   std::reverse(out.begin(), out.end());
   return out;
 }
@@ -172,6 +160,56 @@ void restrict_to(const std::array<Refinement, 2>& r, std::span<const double> fin
   }
 }
 
+// restrict_system's pass along v over fine row i (v refined by rv):
+// t[b][(di, db)] = Σ_j Σ_j' Pv[j][b] A[(i, j)][(i + di, j')] Pv[j'][b + db], both halves,
+// in a fixed order: first z = the row's entries times Pv (the coarse functions b' that
+// (i, j)'s neighbours refine, from zlo on), then Pv[j][b] z into t (about half the
+// products of both at once); tb likewise for the right-hand sides.
+void restrict_row_along_v(const System& fine, const Refinement& rv, std::size_t i, double* t, double* tb, std::vector<double>& z) {
+  const NetMatrix& a = fine.a;
+  const int hu = a.hu(), hv = a.hv(), wu = 2 * hu + 1, wv = 2 * hv + 1;
+  const auto c = static_cast<std::size_t>(fine.cols), band = static_cast<std::size_t>(wu * wv);
+  const auto fu = static_cast<std::size_t>(a.nu()), fv = static_cast<std::size_t>(rv.fine), cv = static_cast<std::size_t>(rv.coarse);
+  const auto pv = static_cast<std::size_t>(rv.p + 1);
+  std::fill(t, t + cv * band, 0.0);
+  std::fill(tb, tb + cv * c, 0.0);
+  for (std::size_t j = 0; j < fv; ++j) {
+    const std::size_t row = i * fv + j;
+    const double* wj = &rv.weight[j * pv];
+    const int fj = rv.first[j];
+    for (std::size_t e = 0; e < pv; ++e) {
+      const std::size_t b = static_cast<std::size_t>(fj) + e;
+      for (std::size_t m = 0; m < c && wj[e] != 0; ++m) tb[b * c + m] += wj[e] * fine.rhs[row * c + m];
+    }
+    const int jlo = std::max(-hv, -static_cast<int>(j)), jhi = std::min(hv, static_cast<int>(fv - 1 - j));
+    const int zlo = rv.first[static_cast<std::size_t>(static_cast<int>(j) + jlo)];
+    const int zhi = rv.first[static_cast<std::size_t>(static_cast<int>(j) + jhi)] + static_cast<int>(pv) - 1;
+    for (int di = -hu; di <= hu; ++di) {
+      if (static_cast<long long>(i) + di < 0 || static_cast<long long>(i) + di >= static_cast<long long>(fu)) continue;
+      std::fill(z.begin(), z.begin() + (zhi - zlo + 1), 0.0);
+      bool any = false;
+      for (int dj = jlo; dj <= jhi; ++dj) {
+        const double v = a.entry(row, di, dj);
+        if (v == 0) continue;
+        any = true;
+        const auto j2 = static_cast<std::size_t>(static_cast<int>(j) + dj);
+        double* to = &z[static_cast<std::size_t>(rv.first[j2] - zlo)];
+        for (std::size_t e2 = 0; e2 < pv; ++e2) to[e2] += v * rv.weight[j2 * pv + e2];
+      }
+      if (!any) continue;
+      for (std::size_t e = 0; e < pv; ++e) {
+        if (wj[e] == 0) continue;
+        const int b = fj + static_cast<int>(e);
+        // Coarse functions more than hv apart: zero (the header says why).
+        const int lo = std::max(zlo, b - hv), hi = std::min(zhi, b + hv);
+        double* to = &t[(static_cast<std::size_t>(b) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(di + hu)) * static_cast<std::size_t>(wv) +
+                        static_cast<std::size_t>(hv - b)];
+        for (int bb = lo; bb <= hi; ++bb) to[bb] += wj[e] * z[static_cast<std::size_t>(bb - zlo)];
+      }
+    }
+  }
+}
+
 }  // namespace
 
 System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
@@ -182,89 +220,55 @@ System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
   const auto fu = static_cast<std::size_t>(ru.fine), fv = static_cast<std::size_t>(rv.fine);
   const auto cu = static_cast<std::size_t>(ru.coarse), cv = static_cast<std::size_t>(rv.coarse);
   const auto pu = static_cast<std::size_t>(ru.p + 1), pv = static_cast<std::size_t>(rv.p + 1);
-  // Along v: t[(i, b)][(di, db)] = Σ_j Σ_j' Pv[j][b] A[(i, j)][(i + di, j')] Pv[j'][b + db], both
-  // halves, each fine row i summed by one thread in a fixed order: first z = the row's
-  // entries times Pv (the coarse functions b' that (i, j)'s neighbours refine, from zlo
-  // on), then Pv[j][b] z into t (about half the products of both at once).
-  std::vector<double> t(fu * cv * band, 0.0), tb(fu * cv * c, 0.0);
-  const bool parallel = fu * fv * band * pv >= parallel_min_work;
-#pragma omp parallel for schedule(static) if (parallel)
-  for (long long ii = 0; ii < static_cast<long long>(fu); ++ii) {
-    const auto i = static_cast<std::size_t>(ii);
-    std::vector<double> z(static_cast<std::size_t>(2 * hv) + pv + 1);
-    for (std::size_t j = 0; j < fv; ++j) {
-      const std::size_t row = i * fv + j;
-      const double* wj = &rv.weight[j * pv];
-      const int fj = rv.first[j];
-      for (std::size_t e = 0; e < pv; ++e) {
-        const std::size_t b = static_cast<std::size_t>(fj) + e;
-        for (std::size_t m = 0; m < c && wj[e] != 0; ++m) tb[(i * cv + b) * c + m] += wj[e] * fine.rhs[row * c + m];
-      }
-      const int jlo = std::max(-hv, -static_cast<int>(j)), jhi = std::min(hv, static_cast<int>(fv - 1 - j));
-      const int zlo = rv.first[static_cast<std::size_t>(static_cast<int>(j) + jlo)];
-      const int zhi = rv.first[static_cast<std::size_t>(static_cast<int>(j) + jhi)] + static_cast<int>(pv) - 1;
-      for (int di = -hu; di <= hu; ++di) {
-        if (static_cast<long long>(i) + di < 0 || static_cast<long long>(i) + di >= static_cast<long long>(fu)) continue;
-        std::fill(z.begin(), z.begin() + (zhi - zlo + 1), 0.0);
-        bool any = false;
-        for (int dj = jlo; dj <= jhi; ++dj) {
-          const double v = a.entry(row, di, dj);
-          if (v == 0) continue;
-          any = true;
-          const auto j2 = static_cast<std::size_t>(static_cast<int>(j) + dj);
-          double* to = &z[static_cast<std::size_t>(rv.first[j2] - zlo)];
-          for (std::size_t e2 = 0; e2 < pv; ++e2) to[e2] += v * rv.weight[j2 * pv + e2];
-        }
-        if (!any) continue;
-        for (std::size_t e = 0; e < pv; ++e) {
-          if (wj[e] == 0) continue;
-          const int b = fj + static_cast<int>(e);
-          // Coarse functions more than hv apart: zero (the header says why).
-          const int lo = std::max(zlo, b - hv), hi = std::min(zhi, b + hv);
-          double* to = &t[((i * cv + static_cast<std::size_t>(b)) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(di + hu)) * static_cast<std::size_t>(wv) +
-                          static_cast<std::size_t>(hv - b)];
-          for (int bb = lo; bb <= hi; ++bb) to[bb] += wj[e] * z[static_cast<std::size_t>(bb - zlo)];
-        }
-      }
-    }
-  }
   // Along u, each coarse row a from the fine rows i that refine it (the transpose), in
-  // their order; only the offsets da >= 0 the upper half keeps.
+  // their order, into the upper half (offsets da >= 0, neighbours inside the net). The
+  // coarse rows in blocks, each with the fine rows it needs done along v (a few of them
+  // twice, at the blocks' edges): a few MB a thread, where all of them took as many
+  // bytes as the fine matrix.
   System out{NetMatrix(ru.coarse, rv.coarse, hu, hv), std::vector<double>(cu * cv * c, 0.0), fine.cols};
-  std::vector<double> full(cu * cv * band, 0.0);
-#pragma omp parallel for schedule(static) if (parallel)
-  for (long long aa = 0; aa < static_cast<long long>(cu); ++aa) {
-    const auto ca = static_cast<std::size_t>(aa);
-    for (std::size_t x = ru.t_start[ca]; x < ru.t_start[ca + 1]; ++x) {
-      const auto i = static_cast<std::size_t>(ru.t_index[x]);
-      const double w = ru.t_weight[x];
-      for (std::size_t b = 0; b < cv; ++b) {
-        for (std::size_t m = 0; m < c; ++m) out.rhs[(ca * cv + b) * c + m] += w * tb[(i * cv + b) * c + m];
-        for (int di = -hu; di <= hu; ++di) {
-          const long long i2 = static_cast<long long>(i) + di;
-          if (i2 < 0 || i2 >= static_cast<long long>(fu)) continue;
-          const double* from = &t[((i * cv + b) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(di + hu)) * static_cast<std::size_t>(wv)];
-          for (std::size_t e2 = 0; e2 < pu; ++e2) {
-            const double w2 = w * ru.weight[static_cast<std::size_t>(i2) * pu + e2];
-            const int da = ru.first[static_cast<std::size_t>(i2)] + static_cast<int>(e2) - static_cast<int>(ca);
-            if (w2 == 0 || da < 0 || da > hu) continue;  // the upper half is all that is kept
-            double* to = &full[((ca * cv + b) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(da + hu)) * static_cast<std::size_t>(wv)];
-            for (std::size_t k = 0; k < static_cast<std::size_t>(wv); ++k) to[k] += w2 * from[k];
+  constexpr std::size_t block = 16;
+  const std::size_t blocks = (cu + block - 1) / block;
+  const bool parallel = fu * fv * band * pv >= parallel_min_work;
+#pragma omp parallel if (parallel)
+  {
+    std::vector<double> t, tb, z(static_cast<std::size_t>(2 * hv) + pv + 1);
+#pragma omp for schedule(static)
+    for (long long bk = 0; bk < static_cast<long long>(blocks); ++bk) {
+      const std::size_t a0 = static_cast<std::size_t>(bk) * block, a1 = std::min(cu, a0 + block);
+      std::size_t ilo = fu, ihi = 0;
+      for (std::size_t x = ru.t_start[a0]; x < ru.t_start[a1]; ++x) {
+        ilo = std::min(ilo, static_cast<std::size_t>(ru.t_index[x]));
+        ihi = std::max(ihi, static_cast<std::size_t>(ru.t_index[x]));
+      }
+      if (ilo > ihi) continue;
+      t.resize((ihi - ilo + 1) * cv * band);
+      tb.resize((ihi - ilo + 1) * cv * c);
+      for (std::size_t i = ilo; i <= ihi; ++i) restrict_row_along_v(fine, rv, i, &t[(i - ilo) * cv * band], &tb[(i - ilo) * cv * c], z);
+      for (std::size_t ca = a0; ca < a1; ++ca)
+        for (std::size_t x = ru.t_start[ca]; x < ru.t_start[ca + 1]; ++x) {
+          const auto i = static_cast<std::size_t>(ru.t_index[x]);
+          const double w = ru.t_weight[x];
+          for (std::size_t b = 0; b < cv; ++b) {
+            for (std::size_t m = 0; m < c; ++m) out.rhs[(ca * cv + b) * c + m] += w * tb[((i - ilo) * cv + b) * c + m];
+            for (int di = -hu; di <= hu; ++di) {
+              const long long i2 = static_cast<long long>(i) + di;
+              if (i2 < 0 || i2 >= static_cast<long long>(fu)) continue;
+              const double* from = &t[(((i - ilo) * cv + b) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(di + hu)) * static_cast<std::size_t>(wv)];
+              for (std::size_t e2 = 0; e2 < pu; ++e2) {
+                const double w2 = w * ru.weight[static_cast<std::size_t>(i2) * pu + e2];
+                const int da = ru.first[static_cast<std::size_t>(i2)] + static_cast<int>(e2) - static_cast<int>(ca);
+                if (w2 == 0 || da < 0 || da > hu || ca + static_cast<std::size_t>(da) >= cu) continue;  // the upper half is all that is kept
+                for (int db = da == 0 ? 0 : -hv; db <= hv; ++db) {
+                  const long long b2 = static_cast<long long>(b) + db;
+                  if (b2 < 0 || b2 >= static_cast<long long>(cv)) continue;
+                  out.a.at(ca * cv + b, out.a.offset(da, db)) += w2 * from[db + hv];
+                }
+              }
+            }
           }
         }
-      }
     }
   }
-  // The upper half kept, where the neighbour is inside the net.
-  for (std::size_t ca = 0; ca < cu; ++ca)
-    for (std::size_t b = 0; b < cv; ++b)
-      for (int da = 0; da <= hu; ++da)
-        for (int db = da == 0 ? 0 : -hv; db <= hv; ++db) {
-          const long long b2 = static_cast<long long>(b) + db;
-          if (ca + static_cast<std::size_t>(da) >= cu || b2 < 0 || b2 >= static_cast<long long>(cv)) continue;
-          out.a.at(ca * cv + b, out.a.offset(da, db)) =
-              full[((ca * cv + b) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(da + hu)) * static_cast<std::size_t>(wv) + static_cast<std::size_t>(db + hv)];
-        }
   return out;
 }
 

@@ -1,6 +1,6 @@
 #pragma once
 // Multigrid for the normal equations of a scattered fit: the same functional (data term
-// and fairness with the same weight) assembled on nets of halved spans, a symmetric
+// and fairness with the same weight) on nets of halved spans, a symmetric
 // V-cycle of strip Gauss–Seidel (scattered_smoother.hpp) between them and a factored
 // coarsest net, used to precondition conjugate gradients. The data term alone is a mass
 // matrix whose oscillating modes a point smoother damps slowly; the fairness term across
@@ -8,7 +8,6 @@
 
 #include <array>
 #include <cstddef>
-#include <functional>
 #include <optional>
 #include <span>
 #include <vector>
@@ -18,12 +17,10 @@
 
 namespace interpatch::detail::scattered {
 
-/// The control points of a spline on one uniform knot vector as those of a spline on a
-/// finer one along one direction: fine point i is Σ_a weight[i·(p+1) + a] times coarse
-/// point first[i] + a. Exact when every coarse knot is a fine knot (knot insertion by
-/// blossoming, the Oslo algorithm); otherwise the coarse spline at the fine Greville
-/// abscissae (Schoenberg's variation-diminishing approximation); the identity when
-/// both are one.
+/// The control points of a spline on one knot vector as those of a spline on a finer
+/// one, every coarse knot a fine knot, along one direction: fine point i is
+/// Σ_a weight[i·(p+1) + a] times coarse point first[i] + a (knot insertion by
+/// blossoming, the Oslo algorithm); the identity when both are one.
 struct Refinement {
   int p = 3, fine = 0, coarse = 0;
   std::vector<int> first;
@@ -44,22 +41,20 @@ Refinement refinement(const KnotVector& coarse, const KnotVector& fine);
 /// meet either.
 System restrict_system(const System& fine, const std::array<Refinement, 2>& r);
 
-/// Whether every knot of `coarse` is a knot of `fine` (uniform knots on one interval:
-/// the same spans, or twice as many), so that restrict_system is exact.
+/// Whether every knot of `coarse` is a knot of `fine` (with at least its multiplicity),
+/// so that refinement is knot insertion and restrict_system exact.
 bool nests(const KnotVector& coarse, const KnotVector& fine);
 
 /// The data terms of `nets` (coarsest first, each coarser than the next, the last
-/// coarser than `top_net`, whose data term is `top`): each restricted from the next
-/// finer one's where their knots nest in both directions, otherwise `assemble`d (from
-/// the points). Elsewhere Pᵀ D P of the cycle's prolongation couples coarse functions
-/// further apart than the matrix reaches.
-std::vector<System> restrict_down(const System& top, const Net& top_net, std::span<const Net> nets,
-                                  const std::function<System(const Net&)>& assemble);
+/// coarser than `top_net`, whose data term is `top`, their knots nested as hierarchy
+/// makes them): each restricted from the next finer one's, with no pass over the
+/// points.
+std::vector<System> restrict_down(const System& top, const Net& top_net, std::span<const Net> nets);
 
-/// The spans of the nets below a fine net of `spans`, coarsest first and the fine one
-/// last: each direction halved (rounded up) while it has more than 4 spans, until the
-/// net has at most `coarsest` control points.
-std::vector<std::array<int, 2>> hierarchy(std::array<int, 2> spans, int p, int q, std::size_t coarsest);
+/// The nets of a multigrid below `top`, coarsest first and `top` last: each
+/// Net::coarser than the next (each direction's spans halved, rounded up, while above
+/// 4), until a net has at most `coarsest` control points. Their knots nest.
+std::vector<Net> hierarchy(const Net& top, std::size_t coarsest);
 
 /// A V-cycle over nets whose matrices the caller owns (and may change between
 /// factor() calls, as a search over the fairness weight does).

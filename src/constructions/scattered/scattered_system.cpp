@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <utility>
 
 #include <Eigen/SparseCholesky>
 
@@ -14,6 +15,52 @@ namespace interpatch::detail::scattered {
 Net::Net(int p_, int q_, int nu_, int nv_, std::array<double, 2> range)
     : p(p_), q(q_), nu(nu_), nv(nv_), ku(KnotVector::uniform(p_, nu_, 0, range[0])), kv(KnotVector::uniform(q_, nv_, 0, range[1])),
       inv_h{(nu_ - p_) / range[0], (nv_ - q_) / range[1]} {}
+
+Net::Net(KnotVector u, KnotVector v, std::array<bool, 2> even_)
+    : p(u.degree()), q(v.degree()), nu(u.count()), nv(v.count()), ku(std::move(u)), kv(std::move(v)), even(even_) {
+  for (int a = 0; a < 2; ++a) {
+    const KnotVector& k = a == 0 ? ku : kv;
+    const double length = k[static_cast<std::size_t>(k.count())] - k[static_cast<std::size_t>(k.degree())];
+    inv_h[static_cast<std::size_t>(a)] = (k.count() - k.degree()) / length;
+  }
+}
+
+namespace {
+
+// A direction's knots on the coarser net: every other distinct knot, the ends kept (from
+// uniform knots of an even count of spans, the uniform knots of half as many, to the
+// bit: 2k (b - a) / 2n rounds as k (b - a) / n). From an odd count, the widest span at
+// an even index (nearest the middle among equals) stays alone, so that the spans before
+// and after it pair up. `even`: whether the knots are evenly spaced, and are after.
+KnotVector coarser_knots(const KnotVector& k, bool& even) {
+  const int p = k.degree(), spans = k.count() - p;
+  if (spans <= 4) return k;
+  const std::vector<double> t(k.values().begin() + p, k.values().end() - p);  // the spans + 1 distinct knots
+  int alone = -1;
+  if (spans % 2 == 1) {
+    double widest = -1;
+    for (int a = 0; a < spans; a += 2) {
+      const double w = t[static_cast<std::size_t>(a + 1)] - t[static_cast<std::size_t>(a)];
+      if (w > widest || (w == widest && std::abs(2 * a + 1 - spans) < std::abs(2 * alone + 1 - spans))) widest = w, alone = a;
+    }
+    even = false;
+  }
+  std::vector<double> out(static_cast<std::size_t>(p + 1), t.front());
+  for (int a = 0; a < spans;) {
+    a += a == alone ? 1 : 2;
+    out.push_back(t[static_cast<std::size_t>(a)]);
+  }
+  out.insert(out.end(), static_cast<std::size_t>(p), t.back());
+  return KnotVector(p, std::move(out));
+}
+
+}  // namespace
+
+Net Net::coarser(const Net& fine) {
+  std::array<bool, 2> even_ = fine.even;
+  KnotVector u = coarser_knots(fine.ku, even_[0]), v = coarser_knots(fine.kv, even_[1]);
+  return Net(std::move(u), std::move(v), even_);
+}
 
 void Net::uniform_basis(const KnotVector& k, double inv_h, int span, double t, double* n) {
   // The Cox–de Boor recurrence (The NURBS Book's A2.2) on the knots span + 1 - p ..

@@ -1,5 +1,5 @@
 #pragma once
-// The normal equations of a scattered fit on a net of uniform knots over a rectangle: a symmetric banded matrix of the control net (the data term, assembled in
+// The normal equations of a scattered fit on a net of knots over a rectangle: a symmetric banded matrix of the control net (the data term, assembled in
 // one pass over the points, and the thin-plate fairness term), with its right-hand
 // sides, and the conjugate-gradient solver that takes them.
 
@@ -16,27 +16,47 @@
 
 namespace interpatch::detail::scattered {
 
-/// A net of nu × nv control points over uniform knots on [0, range[0]] × [0, range[1]],
-/// index i·nv + j.
+/// A net of nu × nv control points over knots on [0, range[0]] × [0, range[1]], index
+/// i·nv + j: uniform knots, or, for the coarse nets of a multigrid, a finer net's every
+/// other knot (coarser()).
 struct Net {
   int p = 3, q = 3, nu = 0, nv = 0;
   KnotVector ku, kv;
   Net(int p_, int q_, int nu_, int nv_, std::array<double, 2> range = {1, 1});
+  /// The net on every other knot of `fine` along each direction with more than 4 spans
+  /// (the ends kept), the others as they are: its knots are knots of `fine`, so that
+  /// the coarse data term is exactly Pᵀ D P of the fine one (restrict_system). From
+  /// an even count of spans it is uniform again; from an odd count one span of the
+  /// finer net stays alone, the widest nearest the middle (the spans stay within about
+  /// a factor 2 of each other on every net below).
+  static Net coarser(const Net& fine);
   [[nodiscard]] std::size_t size() const { return static_cast<std::size_t>(nu) * static_cast<std::size_t>(nv); }
   /// ku.find_span(t) and kv.find_span(t), found from the knots' even spacing rather
-  /// than by a search (a tenth of a fit's time at 10^6 points).
+  /// than by a search (a tenth of a fit's time at 10^6 points), then moved onto the
+  /// knots.
   [[nodiscard]] int span_u(double t) const { return uniform_span(ku, inv_h[0], t); }
   [[nodiscard]] int span_v(double t) const { return uniform_span(kv, inv_h[1], t); }
   /// ku.basis(span, t, out) and kv.basis(span, t, out): on spans whose knots are all
   /// evenly spaced, the recurrence's denominators are 1, 2 .. p spacings, so no division
-  /// is left (a third of a pass over the points); the clamped ends' spans by the knots.
-  void basis_u(int span, double t, double* out) const { uniform_basis(ku, inv_h[0], span, t, out); }
-  void basis_v(int span, double t, double* out) const { uniform_basis(kv, inv_h[1], span, t, out); }
+  /// is left (a third of a pass over the points); the clamped ends' spans, and every
+  /// span of a net whose knots are not even, by the knots.
+  void basis_u(int span, double t, double* out) const {
+    if (even[0]) return uniform_basis(ku, inv_h[0], span, t, out);
+    ku.basis(span, t, out);
+  }
+  void basis_v(int span, double t, double* out) const {
+    if (even[1]) return uniform_basis(kv, inv_h[1], span, t, out);
+    kv.basis(span, t, out);
+  }
+  /// The same knots in both directions.
+  [[nodiscard]] bool same_knots(const Net& o) const { return ku.values() == o.ku.values() && kv.values() == o.kv.values(); }
 
  private:
+  Net(KnotVector u, KnotVector v, std::array<bool, 2> even_);
   static int uniform_span(const KnotVector& k, double inv_h, double t);
   static void uniform_basis(const KnotVector& k, double inv_h, int span, double t, double* out);
-  std::array<double, 2> inv_h{};  // 1 / the knot spacing
+  std::array<double, 2> inv_h{};  // 1 / the knot spacing (on average, when not even)
+  std::array<bool, 2> even{true, true};
 };
 
 /// A symmetric matrix whose row (i, j) couples only the control points (i + di, j + dj)
