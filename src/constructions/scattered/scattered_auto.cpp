@@ -38,14 +38,20 @@ struct Fold {
   int index = 0;
   std::vector<double> weight;
   double weight_sum = 0;
-  std::vector<System> data;  // coarsest first, as the nets
+  std::vector<System> data;  // the coarsest net's and the finest's (one when they are one)
   std::vector<double> x;
 };
 
 struct Search {
   const Problem& pr;
-  std::vector<Net> nets;
-  std::vector<NetMatrix> fair, sum;
+  std::vector<Net> nets;  // the multigrid's, coarsest first
+  std::vector<NetMatrix> fair, sum;  // the coarsest net's and the finest's, as Fold::data
+
+  // The nets the matrices are of.
+  [[nodiscard]] std::vector<const Net*> ends() const {
+    if (nets.size() == 1) return {&nets.front()};
+    return {&nets.front(), &nets.back()};
+  }
   std::vector<Fold> folds;
   std::optional<Multigrid> mg;
   int evaluations = 0;
@@ -54,7 +60,7 @@ struct Search {
   double score(double lambda) {
     double total = 0;
     for (Fold& f : folds) {
-      for (std::size_t l = 0; l < nets.size(); ++l) {
+      for (std::size_t l = 0; l < sum.size(); ++l) {
         sum[l].assign_sum(f.data[l].a, fair[l], f.weight_sum * lambda);
         sum[l].mirror();
       }
@@ -91,14 +97,14 @@ Chosen choose_lambda(const Problem& pr, const Net& net, const progress_callback&
   search.nets = hierarchy(net, coarsest_net);
   const int evaluated = s.present < all_folds_below ? fold_count : 1;
   std::size_t rows = 0;
-  for (const Net& n : search.nets) rows += n.size();
+  for (const Net* n : search.ends()) rows += n->size();
   const int hu = std::max(net.p, 2), hv = std::max(net.q, 2);
   require_memory(rows, NetMatrix::bytes_per_row(hu, hv) * static_cast<std::size_t>(evaluated + 2) + StripSmoother::bytes_per_row(hu, hv),
                  cat("cross-validation of ", evaluated, " folds on a net of ", net.nu, " x ", net.nv, " control points"));
-  for (const Net& n : search.nets) {
-    search.fair.emplace_back(n.nu, n.nv, hu, hv);
-    add_fairness(n, &search.fair.back(), 1.0);
-    search.sum.emplace_back(n.nu, n.nv, hu, hv);
+  for (const Net* n : search.ends()) {
+    search.fair.emplace_back(n->nu, n->nv, hu, hv);
+    add_fairness(*n, &search.fair.back(), 1.0);
+    search.sum.emplace_back(n->nu, n->nv, hu, hv);
   }
   for (int f = 0; f < evaluated; ++f) {
     Fold fold;
@@ -106,16 +112,16 @@ Chosen choose_lambda(const Problem& pr, const Net& net, const progress_callback&
     fold.weight.resize(pr.size());
     for (std::size_t k = 0; k < fold.weight.size(); ++k) fold.weight[k] = pr.fold[k] == f ? 0.0 : pr.samples().weight_at(k);
     fold.weight_sum = std::accumulate(fold.weight.begin(), fold.weight.end(), 0.0);
-    // The finest net's data term from the points, the coarser ones' restricted from it.
+    // The finest net's data term from the points, the coarsest one's restricted from it
+    // through the nets between.
     System top = data_system(pr, search.nets.back(), fold.weight);
-    fold.data = restrict_down(top, search.nets.back(), std::span<const Net>(search.nets).first(search.nets.size() - 1));
+    if (search.nets.size() > 1)
+      fold.data.push_back(std::move(restrict_down(top, search.nets.back(), std::span<const Net>(search.nets).first(search.nets.size() - 1)).front()));
     fold.data.push_back(std::move(top));
     fold.x.assign(net.size() * static_cast<std::size_t>(pr.cols), 0.0);
     search.folds.push_back(std::move(fold));
   }
-  std::vector<const NetMatrix*> matrices;
-  for (const NetMatrix& m : search.sum) matrices.push_back(&m);
-  search.mg.emplace(search.nets, std::move(matrices), pr.cols);
+  search.mg.emplace(search.nets, &search.sum.front(), &search.sum.back(), pr.cols);
 
   // λ in decades of the balance, where J's diagonal equals the data term's on average:
   // from it, one decade at a time in the direction the score falls, until it rises.

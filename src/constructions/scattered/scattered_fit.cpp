@@ -32,29 +32,22 @@ constexpr int slow_steps = 150;
        "equations are not positive definite (points all on one line of the parameter plane)");
 }
 
-// The nets below `net` for multigrid, their matrices (data and fairness at `scaled`,
-// the weight times the points' weight sum) moved out of `kept`, and the cycle over them
-// and `top`.
+// The nets below `net` for multigrid, the coarsest one's matrix (data and fairness at
+// `scaled`, the weight times the points' weight sum) moved out of `kept`, and the
+// preconditioner over them and `top`.
 struct Hierarchy {
   std::vector<Net> nets;
-  std::vector<NetMatrix> below;
+  std::optional<NetMatrix> coarsest;
   std::optional<Multigrid> mg;
 };
 
 Hierarchy hierarchy_for(const Net& net, const NetMatrix& top, double scaled, KeptMatrices& kept, int cols) {
   Hierarchy h;
   h.nets = hierarchy(net, coarsest_net);
-  h.below.reserve(h.nets.size() - 1);
-  std::vector<const NetMatrix*> matrices;
-  for (std::size_t l = 0; l + 1 < h.nets.size(); ++l) {
-    std::optional<NetMatrix> a = kept.take(h.nets[l], scaled);
-    if (!a) fail(errc::internal, "scattered multigrid: no matrix for the coarse net of ", h.nets[l].nu, " x ", h.nets[l].nv, " control points");
-    h.below.push_back(std::move(*a));
-    h.below.back().mirror();
-    matrices.push_back(&h.below.back());
-  }
-  matrices.push_back(&top);
-  h.mg.emplace(h.nets, std::move(matrices), cols);
+  h.coarsest = kept.take(h.nets.front(), scaled);
+  if (!h.coarsest)
+    fail(errc::internal, "scattered multigrid: no matrix for the coarse net of ", h.nets.front().nu, " x ", h.nets.front().nv, " control points");
+  h.mg.emplace(h.nets, &*h.coarsest, &top, cols);
   return h;
 }
 
@@ -209,7 +202,7 @@ void solve_net(const Problem& pr, const Net& net, System& sys, double scaled, st
     };
     sol = solve_cg(sys.a, sys.rhs, x, pr.cols, 1e-12, factorable ? 4 * slow_steps : 200 + 40 * (net.nu + net.nv),
                    [&mg](std::span<const double> r, std::span<double> z, int) { mg.apply(r, z); }, keep_going);
-    for (std::size_t l = 0; l < h.below.size(); ++l) kept.keep(h.nets[l], std::move(h.below[l]), scaled);
+    kept.keep(h.nets.front(), std::move(*h.coarsest), scaled);
   }
   if (sol.residual <= 1e-12) return;
   if (factorable) {
@@ -225,16 +218,18 @@ namespace {
 
 // The data terms of the nets of `net`'s multigrid that `kept` lacks, each restricted
 // from the next finer one's (from `data`, the net's own, for the first), summed with the
-// fairness at `scaled` and kept. A pass over the points costs about as much on every
-// net; a restriction, a few hundred numbers a fine control point.
-void restrict_hierarchy(const Net& net, const System& data, double scaled, KeptMatrices& kept) {
+// fairness at `scaled` and kept: all of them when `all` (finer nets to be solved later
+// take them), otherwise the coarsest alone, the only one the solve uses. A pass over the
+// points costs about as much on every net; a restriction, a few hundred numbers a fine
+// control point.
+void restrict_hierarchy(const Net& net, const System& data, double scaled, KeptMatrices& kept, bool all) {
   std::vector<Net> below = hierarchy(net, coarsest_net);  // coarsest first
   below.pop_back();
   std::size_t first = below.size();
   while (first > 0 && !kept.has(below[first - 1])) --first;  // the nets below a kept one are kept with it
   below.erase(below.begin(), below.begin() + static_cast<std::ptrdiff_t>(first));
   std::vector<System> terms = restrict_down(data, net, below);
-  for (std::size_t l = 0; l < below.size(); ++l) {
+  for (std::size_t l = 0; l < (all ? below.size() : std::min<std::size_t>(below.size(), 1)); ++l) {
     add_fairness(below[l], &terms[l].a, scaled);
     kept.keep(below[l], std::move(terms[l].a), scaled);
   }
@@ -252,7 +247,7 @@ Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoot
   Level out;
   out.lambda = std::max(fill_lambda(net, sys.a, s.weight_sum), smoothing.value_or(0.0));
   KeptMatrices own;
-  if (net.size() > coarsest_net) restrict_hierarchy(net, sys, s.weight_sum * out.lambda, kept ? *kept : own);
+  if (net.size() > coarsest_net) restrict_hierarchy(net, sys, s.weight_sum * out.lambda, kept ? *kept : own, kept != nullptr);
   add_fairness(net, &sys.a, s.weight_sum * out.lambda);
   const bool started = start.size() == sys.rhs.size();
   if (started) out.x = std::move(start);

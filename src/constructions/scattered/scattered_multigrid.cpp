@@ -272,52 +272,49 @@ System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
   return out;
 }
 
-Multigrid::Multigrid(std::vector<Net> nets, std::vector<const NetMatrix*> matrices, int cols)
-    : nets_(std::move(nets)), a_(std::move(matrices)), cols_(cols) {
+Multigrid::Multigrid(std::vector<Net> nets, const NetMatrix* coarsest, const NetMatrix* finest, int cols)
+    : nets_(std::move(nets)), coarsest_a_(coarsest), finest_a_(finest), cols_(cols) {
   const std::size_t n = nets_.size();
   up_.resize(n);
   for (std::size_t l = 1; l < n; ++l)
     up_[l] = {refinement(nets_[l - 1].ku, nets_[l].ku), refinement(nets_[l - 1].kv, nets_[l].kv)};
-  r_.resize(n), b_.resize(n), x_.resize(n), tmp_.resize(n);
-  for (std::size_t l = 0; l < n; ++l) {
+  // Below the finest net, each net's share of the residual carried down and of the
+  // correction carried up.
+  b_.resize(n), x_.resize(n);
+  for (std::size_t l = 0; l + 1 < n; ++l) {
     const std::size_t len = nets_[l].size() * static_cast<std::size_t>(cols);
-    // r: a finer net's residual; b, x: a coarser net's problem and solution (the finest's
-    // are the caller's).
-    if (l > 0) r_[l].assign(len, 0.0);
-    if (l + 1 < n) b_[l].assign(len, 0.0), x_[l].assign(len, 0.0);
+    b_[l].assign(len, 0.0), x_[l].assign(len, 0.0);
   }
+  if (n > 1) r_.assign(nets_.back().size() * static_cast<std::size_t>(cols), 0.0);
 }
 
 bool Multigrid::factor() {
-  coarsest_.emplace(*a_.front());
-  smoothers_.clear();
-  smoothers_.reserve(a_.size());
-  // The finest net's strips along both directions; the coarser nets', whose knot cells
-  // hold four times the points of the next finer, along u alone: the same steps (15 on
-  // 10^6 points and a 512 × 512 net, 9 on the terrain's 259 × 259), a third less of the
-  // cycle's time below the finest net and of its factors' memory.
-  for (std::size_t l = 1; l < a_.size(); ++l) smoothers_.emplace_back(*a_[l], l + 1 == a_.size());
+  coarsest_.emplace(*coarsest_a_);
+  smoother_.reset();
+  if (nets_.size() > 1) smoother_.emplace(*finest_a_);
   return coarsest_->ok();
 }
 
-void Multigrid::cycle(std::size_t level, std::span<const double> b, std::span<double> x) {
-  if (level == 0) {
-    coarsest_->solve(b, x, cols_);
+void Multigrid::apply(std::span<const double> r, std::span<double> z) {
+  const std::size_t top = nets_.size() - 1;
+  if (top == 0) {
+    coarsest_->solve(r, z, cols_);
     return;
   }
-  const NetMatrix& a = *a_[level];
-  std::fill(x.begin(), x.end(), 0.0);
-  const StripSmoother& smoother = smoothers_[level - 1];
-  smoother.sweep(a, b, x, cols_, false, tmp_[level], true);
-  std::vector<double>& r = r_[level];
-  a.multiply(x, r, cols_);
-  for (std::size_t k = 0; k < r.size(); ++k) r[k] = b[k] - r[k];
-  restrict_to(up_[level], r, b_[level - 1], cols_, tmp_[level]);
-  cycle(level - 1, b_[level - 1], x_[level - 1]);
-  prolong(up_[level], x_[level - 1], x, cols_, tmp_[level]);
-  smoother.sweep(a, b, x, cols_, true, tmp_[level]);
+  std::fill(z.begin(), z.end(), 0.0);
+  smoother_->sweep(*finest_a_, r, z, cols_, false, tmp_, true);
+  finest_a_->multiply(z, r_, cols_);
+  for (std::size_t k = 0; k < r_.size(); ++k) r_[k] = r[k] - r_[k];
+  // The residual carried down to the coarsest net, solved there, the correction carried
+  // back up: the nets between are smoothed no more (see the header).
+  for (std::size_t l = top; l > 0; --l) restrict_to(up_[l], l == top ? std::span<const double>(r_) : b_[l], b_[l - 1], cols_, tmp_);
+  coarsest_->solve(b_[0], x_[0], cols_);
+  for (std::size_t l = 1; l < top; ++l) {
+    std::fill(x_[l].begin(), x_[l].end(), 0.0);
+    prolong(up_[l], x_[l - 1], x_[l], cols_, tmp_);
+  }
+  prolong(up_[top], x_[top - 1], z, cols_, tmp_);
+  smoother_->sweep(*finest_a_, r, z, cols_, true, tmp_);
 }
-
-void Multigrid::apply(std::span<const double> r, std::span<double> z) { cycle(nets_.size() - 1, r, z); }
 
 }  // namespace interpatch::detail::scattered

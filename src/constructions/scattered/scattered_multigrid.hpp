@@ -1,10 +1,10 @@
 #pragma once
 // Multigrid for the normal equations of a scattered fit: the same functional (data term
-// and fairness with the same weight) on nets of halved spans, a symmetric
-// V-cycle of strip Gauss–Seidel (scattered_smoother.hpp) between them and a factored
-// coarsest net, used to precondition conjugate gradients. The data term alone is a mass
-// matrix whose oscillating modes a point smoother damps slowly; the fairness term across
-// voids is a biharmonic one whose smooth modes only the coarse nets reach.
+// and fairness with the same weight) on nets of halved spans, a strip Gauss–Seidel
+// smoother (scattered_smoother.hpp) on the finest and a factored coarsest net, used to
+// precondition conjugate gradients. The data term alone is a mass matrix whose
+// oscillating modes a point smoother damps slowly; the fairness term across voids is a
+// biharmonic one whose smooth modes only the coarse net reaches.
 
 #include <array>
 #include <cstddef>
@@ -56,30 +56,38 @@ std::vector<System> restrict_down(const System& top, const Net& top_net, std::sp
 /// 4), until a net has at most `coarsest` control points. Their knots nest.
 std::vector<Net> hierarchy(const Net& top, std::size_t coarsest);
 
-/// A V-cycle over nets whose matrices the caller owns (and may change between
-/// factor() calls, as a search over the fairness weight does).
+/// The preconditioner: one forward sweep of the strip smoother on the finest net, the
+/// residual carried down the nets below by Pᵀ to the coarsest and solved there by its
+/// factor, the correction carried back up by P, one backward sweep. The nets between
+/// are not smoothed: their knot cells hold four times the points of the next finer
+/// one's or more, and smoothing them changed no step count (15 on 10^6 points and a
+/// 512 × 512 net, 9 on the terrain's 259 × 259, 23 on 140 × 140, 42 on 700 × 700; 58
+/// against 59 on 4·10^6 points and 1 400 × 1 400) for a tenth of the time and their
+/// factors' memory. Their matrices serve only to restrict the coarsest one's.
 class Multigrid {
  public:
-  /// nets and matrices coarsest first; the matrices outlive this object.
-  Multigrid(std::vector<Net> nets, std::vector<const NetMatrix*> matrices, int cols);
-  /// Factors the coarsest matrix and the finer ones' smoothers (again). False when the
+  /// nets coarsest first; the two matrices, of the first and the last net (the same one
+  /// when there is one net), outlive this object and may change between factor() calls,
+  /// as a search over the fairness weight does.
+  Multigrid(std::vector<Net> nets, const NetMatrix* coarsest, const NetMatrix* finest, int cols);
+  /// Factors the coarsest matrix and the finest one's strips (again). False when the
   /// coarsest is not positive definite.
   bool factor();
-  /// z = the V-cycle applied to r: one forward sweep of the strip smoother down, the
-  /// coarsest solved, one backward sweep up, so the operator is symmetric positive
-  /// definite.
+  /// z = the preconditioner applied to r: symmetric positive definite, the backward
+  /// sweep the forward one's adjoint.
   void apply(std::span<const double> r, std::span<double> z);
   [[nodiscard]] const Net& net(std::size_t level) const { return nets_[level]; }
   [[nodiscard]] std::size_t levels() const { return nets_.size(); }
 
  private:
-  void cycle(std::size_t level, std::span<const double> b, std::span<double> x);
   std::vector<Net> nets_;
-  std::vector<const NetMatrix*> a_;
+  const NetMatrix* coarsest_a_;
+  const NetMatrix* finest_a_;
   std::vector<std::array<Refinement, 2>> up_;  // up_[l]: level l - 1 to level l
-  std::vector<std::vector<double>> r_, b_, x_, tmp_;
+  std::vector<std::vector<double>> b_, x_;  // below the finest net: the residual, the correction
+  std::vector<double> r_, tmp_;
   std::optional<DirectSolver> coarsest_;
-  std::vector<StripSmoother> smoothers_;  // smoothers_[l - 1]: level l's
+  std::optional<StripSmoother> smoother_;
   int cols_;
 };
 

@@ -23,10 +23,10 @@ std::size_t StripSmoother::bytes_per_row(int hu, int hv) {
   return sizeof(float) * w * (static_cast<std::size_t>(hu) + static_cast<std::size_t>(hv) + 2);
 }
 
-StripSmoother::StripSmoother(const NetMatrix& a, bool both) : nu_(a.nu()), nv_(a.nv()), directions_(both ? 2 : 1) {
+StripSmoother::StripSmoother(const NetMatrix& a) : nu_(a.nu()), nv_(a.nv()) {
   const int w = strip_width(a);
   std::size_t at = 0;
-  for (int dir = 0; dir < directions_; ++dir) {
+  for (int dir = 0; dir < 2; ++dir) {
     const int across = dir == 0 ? nu_ : nv_, along = dir == 0 ? nv_ : nu_;
     const int reach = dir == 0 ? a.hv() : a.hu();  // the coupling along the strip
     for (int first = 0; first < across; first += w) {
@@ -153,9 +153,9 @@ void StripSmoother::sweep(const NetMatrix& a, std::span<const double> b, std::sp
   // Along v first: its residuals are computed on every row (see residuals), which the
   // first pass from zero skips; along u, on half of them. A V-cycle then reads the
   // matrix 6 times instead of 6.5, in the same steps.
-  const int passes = 2 * directions_;
+  constexpr int passes = 4;
   for (int n = 0; n < passes; ++n) {
-    const int step = backward ? passes - 1 - n : n, dir = directions_ - 1 - step / 2, colour = step % 2;
+    const int step = backward ? passes - 1 - n : n, dir = 1 - step / 2, colour = step % 2;
     std::vector<const Strip*> these;
     for (const Strip& s : strips_)
       if (s.dir == dir && s.ok && s.index % 2 == colour) these.push_back(&s);

@@ -19,9 +19,8 @@ namespace interpatch::detail::scattered {
 /// direction, every strip's matrix factored as a band (LLᵀ).
 class StripSmoother {
  public:
-  /// Factors the strips of `a`, its entries as they are now: along both directions, or
-  /// along u alone when not `both`.
-  explicit StripSmoother(const NetMatrix& a, bool both = true);
+  /// Factors the strips of `a` along both directions, its entries as they are now.
+  explicit StripSmoother(const NetMatrix& a);
   /// One sweep of block Gauss–Seidel on a x = b, in place: the strips along v (if
   /// any), then those along u, each in two colours of strips that share no entry of the matrix
   /// (a colour's strips solved by the threads at once; the same bits on any number of
@@ -65,7 +64,6 @@ class StripSmoother {
   // `scratch` in the strip's order).
   void solve(const Strip& s, std::span<const double> r, std::span<double> x, std::size_t c, std::vector<double>& scratch) const;
   int nu_, nv_;
-  int directions_ = 2;
   std::vector<Strip> strips_;  // along u, then along v, each by first
   // Per strip, row k: L[k][k - band .. k - 1], then 1 / L[k][k]. In single precision:
   // the sweeps read it from memory (two passes a row per sweep) at half the cost, and a
