@@ -111,9 +111,11 @@ TEST(ScatteredRestriction, CoarserNetsNestAndStayAboutUniform) {
 }
 
 // The refinement between nets of the hierarchy below 25 × 19 spans (odd counts, so
-// that the nets below are not uniform): each coarse B-spline is the sum of the fine ones
-// with P's weights, both evaluated by KnotVector::basis at random parameters, to 1e-13
-// (sums of p + 1 products of numbers at most 1).
+// that the nets below are not uniform), from each to the next finer and from each to
+// the finest (several knots inserted in a span, as the coarsest net's term is restricted
+// straight from the finest): each coarse B-spline is the sum of the fine ones with P's
+// weights, both evaluated by KnotVector::basis at random parameters, to 1e-13 (sums of a
+// few dozen products of numbers at most 1).
 TEST(ScatteredRestriction, RefinementWeightsSumTheFineBasisToTheCoarse) {
   std::mt19937_64 g(5);
   std::uniform_real_distribution<double> U(0, 1);
@@ -121,36 +123,37 @@ TEST(ScatteredRestriction, RefinementWeightsSumTheFineBasisToTheCoarse) {
     const std::vector<Net> nets = hierarchy(Net(degree, degree, 25 + degree, 19 + degree, {1, 0.7}), 16);
     ASSERT_GE(nets.size(), 3u);
     for (std::size_t l = 0; l + 1 < nets.size(); ++l)
-      for (const bool along_u : {true, false}) {
-        const KnotVector& c = along_u ? nets[l].ku : nets[l].kv;
-        const KnotVector& f = along_u ? nets[l + 1].ku : nets[l + 1].kv;
-        const Refinement r = refinement(c, f);
-        const double end = f[static_cast<std::size_t>(f.count())];
-        for (int trial = 0; trial < 200; ++trial) {
-          const double t = trial == 0 ? 0.0 : trial == 1 ? end : end * U(g);
-          std::vector<double> coarse(static_cast<std::size_t>(c.count()), 0.0), fine(static_cast<std::size_t>(f.count()), 0.0);
-          double nb[max_degree + 1];
-          const int sc = c.find_span(t), sf = f.find_span(t);
-          c.basis(sc, t, nb);
-          for (int e = 0; e <= degree; ++e) coarse[static_cast<std::size_t>(sc - degree + e)] = nb[e];
-          f.basis(sf, t, nb);
-          for (int e = 0; e <= degree; ++e) fine[static_cast<std::size_t>(sf - degree + e)] = nb[e];
-          std::vector<double> summed(coarse.size(), 0.0);
-          const std::size_t w = static_cast<std::size_t>(degree + 1);
-          for (std::size_t i = 0; i < fine.size(); ++i)
-            for (std::size_t e = 0; e < w; ++e) summed[static_cast<std::size_t>(r.first[i]) + e] += fine[i] * r.weight[i * w + e];
-          for (std::size_t a = 0; a < coarse.size(); ++a)
-            ASSERT_NEAR(summed[a], coarse[a], 1e-13) << "degree " << degree << ", level " << l << ", t " << t << ", function " << a;
+      for (const std::size_t to : {l + 1, nets.size() - 1})
+        for (const bool along_u : {true, false}) {
+          const KnotVector& c = along_u ? nets[l].ku : nets[l].kv;
+          const KnotVector& f = along_u ? nets[to].ku : nets[to].kv;
+          const Refinement r = refinement(c, f);
+          const double end = f[static_cast<std::size_t>(f.count())];
+          for (int trial = 0; trial < 200; ++trial) {
+            const double t = trial == 0 ? 0.0 : trial == 1 ? end : end * U(g);
+            std::vector<double> coarse(static_cast<std::size_t>(c.count()), 0.0), fine(static_cast<std::size_t>(f.count()), 0.0);
+            double nb[max_degree + 1];
+            const int sc = c.find_span(t), sf = f.find_span(t);
+            c.basis(sc, t, nb);
+            for (int e = 0; e <= degree; ++e) coarse[static_cast<std::size_t>(sc - degree + e)] = nb[e];
+            f.basis(sf, t, nb);
+            for (int e = 0; e <= degree; ++e) fine[static_cast<std::size_t>(sf - degree + e)] = nb[e];
+            std::vector<double> summed(coarse.size(), 0.0);
+            const std::size_t w = static_cast<std::size_t>(degree + 1);
+            for (std::size_t i = 0; i < fine.size(); ++i)
+              for (std::size_t e = 0; e < w; ++e) summed[static_cast<std::size_t>(r.first[i]) + e] += fine[i] * r.weight[i * w + e];
+            for (std::size_t a = 0; a < coarse.size(); ++a)
+              ASSERT_NEAR(summed[a], coarse[a], 1e-13) << "degree " << degree << ", level " << l << " to " << to << ", t " << t << ", function " << a;
+          }
         }
-      }
   }
 }
 
 // Pᵀ D P and Pᵀ b from restrict_down, chained over the hierarchy below 25 × 19 spans
 // (nets not uniform below the odd counts), against the dense products built here, each
 // net's from the next finer one's, and against each net's own data term summed over the
-// points: to 1e-12 of the largest entry (sums of some hundred products each, in
-// another order).
+// points; and the coarsest net's straight from the finest, against its own: to 1e-12
+// of the largest entry (sums of some hundred products each, in another order).
 TEST(ScatteredRestriction, RestrictedTermsAreTheCoarseNetsOwn) {
   for (const int degree : {2, 3})
     for (const int cols : {1, 3}) {
@@ -193,6 +196,19 @@ TEST(ScatteredRestriction, RestrictedTermsAreTheCoarseNetsOwn) {
             ASSERT_NEAR(below[l].rhs[at], own_term.rhs[at], 1e-12 * rhs_size) << "degree " << degree << ", level " << l;
           }
       }
+      // The coarsest net's term straight from the finest's, as a fit that keeps no net
+      // between makes it.
+      const System direct = restrict_system(top, {refinement(nets[0].ku, nets.back().ku), refinement(nets[0].kv, nets.back().kv)});
+      const System own_term = data_term(nets[0], pts, cols);
+      const Dense got = dense(direct.a), own = dense(own_term.a);
+      double size = 0, rhs_size = 0;
+      for (std::size_t r = 0; r < own.size(); ++r) size = std::max(size, std::abs(own[r][r]));
+      for (const double b : own_term.rhs) rhs_size = std::max(rhs_size, std::abs(b));
+      for (std::size_t r = 0; r < own.size(); ++r)
+        for (std::size_t c = 0; c < own.size(); ++c)
+          ASSERT_NEAR(got[r][c], own[r][c], 1e-12 * size) << "degree " << degree << ", straight to the coarsest, (" << r << ", " << c << ")";
+      for (std::size_t k = 0; k < own_term.rhs.size(); ++k)
+        ASSERT_NEAR(direct.rhs[k], own_term.rhs[k], 1e-12 * rhs_size) << "degree " << degree << ", straight to the coarsest";
     }
 }
 

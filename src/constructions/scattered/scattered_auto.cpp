@@ -112,11 +112,10 @@ Chosen choose_lambda(const Problem& pr, const Net& net, const progress_callback&
     fold.weight.resize(pr.size());
     for (std::size_t k = 0; k < fold.weight.size(); ++k) fold.weight[k] = pr.fold[k] == f ? 0.0 : pr.samples().weight_at(k);
     fold.weight_sum = std::accumulate(fold.weight.begin(), fold.weight.end(), 0.0);
-    // The finest net's data term from the points, the coarsest one's restricted from it
-    // through the nets between.
+    // The finest net's data term from the points, the coarsest one's restricted from it.
     System top = data_system(pr, search.nets.back(), fold.weight);
-    if (search.nets.size() > 1)
-      fold.data.push_back(std::move(restrict_down(top, search.nets.back(), std::span<const Net>(search.nets).first(search.nets.size() - 1)).front()));
+    const Net &coarse = search.nets.front(), &fine = search.nets.back();
+    if (search.nets.size() > 1) fold.data.push_back(restrict_system(top, {refinement(coarse.ku, fine.ku), refinement(coarse.kv, fine.kv)}));
     fold.data.push_back(std::move(top));
     fold.x.assign(net.size() * static_cast<std::size_t>(pr.cols), 0.0);
     search.folds.push_back(std::move(fold));

@@ -228,8 +228,13 @@ void restrict_hierarchy(const Net& net, const System& data, double scaled, KeptM
   std::size_t first = below.size();
   while (first > 0 && !kept.has(below[first - 1])) --first;  // the nets below a kept one are kept with it
   below.erase(below.begin(), below.begin() + static_cast<std::ptrdiff_t>(first));
-  std::vector<System> terms = restrict_down(data, net, below);
-  for (std::size_t l = 0; l < (all ? below.size() : std::min<std::size_t>(below.size(), 1)); ++l) {
+  if (below.empty()) return;
+  if (!all) below.erase(below.begin() + 1, below.end());
+  // The coarsest alone straight from `data`: P (knot insertion from it to `net`) still has
+  // p + 1 entries a fine row, and the nets between take no pass.
+  std::vector<System> terms = all ? restrict_down(data, net, below) : std::vector<System>{};
+  if (!all) terms.push_back(restrict_system(data, {refinement(below[0].ku, net.ku), refinement(below[0].kv, net.kv)}));
+  for (std::size_t l = 0; l < below.size(); ++l) {
     add_fairness(below[l], &terms[l].a, scaled);
     kept.keep(below[l], std::move(terms[l].a), scaled);
   }
