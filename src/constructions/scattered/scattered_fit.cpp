@@ -156,7 +156,7 @@ double fill_lambda(const Net& net, const NetMatrix& data, double weight_sum) {
 
 // Solves one net's system from the x given: factored when small, otherwise conjugate
 // gradients to a residual of 1e-12 of the right-hand side (the fit to about twelve
-// digits of the data's size), preconditioned by a V-cycle. Where cells hold a few
+// digits of the data's size), preconditioned by multigrid. Where cells hold a few
 // points or more they take one or two dozen steps; where they hold about one or fewer
 // (only the small fill between the points), hundreds: a net the factorization takes is
 // then factored as soon as the first steps show the rate, a larger one runs on and is

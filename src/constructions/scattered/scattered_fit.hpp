@@ -90,9 +90,9 @@ class KeptMatrices {
 
 /// Solves one net's system (fairness added at `scaled`, λ times the weight sum) from
 /// the x given, to a residual of 1e-12 of the right-hand side. Factored when small,
-/// otherwise by conjugate gradients preconditioned by a V-cycle over the coarser nets
-/// of its hierarchy, whose matrices `kept` holds (restricted from this one's) and keeps
-/// afterwards; factored after all when they stall on a net the factorization still
+/// otherwise by conjugate gradients preconditioned by multigrid over the coarser nets
+/// of its hierarchy, whose coarsest matrix `kept` holds (restricted from this one's)
+/// and keeps afterwards; factored after all when they stall on a net the factorization still
 /// takes, an error past it.
 void solve_net(const Problem& pr, const Net& net, System& sys, double scaled, std::vector<double>& x, KeptMatrices& kept);
 

@@ -151,8 +151,8 @@ void StripSmoother::sweep(const NetMatrix& a, std::span<const double> b, std::sp
   for (const Strip& s : strips_) largest = std::max(largest, s.size);
   std::vector<std::vector<double>> scratch(solves >= parallel_min_work ? max_threads() : 1, std::vector<double>(largest * c));
   // Along v first: its residuals are computed on every row (see residuals), which the
-  // first pass from zero skips; along u, on half of them. A V-cycle then reads the
-  // matrix 6 times instead of 6.5, in the same steps.
+  // first pass from zero skips; along u, on half of them. A step of the multigrid then
+  // reads the matrix 6 times instead of 6.5, in the same steps.
   constexpr int passes = 4;
   for (int n = 0; n < passes; ++n) {
     const int step = backward ? passes - 1 - n : n, dir = 1 - step / 2, colour = step % 2;
