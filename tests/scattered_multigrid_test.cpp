@@ -244,7 +244,7 @@ Fixture fixture(int nu, int nv, std::size_t points, double lambda, int cols, std
 }
 
 Multigrid multigrid(const Fixture& f, int cols) {
-  Multigrid mg(f.nets, &f.systems.front().a, &f.systems.back().a, cols);
+  Multigrid mg(f.nets.front(), f.nets.back(), &f.systems.front().a, &f.systems.back().a, cols);
   EXPECT_TRUE(mg.factor());
   return mg;
 }

@@ -198,7 +198,7 @@ TEST(ScatteredRestriction, RestrictedTermsAreTheCoarseNetsOwn) {
       }
       // The coarsest net's term straight from the finest's, as a fit that keeps no net
       // between makes it.
-      const System direct = restrict_system(top, {refinement(nets[0].ku, nets.back().ku), refinement(nets[0].kv, nets.back().kv)});
+      const System direct = restrict_between(top, nets.back(), nets[0]);
       const System own_term = data_term(nets[0], pts, cols);
       const Dense got = dense(direct.a), own = dense(own_term.a);
       double size = 0, rhs_size = 0;

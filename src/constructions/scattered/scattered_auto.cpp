@@ -44,14 +44,8 @@ struct Fold {
 
 struct Search {
   const Problem& pr;
-  std::vector<Net> nets;  // the multigrid's, coarsest first
-  std::vector<NetMatrix> fair, sum;  // the coarsest net's and the finest's, as Fold::data
-
-  // The nets the matrices are of.
-  [[nodiscard]] std::vector<const Net*> ends() const {
-    if (nets.size() == 1) return {&nets.front()};
-    return {&nets.front(), &nets.back()};
-  }
+  std::vector<Net> nets;  // the multigrid's coarsest net and the finest (one when they are one)
+  std::vector<NetMatrix> fair, sum;  // of each net, as Fold::data
   std::vector<Fold> folds;
   std::optional<Multigrid> mg;
   int evaluations = 0;
@@ -94,17 +88,19 @@ std::uint8_t fold_of(const Vec3& point) {
 Chosen choose_lambda(const Problem& pr, const Net& net, const progress_callback& progress, double from, double to) {
   const Sites& s = *pr.sites;
   Search search{pr, {}, {}, {}, {}, std::nullopt, 0};
-  search.nets = hierarchy(net, coarsest_net);
+  const std::vector<Net> all = hierarchy(net, coarsest_net);
+  search.nets = {all.front()};
+  if (all.size() > 1) search.nets.push_back(all.back());
   const int evaluated = s.present < all_folds_below ? fold_count : 1;
   std::size_t rows = 0;
-  for (const Net* n : search.ends()) rows += n->size();
+  for (const Net& n : search.nets) rows += n.size();
   const int hu = std::max(net.p, 2), hv = std::max(net.q, 2);
   require_memory(rows, NetMatrix::bytes_per_row(hu, hv) * static_cast<std::size_t>(evaluated + 2) + StripSmoother::bytes_per_row(hu, hv),
                  cat("cross-validation of ", evaluated, " folds on a net of ", net.nu, " x ", net.nv, " control points"));
-  for (const Net* n : search.ends()) {
-    search.fair.emplace_back(n->nu, n->nv, hu, hv);
-    add_fairness(*n, &search.fair.back(), 1.0);
-    search.sum.emplace_back(n->nu, n->nv, hu, hv);
+  for (const Net& n : search.nets) {
+    search.fair.emplace_back(n.nu, n.nv, hu, hv);
+    add_fairness(n, &search.fair.back(), 1.0);
+    search.sum.emplace_back(n.nu, n.nv, hu, hv);
   }
   for (int f = 0; f < evaluated; ++f) {
     Fold fold;
@@ -114,13 +110,12 @@ Chosen choose_lambda(const Problem& pr, const Net& net, const progress_callback&
     fold.weight_sum = std::accumulate(fold.weight.begin(), fold.weight.end(), 0.0);
     // The finest net's data term from the points, the coarsest one's restricted from it.
     System top = data_system(pr, search.nets.back(), fold.weight);
-    const Net &coarse = search.nets.front(), &fine = search.nets.back();
-    if (search.nets.size() > 1) fold.data.push_back(restrict_system(top, {refinement(coarse.ku, fine.ku), refinement(coarse.kv, fine.kv)}));
+    if (search.nets.size() > 1) fold.data.push_back(restrict_between(top, search.nets.back(), search.nets.front()));
     fold.data.push_back(std::move(top));
     fold.x.assign(net.size() * static_cast<std::size_t>(pr.cols), 0.0);
     search.folds.push_back(std::move(fold));
   }
-  search.mg.emplace(search.nets, &search.sum.front(), &search.sum.back(), pr.cols);
+  search.mg.emplace(search.nets.front(), search.nets.back(), &search.sum.front(), &search.sum.back(), pr.cols);
 
   // λ in decades of the balance, where J's diagonal equals the data term's on average:
   // from it, one decade at a time in the direction the score falls, until it rises.

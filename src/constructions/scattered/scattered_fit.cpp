@@ -32,22 +32,20 @@ constexpr int slow_steps = 150;
        "equations are not positive definite (points all on one line of the parameter plane)");
 }
 
-// The nets below `net` for multigrid, the coarsest one's matrix (data and fairness at
-// `scaled`, the weight times the points' weight sum) moved out of `kept`, and the
-// preconditioner over them and `top`.
+// The coarsest net of `net`'s multigrid, its matrix (data and fairness at `scaled`,
+// the weight times the points' weight sum) moved out of `kept`, and the preconditioner
+// over it and `top`.
 struct Hierarchy {
-  std::vector<Net> nets;
+  Net coarse;
   std::optional<NetMatrix> coarsest;
   std::optional<Multigrid> mg;
 };
 
 Hierarchy hierarchy_for(const Net& net, const NetMatrix& top, double scaled, KeptMatrices& kept, int cols) {
-  Hierarchy h;
-  h.nets = hierarchy(net, coarsest_net);
-  h.coarsest = kept.take(h.nets.front(), scaled);
-  if (!h.coarsest)
-    fail(errc::internal, "scattered multigrid: no matrix for the coarse net of ", h.nets.front().nu, " x ", h.nets.front().nv, " control points");
-  h.mg.emplace(h.nets, &*h.coarsest, &top, cols);
+  Hierarchy h{hierarchy(net, coarsest_net).front(), std::nullopt, std::nullopt};
+  h.coarsest = kept.take(h.coarse, scaled);
+  if (!h.coarsest) fail(errc::internal, "scattered multigrid: no matrix for the coarse net of ", h.coarse.nu, " x ", h.coarse.nv, " control points");
+  h.mg.emplace(h.coarse, net, &*h.coarsest, &top, cols);
   return h;
 }
 
@@ -191,7 +189,7 @@ void solve_net(const Problem& pr, const Net& net, System& sys, double scaled, st
   {
     sys.a.mirror();
     Hierarchy h = hierarchy_for(net, sys.a, scaled, kept, pr.cols);
-    if (!h.mg->factor()) not_definite(h.mg->net(0));
+    if (!h.mg->factor()) not_definite(h.coarse);
     Multigrid& mg = *h.mg;
     double before = 0;  // the residual probe_steps ago
     const KeepGoing keep_going = [&](int steps, double residual) {
@@ -202,7 +200,7 @@ void solve_net(const Problem& pr, const Net& net, System& sys, double scaled, st
     };
     sol = solve_cg(sys.a, sys.rhs, x, pr.cols, 1e-12, factorable ? 4 * slow_steps : 200 + 40 * (net.nu + net.nv),
                    [&mg](std::span<const double> r, std::span<double> z, int) { mg.apply(r, z); }, keep_going);
-    kept.keep(h.nets.front(), std::move(*h.coarsest), scaled);
+    kept.keep(h.coarse, std::move(*h.coarsest), scaled);
   }
   if (sol.residual <= 1e-12) return;
   if (factorable) {
@@ -233,7 +231,7 @@ void restrict_hierarchy(const Net& net, const System& data, double scaled, KeptM
   // The coarsest alone straight from `data`: P (knot insertion from it to `net`) still has
   // p + 1 entries a fine row, and the nets between take no pass.
   std::vector<System> terms = all ? restrict_down(data, net, below) : std::vector<System>{};
-  if (!all) terms.push_back(restrict_system(data, {refinement(below[0].ku, net.ku), refinement(below[0].kv, net.kv)}));
+  if (!all) terms.push_back(restrict_between(data, net, below[0]));
   for (std::size_t l = 0; l < below.size(); ++l) {
     add_fairness(below[l], &terms[l].a, scaled);
     kept.keep(below[l], std::move(terms[l].a), scaled);

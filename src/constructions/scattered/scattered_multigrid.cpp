@@ -79,13 +79,15 @@ bool nests(const KnotVector& coarse, const KnotVector& fine) {
          std::includes(fine.values().begin(), fine.values().end(), coarse.values().begin(), coarse.values().end());
 }
 
+System restrict_between(const System& fine_term, const Net& fine, const Net& coarse) {
+  return restrict_system(fine_term, {refinement(coarse.ku, fine.ku), refinement(coarse.kv, fine.kv)});
+}
+
 std::vector<System> restrict_down(const System& top, const Net& top_net, std::span<const Net> nets) {
   std::vector<System> out;  // finest first while made
   out.reserve(nets.size());
-  for (std::size_t l = nets.size(); l-- > 0;) {
-    const Net& fine = l + 1 < nets.size() ? nets[l + 1] : top_net;
-    out.push_back(restrict_system(out.empty() ? top : out.back(), {refinement(nets[l].ku, fine.ku), refinement(nets[l].kv, fine.kv)}));
-  }
+  for (std::size_t l = nets.size(); l-- > 0;)
+    out.push_back(restrict_between(out.empty() ? top : out.back(), l + 1 < nets.size() ? nets[l + 1] : top_net, nets[l]));
   std::reverse(out.begin(), out.end());
   return out;
 }
@@ -272,32 +274,24 @@ System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
   return out;
 }
 
-Multigrid::Multigrid(std::vector<Net> nets, const NetMatrix* coarsest, const NetMatrix* finest, int cols)
-    : nets_(std::move(nets)), coarsest_a_(coarsest), finest_a_(finest), cols_(cols) {
-  const std::size_t n = nets_.size();
-  up_.resize(n);
-  for (std::size_t l = 1; l < n; ++l)
-    up_[l] = {refinement(nets_[l - 1].ku, nets_[l].ku), refinement(nets_[l - 1].kv, nets_[l].kv)};
-  // Below the finest net, each net's share of the residual carried down and of the
-  // correction carried up.
-  b_.resize(n), x_.resize(n);
-  for (std::size_t l = 0; l + 1 < n; ++l) {
-    const std::size_t len = nets_[l].size() * static_cast<std::size_t>(cols);
-    b_[l].assign(len, 0.0), x_[l].assign(len, 0.0);
-  }
-  if (n > 1) r_.assign(nets_.back().size() * static_cast<std::size_t>(cols), 0.0);
+Multigrid::Multigrid(const Net& coarsest, const Net& finest, const NetMatrix* coarsest_a, const NetMatrix* finest_a, int cols)
+    : coarsest_a_(coarsest_a), finest_a_(finest_a), one_net_(coarsest.same_knots(finest)), cols_(cols) {
+  if (one_net_) return;
+  up_ = {refinement(coarsest.ku, finest.ku), refinement(coarsest.kv, finest.kv)};
+  r_.assign(finest.size() * static_cast<std::size_t>(cols), 0.0);
+  b_.assign(coarsest.size() * static_cast<std::size_t>(cols), 0.0);
+  x_.assign(b_.size(), 0.0);
 }
 
 bool Multigrid::factor() {
   coarsest_.emplace(*coarsest_a_);
   smoother_.reset();
-  if (nets_.size() > 1) smoother_.emplace(*finest_a_);
+  if (!one_net_) smoother_.emplace(*finest_a_);
   return coarsest_->ok();
 }
 
 void Multigrid::apply(std::span<const double> r, std::span<double> z) {
-  const std::size_t top = nets_.size() - 1;
-  if (top == 0) {
+  if (one_net_) {
     coarsest_->solve(r, z, cols_);
     return;
   }
@@ -305,15 +299,9 @@ void Multigrid::apply(std::span<const double> r, std::span<double> z) {
   smoother_->sweep(*finest_a_, r, z, cols_, false, tmp_, true);
   finest_a_->multiply(z, r_, cols_);
   for (std::size_t k = 0; k < r_.size(); ++k) r_[k] = r[k] - r_[k];
-  // The residual carried down to the coarsest net, solved there, the correction carried
-  // back up: the nets between are smoothed no more (see the header).
-  for (std::size_t l = top; l > 0; --l) restrict_to(up_[l], l == top ? std::span<const double>(r_) : b_[l], b_[l - 1], cols_, tmp_);
-  coarsest_->solve(b_[0], x_[0], cols_);
-  for (std::size_t l = 1; l < top; ++l) {
-    std::fill(x_[l].begin(), x_[l].end(), 0.0);
-    prolong(up_[l], x_[l - 1], x_[l], cols_, tmp_);
-  }
-  prolong(up_[top], x_[top - 1], z, cols_, tmp_);
+  restrict_to(up_, r_, b_, cols_, tmp_);
+  coarsest_->solve(b_, x_, cols_);
+  prolong(up_, x_, z, cols_, tmp_);
   smoother_->sweep(*finest_a_, r, z, cols_, true, tmp_);
 }
 

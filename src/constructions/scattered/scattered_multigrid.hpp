@@ -41,6 +41,11 @@ Refinement refinement(const KnotVector& coarse, const KnotVector& fine);
 /// meet either.
 System restrict_system(const System& fine, const std::array<Refinement, 2>& r);
 
+/// `fine_term`, the data term of `fine`, restricted to `coarse`, whose knots are all
+/// knots of `fine`'s (any number of nets apart): restrict_system with the refinement
+/// between them.
+System restrict_between(const System& fine_term, const Net& fine, const Net& coarse);
+
 /// Whether every knot of `coarse` is a knot of `fine` (with at least its multiplicity),
 /// so that refinement is knot insertion and restrict_system exact.
 bool nests(const KnotVector& coarse, const KnotVector& fine);
@@ -57,35 +62,33 @@ std::vector<System> restrict_down(const System& top, const Net& top_net, std::sp
 std::vector<Net> hierarchy(const Net& top, std::size_t coarsest);
 
 /// The preconditioner: one forward sweep of the strip smoother on the finest net, the
-/// residual carried down the nets below by Pᵀ to the coarsest and solved there by its
-/// factor, the correction carried back up by P, one backward sweep. The nets between
-/// are not smoothed: their knot cells hold four times the points of the next finer
-/// one's or more, and smoothing them changed no step count (15 on 10^6 points and a
-/// 512 × 512 net, 9 on the terrain's 259 × 259, 23 on 140 × 140, 42 on 700 × 700; 58
-/// against 59 on 4·10^6 points and 1 400 × 1 400) for a tenth of the time and their
-/// factors' memory. Their matrices serve only to restrict the coarsest one's.
+/// residual carried to the coarsest net of its hierarchy by Pᵀ (knot insertion from the
+/// coarsest knots to the finest, p + 1 weights a fine row whatever the nets between)
+/// and solved there by its factor, the correction carried back by P, one backward
+/// sweep. The nets between are not smoothed: their knot cells hold four times the
+/// points of the next finer one's or more, and smoothing them changed no step count (15
+/// on 10^6 points and a 512 × 512 net, 9 on the terrain's 259 × 259, 23 on 140 × 140,
+/// 42 on 700 × 700; 58 against 59 on 4·10^6 points and 1 400 × 1 400) for a tenth of
+/// the time and their factors' memory.
 class Multigrid {
  public:
-  /// nets coarsest first; the two matrices, of the first and the last net (the same one
-  /// when there is one net), outlive this object and may change between factor() calls,
-  /// as a search over the fairness weight does.
-  Multigrid(std::vector<Net> nets, const NetMatrix* coarsest, const NetMatrix* finest, int cols);
+  /// The coarsest net and the finest (one net: the finest factored), and their
+  /// matrices, which outlive this object and may change between factor() calls, as a
+  /// search over the fairness weight does.
+  Multigrid(const Net& coarsest, const Net& finest, const NetMatrix* coarsest_a, const NetMatrix* finest_a, int cols);
   /// Factors the coarsest matrix and the finest one's strips (again). False when the
   /// coarsest is not positive definite.
   bool factor();
   /// z = the preconditioner applied to r: symmetric positive definite, the backward
   /// sweep the forward one's adjoint.
   void apply(std::span<const double> r, std::span<double> z);
-  [[nodiscard]] const Net& net(std::size_t level) const { return nets_[level]; }
-  [[nodiscard]] std::size_t levels() const { return nets_.size(); }
 
  private:
-  std::vector<Net> nets_;
   const NetMatrix* coarsest_a_;
   const NetMatrix* finest_a_;
-  std::vector<std::array<Refinement, 2>> up_;  // up_[l]: level l - 1 to level l
-  std::vector<std::vector<double>> b_, x_;  // below the finest net: the residual, the correction
-  std::vector<double> r_, tmp_;
+  bool one_net_;
+  std::array<Refinement, 2> up_;  // the coarsest net to the finest
+  std::vector<double> r_, b_, x_, tmp_;  // the finest net's residual; the coarsest's problem and solution
   std::optional<DirectSolver> coarsest_;
   std::optional<StripSmoother> smoother_;
   int cols_;
