@@ -231,21 +231,33 @@ System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
   constexpr std::size_t block = 16;
   const std::size_t blocks = (cu + block - 1) / block;
   const bool parallel = fu * fv * band * pv >= parallel_min_work;
+  // Each block's fine rows [ilo, ihi], and a thread's buffers for the most of them,
+  // made before the threads start (nothing allocates inside them).
+  std::vector<std::array<std::size_t, 2>> rows(blocks, {fu, 0});
+  std::size_t most = 0;
+  for (std::size_t bk = 0; bk < blocks; ++bk) {
+    const std::size_t a0 = bk * block, a1 = std::min(cu, a0 + block);
+    for (std::size_t x = ru.t_start[a0]; x < ru.t_start[a1]; ++x) {
+      rows[bk][0] = std::min(rows[bk][0], static_cast<std::size_t>(ru.t_index[x]));
+      rows[bk][1] = std::max(rows[bk][1], static_cast<std::size_t>(ru.t_index[x]));
+    }
+    if (rows[bk][0] <= rows[bk][1]) most = std::max(most, rows[bk][1] - rows[bk][0] + 1);
+  }
+  struct Buffers {
+    std::vector<double> t, tb, z;
+  };
+  std::vector<Buffers> buffers(parallel ? max_threads() : 1);
+  for (Buffers& buf : buffers) buf = {std::vector<double>(most * cv * band), std::vector<double>(most * cv * c), std::vector<double>(static_cast<std::size_t>(2 * hv) + pv + 1)};
 #pragma omp parallel if (parallel)
   {
-    std::vector<double> t, tb, z(static_cast<std::size_t>(2 * hv) + pv + 1);
+    Buffers& buf = buffers[static_cast<std::size_t>(thread_index())];
+    std::vector<double> &t = buf.t, &tb = buf.tb;
 #pragma omp for schedule(static)
     for (long long bk = 0; bk < static_cast<long long>(blocks); ++bk) {
       const std::size_t a0 = static_cast<std::size_t>(bk) * block, a1 = std::min(cu, a0 + block);
-      std::size_t ilo = fu, ihi = 0;
-      for (std::size_t x = ru.t_start[a0]; x < ru.t_start[a1]; ++x) {
-        ilo = std::min(ilo, static_cast<std::size_t>(ru.t_index[x]));
-        ihi = std::max(ihi, static_cast<std::size_t>(ru.t_index[x]));
-      }
+      const auto [ilo, ihi] = rows[static_cast<std::size_t>(bk)];
       if (ilo > ihi) continue;
-      t.resize((ihi - ilo + 1) * cv * band);
-      tb.resize((ihi - ilo + 1) * cv * c);
-      for (std::size_t i = ilo; i <= ihi; ++i) restrict_row_along_v(fine, rv, i, &t[(i - ilo) * cv * band], &tb[(i - ilo) * cv * c], z);
+      for (std::size_t i = ilo; i <= ihi; ++i) restrict_row_along_v(fine, rv, i, &t[(i - ilo) * cv * band], &tb[(i - ilo) * cv * c], buf.z);
       for (std::size_t ca = a0; ca < a1; ++ca)
         for (std::size_t x = ru.t_start[ca]; x < ru.t_start[ca + 1]; ++x) {
           const auto i = static_cast<std::size_t>(ru.t_index[x]);
