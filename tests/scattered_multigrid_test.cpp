@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <string>
@@ -348,52 +349,67 @@ TEST(ScatteredMultigrid, AStripAsWideAsTheNetSolvesIt) {
 // A matrix's products equal the sums over its entries (taken one by one, from either
 // half) to rounding, 1e-14 of their largest size times 49 terms, for 1 and 3 columns:
 // cubic nets from the upper half alone, other reaches from whole rows once mirrored;
-// mirroring (or not, for cubics) and going back change no entry.
+// mirroring (or not, for cubics) and going back change no entry. The nets are one band
+// of multiply() and several; every band of rows multiply_rows takes, down to one net row
+// (thinner than the matrix reaches), writes its rows and no other.
 TEST(ScatteredMultigrid, ProductsReadEitherHalfAsTheEntries) {
   std::mt19937_64 g(39);
   std::uniform_real_distribution<double> U(-1, 1);
   for (const auto& [hu, hv] : {std::array<int, 2>{3, 3}, {2, 2}, {3, 2}})
-    for (const int cols : {1, 3}) {
-      const int nu = 12, nv = 15;
-      NetMatrix m(nu, nv, hu, hv);
-      for (std::size_t r = 0; r < m.rows(); ++r)
-        for (int di = 0; di <= hu; ++di)
-          for (int dj = di == 0 ? 0 : -hv; dj <= hv; ++dj) {
-            const int i = static_cast<int>(r) / nv + di, j = static_cast<int>(r) % nv + dj;
-            if (i < nu && j >= 0 && j < nv) m.at(r, m.offset(di, dj)) = U(g);
-          }
-      const auto c = static_cast<std::size_t>(cols);
-      std::vector<double> upper, x(m.rows() * c), want(x.size(), 0.0), got(x.size());
-      const int width = hv + 1 + hu * (2 * hv + 1);
-      for (std::size_t r = 0; r < m.rows(); ++r)
-        for (int k = 0; k < width; ++k) upper.push_back(m.at(r, k));
-      for (double& v : x) v = U(g);
-      for (std::size_t r = 0; r < m.rows(); ++r) {
-        const int i = static_cast<int>(r) / nv, j = static_cast<int>(r) % nv;
-        for (int di = -hu; di <= hu; ++di)
-          for (int dj = -hv; dj <= hv; ++dj) {
-            if (i + di < 0 || i + di >= nu || j + dj < 0 || j + dj >= nv) continue;
-            const std::size_t o = static_cast<std::size_t>((i + di) * nv + j + dj);
-            for (std::size_t k = 0; k < c; ++k) want[r * c + k] += m.entry(r, di, dj) * x[o * c + k];
-          }
-      }
-      const auto same_entries = [&] {
-        std::size_t e = 0, moved = 0;
-        const NetMatrix& read = m;
+    for (const int cols : {1, 3})
+      for (const int nu : {12, 2 * NetMatrix::band_rows + 5}) {
+        const int nv = 15;
+        NetMatrix m(nu, nv, hu, hv);
         for (std::size_t r = 0; r < m.rows(); ++r)
-          for (int k = 0; k < width; ++k) moved += read.at(r, k) != upper[e++];
-        return moved;
-      };
-      for (const char* form : {"as assembled", "mirrored"}) {
-        if (std::string(form) == "mirrored") m.mirror();
-        m.multiply(x, got, cols);
-        for (std::size_t k = 0; k < got.size(); ++k)
-          ASSERT_NEAR(got[k], want[k], 1e-14 * 49) << hu << " x " << hv << ", " << cols << " columns, " << form << ", value " << k;
-        EXPECT_EQ(same_entries(), 0u) << form;
+          for (int di = 0; di <= hu; ++di)
+            for (int dj = di == 0 ? 0 : -hv; dj <= hv; ++dj) {
+              const int i = static_cast<int>(r) / nv + di, j = static_cast<int>(r) % nv + dj;
+              if (i < nu && j >= 0 && j < nv) m.at(r, m.offset(di, dj)) = U(g);
+            }
+        const auto c = static_cast<std::size_t>(cols);
+        std::vector<double> upper, x(m.rows() * c), want(x.size(), 0.0), got(x.size());
+        const int width = hv + 1 + hu * (2 * hv + 1);
+        for (std::size_t r = 0; r < m.rows(); ++r)
+          for (int k = 0; k < width; ++k) upper.push_back(m.at(r, k));
+        for (double& v : x) v = U(g);
+        for (std::size_t r = 0; r < m.rows(); ++r) {
+          const int i = static_cast<int>(r) / nv, j = static_cast<int>(r) % nv;
+          for (int di = -hu; di <= hu; ++di)
+            for (int dj = -hv; dj <= hv; ++dj) {
+              if (i + di < 0 || i + di >= nu || j + dj < 0 || j + dj >= nv) continue;
+              const std::size_t o = static_cast<std::size_t>((i + di) * nv + j + dj);
+              for (std::size_t k = 0; k < c; ++k) want[r * c + k] += m.entry(r, di, dj) * x[o * c + k];
+            }
+        }
+        const auto same_entries = [&] {
+          std::size_t e = 0, moved = 0;
+          const NetMatrix& read = m;
+          for (std::size_t r = 0; r < m.rows(); ++r)
+            for (int k = 0; k < width; ++k) moved += read.at(r, k) != upper[e++];
+          return moved;
+        };
+        for (const char* form : {"as assembled", "mirrored"}) {
+          if (std::string(form) == "mirrored") m.mirror();
+          m.multiply(x, got, cols);
+          for (std::size_t k = 0; k < got.size(); ++k)
+            ASSERT_NEAR(got[k], want[k], 1e-14 * 49) << hu << " x " << hv << ", " << cols << " columns, " << form << ", value " << k;
+          EXPECT_EQ(same_entries(), 0u) << form;
+          const std::size_t per_row = static_cast<std::size_t>(nv) * c;  // values a net row
+          for (int i0 = 0; i0 < nu; ++i0)
+            for (const int i1 : {i0 + 1, i0 + 2, i0 + 4, i0 + 7, nu}) {
+              if (i1 > nu) continue;
+              std::fill(got.begin(), got.end(), std::numeric_limits<double>::quiet_NaN());
+              m.multiply_rows(i0, i1, x, got, cols);
+              for (std::size_t k = 0; k < got.size(); ++k) {
+                const bool inside = k >= static_cast<std::size_t>(i0) * per_row && k < static_cast<std::size_t>(i1) * per_row;
+                if (inside) ASSERT_NEAR(got[k], want[k], 1e-14 * 49) << hu << " x " << hv << ", rows " << i0 << ".." << i1 << ", value " << k;
+                else ASSERT_TRUE(std::isnan(got[k])) << hu << " x " << hv << ", rows " << i0 << ".." << i1 << " wrote value " << k;
+              }
+            }
+        }
+        m.unmirror();
+        EXPECT_EQ(same_entries(), 0u) << "back to the upper half";
       }
-      m.unmirror();
-      EXPECT_EQ(same_entries(), 0u) << "back to the upper half";
-    }
 }
 
 // Points are indexed in 32 bits: one more than they reach is refused, by name and count.

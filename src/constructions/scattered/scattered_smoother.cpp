@@ -1,6 +1,7 @@
 #include "constructions/scattered/scattered_smoother.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "base/parallel.hpp"
@@ -88,20 +89,24 @@ void StripSmoother::factor(const NetMatrix& a, Strip& s, std::vector<double>& sc
 
 void StripSmoother::residuals(int dir, int colour, const NetMatrix& a, std::span<const double> b, std::span<const double> x,
                               std::size_t c, std::span<double> r) const {
-  const int w = strip_width(a);
-  // One net row i a task. Along u, the rows of the colour's strips; along v, every row:
-  // reading the matrix in stretches of w rows with gaps as long took a third longer than
-  // reading it whole.
+  // Along u, the rows of the colour's strips, a strip a task; along v, every row, in
+  // multiply()'s bands: reading the matrix in stretches of w rows with gaps as long
+  // took a third longer than reading it whole.
+  std::vector<std::array<int, 2>> bands;
+  if (dir == 0) {
+    for (const Strip& s : strips_)
+      if (s.dir == 0 && s.index % 2 == colour) bands.push_back({s.first, s.first + s.width});
+  } else {
+    for (int i = 0; i < nu_; i += NetMatrix::band_rows) bands.push_back({i, std::min(nu_, i + NetMatrix::band_rows)});
+  }
   const std::size_t work = a.rows() * static_cast<std::size_t>((2 * a.hu() + 1) * (2 * a.hv() + 1)) * c;
+  const auto count = static_cast<long long>(bands.size());
+  const auto nv = static_cast<std::size_t>(nv_);
 #pragma omp parallel for schedule(static) if (work >= parallel_min_work)
-  for (int i = 0; i < nu_; ++i) {
-    if (dir == 0 && (i / w) % 2 != colour) continue;
-    for (int j = 0; j < nv_; ++j) {
-      double acc[3];
-      const std::size_t row = static_cast<std::size_t>(i) * static_cast<std::size_t>(nv_) + static_cast<std::size_t>(j);
-      a.row_product(i, j, x, c, acc);
-      for (std::size_t m = 0; m < c; ++m) r[row * c + m] = b[row * c + m] - acc[m];
-    }
+  for (long long k = 0; k < count; ++k) {
+    const auto [i0, i1] = bands[static_cast<std::size_t>(k)];
+    a.multiply_rows(i0, i1, x, r, static_cast<int>(c));
+    for (std::size_t e = static_cast<std::size_t>(i0) * nv * c; e < static_cast<std::size_t>(i1) * nv * c; ++e) r[e] = b[e] - r[e];
   }
 }
 

@@ -89,8 +89,15 @@ class NetMatrix {
   }
   /// Adds s·v vᵀ for v with entries `coef` at the control points `at` (each (i, j)).
   void add_outer(std::span<const std::array<int, 2>> at, std::span<const double> coef, double s);
-  /// y = A x for `cols` interleaved columns (x[r·cols + c]); rows shared by the threads.
+  /// y = A x for `cols` interleaved columns (x[r·cols + c]); bands of net rows shared by
+  /// the threads.
   void multiply(std::span<const double> x, std::span<double> y, int cols) const;
+  /// The rows of A x for the control points (i, j) with i0 <= i < i1, into the same rows
+  /// of y (no other written), the sums in one order whoever calls.
+  void multiply_rows(int i0, int i1, std::span<const double> x, std::span<double> y, int cols) const;
+  /// Net rows a band of multiply() holds: fixed, so that the bits do not depend on the
+  /// threads.
+  static constexpr int band_rows = 32;
   /// Row (i, j) of A times x, column by column, into acc.
   void row_product(int i, int j, std::span<const double> x, std::size_t cols, double* acc) const;
   /// This matrix set to d + s·f (all three of one net and one pattern).
@@ -101,7 +108,8 @@ class NetMatrix {
   /// and sweeps read one contiguous row instead of entries spread over the rows above
   /// (about 5 times faster through the general path); the upper half alone is then let
   /// go. Changing an entry goes back to the upper half. Nothing for cubic nets (reach
-  /// 3 × 3), whose products read the upper half as fast with half the memory.
+  /// 3 × 3), whose products read each entry of the upper half once for its row and its
+  /// mirror, faster with half the memory.
   void mirror();
   /// Back to the upper half alone, the smaller form (a matrix kept for later).
   void unmirror();
@@ -113,8 +121,8 @@ class NetMatrix {
   }
 
  private:
-  // Cubic nets' products read the upper half as fast as whole rows (upper_row): memory,
-  // not the adder, bounds them, and the lower entries come from rows just read.
+  // Cubic nets' products read the upper half alone (multiply_rows), a quarter faster
+  // than whole rows.
   static bool stays_upper(int hu, int hv) { return hu == 3 && hv == 3; }
   [[nodiscard]] std::size_t full_width() const { return static_cast<std::size_t>((2 * hu_ + 1) * (2 * hv_ + 1)); }
   int nu_, nv_, hu_, hv_, width_;
