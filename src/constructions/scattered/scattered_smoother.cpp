@@ -47,31 +47,28 @@ StripSmoother::StripSmoother(const NetMatrix& a) : nu_(a.nu()), nv_(a.nv()) {
   const bool parallel = a.rows() * band * band >= parallel_min_work;
   std::size_t largest = 0;
   for (const Strip& s : strips_) largest = std::max(largest, s.size * static_cast<std::size_t>(s.band + 1));
-  std::vector<std::vector<double>> scratch(parallel ? max_threads() : 1, std::vector<double>(largest));
+  std::size_t longest = 0;
+  for (const Strip& s : strips_) longest = std::max(longest, s.size);
+  std::vector<FactorScratch> scratch(parallel ? max_threads() : 1);
+  for (FactorScratch& f : scratch) f = {std::vector<double>(largest), std::vector<std::array<int, 2>>(longest), std::vector<std::size_t>(longest)};
 #pragma omp parallel for schedule(dynamic, 1) if (parallel)
   for (long long k = 0; k < count; ++k) factor(a, strips_[static_cast<std::size_t>(k)], scratch[static_cast<std::size_t>(thread_index())]);
 }
 
-std::size_t StripSmoother::row_of(const Strip& s, std::size_t k) const {
-  const auto w = static_cast<std::size_t>(s.width);
-  const std::size_t along = k / w, across = static_cast<std::size_t>(s.first) + k % w;
-  return s.dir == 0 ? across * static_cast<std::size_t>(nv_) + along : along * static_cast<std::size_t>(nv_) + across;
-}
-
-void StripSmoother::factor(const NetMatrix& a, Strip& s, std::vector<double>& scratch) {
+void StripSmoother::factor(const NetMatrix& a, Strip& s, FactorScratch& scratch) {
   // Band Cholesky by rows: L[k][j] = (A[k][j] - Σ_i L[k][i] L[j][i]) / L[j][j], in
-  // double, then kept in single precision.
+  // double, then kept in single precision. Each unknown's control point found once.
   const auto band = static_cast<std::size_t>(s.band), stride = band + 1;
-  double* f = scratch.data();
+  double* f = scratch.band.data();
+  std::vector<std::array<int, 2>>& at = scratch.at;
+  std::vector<std::size_t>& row = scratch.row;
+  for_each_row(s, [&](std::size_t k, int i, int j, std::size_t r) { at[k] = {i, j}, row[k] = r; });
   for (std::size_t k = 0; k < s.size; ++k) {
     const std::size_t j0 = k > band ? k - band : 0;
     double* lk = f + k * stride;  // lk[band - (k - j)] = L[k][j]
-    const std::size_t rk = row_of(s, k);
-    const int ik = static_cast<int>(rk / static_cast<std::size_t>(nv_)), jk = static_cast<int>(rk % static_cast<std::size_t>(nv_));
     for (std::size_t j = j0; j <= k; ++j) {
-      const std::size_t rj = row_of(s, j);
-      const int di = static_cast<int>(rj / static_cast<std::size_t>(nv_)) - ik, dj = static_cast<int>(rj % static_cast<std::size_t>(nv_)) - jk;
-      double sum = std::abs(di) <= a.hu() && std::abs(dj) <= a.hv() ? a.entry(rk, di, dj) : 0.0;
+      const int di = at[j][0] - at[k][0], dj = at[j][1] - at[k][1];
+      double sum = std::abs(di) <= a.hu() && std::abs(dj) <= a.hv() ? a.entry(row[k], di, dj) : 0.0;
       const double* lj = f + j * stride;
       const std::size_t i0 = std::max(j0, j > band ? j - band : 0);
       for (std::size_t i = i0; i < j; ++i) sum -= lk[band - (k - i)] * lj[band - (j - i)];

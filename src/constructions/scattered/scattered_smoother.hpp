@@ -7,6 +7,7 @@
 // coarse nets cannot hold them; a strip solved whole removes them. Strips along v, then
 // strips along u.
 
+#include <array>
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -42,8 +43,6 @@ class StripSmoother {
     std::size_t size = 0, at = 0;  // unknowns, offset of its factor in factor_
     bool ok = false;
   };
-  // Control point (i, j) of a strip's unknown k: along the strip, then across it.
-  [[nodiscard]] std::size_t row_of(const Strip& s, std::size_t k) const;
   // f(k, i, j, row) for a strip's unknowns in order, without dividing for each.
   template <class F>
   void for_each_row(const Strip& s, F&& f) const {
@@ -55,7 +54,14 @@ class StripSmoother {
         f(k, i, j, static_cast<std::size_t>(i) * static_cast<std::size_t>(nv_) + static_cast<std::size_t>(j));
       }
   }
-  void factor(const NetMatrix& a, Strip& s, std::vector<double>& scratch);
+  // A thread's room to factor a strip, made before the threads start: the band in double,
+  // and each unknown's control point (i, j) and row.
+  struct FactorScratch {
+    std::vector<double> band;
+    std::vector<std::array<int, 2>> at;
+    std::vector<std::size_t> row;
+  };
+  void factor(const NetMatrix& a, Strip& s, FactorScratch& scratch);
   // r = b - A x at (at least) the control points of one direction's strips of one
   // colour, the matrix's rows read in memory order whatever the direction.
   void residuals(int dir, int colour, const NetMatrix& a, std::span<const double> b, std::span<const double> x, std::size_t c,

@@ -31,11 +31,9 @@ struct Net {
   /// a factor 2 of each other on every net below).
   static Net coarser(const Net& fine);
   [[nodiscard]] std::size_t size() const { return static_cast<std::size_t>(nu) * static_cast<std::size_t>(nv); }
-  /// ku.find_span(t) and kv.find_span(t), found from the knots' even spacing rather
-  /// than by a search (a tenth of a fit's time at 10^6 points), then moved onto the
-  /// knots.
-  [[nodiscard]] int span_u(double t) const { return uniform_span(ku, inv_h[0], t); }
-  [[nodiscard]] int span_v(double t) const { return uniform_span(kv, inv_h[1], t); }
+  /// ku.find_span(t) and kv.find_span(t).
+  [[nodiscard]] int span_u(double t) const { return ku.find_span(t); }
+  [[nodiscard]] int span_v(double t) const { return kv.find_span(t); }
   /// ku.basis(span, t, out) and kv.basis(span, t, out): on spans whose knots are all
   /// evenly spaced, the recurrence's denominators are 1, 2 .. p spacings, so no division
   /// is left (a third of a pass over the points); the clamped ends' spans, and every
@@ -53,7 +51,6 @@ struct Net {
 
  private:
   Net(KnotVector u, KnotVector v, std::array<bool, 2> even_);
-  static int uniform_span(const KnotVector& k, double inv_h, double t);
   static void uniform_basis(const KnotVector& k, double inv_h, int span, double t, double* out);
   std::array<double, 2> inv_h{};  // 1 / the knot spacing (on average, when not even)
   std::array<bool, 2> even{true, true};
