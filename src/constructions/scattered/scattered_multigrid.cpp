@@ -162,12 +162,41 @@ void restrict_to(const std::array<Refinement, 2>& r, std::span<const double> fin
   }
 }
 
+// For each fine column j, the weights that take the entries of a row (i, j) with its
+// neighbours (·, j + dj) to the coarse functions b' those neighbours refine: zlo[j] the
+// first such b', w[(j · (2hv + 1) + dj + hv) · width + b' - zlo[j]] = Pv[j + dj][b']
+// (zero where j + dj does not refine b' or falls outside). The same for every fine row
+// and every di: made once.
+struct Gather {
+  std::vector<int> zlo, count;
+  std::vector<double> w;
+  std::size_t width = 0;
+  Gather(const Refinement& rv, int hv) : width(static_cast<std::size_t>(2 * hv + rv.p + 2)) {
+    const auto fv = static_cast<std::size_t>(rv.fine), pv = static_cast<std::size_t>(rv.p + 1), wv = static_cast<std::size_t>(2 * hv + 1);
+    zlo.resize(fv), count.resize(fv);
+    w.assign(fv * wv * width, 0.0);
+    for (std::size_t j = 0; j < fv; ++j) {
+      const int jlo = std::max(-hv, -static_cast<int>(j)), jhi = std::min(hv, static_cast<int>(fv - 1 - j));
+      zlo[j] = rv.first[static_cast<std::size_t>(static_cast<int>(j) + jlo)];
+      count[j] = rv.first[static_cast<std::size_t>(static_cast<int>(j) + jhi)] + rv.p + 1 - zlo[j];
+      for (int dj = jlo; dj <= jhi; ++dj) {
+        const auto j2 = static_cast<std::size_t>(static_cast<int>(j) + dj);
+        double* to = &w[(j * wv + static_cast<std::size_t>(dj + hv)) * width + static_cast<std::size_t>(rv.first[j2] - zlo[j])];
+        for (std::size_t e2 = 0; e2 < pv; ++e2) to[e2] = rv.weight[j2 * pv + e2];
+      }
+    }
+  }
+};
+
 // restrict_system's pass along v over fine row i (v refined by rv):
 // t[b][(di, db)] = Σ_j Σ_j' Pv[j][b] A[(i, j)][(i + di, j')] Pv[j'][b + db], both halves,
 // in a fixed order: first z = the row's entries times Pv (the coarse functions b' that
-// (i, j)'s neighbours refine, from zlo on), then Pv[j][b] z into t (about half the
-// products of both at once); tb likewise for the right-hand sides.
-void restrict_row_along_v(const System& fine, const Refinement& rv, std::size_t i, double* t, double* tb, std::vector<double>& z) {
+// (i, j)'s neighbours refine, from zlo on; each z a sum over the neighbours held in a
+// register, where adding each neighbour's share into z in memory waited on the last
+// store), then Pv[j][b] z into t (about half the products of both at once); tb likewise
+// for the right-hand sides.
+void restrict_row_along_v(const System& fine, const Refinement& rv, const Gather& gather, std::size_t i, double* t, double* tb,
+                          std::vector<double>& z) {
   const NetMatrix& a = fine.a;
   const int hu = a.hu(), hv = a.hv(), wu = 2 * hu + 1, wv = 2 * hv + 1;
   const auto c = static_cast<std::size_t>(fine.cols), band = static_cast<std::size_t>(wu * wv);
@@ -184,21 +213,23 @@ void restrict_row_along_v(const System& fine, const Refinement& rv, std::size_t 
       for (std::size_t m = 0; m < c && wj[e] != 0; ++m) tb[b * c + m] += wj[e] * fine.rhs[row * c + m];
     }
     const int jlo = std::max(-hv, -static_cast<int>(j)), jhi = std::min(hv, static_cast<int>(fv - 1 - j));
-    const int zlo = rv.first[static_cast<std::size_t>(static_cast<int>(j) + jlo)];
-    const int zhi = rv.first[static_cast<std::size_t>(static_cast<int>(j) + jhi)] + static_cast<int>(pv) - 1;
+    const int zlo = gather.zlo[j], zhi = zlo + gather.count[j] - 1;
+    const auto zn = static_cast<std::size_t>(gather.count[j]);
+    const double* gw = &gather.w[j * static_cast<std::size_t>(wv) * gather.width];
+    double v[2 * max_degree + 1];
     for (int di = -hu; di <= hu; ++di) {
       if (static_cast<long long>(i) + di < 0 || static_cast<long long>(i) + di >= static_cast<long long>(fu)) continue;
-      std::fill(z.begin(), z.begin() + (zhi - zlo + 1), 0.0);
       bool any = false;
-      for (int dj = jlo; dj <= jhi; ++dj) {
-        const double v = a.entry(row, di, dj);
-        if (v == 0) continue;
-        any = true;
-        const auto j2 = static_cast<std::size_t>(static_cast<int>(j) + dj);
-        double* to = &z[static_cast<std::size_t>(rv.first[j2] - zlo)];
-        for (std::size_t e2 = 0; e2 < pv; ++e2) to[e2] += v * rv.weight[j2 * pv + e2];
+      for (int dj = -hv; dj <= hv; ++dj) {
+        v[dj + hv] = dj >= jlo && dj <= jhi ? a.entry(row, di, dj) : 0.0;
+        any = any || v[dj + hv] != 0;
       }
       if (!any) continue;
+      for (std::size_t k = 0; k < zn; ++k) {
+        double sum = 0;
+        for (int d = 0; d < wv; ++d) sum += v[d] * gw[static_cast<std::size_t>(d) * gather.width + k];
+        z[k] = sum;
+      }
       for (std::size_t e = 0; e < pv; ++e) {
         if (wj[e] == 0) continue;
         const int b = fj + static_cast<int>(e);
@@ -246,6 +277,7 @@ System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
   struct Buffers {
     std::vector<double> t, tb, z;
   };
+  const Gather gather(rv, hv);
   std::vector<Buffers> buffers(parallel ? max_threads() : 1);
   for (Buffers& buf : buffers) buf = {std::vector<double>(most * cv * band), std::vector<double>(most * cv * c), std::vector<double>(static_cast<std::size_t>(2 * hv) + pv + 1)};
 #pragma omp parallel if (parallel)
@@ -257,26 +289,27 @@ System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
       const std::size_t a0 = static_cast<std::size_t>(bk) * block, a1 = std::min(cu, a0 + block);
       const auto [ilo, ihi] = rows[static_cast<std::size_t>(bk)];
       if (ilo > ihi) continue;
-      for (std::size_t i = ilo; i <= ihi; ++i) restrict_row_along_v(fine, rv, i, &t[(i - ilo) * cv * band], &tb[(i - ilo) * cv * c], buf.z);
+      for (std::size_t i = ilo; i <= ihi; ++i) restrict_row_along_v(fine, rv, gather, i, &t[(i - ilo) * cv * band], &tb[(i - ilo) * cv * c], buf.z);
       for (std::size_t ca = a0; ca < a1; ++ca)
         for (std::size_t x = ru.t_start[ca]; x < ru.t_start[ca + 1]; ++x) {
           const auto i = static_cast<std::size_t>(ru.t_index[x]);
           const double w = ru.t_weight[x];
-          for (std::size_t b = 0; b < cv; ++b) {
+          for (std::size_t b = 0; b < cv; ++b)
             for (std::size_t m = 0; m < c; ++m) out.rhs[(ca * cv + b) * c + m] += w * tb[((i - ilo) * cv + b) * c + m];
-            for (int di = -hu; di <= hu; ++di) {
-              const long long i2 = static_cast<long long>(i) + di;
-              if (i2 < 0 || i2 >= static_cast<long long>(fu)) continue;
-              const double* from = &t[(((i - ilo) * cv + b) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(di + hu)) * static_cast<std::size_t>(wv)];
-              for (std::size_t e2 = 0; e2 < pu; ++e2) {
-                const double w2 = w * ru.weight[static_cast<std::size_t>(i2) * pu + e2];
-                const int da = ru.first[static_cast<std::size_t>(i2)] + static_cast<int>(e2) - static_cast<int>(ca);
-                if (w2 == 0 || da < 0 || da > hu || ca + static_cast<std::size_t>(da) >= cu) continue;  // the upper half is all that is kept
-                for (int db = da == 0 ? 0 : -hv; db <= hv; ++db) {
-                  const long long b2 = static_cast<long long>(b) + db;
-                  if (b2 < 0 || b2 >= static_cast<long long>(cv)) continue;
-                  out.a.at(ca * cv + b, out.a.offset(da, db)) += w2 * from[db + hv];
-                }
+          // Each entry's sum in the order of i, di, e2 as before; the coarse columns b
+          // innermost but one, each (da, db) run a contiguous stretch of its row.
+          for (int di = -hu; di <= hu; ++di) {
+            const long long i2 = static_cast<long long>(i) + di;
+            if (i2 < 0 || i2 >= static_cast<long long>(fu)) continue;
+            for (std::size_t e2 = 0; e2 < pu; ++e2) {
+              const double w2 = w * ru.weight[static_cast<std::size_t>(i2) * pu + e2];
+              const int da = ru.first[static_cast<std::size_t>(i2)] + static_cast<int>(e2) - static_cast<int>(ca);
+              if (w2 == 0 || da < 0 || da > hu || ca + static_cast<std::size_t>(da) >= cu) continue;  // the upper half is all that is kept
+              for (std::size_t b = 0; b < cv; ++b) {
+                const double* from = &t[(((i - ilo) * cv + b) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(di + hu)) * static_cast<std::size_t>(wv)];
+                const int lo = std::max(da == 0 ? 0 : -hv, -static_cast<int>(b)), hi = std::min(hv, static_cast<int>(cv - 1 - b));
+                double* to = &out.a.at(ca * cv + b, out.a.offset(da, lo)) - lo;  // to[db]: offset (da, db)
+                for (int db = lo; db <= hi; ++db) to[db] += w2 * from[db + hv];
               }
             }
           }
