@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstddef>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -74,7 +75,7 @@ class StripSmoother {
   // Per strip, row k: L[k][k - band .. k - 1], then 1 / L[k][k]. In single precision:
   // the sweeps read it from memory (two passes a row per sweep) at half the cost, and a
   // smoother needs no more than its seven digits.
-  std::vector<float> factor_;
+  std::unique_ptr<float[]> factor_;
 };
 
 }  // namespace interpatch::detail::scattered
