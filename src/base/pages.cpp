@@ -1,7 +1,11 @@
+#include "base/pages.hpp"
+
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
+#include <cstdlib>
 #include <mutex>
 
 #include "interpatch/allocator.hpp"
@@ -85,5 +89,23 @@ void unmap_pages(void* p, std::size_t bytes) noexcept {
   const std::size_t size = rounded(bytes);
   if (!keep(p, size)) ::munmap(p, size);
 }
+
+void* zeroed_huge(std::size_t bytes) {
+  void* p = std::calloc(bytes, 1);
+  if (p == nullptr) throw std::bad_alloc();
+  const auto base = reinterpret_cast<std::uintptr_t>(p);
+  const std::uintptr_t first = (base + huge - 1) / huge * huge, last = (base + bytes) / huge * huge;
+  if (last > first) ::madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);  // advice only
+  return p;
+}
+
+ZeroedDoubles::ZeroedDoubles(const ZeroedDoubles& o) : ZeroedDoubles(o.n_) { std::copy(o.p_, o.p_ + o.n_, p_); }
+
+ZeroedDoubles& ZeroedDoubles::operator=(const ZeroedDoubles& o) {
+  if (this != &o) *this = ZeroedDoubles(o);
+  return *this;
+}
+
+ZeroedDoubles::~ZeroedDoubles() { std::free(p_); }
 
 }  // namespace interpatch::detail

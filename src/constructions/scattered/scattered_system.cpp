@@ -87,7 +87,7 @@ void Net::uniform_basis(const KnotVector& k, double inv_h, int span, double t, d
 
 NetMatrix::NetMatrix(int nu, int nv, int hu, int hv)
     : nu_(nu), nv_(nv), hu_(hu), hv_(hv), width_(hv + 1 + hu * (2 * hv + 1)) {
-  resize_zeroed(a_, rows() * static_cast<std::size_t>(width_));
+  a_ = Values(rows() * static_cast<std::size_t>(width_));
   in_full_.resize(static_cast<std::size_t>(width_));
   for (int di = 0; di <= hu_; ++di)
     for (int dj = di == 0 ? 0 : -hv_; dj <= hv_; ++dj) in_full_[static_cast<std::size_t>(offset(di, dj))] = (di + hu_) * (2 * hv_ + 1) + dj + hv_;
@@ -108,7 +108,7 @@ void NetMatrix::add_outer(std::span<const std::array<int, 2>> at, std::span<cons
 void NetMatrix::mirror() {
   if (mirrored_ || stays_upper(hu_, hv_)) return;
   const int fw = (2 * hu_ + 1) * (2 * hv_ + 1);
-  resize_zeroed(full_, rows() * static_cast<std::size_t>(fw));
+  full_ = Values(rows() * static_cast<std::size_t>(fw));
   const std::size_t nv = static_cast<std::size_t>(nv_);
   for (int i = 0; i < nu_; ++i)
     for (int j = 0; j < nv_; ++j) {
@@ -123,17 +123,17 @@ void NetMatrix::mirror() {
                                                            static_cast<std::size_t>(upper ? offset(di, dj) : offset(-di, -dj))];
         }
     }
-  Values().swap(a_);
+  a_ = {};
   mirrored_ = true;
 }
 
 void NetMatrix::unmirror() {
   if (!mirrored_) return;
   const std::size_t w = static_cast<std::size_t>(width_), fw = full_width();
-  resize_for_overwrite(a_, rows() * w);
+  a_ = Values(rows() * w);
   for (std::size_t r = 0; r < rows(); ++r)
     for (std::size_t k = 0; k < w; ++k) a_[r * w + k] = full_[r * fw + static_cast<std::size_t>(in_full_[k])];
-  Values().swap(full_);
+  full_ = {};
   mirrored_ = false;
 }
 
@@ -248,8 +248,8 @@ void NetMatrix::multiply(std::span<const double> x, std::span<double> y, int col
 
 void NetMatrix::assign_sum(const NetMatrix& d, const NetMatrix& f, double s) {
   if (mirrored_) {
-    Values().swap(full_);
-    resize_for_overwrite(a_, rows() * static_cast<std::size_t>(width_));
+    full_ = {};
+    a_ = Values(rows() * static_cast<std::size_t>(width_));
     mirrored_ = false;
   }
   const std::size_t w = static_cast<std::size_t>(width_);

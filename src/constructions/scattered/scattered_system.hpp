@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "constructions/scattered/scattered_sites.hpp"
-#include "interpatch/allocator.hpp"
+#include "base/pages.hpp"
 #include "interpatch/knot_vector.hpp"
 #include "interpatch/vec3.hpp"
 
@@ -124,10 +124,12 @@ class NetMatrix {
   static bool stays_upper(int hu, int hv) { return hu == 3 && hv == 3; }
   [[nodiscard]] std::size_t full_width() const { return static_cast<std::size_t>((2 * hu_ + 1) * (2 * hv_ + 1)); }
   int nu_, nv_, hu_, hv_, width_;
-  // Mapped from the system (large_allocator): zero pages the kernel fills as they are
-  // first written, in huge pages where it can. The sweeps read it in strides of a net
-  // row: with huge pages, conjugate gradients on a 512² net took a tenth less time.
-  using Values = std::vector<double, large_allocator<double>>;
+  // Zero pages first touched as they are written, in huge pages where the kernel can
+  // (ZeroedDoubles). The sweeps read the matrix in strides of a net row: with huge pages,
+  // conjugate gradients on a 512² net took a tenth less time. Given back when freed:
+  // mappings kept for reuse (large_allocator) held their memory through the tolerance's
+  // doubling nets and the folds of "auto", 8 and 27 MB more at the peak.
+  using Values = ZeroedDoubles;
   Values a_;  // the upper half, `width_` a row; empty while mirrored
   Values full_;  // (2hu+1)(2hv+1) a row, (di, dj) row-major from (-hu, -hv); empty unless mirrored
   std::vector<int> in_full_;  // upper offset k's place in a whole row
