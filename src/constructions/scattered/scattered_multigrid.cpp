@@ -259,15 +259,19 @@ System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
   // twice, at the blocks' edges): a few MB a thread, where all of them took as many
   // bytes as the fine matrix.
   System out{NetMatrix(ru.coarse, rv.coarse, hu, hv), std::vector<double>(cu * cv * c, 0.0), fine.cols};
-  constexpr std::size_t block = 16;
-  const std::size_t blocks = (cu + block - 1) / block;
+  // At most 16 coarse rows a block, and as many blocks as a multiple of the threads,
+  // even in size: with 16 rows, a 35-row coarsest net made blocks of 16, 16 and 3, and
+  // one thread did nearly all the work. Each coarse entry's sum runs in the same order
+  // whatever the blocks: the same bits on any number of threads.
   const bool parallel = fu * fv * band * pv >= parallel_min_work;
+  const std::size_t threads = parallel ? max_threads() : 1;
+  const std::size_t blocks = ((cu + 15) / 16 + threads - 1) / threads * threads, block = (cu + blocks - 1) / blocks;
   // Each block's fine rows [ilo, ihi], and a thread's buffers for the most of them,
   // made before the threads start (nothing allocates inside them).
   std::vector<std::array<std::size_t, 2>> rows(blocks, {fu, 0});
   std::size_t most = 0;
   for (std::size_t bk = 0; bk < blocks; ++bk) {
-    const std::size_t a0 = bk * block, a1 = std::min(cu, a0 + block);
+    const std::size_t a0 = std::min(cu, bk * block), a1 = std::min(cu, a0 + block);
     for (std::size_t x = ru.t_start[a0]; x < ru.t_start[a1]; ++x) {
       rows[bk][0] = std::min(rows[bk][0], static_cast<std::size_t>(ru.t_index[x]));
       rows[bk][1] = std::max(rows[bk][1], static_cast<std::size_t>(ru.t_index[x]));
@@ -286,7 +290,7 @@ System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
     std::vector<double> &t = buf.t, &tb = buf.tb;
 #pragma omp for schedule(static)
     for (long long bk = 0; bk < static_cast<long long>(blocks); ++bk) {
-      const std::size_t a0 = static_cast<std::size_t>(bk) * block, a1 = std::min(cu, a0 + block);
+      const std::size_t a0 = std::min(cu, static_cast<std::size_t>(bk) * block), a1 = std::min(cu, a0 + block);
       const auto [ilo, ihi] = rows[static_cast<std::size_t>(bk)];
       if (ilo > ihi) continue;
       for (std::size_t i = ilo; i <= ihi; ++i) restrict_row_along_v(fine, rv, gather, i, &t[(i - ilo) * cv * band], &tb[(i - ilo) * cv * c], buf.z);
