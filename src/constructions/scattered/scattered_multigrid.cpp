@@ -347,6 +347,7 @@ void Multigrid::apply(std::span<const double> r, std::span<double> z) {
   std::fill(z.begin(), z.end(), 0.0);
   smoother_->sweep(*finest_a_, r, z, cols_, false, tmp_, true);
   finest_a_->multiply(z, r_, cols_);
+#pragma omp parallel for schedule(static) if (r_.size() >= parallel_min_work / 4)
   for (std::size_t k = 0; k < r_.size(); ++k) r_[k] = r[k] - r_[k];
   restrict_to(up_, r_, b_, cols_, tmp_);
   coarsest_->solve(b_, x_, cols_);

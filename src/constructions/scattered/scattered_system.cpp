@@ -522,6 +522,8 @@ Solved solve_cg(const NetMatrix& a, std::span<const double> b, std::span<double>
     dots(p, ap, cols, pap, partial);
     double alpha[3] = {0, 0, 0};
     for (std::size_t k = 0; k < c; ++k) alpha[k] = active[k] && pap[k] > 0 ? rz[k] / pap[k] : 0.0;
+    // Value by value, no sums: the threads change no bit.
+#pragma omp parallel for schedule(static) if (len >= parallel_min_work / 4)
     for (std::size_t i = 0; i < len; ++i) {
       x[i] += alpha[i % c] * p[i];
       r[i] -= alpha[i % c] * ap[i];
@@ -532,6 +534,7 @@ Solved solve_cg(const NetMatrix& a, std::span<const double> b, std::span<double>
     for (std::size_t k = 0; k < c; ++k) {
       const double beta = rz[k] > 0 ? rz_new[k] / rz[k] : 0.0;
       rz[k] = rz_new[k];
+#pragma omp parallel for schedule(static) if (len >= parallel_min_work / 4)
       for (std::size_t i = k; i < len; i += c) p[i] = z[i] + beta * p[i];
     }
     out.residual = worst();
