@@ -77,12 +77,13 @@ void fairness_terms(const Net& net, Add&& add) {
     }
 }
 
-// s times the terms added to the matrix, each entry's sum in the order of fairness_terms
-// (the same bits as NetMatrix::add_outer on each term), the threads on rows or columns
-// of their own: along u, each column's terms write only that column; along v, each row's
-// only that row; a twist writes its row and the next, so each row takes the next
-// lower row's twists' share first, then its own.
+// s times the terms added to the matrix (each term's s·w c cᵀ, its upper half), each
+// entry's sum in the order of fairness_terms whatever the threads. The threads take
+// rows or columns of their own: along u, each column's terms write only that column;
+// along v, each row's only that row; a twist writes its row and the next, so each row
+// takes the twists of the row above it first, then its own.
 void add_terms(const Net& net, NetMatrix& a, double s) {
+  a.unmirror();  // at() below, on the threads, then never changes the form
   const Stencil st(net);
   const int nu = net.nu, nv = net.nv;
   const auto row = [nv](int i, int j) { return static_cast<std::size_t>(i) * static_cast<std::size_t>(nv) + static_cast<std::size_t>(j); };

@@ -93,18 +93,6 @@ NetMatrix::NetMatrix(int nu, int nv, int hu, int hv)
     for (int dj = di == 0 ? 0 : -hv_; dj <= hv_; ++dj) in_full_[static_cast<std::size_t>(offset(di, dj))] = (di + hu_) * (2 * hv_ + 1) + dj + hv_;
 }
 
-void NetMatrix::add_outer(std::span<const std::array<int, 2>> at, std::span<const double> coef, double s) {
-  for (std::size_t x = 0; x < at.size(); ++x)
-    for (std::size_t y = 0; y < at.size(); ++y) {
-      const auto [i0, j0] = at[x];
-      const auto [i1, j1] = at[y];
-      const int di = i1 - i0, dj = j1 - j0;
-      if (di < 0 || (di == 0 && dj < 0)) continue;  // the lower half is the upper's mirror
-      this->at(static_cast<std::size_t>(i0) * static_cast<std::size_t>(nv_) + static_cast<std::size_t>(j0), offset(di, dj)) +=
-          s * coef[x] * coef[y];
-    }
-}
-
 void NetMatrix::mirror() {
   if (mirrored_ || stays_upper(hu_, hv_)) return;
   const int fw = (2 * hu_ + 1) * (2 * hv_ + 1);
@@ -401,6 +389,7 @@ constexpr std::size_t cell_block = 2048;
 }  // namespace
 
 void add_data_term(const Net& net, const Samples& s, System& sys) {
+  sys.a.unmirror();  // at() below, on the threads, then never changes the form
   const Cells cells = sort_by_cell(net, s);
   const CellPattern pattern(net, sys.a);
   const std::size_t su = static_cast<std::size_t>(net.nu - net.p), sv = static_cast<std::size_t>(net.nv - net.q);

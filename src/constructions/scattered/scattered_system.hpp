@@ -85,8 +85,6 @@ class NetMatrix {
     const auto back = static_cast<std::ptrdiff_t>(-di) * nv_ - dj;
     return at(static_cast<std::size_t>(static_cast<std::ptrdiff_t>(row) - back), offset(-di, -dj));
   }
-  /// Adds s·v vᵀ for v with entries `coef` at the control points `at` (each (i, j)).
-  void add_outer(std::span<const std::array<int, 2>> at, std::span<const double> coef, double s);
   /// y = A x for `cols` interleaved columns (x[r·cols + c]); bands of net rows shared by
   /// the threads.
   void multiply(std::span<const double> x, std::span<double> y, int cols) const;
