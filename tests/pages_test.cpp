@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <utility>
 
@@ -55,6 +56,27 @@ TEST(Pages, LargeZeroedDoublesAreTouchedOnlyWhereWritten) {
   EXPECT_LT(after, before + (std::size_t{8} << 20)) << "before " << before << ", after " << after;
   for (std::size_t k = 0; k < n; k += 512) v[k] = 1.0;  // one value per 4 KiB page
   EXPECT_GT(resident(), before + (std::size_t{48} << 20));
+}
+
+TEST(Pages, PagesLetGoReadZeroAndLeaveTheResidentSet) {
+  const std::size_t n = std::size_t{8} << 20;  // 64 MiB
+  ZeroedDoubles v(n);
+  for (std::size_t k = 0; k < n; ++k) v[k] = static_cast<double>(k % 1000) + 1;
+  const std::size_t full = resident();
+  if (full == 0) GTEST_SKIP() << "no /proc/self/statm";
+  const std::size_t kept = (std::size_t{16} << 20) + 12;  // bytes: 16 MiB and a part of a page
+  v.let_go_after(kept);
+  // Rounding up to the next page: nothing before `kept` is lost.
+  for (std::size_t k = 0; k < kept / sizeof(double); ++k) ASSERT_EQ(v[k], static_cast<double>(k % 1000) + 1) << k;
+  const std::size_t after = resident();
+  // 48 MiB less the page the cut falls in, the rest of the resident set unchanged.
+  EXPECT_LT(after + (std::size_t{44} << 20), full) << "full " << full << ", after " << after;
+  // Every whole page past the cut reads zero (the block's last page may be partial).
+  const auto base = reinterpret_cast<std::uintptr_t>(v.data());
+  const std::uintptr_t from = (base + kept + 4095) / 4096 * 4096, to = (base + n * sizeof(double)) / 4096 * 4096;
+  for (std::uintptr_t at = from; at < to; at += 8 * 97) ASSERT_EQ(v[(at - base) / sizeof(double)], 0.0) << at - base;
+  v[n - 1] = 2.0;  // written again like any page
+  EXPECT_EQ(v[n - 1], 2.0);
 }
 
 }  // namespace

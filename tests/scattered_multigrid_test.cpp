@@ -378,15 +378,20 @@ TEST(ScatteredMultigrid, ProductsReadEitherHalfAsTheEntries) {
         for (std::size_t r = 0; r < m.rows(); ++r)
           for (int k = 0; k < width; ++k) upper.push_back(m.at(r, k));
         for (double& v : x) v = U(g);
-        for (std::size_t r = 0; r < m.rows(); ++r) {
-          const int i = static_cast<int>(r) / nv, j = static_cast<int>(r) % nv;
-          for (int di = -hu; di <= hu; ++di)
-            for (int dj = -hv; dj <= hv; ++dj) {
-              if (i + di < 0 || i + di >= nu || j + dj < 0 || j + dj >= nv) continue;
-              const std::size_t o = static_cast<std::size_t>((i + di) * nv + j + dj);
-              for (std::size_t k = 0; k < c; ++k) want[r * c + k] += m.entry(r, di, dj) * x[o * c + k];
-            }
-        }
+        // A x from the entries one by one, either half.
+        const auto product_of_entries = [&](const NetMatrix& read) {
+          std::fill(want.begin(), want.end(), 0.0);
+          for (std::size_t r = 0; r < read.rows(); ++r) {
+            const int i = static_cast<int>(r) / nv, j = static_cast<int>(r) % nv;
+            for (int di = -hu; di <= hu; ++di)
+              for (int dj = -hv; dj <= hv; ++dj) {
+                if (i + di < 0 || i + di >= nu || j + dj < 0 || j + dj >= nv) continue;
+                const std::size_t o = static_cast<std::size_t>((i + di) * nv + j + dj);
+                for (std::size_t k = 0; k < c; ++k) want[r * c + k] += read.entry(r, di, dj) * x[o * c + k];
+              }
+          }
+        };
+        product_of_entries(m);
         const auto same_entries = [&] {
           std::size_t e = 0, moved = 0;
           const NetMatrix& read = m;
@@ -415,7 +420,63 @@ TEST(ScatteredMultigrid, ProductsReadEitherHalfAsTheEntries) {
         }
         m.unmirror();
         EXPECT_EQ(same_entries(), 0u) << "back to the upper half";
+        // Packed (cubic nets only): each entry within 2^-39 of its row's largest, the
+        // products those of the entries decoded, and writing goes back to doubles.
+        m.pack();
+        ASSERT_EQ(m.packed(), hu == 3 && hv == 3);
+        if (!m.packed()) continue;
+        const NetMatrix& read = m;
+        std::vector<double> decoded;
+        for (std::size_t r = 0, e = 0; r < m.rows(); ++r, e += static_cast<std::size_t>(width)) {
+          double top = 0;
+          for (int k = 0; k < width; ++k) top = std::max(top, std::abs(upper[e + static_cast<std::size_t>(k)]));
+          for (int k = 0; k < width; ++k) {
+            decoded.push_back(read.at(r, k));
+            ASSERT_LE(std::abs(decoded.back() - upper[e + static_cast<std::size_t>(k)]), 0x1p-39 * top) << "row " << r << ", entry " << k;
+          }
+        }
+        product_of_entries(read);
+        const std::size_t per_row = static_cast<std::size_t>(nv) * c;
+        for (int i0 = 0; i0 < nu; ++i0)
+          for (const int i1 : {i0 + 1, i0 + 3, nu}) {
+            if (i1 > nu) continue;
+            std::fill(got.begin(), got.end(), std::numeric_limits<double>::quiet_NaN());
+            m.multiply_rows(i0, i1, x, got, cols);
+            for (std::size_t k = 0; k < got.size(); ++k) {
+              const bool inside = k >= static_cast<std::size_t>(i0) * per_row && k < static_cast<std::size_t>(i1) * per_row;
+              if (inside) ASSERT_NEAR(got[k], want[k], 1e-14 * 49) << "packed, rows " << i0 << ".." << i1 << ", value " << k;
+              else ASSERT_TRUE(std::isnan(got[k])) << "packed, rows " << i0 << ".." << i1 << " wrote value " << k;
+            }
+          }
+        m.at(0, 0) += 0.0;  // a write: back to doubles, those decoded
+        EXPECT_FALSE(m.packed());
+        for (std::size_t r = 0, e = 0; r < m.rows(); ++r)
+          for (int k = 0; k < width; ++k, ++e) ASSERT_EQ(m.at(r, k), decoded[e]) << "row " << r << ", entry " << k;
       }
+}
+
+// An entry beyond 2^100 leaves the whole matrix in doubles, the rows packed before it
+// back to their values to within the packing's precision; the next pack takes it once
+// the entry is back in range.
+TEST(ScatteredMultigrid, PackingLeavesHugeEntriesInDoubles) {
+  std::mt19937_64 g(40);
+  std::uniform_real_distribution<double> U(0.5, 2);
+  NetMatrix m(20, 17, 3, 3);
+  std::vector<double> was;
+  for (std::size_t r = 0; r < m.rows(); ++r)
+    for (int k = 0; k < 25; ++k) was.push_back(m.at(r, k) = U(g));
+  const std::size_t late = m.rows() - 5;
+  m.at(late, 3) = 0x1p101;
+  m.pack();
+  EXPECT_FALSE(m.packed());
+  for (std::size_t r = 0, e = 0; r < m.rows(); ++r)
+    for (int k = 0; k < 25; ++k, ++e) {
+      const double v = m.at(r, k), expected = r == late && k == 3 ? 0x1p101 : was[e];
+      ASSERT_LE(std::abs(v - expected), r < late ? 0x1p-38 : 0.0) << "row " << r << ", entry " << k;
+    }
+  m.at(late, 3) = 1;
+  m.pack();
+  EXPECT_TRUE(m.packed());
 }
 
 // Points are indexed in 32 bits: one more than they reach is refused, by name and count.

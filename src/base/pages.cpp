@@ -108,4 +108,13 @@ ZeroedDoubles& ZeroedDoubles::operator=(const ZeroedDoubles& o) {
 
 ZeroedDoubles::~ZeroedDoubles() { std::free(p_); }
 
+void ZeroedDoubles::let_go_after(std::size_t bytes) noexcept {
+  constexpr std::uintptr_t page = 4096;
+  const auto base = reinterpret_cast<std::uintptr_t>(p_);
+  const std::uintptr_t first = (base + bytes + page - 1) / page * page, last = (base + n_ * sizeof(double)) / page * page;
+  // Within the block, whichever way calloc made it: the allocator keeps nothing in the
+  // bytes it handed out.
+  if (last > first) ::madvise(reinterpret_cast<void*>(first), last - first, MADV_DONTNEED);
+}
+
 }  // namespace interpatch::detail

@@ -35,6 +35,9 @@ class ZeroedDoubles {
   const double& operator[](std::size_t k) const noexcept { return p_[k]; }
   double* begin() noexcept { return p_; }
   double* end() noexcept { return p_ + n_; }
+  /// Gives the whole pages past the first `bytes` back to the system: they read as zero
+  /// again, and count in no process's memory until written.
+  void let_go_after(std::size_t bytes) noexcept;
 
  private:
   double* p_ = nullptr;

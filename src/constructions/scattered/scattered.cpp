@@ -94,16 +94,20 @@ struct Fitted {
   int fits = 0;
 };
 
-Fitted solve_once(const Problem& pr, std::array<int, 2> spans, std::optional<double> smoothing, const progress_callback& progress,
+// The fit's last use of `pr`'s points: their order is let go once the data term is
+// made, before the solve's peak of memory (4 MB of a million points).
+Fitted solve_once(Problem& pr, std::array<int, 2> spans, std::optional<double> smoothing, const progress_callback& progress,
                   std::vector<double> start = {}) {
   Fitted f{Net(pr.p, pr.q, spans[0] + pr.p, spans[1] + pr.q, pr.range), {}, 1};
-  f.level = solve_level(pr, f.net, smoothing, nullptr, std::move(start));
+  System data = data_system(pr, f.net, pr.weight);
+  std::vector<std::uint32_t>().swap(pr.order);  // = {} would keep the capacity
+  f.level = solve_level(pr, f.net, smoothing, nullptr, std::move(start), nullptr, std::move(data));
   if (progress) progress(0.9);
   return f;
 }
 
 // A smoothing fit, λ given or chosen by cross-validation.
-Fitted solve_smoothing(const Problem& pr, const ScatteredApproximationOptions& o) {
+Fitted solve_smoothing(Problem& pr, const ScatteredApproximationOptions& o) {
   const auto spans = smoothing_spans(pr, *pr.sites);
   if (!o.auto_smoothing) return solve_once(pr, spans, o.smoothing, o.progress);
   Chosen c = choose_lambda(pr, Net(pr.p, pr.q, spans[0] + pr.p, spans[1] + pr.q, pr.range), o.progress, 0.0, 0.85);
@@ -226,7 +230,7 @@ struct Solution {
 };
 
 Solution solve(std::span<const Vec3> points, const Sites& s, int p, int q, const ScatteredApproximationOptions& o) {
-  const Problem pr = frame(points, s, p, q, o.param == ScatteredParam::xy, o.auto_smoothing);
+  Problem pr = frame(points, s, p, q, o.param == ScatteredParam::xy, o.auto_smoothing);
   Fitted f = o.tolerance ? solve_tolerance(pr, *o.tolerance, o, o.progress)
              : o.control_points
                  ? solve_once(pr, {(*o.control_points)[0] - p, (*o.control_points)[1] - q}, std::nullopt, o.progress)

@@ -83,7 +83,7 @@ void fairness_terms(const Net& net, Add&& add) {
 // along v, each row's only that row; a twist writes its row and the next, so each row
 // takes the twists of the row above it first, then its own.
 void add_terms(const Net& net, NetMatrix& a, double s) {
-  a.unmirror();  // at() below, on the threads, then never changes the form
+  a.make_writable();  // at() below, on the threads, then never changes the form
   const Stencil st(net);
   const int nu = net.nu, nv = net.nv;
   const auto row = [nv](int i, int j) { return static_cast<std::size_t>(i) * static_cast<std::size_t>(nv) + static_cast<std::size_t>(j); };

@@ -179,7 +179,8 @@ void KeptMatrices::keep(const Net& net, NetMatrix a, double scaled) {
   kept_.push_back(Entry{net, scaled, std::move(a)});
 }
 
-void solve_net(const Problem& pr, const Net& net, System& sys, double scaled, std::vector<double>& x, KeptMatrices& kept) {
+void solve_net(const Problem& pr, const Net& net, System& sys, double scaled, std::vector<double>& x, KeptMatrices& kept,
+               bool rhs_after) {
   if (net.size() <= coarsest_net) {
     if (!solve_direct(sys.a, sys.rhs, x, pr.cols)) not_definite(net);
     return;
@@ -188,6 +189,7 @@ void solve_net(const Problem& pr, const Net& net, System& sys, double scaled, st
   Solved sol;
   {
     sys.a.mirror();
+    sys.a.pack();  // before the strips' factors are made: the peak of a large net's memory
     Hierarchy h = hierarchy_for(net, sys.a, scaled, kept, pr.cols);
     if (!h.mg->factor()) not_definite(h.coarse);
     Multigrid& mg = *h.mg;
@@ -198,8 +200,13 @@ void solve_net(const Problem& pr, const Net& net, System& sys, double scaled, st
       before = residual;
       return steps == 0 || (rate < 0 && steps + std::log(1e-12 / residual) / rate <= slow_steps);
     };
+    // Without the factorization to fall back on, nor a caller that needs it, the
+    // right-hand side's memory holds the residual.
+    const bool consume = !factorable && !rhs_after;
     sol = solve_cg(sys.a, sys.rhs, x, pr.cols, 1e-12, factorable ? 4 * slow_steps : 200 + 40 * (net.nu + net.nv),
-                   [&mg](std::span<const double> r, std::span<double> z, int) { mg.apply(r, z); }, keep_going);
+                   [&mg](std::span<const double> r, std::span<double> z, int) { mg.apply(r, z); }, keep_going,
+                   consume ? std::span<double>(sys.rhs) : std::span<double>());
+    if (consume) std::vector<double>().swap(sys.rhs);
     kept.keep(h.coarse, std::move(*h.coarsest), scaled);
   }
   if (sol.residual <= 1e-12) return;
@@ -264,7 +271,7 @@ Level solve_level(const Problem& pr, const Net& net, std::optional<double> smoot
       else out.x[3 * r] = at[r].x, out.x[3 * r + 1] = at[r].y, out.x[3 * r + 2] = at[r].z;
     }
   }
-  solve_net(pr, net, sys, s.weight_sum * out.lambda, out.x, kept ? *kept : own);
+  solve_net(pr, net, sys, s.weight_sum * out.lambda, out.x, kept ? *kept : own, kept != nullptr);
   if (kept) {
     std::vector<double> ax(out.x.size());
     sys.a.multiply(out.x, ax, pr.cols);

@@ -93,8 +93,9 @@ class KeptMatrices {
 /// otherwise by conjugate gradients preconditioned by multigrid over the coarser nets
 /// of its hierarchy, whose coarsest matrix `kept` holds (restricted from this one's)
 /// and keeps afterwards; factored after all when they stall on a net the factorization still
-/// takes, an error past it.
-void solve_net(const Problem& pr, const Net& net, System& sys, double scaled, std::vector<double>& x, KeptMatrices& kept);
+/// takes, an error past it. Without `rhs_after`, sys.rhs may be spent (emptied).
+void solve_net(const Problem& pr, const Net& net, System& sys, double scaled, std::vector<double>& x, KeptMatrices& kept,
+               bool rhs_after = true);
 
 /// The distance of a value (cols numbers) from the fit whose net holds `x` (cols per
 /// control point) at a unit site, in the fit's frame: the basis there times the net's values.

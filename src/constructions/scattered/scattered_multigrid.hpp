@@ -88,7 +88,9 @@ class Multigrid {
   const NetMatrix* finest_a_;
   bool one_net_;
   std::array<Refinement, 2> up_;  // the coarsest net to the finest
-  std::vector<double> r_, b_, x_, tmp_;  // the finest net's residual; the coarsest's problem and solution
+  // The finest net's residual (and the sweeps' room); the coarsest's problem and solution;
+  // a pass of the restriction or the prolongation.
+  std::vector<double> r_, b_, x_, tmp_;
   std::optional<DirectSolver> coarsest_;
   std::optional<StripSmoother> smoother_;
   int cols_;

@@ -18,10 +18,11 @@ int strip_width(const NetMatrix& a) { return std::max(a.hu(), a.hv()) + 1; }
 }  // namespace
 
 std::size_t StripSmoother::bytes_per_row(int hu, int hv) {
-  // A strip of width w along one direction has half bandwidth h w + w - 1 across the
-  // other's reach h: w (h + 1) numbers a row (the band and the inverse diagonal).
+  // A strip of width w along a direction of reach h keeps h w + (w - 1) / 2 entries a
+  // row on average, and the inverse diagonal (Strip::length): along both directions,
+  // (hu + hv) w + w + 1 numbers, rounded up.
   const std::size_t w = static_cast<std::size_t>(std::max(hu, hv) + 1);
-  return sizeof(float) * w * (static_cast<std::size_t>(hu) + static_cast<std::size_t>(hv) + 2);
+  return sizeof(float) * ((static_cast<std::size_t>(hu) + static_cast<std::size_t>(hv)) * w + w + 1);
 }
 
 StripSmoother::StripSmoother(const NetMatrix& a) : nu_(a.nu()), nv_(a.nv()) {
@@ -33,10 +34,11 @@ StripSmoother::StripSmoother(const NetMatrix& a) : nu_(a.nu()), nv_(a.nv()) {
     for (int first = 0; first < across; first += w) {
       Strip s;
       s.dir = dir, s.index = first / w, s.first = first, s.width = std::min(w, across - first);
+      s.reach = reach;
       s.band = reach * s.width + s.width - 1;
       s.size = static_cast<std::size_t>(s.width) * static_cast<std::size_t>(along);
       s.at = at;
-      at += s.size * static_cast<std::size_t>(s.band + 1);
+      for (std::size_t k = 0; k < s.size; ++k) at += s.length(k) + 1;
       strips_.push_back(s);
     }
   }
@@ -66,13 +68,13 @@ void StripSmoother::factor(const NetMatrix& a, Strip& s, FactorScratch& scratch)
   std::vector<std::size_t>& row = scratch.row;
   for_each_row(s, [&](std::size_t k, int i, int j, std::size_t r) { at[k] = {i, j}, row[k] = r; });
   for (std::size_t k = 0; k < s.size; ++k) {
-    const std::size_t j0 = k > band ? k - band : 0;
+    const std::size_t j0 = k - s.length(k);  // L[k][j] is 0 left of it, and left unwritten
     double* lk = f + k * stride;  // lk[band - (k - j)] = L[k][j]
     for (std::size_t j = j0; j <= k; ++j) {
       const int di = at[j][0] - at[k][0], dj = at[j][1] - at[k][1];
       double sum = std::abs(di) <= a.hu() && std::abs(dj) <= a.hv() ? a.entry(row[k], di, dj) : 0.0;
       const double* lj = f + j * stride;
-      const std::size_t i0 = std::max(j0, j > band ? j - band : 0);
+      const std::size_t i0 = std::max(j0, j - s.length(j));
       for (std::size_t i = i0; i < j; ++i) sum -= lk[band - (k - i)] * lj[band - (j - i)];
       if (j < k) {
         lk[band - (k - j)] = sum * lj[band];
@@ -82,7 +84,11 @@ void StripSmoother::factor(const NetMatrix& a, Strip& s, FactorScratch& scratch)
       }
     }
   }
-  std::copy(f, f + s.size * stride, factor_.get() + s.at);
+  float* out = factor_.get() + s.at;
+  for (std::size_t k = 0; k < s.size; ++k) {
+    const std::size_t n = s.length(k);
+    out = std::copy(f + k * stride + band - n, f + k * stride + band + 1, out);
+  }
   s.ok = true;
 }
 
@@ -111,29 +117,33 @@ void StripSmoother::residuals(int dir, int colour, const NetMatrix& a, std::span
 
 namespace {
 
-// L y = r, then Lᵀ z = y, in place, for c interleaved columns; the forward sums in four
+// L y = r, then Lᵀ z = y, in place, for c interleaved columns (row k of the factor:
+// L[k][k - n .. k - 1], then 1 / L[k][k], n = s.length(k)); the forward sums in four
 // interleaved parts so that they do not wait on one adder.
-void solve_band(const float* f, std::size_t band, std::size_t size, std::size_t c, double* r) {
-  const std::size_t stride = band + 1;
-  for (std::size_t k = 0; k < size; ++k) {
-    const float* lk = f + k * stride;
-    const std::size_t i0 = k > band ? k - band : 0;
+template <class Strip>
+void solve_band(const float* f, const Strip& s, std::size_t c, double* r) {
+  std::size_t at = 0;
+  for (std::size_t k = 0; k < s.size; ++k) {
+    const std::size_t n = s.length(k);
+    const float* lk = f + at;  // lk[n - (k - i)] = L[k][i]
     for (std::size_t m = 0; m < c; ++m) {
       double part[4] = {r[k * c + m], 0, 0, 0};
-      std::size_t i = i0;
+      std::size_t i = k - n;
       for (; i + 4 <= k; i += 4)
-        for (std::size_t e = 0; e < 4; ++e) part[e] -= lk[band - (k - i - e)] * r[(i + e) * c + m];
-      for (; i < k; ++i) part[0] -= lk[band - (k - i)] * r[i * c + m];
-      r[k * c + m] = ((part[0] + part[1]) + (part[2] + part[3])) * lk[band];
+        for (std::size_t e = 0; e < 4; ++e) part[e] -= lk[n - (k - i - e)] * r[(i + e) * c + m];
+      for (; i < k; ++i) part[0] -= lk[n - (k - i)] * r[i * c + m];
+      r[k * c + m] = ((part[0] + part[1]) + (part[2] + part[3])) * lk[n];
     }
+    at += n + 1;
   }
-  for (std::size_t k = size; k-- > 0;) {
-    const float* lk = f + k * stride;
-    const std::size_t i0 = k > band ? k - band : 0;
+  for (std::size_t k = s.size; k-- > 0;) {
+    const std::size_t n = s.length(k);
+    at -= n + 1;
+    const float* lk = f + at;
     for (std::size_t m = 0; m < c; ++m) {
-      const double z = r[k * c + m] * lk[band];
+      const double z = r[k * c + m] * lk[n];
       r[k * c + m] = z;
-      for (std::size_t i = i0; i < k; ++i) r[i * c + m] -= lk[band - (k - i)] * z;
+      for (std::size_t i = k - n; i < k; ++i) r[i * c + m] -= lk[n - (k - i)] * z;
     }
   }
 }
@@ -141,11 +151,12 @@ void solve_band(const float* f, std::size_t band, std::size_t size, std::size_t 
 // The same for one column: each row's band one contiguous stretch of the factor and of
 // r (vectors for the compiler), and the term of the row just solved taken last, so that
 // the others need not wait on it (the conjugate gradients of a 512² net a tenth faster).
-void solve_band_one(const float* f, std::size_t band, std::size_t size, double* r) {
-  const std::size_t stride = band + 1;
-  for (std::size_t k = 0; k < size; ++k) {
-    const std::size_t n = std::min(k, band);
-    const float* l = f + k * stride + band - n;  // l[t] = L[k][k - n + t]
+template <class Strip>
+void solve_band_one(const float* f, const Strip& s, double* r) {
+  std::size_t at = 0;
+  for (std::size_t k = 0; k < s.size; ++k) {
+    const std::size_t n = s.length(k);
+    const float* l = f + at;  // l[t] = L[k][k - n + t], l[n] = 1 / L[k][k]
     const double* y = r + (k - n);
     double part[4] = {0, 0, 0, 0};
     std::size_t t = 0;
@@ -154,13 +165,15 @@ void solve_band_one(const float* f, std::size_t band, std::size_t size, double* 
     for (; t + 1 < n; ++t) part[0] += l[t] * y[t];
     double sum = r[k] - ((part[0] + part[1]) + (part[2] + part[3]));
     if (n > 0) sum -= l[n - 1] * y[n - 1];
-    r[k] = sum * f[k * stride + band];
+    r[k] = sum * l[n];
+    at += n + 1;
   }
-  for (std::size_t k = size; k-- > 0;) {
-    const std::size_t n = std::min(k, band);
-    const float* l = f + k * stride + band - n;
+  for (std::size_t k = s.size; k-- > 0;) {
+    const std::size_t n = s.length(k);
+    at -= n + 1;
+    const float* l = f + at;
     double* y = r + (k - n);
-    const double z = r[k] * f[k * stride + band];
+    const double z = r[k] * l[n];
     r[k] = z;
     for (std::size_t t = 0; t < n; ++t) y[t] -= l[t] * z;
   }
@@ -170,14 +183,13 @@ void solve_band_one(const float* f, std::size_t band, std::size_t size, double* 
 
 void StripSmoother::solve(const Strip& s, std::span<const double> all, std::span<double> x, std::size_t c,
                           std::vector<double>& scratch) const {
-  const auto band = static_cast<std::size_t>(s.band);
   const float* f = &factor_[s.at];
   double* r = scratch.data();
   for_each_row(s, [&](std::size_t k, int, int, std::size_t row) {
     for (std::size_t m = 0; m < c; ++m) r[k * c + m] = all[row * c + m];
   });
-  if (c == 1) solve_band_one(f, band, s.size, r);
-  else solve_band(f, band, s.size, c, r);
+  if (c == 1) solve_band_one(f, s, r);
+  else solve_band(f, s, c, r);
   for_each_row(s, [&](std::size_t k, int, int, std::size_t row) {
     for (std::size_t m = 0; m < c; ++m) x[row * c + m] += r[k * c + m];
   });

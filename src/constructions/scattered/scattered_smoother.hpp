@@ -7,6 +7,7 @@
 // coarse nets cannot hold them; a strip solved whole removes them. Strips along v, then
 // strips along u.
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <memory>
@@ -40,9 +41,18 @@ class StripSmoother {
   struct Strip {
     int dir = 0;  // 0: rows i in [first, first + width), every j; 1: columns j likewise
     int index = 0, first = 0, width = 0;  // index: its place along the direction (the colour's parity)
+    int reach = 0;  // the matrix's reach along the strip
     int band = 0;   // half bandwidth of the strip's matrix in its own order
     std::size_t size = 0, at = 0;  // unknowns, offset of its factor in factor_
     bool ok = false;
+    /// Entries of the factor's row k left of the diagonal: unknown (t, w) of the strip
+    /// couples back to (t - reach, 0) at most, reach·width + w places before it, and the
+    /// factor fills no place before a row's first entry (the band's whole width kept a
+    /// tenth more numbers, all zero).
+    [[nodiscard]] std::size_t length(std::size_t k) const {
+      const auto w = static_cast<std::size_t>(width);
+      return std::min(k, static_cast<std::size_t>(reach) * w + k % w);
+    }
   };
   // f(k, i, j, row) for a strip's unknowns in order, without dividing for each.
   template <class F>
@@ -72,7 +82,7 @@ class StripSmoother {
   void solve(const Strip& s, std::span<const double> r, std::span<double> x, std::size_t c, std::vector<double>& scratch) const;
   int nu_, nv_;
   std::vector<Strip> strips_;  // along u, then along v, each by first
-  // Per strip, row k: L[k][k - band .. k - 1], then 1 / L[k][k]. In single precision:
+  // Per strip, row k: L[k][k - n .. k - 1], then 1 / L[k][k], n = Strip::length(k). In single precision:
   // the sweeps read it from memory (two passes a row per sweep) at half the cost, and a
   // smoother needs no more than its seven digits.
   std::unique_ptr<float[]> factor_;

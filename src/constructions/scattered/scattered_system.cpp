@@ -3,6 +3,7 @@
 #include <Eigen/Sparse>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numeric>
 #include <utility>
 
@@ -83,171 +84,6 @@ void Net::uniform_basis(const KnotVector& k, double inv_h, int span, double t, d
     }
     n[j] = saved;
   }
-}
-
-NetMatrix::NetMatrix(int nu, int nv, int hu, int hv)
-    : nu_(nu), nv_(nv), hu_(hu), hv_(hv), width_(hv + 1 + hu * (2 * hv + 1)) {
-  a_ = Values(rows() * static_cast<std::size_t>(width_));
-  in_full_.resize(static_cast<std::size_t>(width_));
-  for (int di = 0; di <= hu_; ++di)
-    for (int dj = di == 0 ? 0 : -hv_; dj <= hv_; ++dj) in_full_[static_cast<std::size_t>(offset(di, dj))] = (di + hu_) * (2 * hv_ + 1) + dj + hv_;
-}
-
-void NetMatrix::mirror() {
-  if (mirrored_ || stays_upper(hu_, hv_)) return;
-  const int fw = (2 * hu_ + 1) * (2 * hv_ + 1);
-  full_ = Values(rows() * static_cast<std::size_t>(fw));
-  const std::size_t nv = static_cast<std::size_t>(nv_);
-  for (int i = 0; i < nu_; ++i)
-    for (int j = 0; j < nv_; ++j) {
-      const std::size_t r = static_cast<std::size_t>(i) * nv + static_cast<std::size_t>(j);
-      double* row = &full_[r * static_cast<std::size_t>(fw)];
-      for (int di = -hu_; di <= hu_; ++di)
-        for (int dj = -hv_; dj <= hv_; ++dj) {
-          if (i + di < 0 || i + di >= nu_ || j + dj < 0 || j + dj >= nv_) continue;
-          const bool upper = di > 0 || (di == 0 && dj >= 0);
-          const std::size_t o = upper ? r : r - static_cast<std::size_t>(-di) * nv - static_cast<std::size_t>(-dj);
-          row[(di + hu_) * (2 * hv_ + 1) + dj + hv_] = a_[o * static_cast<std::size_t>(width_) +
-                                                           static_cast<std::size_t>(upper ? offset(di, dj) : offset(-di, -dj))];
-        }
-    }
-  a_ = {};
-  mirrored_ = true;
-}
-
-void NetMatrix::unmirror() {
-  if (!mirrored_) return;
-  const std::size_t w = static_cast<std::size_t>(width_), fw = full_width();
-  a_ = Values(rows() * w);
-  for (std::size_t r = 0; r < rows(); ++r)
-    for (std::size_t k = 0; k < w; ++k) a_[r * w + k] = full_[r * fw + static_cast<std::size_t>(in_full_[k])];
-  full_ = {};
-  mirrored_ = false;
-}
-
-void NetMatrix::row_product(int i, int j, std::span<const double> x, std::size_t c, double* acc) const {
-  const std::size_t nv = static_cast<std::size_t>(nv_);
-  const std::size_t r = static_cast<std::size_t>(i) * nv + static_cast<std::size_t>(j);
-  for (std::size_t k = 0; k < c; ++k) acc[k] = 0;
-  if (mirrored_ && i >= hu_ && i + hu_ < nu_ && j >= hv_ && j + hv_ < nv_) {
-    // Inside the net: the whole row, one contiguous stretch of x per di.
-    const std::size_t w = static_cast<std::size_t>(2 * hv_ + 1);
-    const double* row = &full_[r * w * static_cast<std::size_t>(2 * hu_ + 1)];
-    const double* xs = &x[(r - static_cast<std::size_t>(hu_) * nv - static_cast<std::size_t>(hv_)) * c];
-    for (int di = -hu_; di <= hu_; ++di, row += w, xs += nv * c)
-      for (std::size_t k = 0; k < w; ++k)
-        for (std::size_t m = 0; m < c; ++m) acc[m] += row[k] * xs[k * c + m];
-    return;
-  }
-  for (int di = 0; di <= hu_; ++di) {
-    // The upper half of row r, and row r's entries kept by the rows above it.
-    const int jlo = std::max(di == 0 ? 0 : -hv_, -j), jhi = std::min(hv_, nv_ - 1 - j);
-    if (i + di < nu_)
-      for (int dj = jlo; dj <= jhi; ++dj) {
-        const double a = at(r, offset(di, dj));
-        const std::size_t s = (r + static_cast<std::size_t>(di) * nv + static_cast<std::size_t>(dj)) * c;
-        for (std::size_t k = 0; k < c; ++k) acc[k] += a * x[s + k];
-      }
-    if (i - di < 0) continue;
-    const int klo = std::max(di == 0 ? 1 : -hv_, j - (nv_ - 1)), khi = std::min(hv_, j);
-    for (int dj = klo; dj <= khi; ++dj) {
-      const std::size_t o = r - static_cast<std::size_t>(di) * nv - static_cast<std::size_t>(dj);
-      const double a = at(o, offset(di, dj));
-      for (std::size_t k = 0; k < c; ++k) acc[k] += a * x[o * c + k];
-    }
-  }
-}
-
-namespace {
-
-// Net rows [i0, i1) of A x from the upper half alone, row by row in memory order: each
-// row's own entries times x (its upper half) and, into the rows below it, the same
-// entries times its x (their lower half, A being symmetric). The hu rows above the band
-// add their share too. Every entry is read once and as a contiguous stretch, where
-// gathering the lower half from the rows above read it with a stride: a quarter less
-// time a product on a 512² net. Whole rows (mirror()) took as long as that gather with
-// twice the memory.
-template <int H, int C>
-void upper_band(const double* a, int nu, int nv, int i0, int i1, const double* x, double* y) {
-  constexpr int W = H + 1 + H * (2 * H + 1), L = 2 * H + 1;
-  const auto snv = static_cast<std::size_t>(nv);
-  std::fill(y + static_cast<std::size_t>(i0) * snv * C, y + static_cast<std::size_t>(i1) * snv * C, 0.0);
-  for (int i = std::max(0, i0 - H); i < i1; ++i) {
-    const bool own = i >= i0;
-    const int dlo = own ? 1 : i0 - i, dhi = std::min(H, nu - 1 - i), into = std::min(dhi, i1 - 1 - i);
-    // One control point; Edge: columns near the net's sides, where some dj fall outside.
-    const auto point = [&]<bool Edge>(int j) {
-      const std::size_t r = static_cast<std::size_t>(i) * snv + static_cast<std::size_t>(j);
-      const double* row = a + r * W;
-      double xr[C], acc[C] = {};
-      for (int m = 0; m < C; ++m) xr[m] = x[r * C + m];
-      const int elo = Edge ? std::max(-H, -j) : -H, ehi = Edge ? std::min(H, nv - 1 - j) : H;
-      if (own) {
-        for (int m = 0; m < C; ++m) acc[m] = row[0] * xr[m];
-        for (int dj = 1; dj <= ehi; ++dj)
-          for (int m = 0; m < C; ++m) {
-            acc[m] += row[dj] * x[(r + dj) * C + m];
-            y[(r + dj) * C + m] += row[dj] * xr[m];
-          }
-      }
-      for (int di = dlo; di <= dhi; ++di) {
-        const double* rk = row + H + 1 + (di - 1) * L + H;  // rk[dj]: offset (di, dj)
-        const std::size_t base = r + static_cast<std::size_t>(di) * snv;
-        if (own)
-          for (int dj = elo; dj <= ehi; ++dj)
-            for (int m = 0; m < C; ++m) acc[m] += rk[dj] * x[(base + dj) * C + m];
-        if (di <= into)
-          for (int dj = elo; dj <= ehi; ++dj)
-            for (int m = 0; m < C; ++m) y[(base + dj) * C + m] += rk[dj] * xr[m];
-      }
-      if (own)
-        for (int m = 0; m < C; ++m) y[r * C + m] += acc[m];
-    };
-    const int lo = std::min(H, nv), hi = std::max(lo, nv - H);
-    for (int j = 0; j < lo; ++j) point.template operator()<true>(j);
-    for (int j = lo; j < hi; ++j) point.template operator()<false>(j);
-    for (int j = hi; j < nv; ++j) point.template operator()<true>(j);
-  }
-}
-
-}  // namespace
-
-void NetMatrix::multiply_rows(int i0, int i1, std::span<const double> x, std::span<double> y, int cols) const {
-  const std::size_t c = static_cast<std::size_t>(cols), nv = static_cast<std::size_t>(nv_);
-  if (!mirrored_ && stays_upper(hu_, hv_) && (c == 1 || c == 3)) {
-    if (c == 1) return upper_band<3, 1>(a_.data(), nu_, nv_, i0, i1, x.data(), y.data());
-    return upper_band<3, 3>(a_.data(), nu_, nv_, i0, i1, x.data(), y.data());
-  }
-  for (int i = i0; i < i1; ++i)
-    for (int j = 0; j < nv_; ++j) {
-      const std::size_t r = static_cast<std::size_t>(i) * nv + static_cast<std::size_t>(j);
-      double acc[3];
-      row_product(i, j, x, c, acc);
-      for (std::size_t k = 0; k < c; ++k) y[r * c + k] = acc[k];
-    }
-}
-
-void NetMatrix::multiply(std::span<const double> x, std::span<double> y, int cols) const {
-  const bool parallel = rows() * static_cast<std::size_t>(2 * width_) * static_cast<std::size_t>(cols) >= parallel_min_work;
-  const int bands = (nu_ + band_rows - 1) / band_rows;
-#pragma omp parallel for schedule(static) if (parallel)
-  for (int b = 0; b < bands; ++b) multiply_rows(b * band_rows, std::min(nu_, (b + 1) * band_rows), x, y, cols);
-}
-
-void NetMatrix::assign_sum(const NetMatrix& d, const NetMatrix& f, double s) {
-  if (mirrored_) {
-    full_ = {};
-    a_ = Values(rows() * static_cast<std::size_t>(width_));
-    mirrored_ = false;
-  }
-  const std::size_t w = static_cast<std::size_t>(width_);
-  for (std::size_t r = 0; r < rows(); ++r)
-    for (std::size_t k = 0; k < w; ++k) a_[r * w + k] = d.at(r, static_cast<int>(k)) + s * f.at(r, static_cast<int>(k));
-}
-
-void NetMatrix::scale(double s) {
-  unmirror();
-  for (double& v : a_) v *= s;
 }
 
 double mean_diagonal(const NetMatrix& m) {
@@ -389,7 +225,7 @@ constexpr std::size_t cell_block = 2048;
 }  // namespace
 
 void add_data_term(const Net& net, const Samples& s, System& sys) {
-  sys.a.unmirror();  // at() below, on the threads, then never changes the form
+  sys.a.make_writable();  // at() below, on the threads, then never changes the form
   const Cells cells = sort_by_cell(net, s);
   const CellPattern pattern(net, sys.a);
   const std::size_t su = static_cast<std::size_t>(net.nu - net.p), sv = static_cast<std::size_t>(net.nv - net.q);
@@ -473,9 +309,15 @@ void dots(std::span<const double> x, std::span<const double> y, int cols, double
 }  // namespace
 
 Solved solve_cg(const NetMatrix& a, std::span<const double> b, std::span<double> x, int cols, double rel, int max_iter,
-                const Preconditioner& precondition, const KeepGoing& keep_going) {
+                const Preconditioner& precondition, const KeepGoing& keep_going, std::span<double> residual_room) {
   const std::size_t c = static_cast<std::size_t>(cols), n = a.rows(), len = n * c;
-  std::vector<double> inv, r(len), z(len), p(len), ap(len), partial;
+  // z = M⁻¹ r and A p take turns in one vector: A p is spent once r is updated, before z
+  // is made, and z once it is in p (a net's values fewer at the peak of a large fit).
+  std::vector<double> inv, own_r, p(len), zap(len), partial;
+  if (residual_room.size() != len) own_r.resize(len);
+  const std::span<double> r = residual_room.size() == len ? residual_room : std::span<double>(own_r);
+  std::vector<double>& z = zap;
+  std::vector<double>& ap = zap;
   if (!precondition) {
     inv.resize(n);
     for (std::size_t i = 0; i < n; ++i) inv[i] = a.at(i, 0) > 0 ? 1 / a.at(i, 0) : 1.0;
@@ -485,12 +327,12 @@ Solved solve_cg(const NetMatrix& a, std::span<const double> b, std::span<double>
     else
       for (std::size_t i = 0; i < len; ++i) z[i] = r[i] * inv[i / c];
   };
+  double bb[3], rz[3], rr[3], pap[3];
+  dots(b, b, cols, bb, partial);  // before r, which may be b itself
   a.multiply(x, ap, cols);
   for (std::size_t i = 0; i < len; ++i) r[i] = b[i] - ap[i];
   apply();
   p = z;
-  double bb[3], rz[3], rr[3], pap[3];
-  dots(b, b, cols, bb, partial);
   dots(r, z, cols, rz, partial);
   bool active[3] = {true, true, true};
   Solved out;

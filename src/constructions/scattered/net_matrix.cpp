@@ -1,0 +1,291 @@
+#include "constructions/scattered/scattered_system.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+#include "base/kernel.hpp"
+#include "base/parallel.hpp"
+
+// NetMatrix: its forms (the upper half, whole rows, packed) and its products.
+
+namespace interpatch::detail::scattered {
+
+NetMatrix::NetMatrix(int nu, int nv, int hu, int hv)
+    : nu_(nu), nv_(nv), hu_(hu), hv_(hv), width_(hv + 1 + hu * (2 * hv + 1)) {
+  a_ = Values(rows() * static_cast<std::size_t>(width_));
+  in_full_.resize(static_cast<std::size_t>(width_));
+  for (int di = 0; di <= hu_; ++di)
+    for (int dj = di == 0 ? 0 : -hv_; dj <= hv_; ++dj) in_full_[static_cast<std::size_t>(offset(di, dj))] = (di + hu_) * (2 * hv_ + 1) + dj + hv_;
+}
+
+void NetMatrix::mirror() {
+  if (mirrored_ || stays_upper(hu_, hv_)) return;
+  const int fw = (2 * hu_ + 1) * (2 * hv_ + 1);
+  full_ = Values(rows() * static_cast<std::size_t>(fw));
+  const std::size_t nv = static_cast<std::size_t>(nv_);
+  for (int i = 0; i < nu_; ++i)
+    for (int j = 0; j < nv_; ++j) {
+      const std::size_t r = static_cast<std::size_t>(i) * nv + static_cast<std::size_t>(j);
+      double* row = &full_[r * static_cast<std::size_t>(fw)];
+      for (int di = -hu_; di <= hu_; ++di)
+        for (int dj = -hv_; dj <= hv_; ++dj) {
+          if (i + di < 0 || i + di >= nu_ || j + dj < 0 || j + dj >= nv_) continue;
+          const bool upper = di > 0 || (di == 0 && dj >= 0);
+          const std::size_t o = upper ? r : r - static_cast<std::size_t>(-di) * nv - static_cast<std::size_t>(-dj);
+          row[(di + hu_) * (2 * hv_ + 1) + dj + hv_] = a_[o * static_cast<std::size_t>(width_) +
+                                                           static_cast<std::size_t>(upper ? offset(di, dj) : offset(-di, -dj))];
+        }
+    }
+  a_ = {};
+  mirrored_ = true;
+}
+
+void NetMatrix::unmirror() {
+  if (!mirrored_) return;
+  const std::size_t w = static_cast<std::size_t>(width_), fw = full_width();
+  a_ = Values(rows() * w);
+  for (std::size_t r = 0; r < rows(); ++r)
+    for (std::size_t k = 0; k < w; ++k) a_[r * w + k] = full_[r * fw + static_cast<std::size_t>(in_full_[k])];
+  full_ = {};
+  mirrored_ = false;
+}
+
+namespace {
+
+// A packed row (NetMatrix::pack): each entry's nearest float, then each one's rest in
+// steps of 2^(e - 38) as a 16-bit integer, e the binade of the row's largest float
+// (kept in the row's last two bytes): a rest is at most half a float's unit, 2^(e - 24),
+// so at most 2^14 steps.
+constexpr int rest_bits = 38;
+
+// Bytes of a packed row of w entries: w floats, w 16-bit rests, the binade, then the
+// next row's floats aligned again.
+constexpr std::size_t packed_row_bytes(std::size_t w) { return (6 * w + 2 + 3) / 4 * 4; }
+
+inline double step_of(std::int16_t binade) {
+  return std::bit_cast<double>(static_cast<std::uint64_t>(binade - rest_bits + 1023) << 52);
+}
+
+// A packed row of W entries into `out`, read where it lies (copied out first, the
+// copies' stores and the wider loads after them stalled the product on every row).
+using packed_float = float __attribute__((may_alias));
+using packed_rest = std::int16_t __attribute__((may_alias));
+template <std::size_t W>
+inline void decode_row(const std::byte* p, double* out) {
+  const auto* hi = reinterpret_cast<const packed_float*>(p);
+  const auto* rest = reinterpret_cast<const packed_rest*>(p + W * sizeof(float));
+  const double step = step_of(rest[W]);
+  for (std::size_t k = 0; k < W; ++k) out[k] = static_cast<double>(hi[k]) + static_cast<double>(rest[k]) * step;
+}
+
+}  // namespace
+
+void NetMatrix::pack() {
+  if (packed_ || mirrored_ || !stays_upper(hu_, hv_) || a_.empty()) return;
+  constexpr std::size_t w = 25;  // the upper half of a cubic net's row
+  const std::size_t pb = packed_row_bytes(w);
+  auto* bytes = reinterpret_cast<std::byte*>(a_.data());
+  // Row r goes to byte pb·r, never past the 8 w r where it is read from: in place, in
+  // order, each row copied out before it is written.
+  for (std::size_t r = 0; r < rows(); ++r) {
+    double row[w];
+    float hi[w];
+    std::int16_t rest[w];
+    std::memcpy(row, &a_[r * w], sizeof row);
+    float top = 0;
+    for (std::size_t k = 0; k < w; ++k) {
+      // Far inside a float's range, so that every float and step is a normal number;
+      // otherwise the rows packed so far go back (row r is still whole).
+      if (!(std::abs(row[k]) < 0x1p100)) return unpack_rows(r);
+      top = std::max(top, std::abs(hi[k] = static_cast<float>(row[k])));
+    }
+    const auto binade = static_cast<std::int16_t>(top > 0 ? std::ilogb(top) : 0);  // a row of zeros has no rest
+    const double step = step_of(binade);
+    for (std::size_t k = 0; k < w; ++k)
+      rest[k] = static_cast<std::int16_t>(std::nearbyint((row[k] - static_cast<double>(hi[k])) / step));
+    std::memcpy(bytes + r * pb, hi, sizeof hi);
+    std::memcpy(bytes + r * pb + sizeof hi, rest, sizeof rest);
+    std::memcpy(bytes + r * pb + sizeof hi + sizeof rest, &binade, sizeof binade);
+  }
+  a_.let_go_after(rows() * pb);
+  packed_ = true;
+}
+
+void NetMatrix::unpack() {
+  if (!packed_) return;
+  unpack_rows(rows());
+  packed_ = false;
+}
+
+void NetMatrix::unpack_rows(std::size_t count) {
+  constexpr std::size_t w = 25;
+  const std::size_t pb = packed_row_bytes(w);
+  const auto* bytes = reinterpret_cast<const std::byte*>(a_.data());
+  // Backwards: row r's doubles at 8 w r lie at or past its packed bytes at pb·r.
+  for (std::size_t r = count; r-- > 0;) {
+    double row[w];
+    decode_row<w>(bytes + r * pb, row);
+    std::memcpy(&a_[r * w], row, sizeof row);
+  }
+}
+
+double NetMatrix::packed_at(std::size_t row, int k) const {
+  const std::size_t w = static_cast<std::size_t>(width_), at = row * packed_row_bytes(w);
+  const auto* bytes = reinterpret_cast<const std::byte*>(a_.data());
+  float hi = 0;
+  std::int16_t rest = 0, binade = 0;
+  std::memcpy(&hi, bytes + at + sizeof(float) * static_cast<std::size_t>(k), sizeof hi);
+  std::memcpy(&rest, bytes + at + sizeof(float) * w + sizeof(std::int16_t) * static_cast<std::size_t>(k), sizeof rest);
+  std::memcpy(&binade, bytes + at + (sizeof(float) + sizeof(std::int16_t)) * w, sizeof binade);
+  return static_cast<double>(hi) + static_cast<double>(rest) * step_of(binade);
+}
+
+void NetMatrix::row_product(int i, int j, std::span<const double> x, std::size_t c, double* acc) const {
+  const std::size_t nv = static_cast<std::size_t>(nv_);
+  const std::size_t r = static_cast<std::size_t>(i) * nv + static_cast<std::size_t>(j);
+  for (std::size_t k = 0; k < c; ++k) acc[k] = 0;
+  if (mirrored_ && i >= hu_ && i + hu_ < nu_ && j >= hv_ && j + hv_ < nv_) {
+    // Inside the net: the whole row, one contiguous stretch of x per di.
+    const std::size_t w = static_cast<std::size_t>(2 * hv_ + 1);
+    const double* row = &full_[r * w * static_cast<std::size_t>(2 * hu_ + 1)];
+    const double* xs = &x[(r - static_cast<std::size_t>(hu_) * nv - static_cast<std::size_t>(hv_)) * c];
+    for (int di = -hu_; di <= hu_; ++di, row += w, xs += nv * c)
+      for (std::size_t k = 0; k < w; ++k)
+        for (std::size_t m = 0; m < c; ++m) acc[m] += row[k] * xs[k * c + m];
+    return;
+  }
+  for (int di = 0; di <= hu_; ++di) {
+    // The upper half of row r, and row r's entries kept by the rows above it.
+    const int jlo = std::max(di == 0 ? 0 : -hv_, -j), jhi = std::min(hv_, nv_ - 1 - j);
+    if (i + di < nu_)
+      for (int dj = jlo; dj <= jhi; ++dj) {
+        const double a = at(r, offset(di, dj));
+        const std::size_t s = (r + static_cast<std::size_t>(di) * nv + static_cast<std::size_t>(dj)) * c;
+        for (std::size_t k = 0; k < c; ++k) acc[k] += a * x[s + k];
+      }
+    if (i - di < 0) continue;
+    const int klo = std::max(di == 0 ? 1 : -hv_, j - (nv_ - 1)), khi = std::min(hv_, j);
+    for (int dj = klo; dj <= khi; ++dj) {
+      const std::size_t o = r - static_cast<std::size_t>(di) * nv - static_cast<std::size_t>(dj);
+      const double a = at(o, offset(di, dj));
+      for (std::size_t k = 0; k < c; ++k) acc[k] += a * x[o * c + k];
+    }
+  }
+}
+
+namespace {
+
+// Net rows [i0, i1) of A x from the upper half alone, row by row in memory order: each
+// row's own entries times x (its upper half) and, into the rows below it, the same
+// entries times its x (their lower half, A being symmetric). The hu rows above the band
+// add their share too. Every entry is read once and as a contiguous stretch, where
+// gathering the lower half from the rows above read it with a stride: a quarter less
+// time a product on a 512² net. Whole rows (mirror()) took as long as that gather with
+// twice the memory.
+template <int H, int C, bool Packed>
+void upper_band(const void* entries, int nu, int nv, int i0, int i1, const double* x, double* y) {
+  constexpr int W = H + 1 + H * (2 * H + 1), L = 2 * H + 1;
+  const auto* a = static_cast<const double*>(entries);
+  const auto* bytes = static_cast<const std::byte*>(entries);
+  const std::size_t pb = packed_row_bytes(W);
+  double decoded_row[W];
+  const auto snv = static_cast<std::size_t>(nv);
+  std::fill(y + static_cast<std::size_t>(i0) * snv * C, y + static_cast<std::size_t>(i1) * snv * C, 0.0);
+  for (int i = std::max(0, i0 - H); i < i1; ++i) {
+    const bool own = i >= i0;
+    const int dlo = own ? 1 : i0 - i, dhi = std::min(H, nu - 1 - i), into = std::min(dhi, i1 - 1 - i);
+    // One control point; Edge: columns near the net's sides, where some dj fall outside.
+    const auto point = [&]<bool Edge>(int j) {
+      const std::size_t r = static_cast<std::size_t>(i) * snv + static_cast<std::size_t>(j);
+      const double* row = a + r * W;
+      if constexpr (Packed) {
+        decode_row<W>(bytes + r * pb, decoded_row);
+        row = decoded_row;
+      }
+      double xr[C], acc[C] = {};
+      for (int m = 0; m < C; ++m) xr[m] = x[r * C + m];
+      const int elo = Edge ? std::max(-H, -j) : -H, ehi = Edge ? std::min(H, nv - 1 - j) : H;
+      if (own) {
+        for (int m = 0; m < C; ++m) acc[m] = row[0] * xr[m];
+        for (int dj = 1; dj <= ehi; ++dj)
+          for (int m = 0; m < C; ++m) {
+            acc[m] += row[dj] * x[(r + dj) * C + m];
+            y[(r + dj) * C + m] += row[dj] * xr[m];
+          }
+      }
+      for (int di = dlo; di <= dhi; ++di) {
+        const double* rk = row + H + 1 + (di - 1) * L + H;  // rk[dj]: offset (di, dj)
+        const std::size_t base = r + static_cast<std::size_t>(di) * snv;
+        if (own)
+          for (int dj = elo; dj <= ehi; ++dj)
+            for (int m = 0; m < C; ++m) acc[m] += rk[dj] * x[(base + dj) * C + m];
+        if (di <= into)
+          for (int dj = elo; dj <= ehi; ++dj)
+            for (int m = 0; m < C; ++m) y[(base + dj) * C + m] += rk[dj] * xr[m];
+      }
+      if (own)
+        for (int m = 0; m < C; ++m) y[r * C + m] += acc[m];
+    };
+    const int lo = std::min(H, nv), hi = std::max(lo, nv - H);
+    for (int j = 0; j < lo; ++j) point.template operator()<true>(j);
+    for (int j = lo; j < hi; ++j) point.template operator()<false>(j);
+    for (int j = hi; j < nv; ++j) point.template operator()<true>(j);
+  }
+}
+
+// Packed rows decoded as they are read: with AVX2 the decoding hides behind the reads.
+[[gnu::flatten]] INTERPATCH_KERNEL void packed_band_1(const void* e, int nu, int nv, int i0, int i1, const double* x, double* y) {
+  upper_band<3, 1, true>(e, nu, nv, i0, i1, x, y);
+}
+[[gnu::flatten]] INTERPATCH_KERNEL void packed_band_3(const void* e, int nu, int nv, int i0, int i1, const double* x, double* y) {
+  upper_band<3, 3, true>(e, nu, nv, i0, i1, x, y);
+}
+
+}  // namespace
+
+void NetMatrix::multiply_rows(int i0, int i1, std::span<const double> x, std::span<double> y, int cols) const {
+  const std::size_t c = static_cast<std::size_t>(cols), nv = static_cast<std::size_t>(nv_);
+  if (packed_) {
+    if (c == 1) return packed_band_1(a_.data(), nu_, nv_, i0, i1, x.data(), y.data());
+    if (c == 3) return packed_band_3(a_.data(), nu_, nv_, i0, i1, x.data(), y.data());
+  }
+  if (!mirrored_ && !packed_ && stays_upper(hu_, hv_) && (c == 1 || c == 3)) {
+    if (c == 1) return upper_band<3, 1, false>(a_.data(), nu_, nv_, i0, i1, x.data(), y.data());
+    return upper_band<3, 3, false>(a_.data(), nu_, nv_, i0, i1, x.data(), y.data());
+  }
+  for (int i = i0; i < i1; ++i)
+    for (int j = 0; j < nv_; ++j) {
+      const std::size_t r = static_cast<std::size_t>(i) * nv + static_cast<std::size_t>(j);
+      double acc[3];
+      row_product(i, j, x, c, acc);
+      for (std::size_t k = 0; k < c; ++k) y[r * c + k] = acc[k];
+    }
+}
+
+void NetMatrix::multiply(std::span<const double> x, std::span<double> y, int cols) const {
+  const bool parallel = rows() * static_cast<std::size_t>(2 * width_) * static_cast<std::size_t>(cols) >= parallel_min_work;
+  const int bands = (nu_ + band_rows - 1) / band_rows;
+#pragma omp parallel for schedule(static) if (parallel)
+  for (int b = 0; b < bands; ++b) multiply_rows(b * band_rows, std::min(nu_, (b + 1) * band_rows), x, y, cols);
+}
+
+void NetMatrix::assign_sum(const NetMatrix& d, const NetMatrix& f, double s) {
+  if (mirrored_ || packed_) {
+    full_ = {};
+    a_ = Values(rows() * static_cast<std::size_t>(width_));
+    mirrored_ = packed_ = false;
+  }
+  const std::size_t w = static_cast<std::size_t>(width_);
+  for (std::size_t r = 0; r < rows(); ++r)
+    for (std::size_t k = 0; k < w; ++k) a_[r * w + k] = d.at(r, static_cast<int>(k)) + s * f.at(r, static_cast<int>(k));
+}
+
+void NetMatrix::scale(double s) {
+  make_writable();
+  for (double& v : a_) v *= s;
+}
+
+}  // namespace interpatch::detail::scattered
