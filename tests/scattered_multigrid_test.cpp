@@ -456,12 +456,12 @@ TEST(ScatteredMultigrid, ProductsReadEitherHalfAsTheEntries) {
 }
 
 // An entry beyond 2^100 leaves the whole matrix in doubles, the rows packed before it
-// back to their values to within the packing's precision; the next pack takes it once
-// the entry is back in range.
+// (the blocks of 8 192 before its own) back to their values to within the packing's
+// precision; the next pack takes it once the entry is back in range.
 TEST(ScatteredMultigrid, PackingLeavesHugeEntriesInDoubles) {
   std::mt19937_64 g(40);
   std::uniform_real_distribution<double> U(0.5, 2);
-  NetMatrix m(20, 17, 3, 3);
+  NetMatrix m(100, 97, 3, 3);  // 9 700 rows: two blocks
   std::vector<double> was;
   for (std::size_t r = 0; r < m.rows(); ++r)
     for (int k = 0; k < 25; ++k) was.push_back(m.at(r, k) = U(g));

@@ -83,32 +83,59 @@ inline void decode_row(const std::byte* p, double* out) {
 
 }  // namespace
 
+namespace {
+
+// Rows of 25 doubles packed (NetMatrix::pack) into consecutive packed rows: how many
+// before the first with an entry beyond 2^100 (far inside a float's range, so that
+// every float and step is a normal number), `count` when none.
+[[gnu::flatten]] INTERPATCH_KERNEL std::size_t pack_rows(const double* from, std::size_t count, std::byte* to) {
+  constexpr std::size_t w = 25;
+  for (std::size_t r = 0; r < count; ++r) {
+    const double* row = from + r * w;
+    float hi[w];
+    std::int16_t rest[w];
+    float top = 0;
+    bool in_range = true;
+    for (std::size_t k = 0; k < w; ++k) {
+      in_range = in_range && std::abs(row[k]) < 0x1p100;
+      hi[k] = static_cast<float>(row[k]);
+      top = std::max(top, std::abs(hi[k]));
+    }
+    if (!in_range) return r;
+    const auto binade = static_cast<std::int16_t>(top > 0 ? std::ilogb(top) : 0);  // a row of zeros has no rest
+    const double per_step = 1 / step_of(binade);  // a power of two: exact
+    // At most 2^14 steps: lrint's nearest integer fits.
+    for (std::size_t k = 0; k < w; ++k) rest[k] = static_cast<std::int16_t>(std::lrint((row[k] - static_cast<double>(hi[k])) * per_step));
+    std::byte* p = to + r * packed_row_bytes(w);
+    std::memcpy(p, hi, sizeof hi);
+    std::memcpy(p + sizeof hi, rest, sizeof rest);
+    std::memcpy(p + sizeof hi + sizeof rest, &binade, sizeof binade);
+  }
+  return count;
+}
+
+}  // namespace
+
 void NetMatrix::pack() {
   if (packed_ || mirrored_ || !stays_upper(hu_, hv_) || a_.empty()) return;
   constexpr std::size_t w = 25;  // the upper half of a cubic net's row
   const std::size_t pb = packed_row_bytes(w);
   auto* bytes = reinterpret_cast<std::byte*>(a_.data());
-  // Row r goes to byte pb·r, never past the 8 w r where it is read from: in place, in
-  // order, each row copied out before it is written.
-  for (std::size_t r = 0; r < rows(); ++r) {
-    double row[w];
-    float hi[w];
-    std::int16_t rest[w];
-    std::memcpy(row, &a_[r * w], sizeof row);
-    float top = 0;
-    for (std::size_t k = 0; k < w; ++k) {
-      // Far inside a float's range, so that every float and step is a normal number;
-      // otherwise the rows packed so far go back (row r is still whole).
-      if (!(std::abs(row[k]) < 0x1p100)) return unpack_rows(r);
-      top = std::max(top, std::abs(hi[k] = static_cast<float>(row[k])));
-    }
-    const auto binade = static_cast<std::int16_t>(top > 0 ? std::ilogb(top) : 0);  // a row of zeros has no rest
-    const double step = step_of(binade);
-    for (std::size_t k = 0; k < w; ++k)
-      rest[k] = static_cast<std::int16_t>(std::nearbyint((row[k] - static_cast<double>(hi[k])) / step));
-    std::memcpy(bytes + r * pb, hi, sizeof hi);
-    std::memcpy(bytes + r * pb + sizeof hi, rest, sizeof rest);
-    std::memcpy(bytes + r * pb + sizeof hi + sizeof rest, &binade, sizeof binade);
+  // In place, in blocks of rows: a block packed on the threads into `out`, then copied
+  // to bytes pb·r, below the 8 w r of every row not yet read. An entry out of range
+  // sends the rows packed so far back (its block is still whole).
+  constexpr std::size_t block = 8192, share = 1024;
+  std::vector<std::byte> out(block * pb);
+  std::vector<std::size_t> done(block / share);
+  for (std::size_t r0 = 0; r0 < rows(); r0 += block) {
+    const std::size_t n = std::min(block, rows() - r0), shares = (n + share - 1) / share;
+    parallel_for(shares, n * w >= parallel_min_work / 8, Share::blocks, [&](std::size_t t) {
+      const std::size_t k0 = t * share, k = std::min(share, n - k0);
+      done[t] = pack_rows(&a_[(r0 + k0) * w], k, out.data() + k0 * pb) == k ? k : 0;
+    });
+    for (std::size_t t = 0; t < shares; ++t)
+      if (done[t] != std::min(share, n - t * share)) return unpack_rows(r0);
+    std::memcpy(bytes + r0 * pb, out.data(), n * pb);
   }
   a_.let_go_after(rows() * pb);
   packed_ = true;
