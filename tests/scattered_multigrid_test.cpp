@@ -379,7 +379,7 @@ TEST(ScatteredMultigrid, ProductsReadEitherHalfAsTheEntries) {
           for (int k = 0; k < width; ++k) upper.push_back(m.at(r, k));
         for (double& v : x) v = U(g);
         // A x from the entries one by one, either half.
-        const auto product_of_entries = [&](const NetMatrix& read) {
+        const auto product_of_entries = [&](const NetMatrix& read, NetMatrix::Part part = NetMatrix::Part::whole) {
           std::fill(want.begin(), want.end(), 0.0);
           for (std::size_t r = 0; r < read.rows(); ++r) {
             const int i = static_cast<int>(r) / nv, j = static_cast<int>(r) % nv;
@@ -387,7 +387,7 @@ TEST(ScatteredMultigrid, ProductsReadEitherHalfAsTheEntries) {
               for (int dj = -hv; dj <= hv; ++dj) {
                 if (i + di < 0 || i + di >= nu || j + dj < 0 || j + dj >= nv) continue;
                 const std::size_t o = static_cast<std::size_t>((i + di) * nv + j + dj);
-                for (std::size_t k = 0; k < c; ++k) want[r * c + k] += read.entry(r, di, dj) * x[o * c + k];
+                for (std::size_t k = 0; k < c; ++k) want[r * c + k] += read.entry(r, di, dj, part) * x[o * c + k];
               }
           }
         };
@@ -448,6 +448,21 @@ TEST(ScatteredMultigrid, ProductsReadEitherHalfAsTheEntries) {
               else ASSERT_TRUE(std::isnan(got[k])) << "packed, rows " << i0 << ".." << i1 << " wrote value " << k;
             }
           }
+        // The floats alone, what the preconditioner reads: each entry's nearest float.
+        for (std::size_t r = 0, e = 0; r < m.rows(); ++r)
+          for (int k = 0; k < width; ++k, ++e)
+            ASSERT_EQ(read.at(r, k, NetMatrix::Part::floats), static_cast<double>(static_cast<float>(upper[e]))) << "row " << r << ", entry " << k;
+        product_of_entries(read, NetMatrix::Part::floats);
+        for (int i0 = 0; i0 < nu; i0 += 5) {
+          const int i1 = std::min(nu, i0 + 1 + i0 % 7);
+          std::fill(got.begin(), got.end(), std::numeric_limits<double>::quiet_NaN());
+          m.multiply_rows(i0, i1, x, got, cols, NetMatrix::Part::floats);
+          for (std::size_t k = 0; k < got.size(); ++k) {
+            const bool inside = k >= static_cast<std::size_t>(i0) * per_row && k < static_cast<std::size_t>(i1) * per_row;
+            if (inside) ASSERT_NEAR(got[k], want[k], 1e-14 * 49) << "floats, rows " << i0 << ".." << i1 << ", value " << k;
+            else ASSERT_TRUE(std::isnan(got[k])) << "floats, rows " << i0 << ".." << i1 << " wrote value " << k;
+          }
+        }
         m.at(0, 0) += 0.0;  // a write: back to doubles, those decoded
         EXPECT_FALSE(m.packed());
         for (std::size_t r = 0, e = 0; r < m.rows(); ++r)

@@ -73,13 +73,21 @@ inline double step_of(std::int16_t binade) {
 // copies' stores and the wider loads after them stalled the product on every row).
 using packed_float = float __attribute__((may_alias));
 using packed_rest = std::int16_t __attribute__((may_alias));
-template <std::size_t W>
-inline void decode_row(const std::byte* p, double* out) {
+// With Floats, the floats alone (NetMatrix::Part::floats).
+template <std::size_t W, bool Floats = false>
+inline void decode_row(const std::byte* p, double* __restrict out) {
   const auto* hi = reinterpret_cast<const packed_float*>(p);
+  if constexpr (Floats) {
+    for (std::size_t k = 0; k < W; ++k) out[k] = static_cast<double>(hi[k]);
+    return;
+  }
   const auto* rest = reinterpret_cast<const packed_rest*>(p + W * sizeof(float));
   const double step = step_of(rest[W]);
   for (std::size_t k = 0; k < W; ++k) out[k] = static_cast<double>(hi[k]) + static_cast<double>(rest[k]) * step;
 }
+
+// How a product reads the entries: doubles, packed rows whole, or their floats alone.
+enum class Form { doubles, packed, floats };
 
 }  // namespace
 
@@ -159,12 +167,13 @@ void NetMatrix::unpack_rows(std::size_t count) {
   }
 }
 
-double NetMatrix::packed_at(std::size_t row, int k) const {
+double NetMatrix::packed_at(std::size_t row, int k, Part part) const {
   const std::size_t w = static_cast<std::size_t>(width_), at = row * packed_row_bytes(w);
   const auto* bytes = reinterpret_cast<const std::byte*>(a_.data());
   float hi = 0;
   std::int16_t rest = 0, binade = 0;
   std::memcpy(&hi, bytes + at + sizeof(float) * static_cast<std::size_t>(k), sizeof hi);
+  if (part == Part::floats) return hi;
   std::memcpy(&rest, bytes + at + sizeof(float) * w + sizeof(std::int16_t) * static_cast<std::size_t>(k), sizeof rest);
   std::memcpy(&binade, bytes + at + (sizeof(float) + sizeof(std::int16_t)) * w, sizeof binade);
   return static_cast<double>(hi) + static_cast<double>(rest) * step_of(binade);
@@ -222,24 +231,46 @@ using v4s = std::int16_t __attribute__((vector_size(8)));
 [[gnu::always_inline]] inline void load4(const double* p, v4& v) { std::memcpy(&v, p, sizeof v); }
 
 // Entries k .. k + 3 of a cubic net's row r (k + 3 < 25), and k .. k + 2 with a zero,
-// after row(r): a packed row decoded whole first (its 25 entries at once, in vectors).
-template <bool Packed>
+// after row(r). A packed row is decoded whole first, in vectors (decoded as asked for,
+// a product took a third longer); its floats alone are read straight from its bytes
+// (through a row of doubles, the reads of four that straddle two of its stores waited
+// for both: a third longer too).
+template <Form F>
 struct RowEntries {
   const double* a;
   const std::byte* bytes;
   double decoded[28] = {};
   const double* at = nullptr;
+  const std::byte* p = nullptr;
   [[gnu::always_inline]] void row(std::size_t r) {
-    if constexpr (Packed) {
+    if constexpr (F == Form::doubles) {
+      at = a + r * 25;
+    } else if constexpr (F == Form::packed) {
       decode_row<25>(bytes + r * packed_row_bytes(25), decoded);
       at = decoded;
     } else {
-      at = a + r * 25;
+      p = bytes + r * packed_row_bytes(25);
     }
   }
-  [[gnu::always_inline]] void four(std::size_t k, v4& v) const { load4(at + k, v); }
-  // Not four: past the doubles' last row there is nothing.
-  [[gnu::always_inline]] void three(std::size_t k, v4& v) const { v = v4{at[k], at[k + 1], at[k + 2], 0.0}; }
+  [[gnu::always_inline]] void four(std::size_t k, v4& v) const {
+    if constexpr (F == Form::floats) {
+      v4f hi;
+      std::memcpy(&hi, p + 4 * k, sizeof hi);
+      v = __builtin_convertvector(hi, v4);
+    } else {
+      load4(at + k, v);
+    }
+  }
+  // A packed row's bytes hold 26 floats' worth (its rests after the 25th); past the
+  // doubles' last row there is nothing.
+  [[gnu::always_inline]] void three(std::size_t k, v4& v) const {
+    if constexpr (F == Form::floats) {
+      four(k, v);
+      v = __builtin_shufflevector(v, v4{}, 0, 1, 2, 4);
+    } else {
+      v = v4{at[k], at[k + 1], at[k + 2], 0.0};
+    }
+  }
 };
 
 // One net row's control points j in [j0, j1) of a one-column product, far enough from
@@ -248,8 +279,8 @@ struct RowEntries {
 // registers, a window of 7 places a direction that moves one place a point, each place
 // written to y once complete. Scattered point by point, each sum waited on the store
 // of the point before: a product on a 512² net took 3.1 ms against 2.1.
-template <bool Packed>
-[[gnu::always_inline]] inline void band_run_1(RowEntries<Packed>& e, std::size_t snv, int i, int j0, int j1, bool own, int dlo,
+template <Form F>
+[[gnu::always_inline]] inline void band_run_1(RowEntries<F>& e, std::size_t snv, int i, int j0, int j1, bool own, int dlo,
                                               int dhi, int into, const double* x, double* y) {
   constexpr int H = 3;
   const v4 zero{};
@@ -304,7 +335,7 @@ template <bool Packed>
   }
 }
 
-template <int H, int C, bool Packed>
+template <int H, int C, Form F>
 void upper_band(const void* entries, int nu, int nv, int i0, int i1, const double* x, double* y) {
   constexpr int W = H + 1 + H * (2 * H + 1), L = 2 * H + 1;
   const auto* a = static_cast<const double*>(entries);
@@ -320,8 +351,8 @@ void upper_band(const void* entries, int nu, int nv, int i0, int i1, const doubl
     const auto point = [&]<bool Edge>(int j) {
       const std::size_t r = static_cast<std::size_t>(i) * snv + static_cast<std::size_t>(j);
       const double* row = a + r * W;
-      if constexpr (Packed) {
-        decode_row<W>(bytes + r * pb, decoded_row);
+      if constexpr (F != Form::doubles) {
+        decode_row<W, F == Form::floats>(bytes + r * pb, decoded_row);
         row = decoded_row;
       }
       double xr[C], acc[C] = {};
@@ -353,8 +384,8 @@ void upper_band(const void* entries, int nu, int nv, int i0, int i1, const doubl
     int from = lo;
     if constexpr (C == 1 && H == 3) {
       from = std::max(lo, nv - H - 1);  // the run reads dj = 4 too
-      RowEntries<Packed> rows{a, bytes};
-      band_run_1<Packed>(rows, snv, i, lo, from, own, dlo, dhi, into, x, y);
+      RowEntries<F> rows{a, bytes};
+      band_run_1<F>(rows, snv, i, lo, from, own, dlo, dhi, into, x, y);
     }
     for (int j = from; j < hi; ++j) point.template operator()<false>(j);
     for (int j = hi; j < nv; ++j) point.template operator()<true>(j);
@@ -363,26 +394,36 @@ void upper_band(const void* entries, int nu, int nv, int i0, int i1, const doubl
 
 // The kernels, cloned for AVX2 (vectors of four doubles in one register).
 [[gnu::flatten]] INTERPATCH_KERNEL void packed_band_1(const void* e, int nu, int nv, int i0, int i1, const double* x, double* y) {
-  upper_band<3, 1, true>(e, nu, nv, i0, i1, x, y);
+  upper_band<3, 1, Form::packed>(e, nu, nv, i0, i1, x, y);
 }
 [[gnu::flatten]] INTERPATCH_KERNEL void packed_band_3(const void* e, int nu, int nv, int i0, int i1, const double* x, double* y) {
-  upper_band<3, 3, true>(e, nu, nv, i0, i1, x, y);
+  upper_band<3, 3, Form::packed>(e, nu, nv, i0, i1, x, y);
+}
+[[gnu::flatten]] INTERPATCH_KERNEL void floats_band_1(const void* e, int nu, int nv, int i0, int i1, const double* x, double* y) {
+  upper_band<3, 1, Form::floats>(e, nu, nv, i0, i1, x, y);
+}
+[[gnu::flatten]] INTERPATCH_KERNEL void floats_band_3(const void* e, int nu, int nv, int i0, int i1, const double* x, double* y) {
+  upper_band<3, 3, Form::floats>(e, nu, nv, i0, i1, x, y);
 }
 [[gnu::flatten]] INTERPATCH_KERNEL void double_band_1(const void* e, int nu, int nv, int i0, int i1, const double* x, double* y) {
-  upper_band<3, 1, false>(e, nu, nv, i0, i1, x, y);
+  upper_band<3, 1, Form::doubles>(e, nu, nv, i0, i1, x, y);
 }
 
 }  // namespace
 
-void NetMatrix::multiply_rows(int i0, int i1, std::span<const double> x, std::span<double> y, int cols) const {
+void NetMatrix::multiply_rows(int i0, int i1, std::span<const double> x, std::span<double> y, int cols, Part part) const {
   const std::size_t c = static_cast<std::size_t>(cols), nv = static_cast<std::size_t>(nv_);
+  if (packed_ && part == Part::floats) {
+    if (c == 1) return floats_band_1(a_.data(), nu_, nv_, i0, i1, x.data(), y.data());
+    if (c == 3) return floats_band_3(a_.data(), nu_, nv_, i0, i1, x.data(), y.data());
+  }
   if (packed_) {
     if (c == 1) return packed_band_1(a_.data(), nu_, nv_, i0, i1, x.data(), y.data());
     if (c == 3) return packed_band_3(a_.data(), nu_, nv_, i0, i1, x.data(), y.data());
   }
   if (!mirrored_ && !packed_ && stays_upper(hu_, hv_) && (c == 1 || c == 3)) {
     if (c == 1) return double_band_1(a_.data(), nu_, nv_, i0, i1, x.data(), y.data());
-    return upper_band<3, 3, false>(a_.data(), nu_, nv_, i0, i1, x.data(), y.data());
+    return upper_band<3, 3, Form::doubles>(a_.data(), nu_, nv_, i0, i1, x.data(), y.data());
   }
   for (int i = i0; i < i1; ++i)
     for (int j = 0; j < nv_; ++j) {
@@ -393,11 +434,11 @@ void NetMatrix::multiply_rows(int i0, int i1, std::span<const double> x, std::sp
     }
 }
 
-void NetMatrix::multiply(std::span<const double> x, std::span<double> y, int cols) const {
+void NetMatrix::multiply(std::span<const double> x, std::span<double> y, int cols, Part part) const {
   const bool parallel = rows() * static_cast<std::size_t>(2 * width_) * static_cast<std::size_t>(cols) >= parallel_min_work;
   const int bands = (nu_ + band_rows - 1) / band_rows;
 #pragma omp parallel for schedule(static) if (parallel)
-  for (int b = 0; b < bands; ++b) multiply_rows(b * band_rows, std::min(nu_, (b + 1) * band_rows), x, y, cols);
+  for (int b = 0; b < bands; ++b) multiply_rows(b * band_rows, std::min(nu_, (b + 1) * band_rows), x, y, cols, part);
 }
 
 void NetMatrix::assign_sum(const NetMatrix& d, const NetMatrix& f, double s) {

@@ -348,7 +348,7 @@ void Multigrid::apply(std::span<const double> r, std::span<double> z) {
   // r_ is also the sweeps' room for their residuals: each sweep is done with it before
   // the next use (tmp_, the restriction's and the prolongation's, is a coarse row's size).
   smoother_->sweep(*finest_a_, r, z, cols_, false, r_, true);
-  finest_a_->multiply(z, r_, cols_);
+  finest_a_->multiply(z, r_, cols_, NetMatrix::Part::floats);
 #pragma omp parallel for schedule(static) if (r_.size() >= parallel_min_work / 4)
   for (std::size_t k = 0; k < r_.size(); ++k) r_[k] = r[k] - r_[k];
   restrict_to(up_, r_, b_, cols_, tmp_);

@@ -70,6 +70,13 @@ std::vector<Net> hierarchy(const Net& top, std::size_t coarsest);
 /// on 10^6 points and a 512 × 512 net, 9 on the terrain's 259 × 259, 23 on 140 × 140,
 /// 42 on 700 × 700; 58 against 59 on 4·10^6 points and 1 400 × 1 400) for a tenth of
 /// the time and their factors' memory.
+///
+/// The sweeps, their strips' factors and the residual carried down read a packed
+/// matrix's floats alone (NetMatrix::Part::floats), a third less time than its entries
+/// whole: the cycle is then the same one for the matrix F of those floats, symmetric,
+/// and positive definite whenever the strips' own blocks of F are (a forward sweep's M
+/// has M + Mᵀ − F = those blocks, which their factoring checks), F itself or not.
+/// Conjugate gradients' products read the entries whole.
 class Multigrid {
  public:
   /// The coarsest net and the finest (one net: the finest factored), and their

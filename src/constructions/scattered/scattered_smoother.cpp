@@ -72,7 +72,7 @@ void StripSmoother::factor(const NetMatrix& a, Strip& s, FactorScratch& scratch)
     double* lk = f + k * stride;  // lk[band - (k - j)] = L[k][j]
     for (std::size_t j = j0; j <= k; ++j) {
       const int di = at[j][0] - at[k][0], dj = at[j][1] - at[k][1];
-      double sum = std::abs(di) <= a.hu() && std::abs(dj) <= a.hv() ? a.entry(row[k], di, dj) : 0.0;
+      double sum = std::abs(di) <= a.hu() && std::abs(dj) <= a.hv() ? a.entry(row[k], di, dj, NetMatrix::Part::floats) : 0.0;
       const double* lj = f + j * stride;
       const std::size_t i0 = std::max(j0, j - s.length(j));
       for (std::size_t i = i0; i < j; ++i) sum -= lk[band - (k - i)] * lj[band - (j - i)];
@@ -110,7 +110,7 @@ void StripSmoother::residuals(int dir, int colour, const NetMatrix& a, std::span
 #pragma omp parallel for schedule(static) if (work >= parallel_min_work)
   for (long long k = 0; k < count; ++k) {
     const auto [i0, i1] = bands[static_cast<std::size_t>(k)];
-    a.multiply_rows(i0, i1, x, r, static_cast<int>(c));
+    a.multiply_rows(i0, i1, x, r, static_cast<int>(c), NetMatrix::Part::floats);
     for (std::size_t e = static_cast<std::size_t>(i0) * nv * c; e < static_cast<std::size_t>(i1) * nv * c; ++e) r[e] = b[e] - r[e];
   }
 }

@@ -62,6 +62,10 @@ struct Net {
 /// di > 0, or di = 0 and dj ≥ 0.
 class NetMatrix {
  public:
+  /// Which part of a packed entry a read takes: the entry (to 2^-39 of its row), or its
+  /// float alone, what the multigrid preconditioner works with (pack()). The same for a
+  /// matrix not packed.
+  enum class Part { whole, floats };
   NetMatrix(int nu, int nv, int hu, int hv);
   [[nodiscard]] int nu() const { return nu_; }
   [[nodiscard]] int nv() const { return nv_; }
@@ -74,24 +78,24 @@ class NetMatrix {
     make_writable();
     return a_[row * static_cast<std::size_t>(width_) + static_cast<std::size_t>(k)];
   }
-  [[nodiscard]] double at(std::size_t row, int k) const {
+  [[nodiscard]] double at(std::size_t row, int k, Part part = Part::whole) const {
     if (mirrored_) return full_[row * full_width() + static_cast<std::size_t>(in_full_[static_cast<std::size_t>(k)])];
-    if (packed_) return packed_at(row, k);
+    if (packed_) return packed_at(row, k, part);
     return a_[row * static_cast<std::size_t>(width_) + static_cast<std::size_t>(k)];
   }
   /// The entry coupling row (i, j), index `row`, with (i + di, j + dj), either half
   /// (|di| <= hu, |dj| <= hv, both inside the net).
-  [[nodiscard]] double entry(std::size_t row, int di, int dj) const {
-    if (di > 0 || (di == 0 && dj >= 0)) return at(row, offset(di, dj));
+  [[nodiscard]] double entry(std::size_t row, int di, int dj, Part part = Part::whole) const {
+    if (di > 0 || (di == 0 && dj >= 0)) return at(row, offset(di, dj), part);
     const auto back = static_cast<std::ptrdiff_t>(-di) * nv_ - dj;
-    return at(static_cast<std::size_t>(static_cast<std::ptrdiff_t>(row) - back), offset(-di, -dj));
+    return at(static_cast<std::size_t>(static_cast<std::ptrdiff_t>(row) - back), offset(-di, -dj), part);
   }
   /// y = A x for `cols` interleaved columns (x[r·cols + c]); bands of net rows shared by
   /// the threads.
-  void multiply(std::span<const double> x, std::span<double> y, int cols) const;
+  void multiply(std::span<const double> x, std::span<double> y, int cols, Part part = Part::whole) const;
   /// The rows of A x for the control points (i, j) with i0 <= i < i1, into the same rows
   /// of y (no other written), the sums in one order whoever calls.
-  void multiply_rows(int i0, int i1, std::span<const double> x, std::span<double> y, int cols) const;
+  void multiply_rows(int i0, int i1, std::span<const double> x, std::span<double> y, int cols, Part part = Part::whole) const;
   /// Net rows a band of multiply() holds: fixed, so that the bits do not depend on the
   /// threads.
   static constexpr int band_rows = 32;
@@ -139,7 +143,7 @@ class NetMatrix {
   // than whole rows.
   static bool stays_upper(int hu, int hv) { return hu == 3 && hv == 3; }
   [[nodiscard]] std::size_t full_width() const { return static_cast<std::size_t>((2 * hu_ + 1) * (2 * hv_ + 1)); }
-  [[nodiscard]] double packed_at(std::size_t row, int k) const;
+  [[nodiscard]] double packed_at(std::size_t row, int k, Part part) const;
   void unpack();
   void unpack_rows(std::size_t count);  // the first `count` rows of a packed form back to doubles
   int nu_, nv_, hu_, hv_, width_;
