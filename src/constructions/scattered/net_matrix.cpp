@@ -89,10 +89,6 @@ inline void decode_row(const std::byte* p, double* __restrict out) {
 // How a product reads the entries: doubles, packed rows whole, or their floats alone.
 enum class Form { doubles, packed, floats };
 
-}  // namespace
-
-namespace {
-
 // Rows of 25 doubles packed (NetMatrix::pack) into consecutive packed rows: how many
 // before the first with an entry beyond 2^100 (far inside a float's range, so that
 // every float and step is a normal number), `count` when none.
@@ -133,7 +129,7 @@ void NetMatrix::pack() {
   // to bytes pb·r, below the 8 w r of every row not yet read. An entry out of range
   // sends the rows packed so far back (its block is still whole).
   constexpr std::size_t block = 8192, share = 1024;
-  std::vector<std::byte> out(block * pb);
+  std::vector<std::byte> out(std::min(block, rows()) * pb);
   std::vector<std::size_t> done(block / share);
   for (std::size_t r0 = 0; r0 < rows(); r0 += block) {
     const std::size_t n = std::min(block, rows() - r0), shares = (n + share - 1) / share;
@@ -214,13 +210,6 @@ void NetMatrix::row_product(int i, int j, std::span<const double> x, std::size_t
 
 namespace {
 
-// Net rows [i0, i1) of A x from the upper half alone, row by row in memory order: each
-// row's own entries times x (its upper half) and, into the rows below it, the same
-// entries times its x (their lower half, A being symmetric). The hu rows above the band
-// add their share too. Every entry is read once and as a contiguous stretch, where
-// gathering the lower half from the rows above read it with a stride: a quarter less
-// time a product on a 512² net. Whole rows (mirror()) took as long as that gather with
-// twice the memory.
 // Four doubles as one value: the AVX2 clone keeps them in one register, the baseline in
 // two. Handed between functions through references: a vector passed by value without
 // AVX changes the ABI (GCC warns), even between functions inlined into one kernel.
@@ -335,6 +324,13 @@ template <Form F>
   }
 }
 
+// Net rows [i0, i1) of A x from the upper half alone, row by row in memory order: each
+// row's own entries times x (its upper half) and, into the rows below it, the same
+// entries times its x (their lower half, A being symmetric). The hu rows above the band
+// add their share too. Every entry is read once and as a contiguous stretch, where
+// gathering the lower half from the rows above read it with a stride: a quarter less
+// time a product on a 512² net. Whole rows (mirror()) took as long as that gather with
+// twice the memory.
 template <int H, int C, Form F>
 void upper_band(const void* entries, int nu, int nv, int i0, int i1, const double* x, double* y) {
   constexpr int W = H + 1 + H * (2 * H + 1), L = 2 * H + 1;

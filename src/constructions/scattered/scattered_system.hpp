@@ -119,10 +119,9 @@ class NetMatrix {
   /// 8, in place, the rest of its pages given back: the entry rounded to a float, and
   /// the remainder in 16 bits, in steps of 2^-38 of the binade of the row's largest
   /// float: within 2^-39 of the row's largest entry (conjugate gradients stop at a
-  /// residual of 1e-12). Products and sweeps decode it
-  /// as they read it; a 512² net's matrix takes 40 MB instead of 52. Left in doubles
-  /// when an entry is beyond 2^100. Changing an entry goes back to doubles (those
-  /// decoded).
+  /// residual of 1e-12). Products decode it as they read it, or read its floats alone
+  /// (Part::floats); a 512² net's matrix takes 40 MB instead of 52. Left in doubles when
+  /// an entry is beyond 2^100. Changing an entry goes back to doubles (those decoded).
   void pack();
   [[nodiscard]] bool packed() const { return packed_; }
   /// The form at() writes (the upper half in doubles), taken now: before threads write
