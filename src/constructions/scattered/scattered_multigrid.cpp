@@ -1,8 +1,10 @@
 #include "constructions/scattered/scattered_multigrid.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <utility>
 
+#include "base/kernel.hpp"
 #include "base/parallel.hpp"
 #include "base/text.hpp"
 
@@ -171,7 +173,9 @@ struct Gather {
   std::vector<int> zlo, count;
   std::vector<double> w;
   std::size_t width = 0;
-  Gather(const Refinement& rv, int hv) : width(static_cast<std::size_t>(2 * hv + rv.p + 2)) {
+  // width: the coarse functions a row's neighbours refine at most, rounded up to whole
+  // vectors of four (zeros past them).
+  Gather(const Refinement& rv, int hv) : width(static_cast<std::size_t>(2 * hv + rv.p + 2 + 3) / 4 * 4) {
     const auto fv = static_cast<std::size_t>(rv.fine), pv = static_cast<std::size_t>(rv.p + 1), wv = static_cast<std::size_t>(2 * hv + 1);
     zlo.resize(fv), count.resize(fv);
     w.assign(fv * wv * width, 0.0);
@@ -194,15 +198,15 @@ struct Gather {
 // (i, j)'s neighbours refine, from zlo on; each z a sum over the neighbours held in a
 // register, where adding each neighbour's share into z in memory waited on the last
 // store), then Pv[j][b] z into t (about half the products of both at once); tb likewise
-// for the right-hand sides.
+// for the right-hand sides. Without `matrix`, tb alone (restrict_row_cubic makes t).
 void restrict_row_along_v(const System& fine, const Refinement& rv, const Gather& gather, std::size_t i, double* t, double* tb,
-                          std::vector<double>& z) {
+                          std::vector<double>& z, bool matrix) {
   const NetMatrix& a = fine.a;
   const int hu = a.hu(), hv = a.hv(), wu = 2 * hu + 1, wv = 2 * hv + 1;
   const auto c = static_cast<std::size_t>(fine.cols), band = static_cast<std::size_t>(wu * wv);
   const auto fu = static_cast<std::size_t>(a.nu()), fv = static_cast<std::size_t>(rv.fine), cv = static_cast<std::size_t>(rv.coarse);
   const auto pv = static_cast<std::size_t>(rv.p + 1);
-  std::fill(t, t + cv * band, 0.0);
+  if (matrix) std::fill(t, t + cv * band, 0.0);
   std::fill(tb, tb + cv * c, 0.0);
   for (std::size_t j = 0; j < fv; ++j) {
     const std::size_t row = i * fv + j;
@@ -212,6 +216,7 @@ void restrict_row_along_v(const System& fine, const Refinement& rv, const Gather
       const std::size_t b = static_cast<std::size_t>(fj) + e;
       for (std::size_t m = 0; m < c && wj[e] != 0; ++m) tb[b * c + m] += wj[e] * fine.rhs[row * c + m];
     }
+    if (!matrix) continue;
     const int jlo = std::max(-hv, -static_cast<int>(j)), jhi = std::min(hv, static_cast<int>(fv - 1 - j));
     const int zlo = gather.zlo[j], zhi = zlo + gather.count[j] - 1;
     const auto zn = static_cast<std::size_t>(gather.count[j]);
@@ -239,6 +244,67 @@ void restrict_row_along_v(const System& fine, const Refinement& rv, const Gather
                         static_cast<std::size_t>(hv - b)];
         for (int bb = lo; bb <= hi; ++bb) to[bb] += wj[e] * z[static_cast<std::size_t>(bb - zlo)];
       }
+    }
+  }
+}
+
+// restrict_row_along_v for a cubic net's matrix in the upper form (reach 3, 4 weights a
+// fine point, the gather 12 wide): the same sums in the same order, the seven rows di
+// at once and in vectors, each entry read straight from its row (where entry() and
+// loops as long as each point's share took three times as long). t's rows di are 8
+// places apart (the last one unused), so that each takes two whole vectors.
+[[gnu::flatten]] INTERPATCH_KERNEL void restrict_row_cubic(const NetMatrix& a, const Refinement& rv, const Gather& gather, std::size_t i,
+                                                           double* t) {
+  constexpr int H = 3, L = 2 * H + 1, K = 12, P = 4, T = 8;
+  using v4 = double __attribute__((vector_size(32)));
+  const auto fu = static_cast<long long>(a.nu());
+  const auto fv = static_cast<std::size_t>(rv.fine), cv = static_cast<std::size_t>(rv.coarse);
+  std::fill(t, t + cv * L * T, 0.0);
+  // zp[di][H + k]: the row's entries to (i + di, ·) times the refinement, coarse function
+  // zlo + k; zeros either side, where t's band reaches past them (set once here).
+  alignas(32) double zp[L][K + 2 * H + 3] = {};
+  const auto nv = static_cast<std::ptrdiff_t>(fv);
+  for (std::size_t j = 0; j < fv; ++j) {
+    const std::size_t row = i * fv + j;
+    const int jlo = std::max(-H, -static_cast<int>(j)), jhi = std::min(H, static_cast<int>(fv - 1 - j));
+    const double* gw = &gather.w[j * L * K];
+    const double* own = a.upper(row);
+    for (int di = -H; di <= H; ++di) {
+      v4 z[K / 4] = {};
+      if (static_cast<long long>(i) + di >= 0 && static_cast<long long>(i) + di < fu) {
+        double v[L] = {};
+        if (di > 0 && jlo == -H && jhi == H) {
+          std::memcpy(v, own + a.offset(di, -H), sizeof v);
+        } else {
+          for (int dj = jlo; dj <= jhi; ++dj) {
+            const bool upper = di > 0 || (di == 0 && dj >= 0);
+            v[dj + H] = upper ? own[a.offset(di, dj)] : own[(di * nv + dj) * 25 + a.offset(-di, -dj)];
+          }
+        }
+        for (int d = 0; d < L; ++d)
+          for (int q = 0; q < K / 4; ++q) {
+            v4 g;
+            std::memcpy(&g, gw + d * K + 4 * q, sizeof g);
+            z[q] += v[d] * g;
+          }
+      }
+      std::memcpy(&zp[di + H][H], z, sizeof z);
+    }
+    const double* wj = &rv.weight[j * P];
+    const int zlo = gather.zlo[j];
+    for (int e = 0; e < P; ++e) {
+      if (wj[e] == 0) continue;
+      const int b = rv.first[j] + e, at = b - zlo;  // zp[·][at + db]: coarse b + db - H
+      double* to = &t[static_cast<std::size_t>(b) * L * T];
+      const v4 w{wj[e], wj[e], wj[e], wj[e]};
+      for (int di = 0; di < L; ++di)
+        for (int q = 0; q < 2; ++q) {
+          v4 from, sum;
+          std::memcpy(&from, &zp[di][at + 4 * q], sizeof from);
+          std::memcpy(&sum, to + di * T + 4 * q, sizeof sum);
+          sum += w * from;
+          std::memcpy(to + di * T + 4 * q, &sum, sizeof sum);
+        }
     }
   }
 }
@@ -282,8 +348,12 @@ System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
     std::vector<double> t, tb, z;
   };
   const Gather gather(rv, hv);
+  const bool cubic = hu == 3 && hv == 3 && rv.p == 3 && a.upper(0) != nullptr && gather.width == 12;
+  // t's places a fine row, coarse column and di: the band's 2hv + 1, or 8 for the
+  // cubic kernel's two vectors of four.
+  const std::size_t tw = cubic ? 8 : static_cast<std::size_t>(wv), tband = static_cast<std::size_t>(wu) * tw;
   std::vector<Buffers> buffers(parallel ? max_threads() : 1);
-  for (Buffers& buf : buffers) buf = {std::vector<double>(most * cv * band), std::vector<double>(most * cv * c), std::vector<double>(static_cast<std::size_t>(2 * hv) + pv + 1)};
+  for (Buffers& buf : buffers) buf = {std::vector<double>(most * cv * tband), std::vector<double>(most * cv * c), std::vector<double>(static_cast<std::size_t>(2 * hv) + pv + 1)};
 #pragma omp parallel if (parallel)
   {
     Buffers& buf = buffers[static_cast<std::size_t>(thread_index())];
@@ -293,7 +363,10 @@ System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
       const std::size_t a0 = std::min(cu, static_cast<std::size_t>(bk) * block), a1 = std::min(cu, a0 + block);
       const auto [ilo, ihi] = rows[static_cast<std::size_t>(bk)];
       if (ilo > ihi) continue;
-      for (std::size_t i = ilo; i <= ihi; ++i) restrict_row_along_v(fine, rv, gather, i, &t[(i - ilo) * cv * band], &tb[(i - ilo) * cv * c], buf.z);
+      for (std::size_t i = ilo; i <= ihi; ++i) {
+        restrict_row_along_v(fine, rv, gather, i, &t[(i - ilo) * cv * tband], &tb[(i - ilo) * cv * c], buf.z, !cubic);
+        if (cubic) restrict_row_cubic(a, rv, gather, i, &t[(i - ilo) * cv * tband]);
+      }
       for (std::size_t ca = a0; ca < a1; ++ca)
         for (std::size_t x = ru.t_start[ca]; x < ru.t_start[ca + 1]; ++x) {
           const auto i = static_cast<std::size_t>(ru.t_index[x]);
@@ -310,7 +383,7 @@ System restrict_system(const System& fine, const std::array<Refinement, 2>& r) {
               const int da = ru.first[static_cast<std::size_t>(i2)] + static_cast<int>(e2) - static_cast<int>(ca);
               if (w2 == 0 || da < 0 || da > hu || ca + static_cast<std::size_t>(da) >= cu) continue;  // the upper half is all that is kept
               for (std::size_t b = 0; b < cv; ++b) {
-                const double* from = &t[(((i - ilo) * cv + b) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(di + hu)) * static_cast<std::size_t>(wv)];
+                const double* from = &t[(((i - ilo) * cv + b) * static_cast<std::size_t>(wu) + static_cast<std::size_t>(di + hu)) * tw];
                 const int lo = std::max(da == 0 ? 0 : -hv, -static_cast<int>(b)), hi = std::min(hv, static_cast<int>(cv - 1 - b));
                 double* to = &out.a.at(ca * cv + b, out.a.offset(da, lo)) - lo;  // to[db]: offset (da, db)
                 for (int db = lo; db <= hi; ++db) to[db] += w2 * from[db + hv];

@@ -83,6 +83,11 @@ class NetMatrix {
     if (packed_) return packed_at(row, k, part);
     return a_[row * static_cast<std::size_t>(width_) + static_cast<std::size_t>(k)];
   }
+  /// Row `row`'s upper half in doubles (offset order), when the matrix is in that form
+  /// (neither mirrored nor packed); nullptr otherwise.
+  [[nodiscard]] const double* upper(std::size_t row) const {
+    return mirrored_ || packed_ ? nullptr : a_.data() + row * static_cast<std::size_t>(width_);
+  }
   /// The entry coupling row (i, j), index `row`, with (i + di, j + dj), either half
   /// (|di| <= hu, |dj| <= hv, both inside the net).
   [[nodiscard]] double entry(std::size_t row, int di, int dj, Part part = Part::whole) const {
