@@ -18,6 +18,14 @@
 
 namespace interpatch::detail::scattered {
 
+/// Entries left of the diagonal kept in row k of a strip's factor (strip_row_length):
+/// unknown (t, w) of a strip `width` wide couples back to (t - reach, 0) at most,
+/// reach·width + w places before it, and the factor fills no place before a row's first
+/// entry (the band's whole width kept a tenth more numbers, all zero).
+inline std::size_t strip_row_length(std::size_t k, std::size_t reach, std::size_t width) {
+  return std::min(k, reach * width + k % width);
+}
+
 /// Strips of control points max(hu, hv) + 1 wide across the whole net, along each
 /// direction, every strip's matrix factored as a band (LLᵀ).
 class StripSmoother {
@@ -45,13 +53,9 @@ class StripSmoother {
     int band = 0;   // half bandwidth of the strip's matrix in its own order
     std::size_t size = 0, at = 0;  // unknowns, offset of its factor in factor_
     bool ok = false;
-    /// Entries of the factor's row k left of the diagonal: unknown (t, w) of the strip
-    /// couples back to (t - reach, 0) at most, reach·width + w places before it, and the
-    /// factor fills no place before a row's first entry (the band's whole width kept a
-    /// tenth more numbers, all zero).
+    /// Entries of the factor's row k left of the diagonal.
     [[nodiscard]] std::size_t length(std::size_t k) const {
-      const auto w = static_cast<std::size_t>(width);
-      return std::min(k, static_cast<std::size_t>(reach) * w + k % w);
+      return strip_row_length(k, static_cast<std::size_t>(reach), static_cast<std::size_t>(width));
     }
   };
   // f(k, i, j, row) for a strip's unknowns in order, without dividing for each.

@@ -9,6 +9,7 @@
 
 #include <Eigen/SparseCholesky>
 
+#include "base/kernel.hpp"
 #include "base/parallel.hpp"
 
 namespace interpatch::detail::scattered {
@@ -149,13 +150,11 @@ Cells sort_by_cell(const Net& net, const Samples& s) {
 }
 
 // The sums of one cell's points x in [first, last) of its order: the (p+1)(q+1) basis
-// functions' products, then their products with the values, into `local`. P, Q and C
-// fixed at compile time for the common shapes (0: as the net and samples say), so that
-// the products' loops unroll (half a cubic pass's time).
-template <int P, int Q, int C>
+// functions' products (the upper triangle, row by row), then their products with the
+// values, into `local`. Any degrees; cubics by cubic_cell_sums.
 void cell_sums_of(const Net& net, const Samples& s, const Cells& cells, std::size_t a, std::size_t b, std::size_t first,
                   std::size_t last, std::span<double> local) {
-  const int p = P ? P : net.p, q = Q ? Q : net.q, m = (p + 1) * (q + 1), cols = C ? C : s.cols;
+  const int p = net.p, q = net.q, m = (p + 1) * (q + 1), cols = s.cols;
   const std::size_t pairs = static_cast<std::size_t>(m * (m + 1) / 2);
   std::fill(local.begin(), local.end(), 0.0);
   double nu_b[max_degree + 1], nv_b[max_degree + 1], basis[(max_degree + 1) * (max_degree + 1)];
@@ -180,41 +179,87 @@ void cell_sums_of(const Net& net, const Samples& s, const Cells& cells, std::siz
   }
 }
 
-void cell_sums(const Net& net, const Samples& s, const Cells& cells, std::size_t a, std::size_t b, std::size_t first,
-               std::size_t last, std::span<double> local) {
-  if (net.p == 3 && net.q == 3 && s.cols == 1) return cell_sums_of<3, 3, 1>(net, s, cells, a, b, first, last, local);
-  if (net.p == 3 && net.q == 3 && s.cols == 3) return cell_sums_of<3, 3, 3>(net, s, cells, a, b, first, last, local);
-  cell_sums_of<0, 0, 0>(net, s, cells, a, b, first, last, local);
+// cell_sums_of for a cubic net and C columns, in vectors: each point's 16 × 16 products
+// whole, four vectors of four a basis function, where the triangle's rows of 16 down to
+// 1 took a scalar step each (the same sums, in the same order); the triangle taken from
+// them at the cell's end.
+template <std::size_t C>
+[[gnu::always_inline]] inline void cubic_cell_sums(const Net& net, const Samples& s, const Cells& cells, std::size_t a, std::size_t b,
+                                                   std::size_t first, std::size_t last, double* local) {
+  using v4 = double __attribute__((vector_size(32)));
+  constexpr int M = 16;
+  v4 full[M][4] = {};
+  double rhs[M][C] = {};
+  const int span_u = static_cast<int>(a) + 3, span_v = static_cast<int>(b) + 3;
+  for (std::size_t x = first; x < last; ++x) {
+    const std::size_t k = cells.order[x];
+    if (x + ahead < last) s.prefetch(cells.order[x + ahead]);
+    const std::array<double, 2> t = s.site_at(k);
+    double nu_b[4], nv_b[4];
+    net.basis_u(span_u, t[0], nu_b);
+    net.basis_v(span_v, t[1], nv_b);
+    const double w = s.weight_at(k);
+    double value[3];
+    s.values_at(k, value);
+    const v4 along{nv_b[0], nv_b[1], nv_b[2], nv_b[3]};
+    v4 basis[4];  // basis[al][be]: the function (al, be), index 4 al + be
+    for (int al = 0; al < 4; ++al) basis[al] = nu_b[al] * along;
+    for (int l = 0; l < M; ++l) {
+      const double wb = w * basis[l / 4][l % 4];
+      for (int r = 0; r < 4; ++r) full[l][r] += wb * basis[r];
+      for (std::size_t c = 0; c < C; ++c) rhs[l][c] += wb * value[c];
+    }
+  }
+  std::size_t e = 0;
+  for (int l = 0; l < M; ++l)
+    for (int l2 = l; l2 < M; ++l2) local[e++] = full[l][l2 / 4][l2 % 4];
+  for (int l = 0; l < M; ++l)
+    for (std::size_t c = 0; c < C; ++c) local[e++] = rhs[l][c];
 }
 
-// Where a cell's sums go, from the cell's first control point: each pair's row and its
-// upper offset, each basis function's row. Found once a net: told apart for each cell by
-// division, they took a sixth of a cubic pass.
+[[gnu::flatten]] INTERPATCH_KERNEL void cubic_cell_sums_1(const Net& net, const Samples& s, const Cells& cells, std::size_t a,
+                                                          std::size_t b, std::size_t first, std::size_t last, double* local) {
+  cubic_cell_sums<1>(net, s, cells, a, b, first, last, local);
+}
+[[gnu::flatten]] INTERPATCH_KERNEL void cubic_cell_sums_3(const Net& net, const Samples& s, const Cells& cells, std::size_t a,
+                                                          std::size_t b, std::size_t first, std::size_t last, double* local) {
+  cubic_cell_sums<3>(net, s, cells, a, b, first, last, local);
+}
+
+void cell_sums(const Net& net, const Samples& s, const Cells& cells, std::size_t a, std::size_t b, std::size_t first,
+               std::size_t last, std::span<double> local) {
+  if (net.p == 3 && net.q == 3 && s.cols == 1) return cubic_cell_sums_1(net, s, cells, a, b, first, last, local.data());
+  if (net.p == 3 && net.q == 3 && s.cols == 3) return cubic_cell_sums_3(net, s, cells, a, b, first, last, local.data());
+  cell_sums_of(net, s, cells, a, b, first, last, local);
+}
+
+// Where a cell's sums go, from the cell's first control point: each pair's place in the
+// matrix's upper half (row · width + offset), each basis function's row. Found once a
+// net: told apart for each cell by division, they took a sixth of a cubic pass.
 struct CellPattern {
-  std::vector<std::size_t> pair_row, basis_row;
-  std::vector<int> pair_offset;
+  std::vector<std::size_t> pair_at, basis_row;
   CellPattern(const Net& net, const NetMatrix& a) {
     const int q = net.q, m = (net.p + 1) * (q + 1);
-    const auto nv = static_cast<std::size_t>(net.nv);
+    const auto nv = static_cast<std::size_t>(net.nv), width = static_cast<std::size_t>(a.width());
     const auto row = [&](int l) { return static_cast<std::size_t>(l / (q + 1)) * nv + static_cast<std::size_t>(l % (q + 1)); };
     for (int l = 0; l < m; ++l) {
       basis_row.push_back(row(l));
-      for (int l2 = l; l2 < m; ++l2) {
-        pair_row.push_back(row(l));
-        pair_offset.push_back(a.offset(l2 / (q + 1) - l / (q + 1), l2 % (q + 1) - l % (q + 1)));
-      }
+      for (int l2 = l; l2 < m; ++l2)
+        pair_at.push_back(row(l) * width + static_cast<std::size_t>(a.offset(l2 / (q + 1) - l / (q + 1), l2 % (q + 1) - l % (q + 1))));
     }
   }
 };
 
-// A cell's sums added to the system, once.
+// A cell's sums added to the system (its matrix's upper half `upper`, as
+// upper_for_writing gives it), once.
 void add_sums(const Net& net, const CellPattern& pattern, std::size_t a, std::size_t b, std::span<const double> local, int cols,
-              System& sys) {
-  const std::size_t base = a * static_cast<std::size_t>(net.nv) + b, pairs = pattern.pair_row.size();
-  for (std::size_t e = 0; e < pairs; ++e) sys.a.at(base + pattern.pair_row[e], pattern.pair_offset[e]) += local[e];
+              double* upper, int width, std::span<double> rhs) {
+  const std::size_t base = a * static_cast<std::size_t>(net.nv) + b, pairs = pattern.pair_at.size();
+  double* at = upper + base * static_cast<std::size_t>(width);
+  for (std::size_t e = 0; e < pairs; ++e) at[pattern.pair_at[e]] += local[e];
   const auto c = static_cast<std::size_t>(cols);
   for (std::size_t l = 0; l < pattern.basis_row.size(); ++l)
-    for (std::size_t m = 0; m < c; ++m) sys.rhs[(base + pattern.basis_row[l]) * c + m] += local[pairs + l * c + m];
+    for (std::size_t m = 0; m < c; ++m) rhs[(base + pattern.basis_row[l]) * c + m] += local[pairs + l * c + m];
 }
 
 // Cells holding more than this many points are summed in blocks of it by all the threads
@@ -225,7 +270,8 @@ constexpr std::size_t cell_block = 2048;
 }  // namespace
 
 void add_data_term(const Net& net, const Samples& s, System& sys) {
-  sys.a.make_writable();  // at() below, on the threads, then never changes the form
+  double* upper = sys.a.upper_for_writing();  // the form then stays, on the threads too
+  const int width = sys.a.width();
   const Cells cells = sort_by_cell(net, s);
   const CellPattern pattern(net, sys.a);
   const std::size_t su = static_cast<std::size_t>(net.nu - net.p), sv = static_cast<std::size_t>(net.nv - net.q);
@@ -251,7 +297,7 @@ void add_data_term(const Net& net, const Samples& s, System& sys) {
       if (k > 0 && blocks[k - 1][0] == cell)
         for (std::size_t e = 0; e < len; ++e) sums[k * len + e] += sums[(k - 1) * len + e];
       if (k + 1 == blocks.size() || blocks[k + 1][0] != cell)
-        add_sums(net, pattern, cell / sv, cell % sv, std::span<const double>(sums).subspan(k * len, len), s.cols, sys);
+        add_sums(net, pattern, cell / sv, cell % sv, std::span<const double>(sums).subspan(k * len, len), s.cols, upper, width, sys.rhs);
     }
   }
   std::vector<std::vector<double>> local(parallel ? max_threads() : 1, std::vector<double>(len));
@@ -277,7 +323,7 @@ void add_data_term(const Net& net, const Samples& s, System& sys) {
         if (n == 0 || n > cell_block) continue;
         std::vector<double>& sums = local[static_cast<std::size_t>(thread_index())];
         cell_sums(net, s, cells, a, b, cells.start[cell], cells.start[cell + 1], sums);
-        add_sums(net, pattern, a, b, sums, s.cols, sys);
+        add_sums(net, pattern, a, b, sums, s.cols, upper, width, sys.rhs);
       }
     }
   }

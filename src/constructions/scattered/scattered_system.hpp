@@ -88,6 +88,14 @@ class NetMatrix {
   [[nodiscard]] const double* upper(std::size_t row) const {
     return mirrored_ || packed_ ? nullptr : a_.data() + row * static_cast<std::size_t>(width_);
   }
+  /// Entries a row of the upper half.
+  [[nodiscard]] int width() const { return width_; }
+  /// The upper half in doubles, taken for writing (make_writable()): entry (row, k) at
+  /// row · width() + k, for passes that add to many entries at once.
+  [[nodiscard]] double* upper_for_writing() {
+    make_writable();
+    return a_.data();
+  }
   /// The entry coupling row (i, j), index `row`, with (i + di, j + dj), either half
   /// (|di| <= hu, |dj| <= hv, both inside the net).
   [[nodiscard]] double entry(std::size_t row, int di, int dj, Part part = Part::whole) const {
