@@ -8,6 +8,7 @@
 #include "constructions/interpolate/interpolate_internal.hpp"
 #include "base/kernel.hpp"
 #include "base/parallel.hpp"
+#include "base/sums.hpp"
 #include "base/text.hpp"
 #include "interpatch/memory.hpp"
 
@@ -63,26 +64,6 @@ INTERPATCH_KERNEL void chord_lengths(const Vec3* a, const Vec3* b, std::size_t c
 // length (left out) or one so short that its reciprocal overflows (a collapsed line
 // of tiny data, left out with the other collapsed lines).
 double line_weight(double length) { return length >= std::numeric_limits<double>::min() ? 1.0 / length : 0.0; }
-
-// Σ a[i] and Σ a[i] b[i] in four interleaved partial sums: a fixed order (the same
-// bits on every run) without one long chain of dependent additions.
-double sum(const double* a, std::size_t n) {
-  double s[4] = {0, 0, 0, 0};
-  std::size_t i = 0;
-  for (; i + 4 <= n; i += 4)
-    for (std::size_t j = 0; j < 4; ++j) s[j] += a[i + j];
-  for (; i < n; ++i) s[0] += a[i];
-  return (s[0] + s[1]) + (s[2] + s[3]);
-}
-
-double dot(const double* a, const double* b, std::size_t n) {
-  double s[4] = {0, 0, 0, 0};
-  std::size_t i = 0;
-  for (; i + 4 <= n; i += 4)
-    for (std::size_t j = 0; j < 4; ++j) s[j] += a[i + j] * b[i + j];
-  for (; i < n; ++i) s[0] += a[i] * b[i];
-  return (s[0] + s[1]) + (s[2] + s[3]);
-}
 
 }  // namespace
 
@@ -226,7 +207,7 @@ std::vector<double> GridChords::in_row_parameters(std::size_t a) const {
 // Row r's step along u: Σ over the lines along u of chord(r − 1, r) / line length.
 double GridChords::row_step(const Vec3* prev, const Vec3* row, double* scratch) const {
   chord_lengths(prev, row, g_.row, scratch, param_, root_);
-  return dot(scratch, inv_length_.data(), g_.row);
+  return interleaved_dot(scratch, inv_length_.data(), g_.row);
 }
 
 // Parameters along u from the rows' steps (steps[0] unused).
@@ -297,7 +278,7 @@ void GridChords::add_running_lengths(const Vec3* row, std::size_t a, double* acc
     if (inner == 1) {
       chord_lengths(base, base + 1, n - 1, ch, param_, root_);
       if (closed) chord_lengths(base + n - 1, base, 1, ch + n - 1, param_, root_);
-      lengths[o] = sum(ch, closed ? n : n - 1);
+      lengths[o] = interleaved_sum(ch, closed ? n : n - 1);
       const double w = line_weight(lengths[o]);
       for (std::size_t k = 1; k < n; ++k) acc[k] += ch[k - 1] * w;
       continue;
@@ -310,7 +291,7 @@ void GridChords::add_running_lengths(const Vec3* row, std::size_t a, double* acc
     for (std::size_t k = 1; k < (closed ? n + 1 : n); ++k)
       for (std::size_t i = 0; i < inner; ++i) len[i] += ch[(k - 1) * inner + i];
     for (std::size_t i = 0; i < inner; ++i) inv[i] = line_weight(len[i]);
-    for (std::size_t k = 1; k < n; ++k) acc[k] += dot(ch + (k - 1) * inner, inv, inner);
+    for (std::size_t k = 1; k < n; ++k) acc[k] += interleaved_dot(ch + (k - 1) * inner, inv, inner);
   }
 }
 

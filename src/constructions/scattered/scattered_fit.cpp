@@ -1,10 +1,15 @@
 #include "constructions/scattered/scattered_fit.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numeric>
+#include <utility>
+#include <vector>
 
+#include "base/parallel.hpp"
 #include "base/text.hpp"
 #include "constructions/approximate/approx_check.hpp"
 #include "constructions/approximate/approx_rows.hpp"
@@ -53,33 +58,61 @@ Hierarchy hierarchy_for(const Net& net, const NetMatrix& top, double scaled, Kep
 
 namespace {
 
-// Interleaves the bits of two 10-bit cell indices: the cell's place on a Z-curve.
-std::uint32_t z_order(std::uint32_t i, std::uint32_t j) {
-  std::uint32_t key = 0;
-  for (int b = 0; b < 10; ++b) key |= ((i >> b) & 1U) << (2 * b + 1) | ((j >> b) & 1U) << (2 * b);
-  return key;
-}
+// A 10-bit index's bits spread to the even places of 20: a cell's place on a Z-curve is
+// spread(i) << 1 | spread(j).
+constexpr auto spread = [] {
+  std::array<std::uint32_t, 1024> out{};
+  for (std::uint32_t i = 0; i < 1024; ++i)
+    for (int b = 0; b < 10; ++b) out[i] |= ((i >> b) & 1U) << (2 * b);
+  return out;
+}();
 
 // The points present in the order of their cells on a 1024 × 1024 grid over the domain
-// along a Z-curve, the order given within a cell (two stable counting sorts of 10 bits).
+// along a Z-curve, the order given within a cell (two stable counting sorts of 10 bits),
+// on the threads: each in contiguous blocks of points, each block's count of each bin,
+// the blocks placing their points after those of the blocks before. A stable sort has
+// one result, whatever the blocks.
 template <class UnitAt>
 std::vector<std::uint32_t> z_sorted(const Sites& s, const UnitAt& unit_at, std::array<double, 2> range) {
   const std::size_t n = s.size();
-  std::vector<std::uint32_t> key(n), order, next;
-  order.reserve(s.present);
-  for (std::size_t k = 0; k < n; ++k) {
-    if (!s.counts(k)) continue;
+  const bool parallel = n >= parallel_min_work / 16;
+  const std::size_t blocks = parallel ? max_threads() : 1;
+  const auto cut = [&](std::size_t b, std::size_t count) { return std::array<std::size_t, 2>{count * b / blocks, count * (b + 1) / blocks}; };
+  std::vector<std::uint32_t> key(n);
+  std::vector<std::size_t> present(blocks + 1, 0);
+  parallel_for(blocks, parallel, Share::blocks, [&](std::size_t b) {
     const auto cell = [](double t, double r) { return static_cast<std::uint32_t>(std::clamp(t / r * 1024, 0.0, 1023.0)); };
-    const std::array<double, 2> u = unit_at(k);
-    key[k] = z_order(cell(u[0], range[0]), cell(u[1], range[1]));
-    order.push_back(static_cast<std::uint32_t>(k));
-  }
-  next.resize(order.size());
+    const auto [lo, hi] = cut(b, n);
+    for (std::size_t k = lo; k < hi; ++k) {
+      if (!s.counts(k)) continue;
+      const std::array<double, 2> u = unit_at(k);
+      key[k] = spread[cell(u[0], range[0])] << 1 | spread[cell(u[1], range[1])];
+      ++present[b + 1];
+    }
+  });
+  for (std::size_t b = 0; b < blocks; ++b) present[b + 1] += present[b];
+  std::vector<std::uint32_t> order(present.back()), next(present.back());
+  parallel_for(blocks, parallel, Share::blocks, [&](std::size_t b) {
+    const auto [lo, hi] = cut(b, n);
+    std::size_t at = present[b];
+    for (std::size_t k = lo; k < hi; ++k)
+      if (s.counts(k)) order[at++] = static_cast<std::uint32_t>(k);
+  });
+  const std::size_t m = order.size();
+  std::vector<std::size_t> start(1024 * blocks);  // bin-major: where block b's points of a bin go
   for (const int shift : {0, 10}) {
-    std::vector<std::size_t> start(1025, 0);
-    for (const std::uint32_t k : order) ++start[((key[k] >> shift) & 1023U) + 1];
-    for (std::size_t b = 0; b < 1024; ++b) start[b + 1] += start[b];
-    for (const std::uint32_t k : order) next[start[(key[k] >> shift) & 1023U]++] = k;
+    const auto bin = [&](std::uint32_t k) { return (key[k] >> shift) & 1023U; };
+    std::fill(start.begin(), start.end(), 0);
+    parallel_for(blocks, parallel, Share::blocks, [&](std::size_t b) {
+      const auto [lo, hi] = cut(b, m);
+      for (std::size_t x = lo; x < hi; ++x) ++start[bin(order[x]) * blocks + b];
+    });
+    std::size_t sum = 0;
+    for (std::size_t& v : start) sum += std::exchange(v, sum);
+    parallel_for(blocks, parallel, Share::blocks, [&](std::size_t b) {
+      const auto [lo, hi] = cut(b, m);
+      for (std::size_t x = lo; x < hi; ++x) next[start[bin(order[x]) * blocks + b]++] = order[x];
+    });
     order.swap(next);
   }
   return order;

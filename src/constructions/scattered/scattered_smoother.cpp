@@ -6,6 +6,7 @@
 
 #include "base/kernel.hpp"
 #include "base/parallel.hpp"
+#include "base/sums.hpp"
 
 namespace interpatch::detail::scattered {
 
@@ -15,6 +16,39 @@ namespace {
 // colours suffice, and a strip holds every coupling of a control point to its
 // neighbours across it.
 int strip_width(const NetMatrix& a) { return std::max(a.hu(), a.hv()) + 1; }
+
+// A strip's factor as the factoring and the band solves take it: its unknowns, and the
+// reach and width that give each row's length (strip_row_length).
+struct Band {
+  std::size_t size, reach, width;
+  [[nodiscard]] std::size_t length(std::size_t k) const { return strip_row_length(k, reach, width); }
+};
+
+// In place, the band Cholesky factor of the matrix held in `f` (row k's entries A[k][j],
+// j from k - length(k) to k, at f[k (band + 1) + band - (k - j)]): L[k][j] =
+// (A[k][j] - Σ_i L[k][i] L[j][i]) / L[j][j] for j < k, and 1 / L[k][k] in the
+// diagonal's place. False at a pivot not positive. Column by column: the sums of a
+// column's rows do not wait on each other, where by rows each waited on the last (and
+// each sum in four interleaved parts, not waiting on one adder).
+[[gnu::flatten]] INTERPATCH_KERNEL bool factor_band(double* f, Band s, std::size_t band) {
+  const std::size_t stride = band + 1;
+  for (std::size_t j = 0; j < s.size; ++j) {
+    double* lj = f + j * stride;  // lj[band - (j - i)] = L[j][i]
+    const std::size_t nj = s.length(j);
+    const double pivot = lj[band] - interleaved_dot(lj + band - nj, lj + band - nj, nj);
+    if (!(pivot > 0)) return false;
+    const double inverse = 1 / std::sqrt(pivot);
+    lj[band] = inverse;
+    for (std::size_t k = j + 1; k < std::min(s.size, j + band + 1); ++k) {
+      const std::size_t first = k - s.length(k);
+      if (first > j) continue;  // L[k][j] is 0, left of row k's first entry
+      double* lk = f + k * stride;
+      const std::size_t i0 = std::max(first, j - nj), n = j - i0;
+      lk[band - (k - j)] = (lk[band - (k - j)] - interleaved_dot(lk + band - (k - i0), lj + band - n, n)) * inverse;
+    }
+  }
+  return true;
+}
 
 }  // namespace
 
@@ -61,30 +95,33 @@ StripSmoother::StripSmoother(const NetMatrix& a) : nu_(a.nu()), nv_(a.nv()) {
 }
 
 void StripSmoother::factor(const NetMatrix& a, Strip& s, FactorScratch& scratch) {
-  // Band Cholesky by rows: L[k][j] = (A[k][j] - Σ_i L[k][i] L[j][i]) / L[j][j], in
-  // double, then kept in single precision. Each unknown's control point found once.
+  // The strip's entries into the band (each unknown's control point found once), the
+  // band factored in double, then kept in single precision.
   const auto band = static_cast<std::size_t>(s.band), stride = band + 1;
   double* f = scratch.band.data();
   std::vector<std::array<int, 2>>& at = scratch.at;
   std::vector<std::size_t>& row = scratch.row;
   for_each_row(s, [&](std::size_t k, int i, int j, std::size_t r) { at[k] = {i, j}, row[k] = r; });
+  // Each unknown's row of the upper half read whole, its entries to the strip's unknowns
+  // placed in the later one's row of the band (an entry at a time took a third of the
+  // factoring).
+  for (std::size_t k = 0; k < s.size; ++k) std::fill(f + k * stride + band - s.length(k), f + (k + 1) * stride, 0.0);
+  const int hu = a.hu(), hv = a.hv(), w = s.width;
+  double entries[NetMatrix::max_width];
   for (std::size_t k = 0; k < s.size; ++k) {
-    const std::size_t j0 = k - s.length(k);  // L[k][j] is 0 left of it, and left unwritten
-    double* lk = f + k * stride;  // lk[band - (k - j)] = L[k][j]
-    for (std::size_t j = j0; j <= k; ++j) {
-      const int di = at[j][0] - at[k][0], dj = at[j][1] - at[k][1];
-      double sum = std::abs(di) <= a.hu() && std::abs(dj) <= a.hv() ? a.entry(row[k], di, dj, NetMatrix::Part::floats) : 0.0;
-      const double* lj = f + j * stride;
-      const std::size_t i0 = std::max(j0, j - s.length(j));
-      for (std::size_t i = i0; i < j; ++i) sum -= lk[band - (k - i)] * lj[band - (j - i)];
-      if (j < k) {
-        lk[band - (k - j)] = sum * lj[band];
-      } else {
-        if (!(sum > 0)) return;  // s.ok stays false
-        lk[band] = 1 / std::sqrt(sum);
+    a.upper_row(row[k], entries, NetMatrix::Part::floats);
+    const auto [i, j] = at[k];
+    for (int di = 0; di <= hu; ++di)
+      for (int dj = di == 0 ? 0 : -hv; dj <= hv; ++dj) {
+        // The neighbour's place in the strip: across it (w wide), and along it.
+        const int across = s.dir == 0 ? i + di - s.first : j + dj - s.first, along = s.dir == 0 ? j + dj : i + di;
+        if (across < 0 || across >= w || along < 0 || along >= (s.dir == 0 ? nv_ : nu_)) continue;
+        const auto kn = static_cast<std::size_t>(along) * static_cast<std::size_t>(w) + static_cast<std::size_t>(across);
+        const std::size_t later = std::max(k, kn), gap = later - std::min(k, kn);
+        if (gap <= s.length(later)) f[later * stride + band - gap] = entries[a.offset(di, dj)];
       }
-    }
   }
+  if (!factor_band(f, Band{s.size, static_cast<std::size_t>(s.reach), static_cast<std::size_t>(s.width)}, band)) return;  // s.ok stays false
   float* out = factor_.get() + s.at;
   for (std::size_t k = 0; k < s.size; ++k) {
     const std::size_t n = s.length(k);
@@ -117,13 +154,6 @@ void StripSmoother::residuals(int dir, int colour, const NetMatrix& a, std::span
 }
 
 namespace {
-
-// A strip's factor as the band solves read it: its unknowns, and the reach and width
-// that give each row's length (strip_row_length).
-struct Band {
-  std::size_t size, reach, width;
-  [[nodiscard]] std::size_t length(std::size_t k) const { return strip_row_length(k, reach, width); }
-};
 
 // L y = r, then Lᵀ z = y, in place, for c interleaved columns (row k of the factor:
 // L[k][k - n .. k - 1], then 1 / L[k][k], n = s.length(k)); the forward sums in four

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <span>
@@ -90,6 +91,9 @@ class NetMatrix {
   }
   /// Entries a row of the upper half.
   [[nodiscard]] int width() const { return width_; }
+  /// Row `row`'s upper half (width() entries, offset order) into `out`, as `part` reads
+  /// them: one call a row where at() decodes a packed entry each.
+  void upper_row(std::size_t row, double* out, Part part = Part::whole) const;
   /// The upper half in doubles, taken for writing (make_writable()): entry (row, k) at
   /// row · width() + k, for passes that add to many entries at once.
   [[nodiscard]] double* upper_for_writing() {
@@ -112,6 +116,8 @@ class NetMatrix {
   /// Net rows a band of multiply() holds: fixed, so that the bits do not depend on the
   /// threads.
   static constexpr int band_rows = 32;
+  /// The most entries a row of the upper half holds (reach max_degree both ways).
+  static constexpr int max_width = max_degree + 1 + max_degree * (2 * max_degree + 1);
   /// Row (i, j) of A times x, column by column, into acc.
   void row_product(int i, int j, std::span<const double> x, std::size_t cols, double* acc) const;
   /// This matrix set to d + s·f (all three of one net and one pattern).
@@ -129,12 +135,13 @@ class NetMatrix {
   /// matrix stays packed.
   void unmirror();
   /// Keeps each entry of a cubic net's matrix (nothing for others) in 6 bytes instead of
-  /// 8, in place, the rest of its pages given back: the entry rounded to a float, and
-  /// the remainder in 16 bits, in steps of 2^-38 of the binade of the row's largest
-  /// float: within 2^-39 of the row's largest entry (conjugate gradients stop at a
-  /// residual of 1e-12). Products decode it as they read it, or read its floats alone
-  /// (Part::floats); a 512² net's matrix takes 40 MB instead of 52. Left in doubles when
-  /// an entry is beyond 2^100. Changing an entry goes back to doubles (those decoded).
+  /// 8: the entry rounded to a float, in place (the rest of the pages given back), and
+  /// the remainder apart in 16 bits, in steps of 2^-38 of the binade of the row's
+  /// largest float: within 2^-39 of the row's largest entry (conjugate gradients stop at
+  /// a residual of 1e-12). Products decode it as they read it, or read its floats alone
+  /// (Part::floats, contiguous); a 512² net's matrix takes 40 MB instead of 52. Left in
+  /// doubles when an entry is beyond 2^100. Changing an entry goes back to doubles
+  /// (those decoded).
   void pack();
   [[nodiscard]] bool packed() const { return packed_; }
   /// The form at() writes (the upper half in doubles), taken now: before threads write
@@ -169,7 +176,8 @@ class NetMatrix {
   Values full_;  // (2hu+1)(2hv+1) a row, (di, dj) row-major from (-hu, -hv); empty unless mirrored
   std::vector<int> in_full_;  // upper offset k's place in a whole row
   bool mirrored_ = false;
-  bool packed_ = false;  // a_'s bytes hold packed rows (pack())
+  bool packed_ = false;  // a_'s bytes hold packed rows' floats, rests_ their rests (pack())
+  std::vector<std::int16_t> rests_;
 };
 
 /// A fit's system: the matrix (the data term, then the fairness term added to it) and
