@@ -236,6 +236,7 @@ void solve_net(const Problem& pr, const Net& net, System& sys, double scaled, st
     // Without the factorization to fall back on, nor a caller that needs it, the
     // right-hand side's memory holds the residual.
     const bool consume = !factorable && !rhs_after;
+    if (std::all_of(x.begin(), x.end(), [](double v) { return v == 0; })) mg.coarse_guess(sys.rhs, x);
     sol = solve_cg(sys.a, sys.rhs, x, pr.cols, 1e-12, factorable ? 4 * slow_steps : 200 + 40 * (net.nu + net.nv),
                    [&mg](std::span<const double> r, std::span<double> z, int) { mg.apply(r, z); }, keep_going,
                    consume ? std::span<double>(sys.rhs) : std::span<double>());

@@ -89,7 +89,8 @@ class KeptMatrices {
 };
 
 /// Solves one net's system (fairness added at `scaled`, λ times the weight sum) from
-/// the x given, to a residual of 1e-12 of the right-hand side. Factored when small,
+/// the x given (when all zero, conjugate gradients start from the coarsest net's
+/// solution), to a residual of 1e-12 of the right-hand side. Factored when small,
 /// otherwise by conjugate gradients preconditioned by multigrid over the coarser nets
 /// of its hierarchy, whose coarsest matrix `kept` holds (restricted from this one's)
 /// and keeps afterwards; factored after all when they stall on a net the factorization still

@@ -412,6 +412,14 @@ bool Multigrid::factor() {
   return coarsest_->ok();
 }
 
+void Multigrid::coarse_guess(std::span<const double> b, std::span<double> x) {
+  if (one_net_) return;
+  std::fill(x.begin(), x.end(), 0.0);
+  restrict_to(up_, b, b_, cols_, tmp_);
+  coarsest_->solve(b_, x_, cols_);
+  prolong(up_, x_, x, cols_, tmp_);
+}
+
 void Multigrid::apply(std::span<const double> r, std::span<double> z) {
   if (one_net_) {
     coarsest_->solve(r, z, cols_);
