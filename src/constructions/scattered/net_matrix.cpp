@@ -138,7 +138,7 @@ void NetMatrix::pack() {
     for (std::size_t t = 0; t < shares; ++t)
       if (done[t] != std::min(share, n - t * share)) {
         unpack_rows(r0);
-        std::vector<std::int16_t>().swap(rests_);
+        Rests().swap(rests_);
         return;
       }
     std::memcpy(floats + r0 * w, out.data(), n * w * sizeof(float));
@@ -150,7 +150,7 @@ void NetMatrix::pack() {
 void NetMatrix::unpack() {
   if (!packed_) return;
   unpack_rows(rows());
-  std::vector<std::int16_t>().swap(rests_);
+  Rests().swap(rests_);
   packed_ = false;
 }
 
@@ -450,7 +450,7 @@ void NetMatrix::assign_sum(const NetMatrix& d, const NetMatrix& f, double s) {
   if (mirrored_ || packed_) {
     full_ = {};
     a_ = Values(rows() * static_cast<std::size_t>(width_));
-    std::vector<std::int16_t>().swap(rests_);
+    Rests().swap(rests_);
     mirrored_ = packed_ = false;
   }
   const std::size_t w = static_cast<std::size_t>(width_);

@@ -177,7 +177,24 @@ class NetMatrix {
   std::vector<int> in_full_;  // upper offset k's place in a whole row
   bool mirrored_ = false;
   bool packed_ = false;  // a_'s bytes hold packed rows' floats, rests_ their rests (pack())
-  std::vector<std::int16_t> rests_;
+  // A packed matrix's rests, left unset when made (pack() writes each on the threads,
+  // its pages first touched there); from the heap and given back when freed.
+  template <class T>
+  struct Unset : std::allocator<T> {
+    template <class U>
+    struct rebind {
+      using other = Unset<U>;
+    };
+    Unset() noexcept = default;
+    template <class U>
+    Unset(const Unset<U>&) noexcept {}
+    template <class U>
+    void construct(U* p) noexcept {
+      ::new (static_cast<void*>(p)) U;
+    }
+  };
+  using Rests = std::vector<std::int16_t, Unset<std::int16_t>>;
+  Rests rests_;
 };
 
 /// A fit's system: the matrix (the data term, then the fairness term added to it) and
