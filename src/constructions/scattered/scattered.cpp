@@ -230,7 +230,7 @@ struct Solution {
 };
 
 Solution solve(std::span<const Vec3> points, const Sites& s, int p, int q, const ScatteredApproximationOptions& o) {
-  Problem pr = frame(points, s, p, q, o.param == ScatteredParam::xy, o.auto_smoothing);
+  Problem pr = frame(points, s, p, q, o.param == ScatteredParam::xy, o.auto_smoothing, !o.control_points);
   Fitted f = o.tolerance ? solve_tolerance(pr, *o.tolerance, o, o.progress)
              : o.control_points
                  ? solve_once(pr, {(*o.control_points)[0] - p, (*o.control_points)[1] - q}, std::nullopt, o.progress)

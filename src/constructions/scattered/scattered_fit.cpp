@@ -126,7 +126,7 @@ void require_indexable(std::size_t points) {
          " (points are indexed in 32 bits)");
 }
 
-Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool xy, bool folds) {
+Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool xy, bool folds, bool z_curve) {
   require_indexable(points.size());
   Problem pr;
   pr.p = p, pr.q = q, pr.cols = xy ? 1 : 3, pr.sites = &s, pr.points = points;
@@ -144,7 +144,13 @@ Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool x
   pr.side = std::max(u1 - u0, v1 - v0);
   pr.lower = {u0, v0};
   pr.range = {(u1 - u0) / pr.side, (v1 - v0) / pr.side};
-  pr.order = z_sorted(s, [&pr](std::size_t k) { return pr.input_unit(k); }, pr.range);
+  if (z_curve) {
+    pr.order = z_sorted(s, [&pr](std::size_t k) { return pr.input_unit(k); }, pr.range);
+  } else {
+    pr.order.reserve(s.present);
+    for (std::size_t k = 0; k < points.size(); ++k)
+      if (s.counts(k)) pr.order.push_back(static_cast<std::uint32_t>(k));
+  }
   const std::size_t n = pr.order.size();
   bool unit_weights = true;
   for (std::size_t i = 0; i < n && unit_weights; ++i) unit_weights = s.weight_at(pr.order[i]) == 1;

@@ -42,8 +42,10 @@ inline constexpr std::size_t coarsest_net = 4096;
 void require_indexable(std::size_t points);
 
 /// The problem of `points` at sites `s` (one column, z, when `xy`), with each point's
-/// fold when `folds`.
-Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool xy, bool folds = false);
+/// fold when `folds`. The points present in the order of a Z-curve over the domain with
+/// `z_curve` (their knot cells' points together on every net a fit tries), otherwise
+/// in the order given (a fit on one net, which sorts them by its knot cells alone).
+Problem frame(std::span<const Vec3> points, const Sites& s, int p, int q, bool xy, bool folds = false, bool z_curve = true);
 
 /// A point's fold of the cross-validation, from the bits of its coordinates as given:
 /// anything computed from them (the centre, the plane) is summed in the points' order
