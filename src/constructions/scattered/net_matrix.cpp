@@ -222,7 +222,6 @@ namespace {
 // two. Handed between functions through references: a vector passed by value without
 // AVX changes the ABI (GCC warns), even between functions inlined into one kernel.
 using v4 = double __attribute__((vector_size(32)));
-using v4f = float __attribute__((vector_size(16)));
 using v4s = std::int16_t __attribute__((vector_size(8)));
 
 [[gnu::always_inline]] inline void load4(const double* p, v4& v) { std::memcpy(&v, p, sizeof v); }
@@ -231,7 +230,8 @@ using v4s = std::int16_t __attribute__((vector_size(8)));
 // after row(r). A packed row is decoded whole first, in vectors (decoded as asked for,
 // a product took a third longer); its floats alone are read straight from its bytes
 // (through a row of doubles, the reads of four that straddle two of its stores waited
-// for both: a third longer too).
+// for both: a third longer too), one by one into a vector (a vector of four floats
+// converted whole went through the stack a half at a time: 7 % longer).
 template <Form F>
 struct RowEntries {
   const double* a;
@@ -252,9 +252,7 @@ struct RowEntries {
   }
   [[gnu::always_inline]] void four(std::size_t k, v4& v) const {
     if constexpr (F == Form::floats) {
-      v4f hi;
-      std::memcpy(&hi, p + k, sizeof hi);
-      v = __builtin_convertvector(hi, v4);
+      v = v4{static_cast<double>(p[k]), static_cast<double>(p[k + 1]), static_cast<double>(p[k + 2]), static_cast<double>(p[k + 3])};
     } else {
       load4(at + k, v);
     }
