@@ -222,7 +222,6 @@ namespace {
 // two. Handed between functions through references: a vector passed by value without
 // AVX changes the ABI (GCC warns), even between functions inlined into one kernel.
 using v4 = double __attribute__((vector_size(32)));
-using v4s = std::int16_t __attribute__((vector_size(8)));
 
 [[gnu::always_inline]] inline void load4(const double* p, v4& v) { std::memcpy(&v, p, sizeof v); }
 

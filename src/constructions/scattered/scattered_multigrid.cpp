@@ -263,7 +263,7 @@ void restrict_row_along_v(const System& fine, const Refinement& rv, const Gather
   // zp[di][H + k]: the row's entries to (i + di, ·) times the refinement, coarse function
   // zlo + k; zeros either side, where t's band reaches past them (set once here).
   alignas(32) double zp[L][K + 2 * H + 3] = {};
-  const auto nv = static_cast<std::ptrdiff_t>(fv);
+  const auto nv = static_cast<std::ptrdiff_t>(fv), width = static_cast<std::ptrdiff_t>(a.width());
   for (std::size_t j = 0; j < fv; ++j) {
     const std::size_t row = i * fv + j;
     const int jlo = std::max(-H, -static_cast<int>(j)), jhi = std::min(H, static_cast<int>(fv - 1 - j));
@@ -278,7 +278,7 @@ void restrict_row_along_v(const System& fine, const Refinement& rv, const Gather
         } else {
           for (int dj = jlo; dj <= jhi; ++dj) {
             const bool upper = di > 0 || (di == 0 && dj >= 0);
-            v[dj + H] = upper ? own[a.offset(di, dj)] : own[(di * nv + dj) * 25 + a.offset(-di, -dj)];
+            v[dj + H] = upper ? own[a.offset(di, dj)] : own[(di * nv + dj) * width + a.offset(-di, -dj)];
           }
         }
         for (int d = 0; d < L; ++d)

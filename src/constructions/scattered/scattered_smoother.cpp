@@ -95,16 +95,15 @@ StripSmoother::StripSmoother(const NetMatrix& a) : nu_(a.nu()), nv_(a.nv()) {
 }
 
 void StripSmoother::factor(const NetMatrix& a, Strip& s, FactorScratch& scratch) {
-  // The strip's entries into the band (each unknown's control point found once), the
-  // band factored in double, then kept in single precision.
+  // The strip's entries into the band, factored there in double, then kept in single
+  // precision. Each unknown's control point is found once, and its row of the upper
+  // half read whole, its entries to the strip's unknowns placed in the later one's row
+  // of the band (an entry at a time took a third of the factoring).
   const auto band = static_cast<std::size_t>(s.band), stride = band + 1;
   double* f = scratch.band.data();
   std::vector<std::array<int, 2>>& at = scratch.at;
   std::vector<std::size_t>& row = scratch.row;
   for_each_row(s, [&](std::size_t k, int i, int j, std::size_t r) { at[k] = {i, j}, row[k] = r; });
-  // Each unknown's row of the upper half read whole, its entries to the strip's unknowns
-  // placed in the later one's row of the band (an entry at a time took a third of the
-  // factoring).
   for (std::size_t k = 0; k < s.size; ++k) std::fill(f + k * stride + band - s.length(k), f + (k + 1) * stride, 0.0);
   const int hu = a.hu(), hv = a.hv(), w = s.width;
   double entries[NetMatrix::max_width];
